@@ -1,0 +1,42 @@
+"""The typer application object and the entry point that renders robotspec errors."""
+
+from __future__ import annotations
+
+import os
+import sys
+from typing import Annotated
+
+import typer
+
+from robotspec.cli import render
+
+app = typer.Typer(
+    name="robotspec",
+    help="Robot semantics as data: load, validate, inspect and drive robots.",
+    no_args_is_help=True,
+    add_completion=True,
+    pretty_exceptions_enable=False,
+)
+
+
+@app.callback()
+def _root(
+    verbose: Annotated[
+        bool, typer.Option("--verbose", "-v", help="Show a traceback on errors (for bug reports).")
+    ] = False,
+) -> None:
+    """Robot semantics as data: load, validate, inspect and drive robots."""
+    if verbose:
+        os.environ["ROBOTSPEC_VERBOSE"] = "1"
+
+
+def _register() -> None:
+    # Each command module adds its commands to ``app`` on import; the modules import nothing heavy.
+    from robotspec.cli import load_cmd  # noqa: F401
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry point: run the app, render package errors, never leak a traceback."""
+    _register()
+    code = render.run_app(app, argv)
+    sys.exit(code)

@@ -1,0 +1,288 @@
+"""Safe YAML loading that remembers where every value came from.
+
+Why: every user-facing error must name the file and line of the offending YAML node, but pydantic
+only knows a location path (``("chains", 0, "tip")``). :func:`load_yaml` composes the document
+with PyYAML's *safe* loader (no arbitrary tags, no object construction), builds plain Python data
+from the node tree, and records the start mark of each node under its path, so a pydantic error
+location maps back to ``file:line:column``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import BaseModel, ValidationError
+
+from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names
+
+__all__ = ["LocatedYaml", "load_yaml", "load_yaml_text", "validation_errors"]
+
+Loc = tuple[str | int, ...]
+
+#: Refuse documents larger than this; a spec or RobotInfo is a few kB.
+MAX_YAML_BYTES = 8 * 1024 * 1024
+
+
+@dataclass(frozen=True)
+class LocatedYaml:
+    """Plain data of one YAML document plus the ``(line, column)`` of each node, 1-based."""
+
+    data: Any
+    file: str
+    marks: Mapping[Loc, tuple[int, int]] = field(default_factory=dict)
+    key_marks: Mapping[Loc, tuple[int, int]] = field(default_factory=dict)
+
+    def position(self, loc: Sequence[str | int]) -> tuple[int | None, int | None]:
+        """The line and column of the node at ``loc``, or of its nearest existing ancestor."""
+        path = tuple(loc)
+        while True:
+            if path in self.marks:
+                return self.marks[path]
+            if not path:
+                return (None, None)
+            path = path[:-1]
+
+    def key_position(self, loc: Sequence[str | int]) -> tuple[int | None, int | None]:
+        """Where the *key* of a mapping entry is written (for unknown-key errors)."""
+        path = tuple(loc)
+        if path in self.key_marks:
+            return self.key_marks[path]
+        return self.position(path)
+
+
+class _SafeComposer(yaml.SafeLoader):
+    """SafeLoader used only to compose nodes; no Python objects are constructed from tags."""
+
+
+def _scalar(node: yaml.ScalarNode, loader: yaml.SafeLoader) -> Any:
+    return loader.construct_object(node, deep=True)
+
+
+def _build(
+    node: yaml.Node,
+    loader: yaml.SafeLoader,
+    path: Loc,
+    marks: dict[Loc, tuple[int, int]],
+    key_marks: dict[Loc, tuple[int, int]],
+    file: str,
+    depth: int,
+) -> Any:
+    if depth > 100:
+        raise RobotSpecError("YAML nested too deeply", file=file, line=node.start_mark.line + 1)
+    marks[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
+    if isinstance(node, yaml.MappingNode):
+        loader.flatten_mapping(node)
+        out: dict[Any, Any] = {}
+        for key_node, value_node in node.value:
+            key = _scalar(key_node, loader) if isinstance(key_node, yaml.ScalarNode) else None
+            if not isinstance(key, (str, int, float, bool)) or key is None:
+                raise RobotSpecError(
+                    "mapping keys must be plain scalars",
+                    file=file,
+                    line=key_node.start_mark.line + 1,
+                    column=key_node.start_mark.column + 1,
+                )
+            if isinstance(key, bool) or not isinstance(key, str):
+                key = str(key)
+            if key in out:
+                raise RobotSpecError(
+                    f"duplicate key '{key}'",
+                    file=file,
+                    line=key_node.start_mark.line + 1,
+                    column=key_node.start_mark.column + 1,
+                    name=key,
+                )
+            child = (*path, key)
+            key_marks[child] = (key_node.start_mark.line + 1, key_node.start_mark.column + 1)
+            out[key] = _build(value_node, loader, child, marks, key_marks, file, depth + 1)
+        return out
+    if isinstance(node, yaml.SequenceNode):
+        return [
+            _build(item, loader, (*path, i), marks, key_marks, file, depth + 1)
+            for i, item in enumerate(node.value)
+        ]
+    value = _scalar(node, loader)  # type: ignore[arg-type]
+    return value
+
+
+def load_yaml_text(text: str, file: str = "<string>") -> LocatedYaml:
+    """Parse one YAML document from ``text`` safely, keeping node positions."""
+    if len(text.encode("utf-8", errors="replace")) > MAX_YAML_BYTES:
+        raise RobotSpecError(f"YAML file larger than {MAX_YAML_BYTES} bytes", file=file)
+    loader = _SafeComposer(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return LocatedYaml(data=None, file=file)
+        marks: dict[Loc, tuple[int, int]] = {}
+        key_marks: dict[Loc, tuple[int, int]] = {}
+        data = _build(node, loader, (), marks, key_marks, file, 0)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        problem = exc.problem or exc.context or "invalid YAML"
+        raise RobotSpecError(
+            f"invalid YAML: {problem}",
+            file=file,
+            line=None if mark is None else mark.line + 1,
+            column=None if mark is None else mark.column + 1,
+        ) from None
+    except yaml.YAMLError as exc:
+        raise RobotSpecError(f"invalid YAML: {exc}", file=file) from None
+    except RecursionError:
+        raise RobotSpecError("YAML nested too deeply", file=file) from None
+    finally:
+        loader.dispose()
+    return LocatedYaml(data=data, file=file, marks=marks, key_marks=key_marks)
+
+
+def load_yaml(path: str | Path) -> LocatedYaml:
+    """Read and parse a YAML file safely; a missing or unreadable file is a RobotSpecError."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise RobotSpecError("file not found", file=str(path)) from None
+    except IsADirectoryError:
+        raise RobotSpecError("is a directory, not a YAML file", file=str(path)) from None
+    except UnicodeDecodeError as exc:
+        raise RobotSpecError(f"not UTF-8 text ({exc.reason})", file=str(path)) from None
+    except OSError as exc:
+        raise RobotSpecError(f"cannot read file: {exc.strerror}", file=str(path)) from None
+    return load_yaml_text(text, file=str(path))
+
+
+def _loc_text(loc: Sequence[str | int]) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += f".{part}" if out else str(part)
+    return out
+
+
+def _model_fields_at(model: type[BaseModel], loc: Sequence[str | int]) -> list[str]:
+    """Best-effort list of the field names valid at ``loc`` (for unknown-key suggestions)."""
+    current: Any = model
+    for part in loc:
+        if isinstance(part, int) or not (
+            isinstance(current, type) and issubclass(current, BaseModel)
+        ):
+            # Lists and dicts: step into the item type when it is a model.
+            args = getattr(current, "__args__", ())
+            models = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
+            if models:
+                current = models[-1]
+            if isinstance(part, int):
+                continue
+        if isinstance(current, type) and issubclass(current, BaseModel):
+            fld = current.model_fields.get(part)
+            if fld is None:
+                return []
+            current = fld.annotation
+            args = getattr(current, "__args__", ())
+            models = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
+            if models and not (isinstance(current, type) and issubclass(current, BaseModel)):
+                current = models[-1]
+    if isinstance(current, type) and issubclass(current, BaseModel):
+        return [f.alias or n for n, f in current.model_fields.items()]
+    args = getattr(current, "__args__", ())
+    models = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
+    if models:
+        return [f.alias or n for n, f in models[-1].model_fields.items()]
+    return []
+
+
+def validation_errors(
+    exc: ValidationError,
+    doc: LocatedYaml,
+    model: type[BaseModel],
+    error_type: type[RobotSpecError] = RobotSpecError,
+    loc_prefix: Sequence[str | int] = (),
+) -> RobotSpecError:
+    """Turn a pydantic ValidationError into located RobotSpecErrors (one per problem)."""
+    errors: list[RobotSpecError] = []
+    for err in exc.errors(include_url=False):
+        loc = tuple(
+            p for p in err["loc"] if isinstance(p, (str, int))
+        )  # drop discriminator tags
+        # Pydantic appends union member names and function tags to locs; keep real keys only.
+        real_loc = _strip_to_document(loc, doc)
+        full_loc = (*loc_prefix, *real_loc)
+        where = _loc_text(full_loc) or "(document)"
+        kind = err["type"]
+        if kind == "extra_forbidden":
+            key = str(real_loc[-1]) if real_loc else "?"
+            valid = _model_fields_at(model, real_loc[:-1])
+            suggestions = closest_names(key, valid)
+            hint = ""
+            if suggestions:
+                hint = f"; did you mean '{suggestions[0]}'?"
+            elif valid:
+                hint = f"; valid keys: {', '.join(valid)}"
+            line, col = doc.key_position(real_loc)
+            errors.append(
+                error_type(
+                    f"unknown key '{key}' at {where}{hint}",
+                    file=doc.file,
+                    line=line,
+                    column=col,
+                    kind="key",
+                    name=key,
+                    suggestions=suggestions,
+                    location=full_loc,
+                )
+            )
+            continue
+        line, col = doc.position(real_loc)
+        msg = str(err["msg"])
+        if msg.startswith("Value error, "):
+            msg = msg[len("Value error, ") :]
+        given = err.get("input")
+        shown = ""
+        if kind not in ("missing",) and _is_short_scalar(given):
+            shown = f" (got {given!r})"
+        errors.append(
+            error_type(
+                f"{where}: {msg}{shown}",
+                file=doc.file,
+                line=line,
+                column=col,
+                location=full_loc,
+            )
+        )
+    if len(errors) == 1:
+        return errors[0]
+    return RobotSpecErrors(errors, summary=f"{doc.file}: {len(errors)} problems")
+
+
+def _is_short_scalar(value: Any) -> bool:
+    if isinstance(value, float) and not math.isfinite(value):
+        return True
+    return isinstance(value, (str, int, float, bool)) and len(repr(value)) <= 60
+
+
+def _strip_to_document(loc: Loc, doc: LocatedYaml) -> Loc:
+    """Drop pydantic's union/validator tags that are not keys of the document."""
+    out: list[str | int] = []
+    for part in loc:
+        candidate = (*out, part)
+        if candidate in doc.marks or candidate in doc.key_marks:
+            out.append(part)
+        elif isinstance(part, int):
+            out.append(part)
+        elif _is_tag(part):
+            continue
+        else:
+            out.append(part)
+    return tuple(out)
+
+
+def _is_tag(part: str) -> bool:
+    # Pydantic union member tags look like 'function-after[...]', 'list[...]', 'ModelName'.
+    return "[" in part or (part[:1].isupper() and part.isidentifier())

@@ -208,9 +208,7 @@ def validation_errors(
     """Turn a pydantic ValidationError into located RobotSpecErrors (one per problem)."""
     errors: list[RobotSpecError] = []
     for err in exc.errors(include_url=False):
-        loc = tuple(
-            p for p in err["loc"] if isinstance(p, (str, int))
-        )  # drop discriminator tags
+        loc = tuple(p for p in err["loc"] if isinstance(p, (str, int)))  # drop discriminator tags
         # Pydantic appends union member names and function tags to locs; keep real keys only.
         real_loc = _strip_to_document(loc, doc)
         full_loc = (*loc_prefix, *real_loc)

@@ -1,0 +1,45 @@
+"""Shared fixtures: where the real robot files are, and loaded worlds of the main robots."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, settings
+
+settings.register_profile(
+    "ci",
+    derandomize=True,
+    deadline=None,
+    max_examples=60,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.register_profile("dev", deadline=None, max_examples=60)
+settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+#: The steering repo's shared folder sits beside the project checkout (absent in a user's clone).
+SHARED = Path(__file__).resolve().parents[2] / "shared"
+DATA = Path(__file__).resolve().parent / "data"
+
+
+def shared_path(*parts: str) -> Path:
+    """A path under ../shared, or skip the test with a reason when it is absent."""
+    p = SHARED.joinpath(*parts)
+    if not p.exists():
+        pytest.skip(f"needs {p} (the shared robot files beside the checkout), which is absent")
+    return p
+
+
+def erd_robots() -> Path:
+    """example-robot-data's robots folder, or skip when the package is not installed."""
+    import importlib.metadata as md
+
+    try:
+        dist = md.distribution("example-robot-data")
+    except md.PackageNotFoundError:
+        pytest.skip("example-robot-data is not installed (pip install robotspec[data])")
+    share = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data")))
+    if not share.is_dir():
+        pytest.skip(f"example-robot-data's share folder {share} is missing")
+    return share / "robots"

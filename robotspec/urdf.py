@@ -31,7 +31,7 @@ from robotspec.geometry import (
 
 if TYPE_CHECKING:
     from robotspec.packages import PackageResolver
-from robotspec.urdf_check import check_urdf_tree, parse_floats
+from robotspec.urdf_check import check_urdf_tree, geometry_element, parse_floats
 from robotspec.world import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic, World
 from robotspec.xmlsafe import parse_xml_bytes
 
@@ -103,6 +103,8 @@ def world_from_urdf_xml(
     import yourdfpy
 
     check_urdf_tree(root, file)
+    # yourdfpy's own loader strips comments before parsing; its element parser needs the same.
+    etree.strip_tags(root, etree.Comment)
     try:
         robot = yourdfpy.URDF._parse_robot(xml_element=root)
     except (ValueError, TypeError, AttributeError, KeyError) as exc:
@@ -169,11 +171,11 @@ def world_from_urdf_xml(
             leader, mult, off = leaders[j.name]
             mimic = Mimic(leader=leader, multiplier=mult, offset=off)
             dof_idx = own_dofs.get(leader, ())
-            if jtype.dof_count != 1 or len(dof_idx) != 1:
+            if len(dof_idx) != 1:
                 problems.append(
                     DescriptionError(
-                        f"joint '{j.name}': only revolute, continuous and prismatic joints can "
-                        f"mimic one another ('{leader}' is {joints[leader].type})",
+                        f"joint '{j.name}' mimics '{leader}', a {joints[leader].type} joint; "
+                        "only revolute, continuous and prismatic joints can be mimicked",
                         file=file,
                         line=joint_el[j.name].sourceline,
                         kind="joint",
@@ -224,12 +226,17 @@ def _resolve_mimics(
     """Map each mimic joint to its ultimate leader with composed multiplier and offset."""
     out: dict[str, tuple[str, float, float]] = {}
     for name, j in joints.items():
-        if j.mimic is None:
+        # URDF parsers ignore <mimic> on joints that do not move on one axis (Talos's
+        # grippers carry it on fixed joints); so does robotspec.
+        if j.mimic is None or ConnectionType(j.type).dof_count != 1:
             continue
         mult, off = 1.0, 0.0
         current = name
         seen = {name}
-        while joints[current].mimic is not None:
+        while (
+            joints[current].mimic is not None
+            and ConnectionType(joints[current].type).dof_count == 1
+        ):
             m = joints[current].mimic
             m_mult = 1.0 if m.multiplier is None else float(m.multiplier)
             m_off = 0.0 if m.offset is None else float(m.offset)
@@ -261,7 +268,8 @@ def _shapes(
 ) -> tuple[Shape, ...]:
     out: list[Shape] = []
     for rec, el in zip(records, elements, strict=True):
-        geom_el = el.find("geometry")[0]
+        geom_el = geometry_element(el.find("geometry"))
+        assert geom_el is not None  # checked by check_urdf_tree
         geometry = _geometry(rec.geometry, geom_el, file, base, resolver, meshes, problems)
         if geometry is None:
             continue

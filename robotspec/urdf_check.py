@@ -21,7 +21,7 @@ from robotspec.errors import (
     raise_collected,
 )
 
-__all__ = ["JOINT_TYPES", "check_urdf_tree", "parse_floats"]
+__all__ = ["JOINT_TYPES", "check_urdf_tree", "geometry_element", "parse_floats"]
 
 JOINT_TYPES = ("fixed", "revolute", "continuous", "prismatic", "floating", "planar")
 
@@ -174,6 +174,13 @@ def _check_origin(parent: etree._Element, col: _Collector, what: str) -> None:
         col.floats(origin, "rpy", 3, f"{what}: origin rpy")
 
 
+def geometry_element(geom: etree._Element | None) -> etree._Element | None:
+    """The shape element inside ``<geometry>``, skipping comments."""
+    if geom is None:
+        return None
+    return next((c for c in geom if isinstance(c.tag, str)), None)
+
+
 def _check_link(el: etree._Element, name: str, col: _Collector) -> None:
     inertial = el.find("inertial")
     if inertial is not None:
@@ -186,10 +193,11 @@ def _check_link(el: etree._Element, name: str, col: _Collector) -> None:
         for shape in el.iterfind(kind):
             _check_origin(shape, col, f"link '{name}' {kind}")
             geom = shape.find("geometry")
-            if geom is None or len(geom) == 0:
+            inner = geometry_element(geom)
+            if inner is None:
                 col.error(f"link '{name}': <{kind}> has no geometry", shape, kind="link", name=name)
                 continue
-            _check_geometry(geom[0], f"link '{name}' {kind}", col)
+            _check_geometry(inner, f"link '{name}' {kind}", col)
 
 
 def _check_geometry(g: etree._Element, what: str, col: _Collector) -> None:

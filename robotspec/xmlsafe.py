@@ -63,6 +63,21 @@ def parse_xml_bytes(
     """Parse ``data`` (the contents of ``file``) into an lxml element, safely."""
     if len(data) > MAX_XML_BYTES:
         raise error_type(f"XML file larger than {MAX_XML_BYTES} bytes", file=file)
+    # Entities are refused before libxml2 sees them: internal entities are expanded inside
+    # attribute values whatever the parser options say (billion laughs).
+    doctype = data.find(b"<!DOCTYPE")
+    if doctype >= 0:
+        entity = data.find(b"<!ENTITY", doctype)
+        if entity >= 0:
+            name = data[entity + 8 : entity + 80].split()[:1]
+            shown = name[0].decode("utf-8", "replace") if name else "?"
+            raise error_type(
+                f"XML entity declarations are not allowed (found '{shown}')",
+                file=file,
+                line=data.count(b"\n", 0, entity) + 1,
+                kind="entity",
+                name=shown,
+            )
     try:
         root = etree.fromstring(data, parser=safe_parser(), base_url=None)
     except etree.XMLSyntaxError as exc:

@@ -11,9 +11,10 @@ them, the way pydantic reports every validation error of a model at once.
 
 from __future__ import annotations
 
+import copy
 import difflib
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 __all__ = [
@@ -160,6 +161,32 @@ class RobotSpecError(Exception):
     def details(self) -> tuple[ErrorDetail, ...]:
         """All problems this error stands for (one, unless it is a collection)."""
         return (self.detail,)
+
+    @property
+    def severity(self) -> str:
+        """``error`` or ``warning``."""
+        return self.detail.severity
+
+    def with_severity(self, severity: str) -> RobotSpecError:
+        """A copy of this error with another severity (a warning that strict mode may promote)."""
+        new = copy.copy(self)
+        new.detail = replace(self.detail, severity=severity)
+        new.args = (new.detail.render(),)
+        return new
+
+    def located(
+        self,
+        *,
+        file: str | None,
+        line: int | None,
+        column: int | None = None,
+        location: tuple[str | int, ...] = (),
+    ) -> RobotSpecError:
+        """A copy pointing at another place (e.g. the spec node that named a missing link)."""
+        new = copy.copy(self)
+        new.detail = replace(self.detail, file=file, line=line, column=column, location=location)
+        new.args = (new.detail.render(),)
+        return new
 
 
 class NotFoundError(RobotSpecError):

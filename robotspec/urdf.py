@@ -37,10 +37,11 @@ from robotspec.xmlsafe import parse_xml_bytes
 
 __all__ = ["MeshPolicy", "is_xacro", "load_urdf", "read_description_xml", "world_from_urdf_xml"]
 
-MeshPolicy = Literal["resolve", "keep"]
+MeshPolicy = Literal["resolve", "report", "keep"]
 """``resolve``: every mesh URI must resolve to an existing file inside the allowed roots (an
-error otherwise). ``keep``: record the URI unresolved (``Mesh.path`` is ``None``), for
-kinematics-only use; consumers that need the mesh report it."""
+error otherwise). ``report``: resolve what can be resolved and report the rest as warnings in
+the caller's ``issues`` list (``Mesh.path`` is ``None`` for those). ``keep``: record URIs
+unresolved, for kinematics-only use; consumers that need a mesh report it."""
 
 
 def is_xacro(path: Path, data: bytes) -> bool:
@@ -98,8 +99,12 @@ def world_from_urdf_xml(
     *,
     resolver: PackageResolver | None = None,
     meshes: MeshPolicy = "keep",
+    issues: list[RobotSpecError] | None = None,
 ) -> World:
-    """Interpret a checked URDF element tree as a world; all problems are raised together."""
+    """Interpret a checked URDF element tree as a world; all problems are raised together.
+
+    With ``meshes="report"``, unresolvable meshes are appended to ``issues`` as warnings.
+    """
     import yourdfpy
 
     check_urdf_tree(root, file)
@@ -318,14 +323,15 @@ def _geometry(
         )
         scale = (vals[0], vals[0], vals[0]) if len(vals) == 1 else (vals[0], vals[1], vals[2])
     path: str | None = None
-    if meshes == "resolve":
+    if meshes != "keep":
         if resolver is None:
             raise ValueError("resolving meshes needs a PackageResolver")
+        report = meshes == "report"
         try:
             resolved = resolver.resolve(uri, relative_to=base, file=file, line=el.sourceline)
         except RobotSpecError as exc:
-            problems.append(exc)
-            return None
+            problems.append(exc.with_severity("warning") if report else exc)
+            return Mesh(uri=uri, path=None, scale=scale) if report else None
         if not resolved.is_file():
             problems.append(
                 DescriptionError(
@@ -334,8 +340,9 @@ def _geometry(
                     line=el.sourceline,
                     kind="mesh",
                     name=uri,
+                    severity="warning" if report else "error",
                 )
             )
-            return None
+            return Mesh(uri=uri, path=None, scale=scale) if report else None
         path = str(resolved)
     return Mesh(uri=uri, path=path, scale=scale)

@@ -15,6 +15,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from enum import StrEnum
+from typing import TypeVar
 
 import numpy as np
 
@@ -26,6 +27,8 @@ from robotspec.errors import (
     raise_collected,
 )
 from robotspec.geometry import Matrix, Shape, frozen_array
+
+_T = TypeVar("_T")
 
 __all__ = [
     "Body",
@@ -247,6 +250,7 @@ class World:
         for c in self._connections:
             depth[c.child] = depth[c.parent] + 1
         self._depth = tuple(depth)
+        self._annotations: list[object] = []
         self._children: tuple[tuple[int, ...], ...] = tuple(
             tuple(c.child for c in self._connections if c.parent == b.index) for b in self._bodies
         )
@@ -535,6 +539,21 @@ class World:
             ),
         )
         return World(self.name, bodies, conns, [*new_dofs, *dofs], source=self.source)
+
+    # ---------------------------------------------------------------- semantic annotations
+    def add_semantic_annotation(self, annotation: object) -> None:
+        """Register a semantic part viewing this world (once; identity decides)."""
+        if not any(a is annotation for a in self._annotations):
+            self._annotations.append(annotation)
+
+    @property
+    def semantic_annotations(self) -> tuple[object, ...]:
+        """Every registered semantic part, in registration order."""
+        return tuple(self._annotations)
+
+    def get_semantic_annotations_by_type(self, kind: type[_T]) -> list[_T]:
+        """The registered parts that are instances of ``kind``."""
+        return [a for a in self._annotations if isinstance(a, kind)]
 
     # ------------------------------------------------------------------------- limits
     def tighten_velocity_limits(self, limits: Mapping[str, float]) -> None:

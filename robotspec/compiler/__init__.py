@@ -1,0 +1,243 @@
+"""The compiler: a spec file (or a shipped robot's name) to an ``AbstractRobot``.
+
+Pipeline: validate the YAML (``spec``), load the description files (``description``), add the
+spec's extra frames and the base connection to the world, cross-check the SRDF against the URDF,
+then resolve and check every part (``build``). All problems of one spec are reported together.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from robotspec.compiler.build import Build, build_robot
+from robotspec.compiler.diagnostics import Diagnostics
+from robotspec.errors import RobotSpecError, SpecError
+from robotspec.geometry import pose_from_xyz_quaternion, pose_from_xyz_rpy
+from robotspec.semantic import AbstractRobot
+from robotspec.spec import LoadedSpec, load_spec
+from robotspec.world import ConnectionType, World
+
+__all__ = [
+    "CompileResult",
+    "check_spec",
+    "compile_robot",
+    "compile_spec_for_world",
+    "load_camera_presets",
+    "resolve_spec",
+]
+
+
+@dataclass(frozen=True)
+class CompileResult:
+    """What ``robotspec validate`` reports: the robot (if it compiled) and every warning."""
+
+    loaded: LoadedSpec
+    robot: AbstractRobot | None
+    warnings: tuple[RobotSpecError, ...]
+
+
+def _package_data(*parts: str) -> Path:
+    return Path(__file__).resolve().parents[1].joinpath(*parts)
+
+
+def shipped_specs() -> dict[str, Path]:
+    """The robots shipped with robotspec: name -> spec file."""
+    folder = _package_data("specs")
+    return {p.stem: p for p in sorted(folder.glob("*.yaml"))}
+
+
+def resolve_spec(ref: str | Path) -> Path:
+    """A spec path, or the spec of a shipped robot named ``ref`` (``pr2``, ``hsrb``, ...)."""
+    p = Path(ref)
+    if p.is_file():
+        return p
+    shipped = shipped_specs()
+    key = str(ref).lower()
+    if key in shipped:
+        return shipped[key]
+    if p.suffix in (".yaml", ".yml") or "/" in str(ref):
+        raise SpecError("file not found", file=str(ref))
+    from robotspec.errors import NotFoundError
+
+    raise NotFoundError("robot or spec file", str(ref), shipped, where="the shipped robots")
+
+
+def load_camera_presets() -> dict[str, dict[str, Any]]:
+    """Camera models from ``templates/cameras.yaml``."""
+    from robotspec.yamlio import load_yaml
+
+    doc = load_yaml(_package_data("templates", "cameras.yaml"))
+    return dict(doc.data or {})
+
+
+def _frame_pose(frame: Any) -> Any:
+    xyz = tuple(frame.xyz)
+    if frame.quaternion is not None:
+        return pose_from_xyz_quaternion(xyz, tuple(frame.quaternion))
+    return pose_from_xyz_rpy(xyz, tuple(frame.rpy or (0.0, 0.0, 0.0)))
+
+
+def _prepare_world(
+    loaded: LoadedSpec, world: World, srdf: Any, diag: Diagnostics, *, add_drive: bool
+) -> World:
+    """Add the spec's frames and the base connection (drive or SRDF virtual joint)."""
+    spec = loaded.spec
+    frames = []
+    for name, f in spec.description.frames.items():
+        loc = ("description", "frames", name)
+        if f.rpy is not None and f.quaternion is not None:
+            diag.error(loc, "give rpy or quaternion, not both")
+            continue
+        if f.quaternion is not None:
+            n = math.sqrt(sum(x * x for x in f.quaternion))
+            if abs(n - 1.0) > 1e-3:
+                diag.error((*loc, "quaternion"), f"must be a unit quaternion, its norm is {n:.4g}")
+                continue
+        if world.has_body(name):
+            if add_drive:  # loading our own files: a clash is a mistake
+                diag.error(loc, f"frame '{name}' already exists in the URDF")
+            continue  # from_world: the user's world already has it
+        if not world.has_body(f.parent):
+            diag.not_found(
+                (*loc, "parent"),
+                "link",
+                f.parent,
+                world.body_names,
+                (world.source or world.name).rsplit("/", 1)[-1],
+            )
+            continue
+        frames.append((name, f.parent, _frame_pose(f)))
+    if frames:
+        world = world.add_frames(frames)
+    if not add_drive or world.parent_connection(world.root) is not None:
+        return world
+    drive = spec.drive
+    vj = None
+    if srdf is not None:
+        vj = next((v for v in srdf.virtual_joints if v.child_link == world.root.name), None)
+    if drive is not None:
+        if drive.type == "fixed":
+            return world
+        if spec.root != world.root.name:
+            diag.error(
+                ("drive",),
+                f"a drive moves the URDF's root link '{world.root.name}', "
+                f"but the robot's root is '{spec.root}'",
+            )
+            return world
+        kind = ConnectionType.FLOATING if drive.type == "floating" else ConnectionType.PLANAR
+        parent = drive.parent_frame
+        joint = drive.joint or f"{parent}_T_{world.root.name}"
+        return world.with_base_connection(joint, parent, kind)
+    if vj is not None:
+        kind = {"planar": ConnectionType.PLANAR, "floating": ConnectionType.FLOATING}.get(
+            vj.type, ConnectionType.FIXED
+        )
+        return world.with_base_connection(vj.name, vj.parent_frame, kind)
+    return world
+
+
+def _compile(
+    loaded: LoadedSpec,
+    *,
+    package_paths: Sequence[str | Path] = (),
+    world: World | None = None,
+    robot_class: type[AbstractRobot] = AbstractRobot,
+    strict: bool = False,
+) -> CompileResult:
+    from robotspec.description import load_description, resolve_file
+    from robotspec.srdf import check_srdf_against
+
+    spec = loaded.spec
+    diag = Diagnostics(loaded)
+    paths = [*spec.description.package_paths, *map(str, package_paths)]
+    try:
+        desc = load_description(
+            spec.description.urdf,
+            srdf=None,
+            package_paths=paths,
+            xacro_args=spec.description.xacro_args,
+            base_folder=loaded.folder,
+        )
+    except RobotSpecError as exc:
+        diag.add(exc, ("description", "urdf"))
+        diag.raise_if_failed()
+        raise
+    for w in desc.warnings:
+        diag.add(w)
+    srdf = None
+    if spec.description.srdf is not None:
+        from robotspec.srdf import load_srdf
+
+        try:
+            srdf = load_srdf(resolve_file(spec.description.srdf, loaded.folder, desc.resolver))
+        except RobotSpecError as exc:
+            diag.add(exc, ("description", "srdf"))
+    base_world = world if world is not None else desc.world
+    if srdf is not None:
+        for err in check_srdf_against(
+            srdf,
+            base_world.body_names,
+            base_world.connection_names,
+            urdf_name=desc.urdf_file.name,
+        ):
+            diag.add(err)
+    prepared = _prepare_world(loaded, base_world, srdf, diag, add_drive=world is None)
+    build = Build(
+        loaded=loaded, world=prepared, diag=diag, srdf=srdf, presets=load_camera_presets()
+    )
+    robot = build_robot(build, robot_class)
+    diag.raise_if_failed(strict=strict)
+    return CompileResult(loaded=loaded, robot=robot, warnings=tuple(diag.warnings))
+
+
+def check_spec(
+    ref: str | Path, *, package_paths: Sequence[str | Path] = (), strict: bool = False
+) -> CompileResult:
+    """Compile a spec and return its warnings; every error is raised together."""
+    return _compile(load_spec(resolve_spec(ref)), package_paths=package_paths, strict=strict)
+
+
+def compile_robot(
+    ref: str | Path,
+    *,
+    package_paths: Sequence[str | Path] = (),
+    robot_class: type[AbstractRobot] | None = None,
+) -> AbstractRobot:
+    """Compile a spec file, or a shipped robot by name, into an ``AbstractRobot``."""
+    if robot_class is None:
+        from robotspec.robots import robot_class_for
+
+        robot_class = robot_class_for(ref)
+    result = _compile(
+        load_spec(resolve_spec(ref)), package_paths=package_paths, robot_class=robot_class
+    )
+    assert result.robot is not None
+    return result.robot
+
+
+def compile_spec_for_world(
+    ref: str | Path,
+    world: World,
+    *,
+    robot_class: type[AbstractRobot] = AbstractRobot,
+    package_paths: Sequence[str | Path] = (),
+) -> AbstractRobot:
+    """Build the spec's robot over an existing world (the seed's ``from_world``).
+
+    The world must hold the spec's names; frames the spec adds are added if missing (which
+    makes a new world: the robot's ``world`` is then that one). The SRDF, if any, is read from
+    the spec's files for its collision rules.
+    """
+    result = _compile(
+        load_spec(resolve_spec(ref)),
+        package_paths=package_paths,
+        world=world,
+        robot_class=robot_class,
+    )
+    assert result.robot is not None
+    return result.robot

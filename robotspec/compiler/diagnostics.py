@@ -1,0 +1,114 @@
+"""Collecting every problem of a spec in one run, each pointing at its YAML node.
+
+Why: a user fixing a spec wants the whole list at once, each as ``file:line:col`` with the name
+that failed and the closest valid names; stopping at the first error makes them run the tool
+once per typo.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from robotspec.errors import (
+    NotFoundError,
+    RobotSpecError,
+    RobotSpecErrors,
+    SpecError,
+    closest_names,
+)
+from robotspec.spec import LoadedSpec
+
+__all__ = ["Diagnostics", "Loc"]
+
+Loc = tuple[str | int, ...]
+
+
+def _loc_text(loc: Loc) -> str:
+    out = ""
+    for part in loc:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
+@dataclass
+class Diagnostics:
+    """Errors and warnings of one compilation, located in the spec's files."""
+
+    loaded: LoadedSpec
+    errors: list[RobotSpecError] = field(default_factory=list)
+    warnings: list[RobotSpecError] = field(default_factory=list)
+
+    def _at(self, loc: Loc) -> tuple[str, int | None, int | None]:
+        return self.loaded.position(loc)
+
+    def error(
+        self,
+        loc: Loc,
+        message: str,
+        *,
+        name: str | None = None,
+        kind: str | None = None,
+        suggestions: Iterable[str] = (),
+    ) -> None:
+        """Record an error about the spec node at ``loc``."""
+        file, line, col = self._at(loc)
+        self.errors.append(
+            SpecError(
+                f"{_loc_text(loc)}: {message}" if loc else message,
+                file=file,
+                line=line,
+                column=col,
+                name=name,
+                kind=kind,
+                suggestions=suggestions,
+                location=loc,
+            )
+        )
+
+    def warning(self, loc: Loc, message: str, *, name: str | None = None) -> None:
+        """Record a warning (an error in strict mode)."""
+        file, line, col = self._at(loc)
+        self.warnings.append(
+            SpecError(
+                f"{_loc_text(loc)}: {message}" if loc else message,
+                file=file,
+                line=line,
+                column=col,
+                name=name,
+                location=loc,
+                severity="warning",
+            )
+        )
+
+    def not_found(
+        self, loc: Loc, kind: str, name: str, candidates: Iterable[str], where: str
+    ) -> None:
+        """Record a name that does not exist, with the closest valid names."""
+        err = NotFoundError(kind, name, candidates, where=where)
+        file, line, col = self._at(loc)
+        self.errors.append(err.located(file=file, line=line, column=col, location=loc))
+
+    def add(self, err: RobotSpecError, loc: Loc | None = None) -> None:
+        """Record an error raised elsewhere, moved to ``loc`` when it has no file of its own."""
+        if loc is not None and err.file is None:
+            file, line, col = self._at(loc)
+            err = err.located(file=file, line=line, column=col, location=loc)
+        (self.warnings if err.severity == "warning" else self.errors).append(err)
+
+    def suggest(self, name: str, candidates: Iterable[str]) -> tuple[str, ...]:
+        """Closest names, for messages built by hand."""
+        return closest_names(name, candidates)
+
+    def raise_if_failed(self, *, strict: bool = False) -> None:
+        """Raise every error (and, in strict mode, every warning as an error) at once."""
+        problems = list(self.errors)
+        if strict:
+            problems += [w.with_severity("error") for w in self.warnings]
+        if not problems:
+            return
+        if len(problems) == 1:
+            raise problems[0]
+        raise RobotSpecErrors(
+            problems, summary=f"{self.loaded.file.name}: {len(problems)} problems"
+        )

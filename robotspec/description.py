@@ -1,0 +1,99 @@
+"""A robot's description files loaded together: URDF/xacro world, SRDF, and the base connection.
+
+Why one place: the URDF, the SRDF and the spec's extra frames all change the same world (the SRDF
+virtual joint becomes the base connection, spec frames become fixed bodies), and every caller (the
+compiler, the CLI, tests) must get the same world from the same files.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from robotspec.errors import DescriptionError, RobotSpecError
+from robotspec.urdf import MeshPolicy, read_description_xml, world_from_urdf_xml
+from robotspec.world import ConnectionType, World
+
+if TYPE_CHECKING:
+    from robotspec.packages import PackageResolver
+    from robotspec.srdf import Srdf
+
+__all__ = ["Description", "load_description"]
+
+#: SRDF virtual joint types and the world connection each becomes.
+VIRTUAL_JOINT_TYPES = {
+    "planar": ConnectionType.PLANAR,
+    "floating": ConnectionType.FLOATING,
+    "fixed": ConnectionType.FIXED,
+}
+
+
+@dataclass(frozen=True)
+class Description:
+    """The loaded files of one robot and the world they make."""
+
+    world: World
+    urdf_file: Path
+    srdf: Srdf | None
+    resolver: PackageResolver = field(repr=False)
+    warnings: tuple[RobotSpecError, ...] = ()
+
+    @property
+    def urdf_world(self) -> World:
+        """The world as the URDF alone describes it (kept for symmetry; same as ``world``)."""
+        return self.world
+
+
+def resolve_file(
+    ref: str, base: Path, resolver: PackageResolver, *, file: str | None = None
+) -> Path:
+    """A description path from a spec or CLI: ``package://``, ``file://``, relative or absolute."""
+    if "://" in ref:
+        return resolver.resolve(ref, relative_to=base, file=file)
+    p = Path(ref)
+    return p if p.is_absolute() else (base / p)
+
+
+def load_description(
+    urdf: str | Path,
+    *,
+    srdf: str | Path | None = None,
+    package_paths: Sequence[str | Path] = (),
+    xacro_args: Mapping[str, str] | None = None,
+    meshes: MeshPolicy = "report",
+    base_folder: Path | None = None,
+) -> Description:
+    """Load a URDF (or xacro) and optionally its SRDF; URIs resolve through one resolver."""
+    from robotspec.packages import PackageResolver
+
+    base = base_folder or Path.cwd()
+    extra = [p if Path(p).is_absolute() else base / p for p in map(str, package_paths)]
+    urdf_ref = str(urdf)
+    if "://" in urdf_ref:
+        bootstrap = PackageResolver.create(None, extra_paths=extra)
+        urdf_path = bootstrap.resolve(urdf_ref, relative_to=base)
+    else:
+        urdf_path = Path(urdf_ref) if Path(urdf_ref).is_absolute() else base / urdf_ref
+    if not urdf_path.is_file():
+        raise DescriptionError("file not found", file=str(urdf_path))
+    resolver = PackageResolver.create(urdf_path, extra_paths=extra)
+    root = read_description_xml(urdf_path, resolver, xacro_args)
+    issues: list[RobotSpecError] = []
+    world = world_from_urdf_xml(
+        root, str(urdf_path), resolver=resolver, meshes=meshes, issues=issues
+    )
+    srdf_data = None
+    if srdf is not None:
+        from robotspec.srdf import load_srdf
+
+        srdf_path = resolve_file(str(srdf), base, resolver)
+        srdf_data = load_srdf(srdf_path)
+    return Description(
+        world=world,
+        urdf_file=urdf_path,
+        srdf=srdf_data,
+        resolver=resolver,
+        warnings=tuple(issues),
+    )

@@ -1,0 +1,339 @@
+"""The robot spec: a robot's semantics as a short YAML file, validated by Pydantic models.
+
+Why mappings keyed by name (``chains: {left_arm: ...}``) rather than lists: names are the
+identity of parts, YAML refuses duplicate keys, and ``extends:`` can override one part of a base
+spec by naming it. Every model forbids unknown keys and is frozen; positions of every node are
+kept (``yamlio``) so the compiler can report ``file:line:col`` for any name it cannot resolve.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from robotspec.errors import SpecError
+from robotspec.yamlio import LocatedYaml, load_yaml, validation_errors
+
+__all__ = [
+    "CameraSpec",
+    "ChainSpec",
+    "CollisionSpec",
+    "DescriptionSpec",
+    "DriveSpec",
+    "FieldOfViewSpec",
+    "FingerSpec",
+    "FrameSpec",
+    "GenericManipulatorSpec",
+    "GenericSensorSpec",
+    "LoadedSpec",
+    "NeckSpec",
+    "ParallelGripperSpec",
+    "RobotSpec",
+    "SPEC_VERSION",
+    "TorsoSpec",
+    "VelocityLimitsSpec",
+    "json_schema",
+    "load_spec",
+]
+
+SPEC_VERSION = 1
+
+Name = Annotated[str, Field(min_length=1, max_length=256)]
+JointValues = dict[Name, float]
+States = dict[Name, JointValues]
+
+
+def _finite(values: tuple[float, ...]) -> tuple[float, ...]:
+    if not all(math.isfinite(v) for v in values):
+        raise ValueError("values must be finite numbers")
+    return values
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+
+
+class FrameSpec(_Model):
+    """A frame the URDF lacks, fixed to ``parent`` (HSRB's ``hand_gripper_tool_frame``)."""
+
+    parent: Name
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] | None = None
+    quaternion: tuple[float, float, float, float] | None = Field(
+        default=None, description="[x, y, z, w]; give rpy or quaternion, not both"
+    )
+
+    _check_xyz = field_validator("xyz", "rpy", "quaternion")(
+        lambda v: v if v is None else _finite(v)
+    )
+
+
+class DescriptionSpec(_Model):
+    """Where the robot's files are: paths relative to the spec, absolute, or ``package://``."""
+
+    urdf: Name = Field(description="URDF or xacro file")
+    srdf: Name | None = Field(default=None, description="MoveIt SRDF (optional)")
+    xacro_args: dict[Name, str] = Field(default_factory=dict)
+    package_paths: list[Name] = Field(
+        default_factory=list, description="extra folders to search for ROS packages"
+    )
+    frames: dict[Name, FrameSpec] = Field(default_factory=dict)
+
+
+class DriveSpec(_Model):
+    """How the base moves; by default taken from the SRDF's virtual joint."""
+
+    type: Literal["omni", "differential", "fixed", "floating"]
+    joint: Name | None = Field(default=None, description="name of the base connection")
+    parent_frame: Name = Field(default="odom", description="the frame the base moves in")
+
+
+class FingerSpec(_Model):
+    """A finger as a chain from ``root`` to ``tip``."""
+
+    root: Name
+    tip: Name
+
+
+class _ManipulatorBase(_Model):
+    root: Name
+    tool_frame: Name
+    front_facing_orientation: tuple[float, float, float, float] = Field(
+        default=(0.0, 0.0, 0.0, 1.0),
+        description="tool-frame orientation of a front grasp, quaternion [x, y, z, w]",
+    )
+    front_facing_axis: tuple[float, float, float] | None = Field(
+        default=None, description="derived from the orientation (R^T x) when omitted"
+    )
+    states: States = Field(default_factory=dict)
+
+    _check = field_validator("front_facing_orientation", "front_facing_axis")(
+        lambda v: v if v is None else _finite(v)
+    )
+
+
+class ParallelGripperSpec(_ManipulatorBase):
+    """A two-finger gripper; the thumb is the finger that always touches the object."""
+
+    type: Literal["parallel_gripper"]
+    finger: FingerSpec
+    thumb: FingerSpec
+
+
+class GenericManipulatorSpec(_ManipulatorBase):
+    """Any other end effector: a tool frame and an orientation."""
+
+    type: Literal["generic"]
+
+
+ManipulatorSpec = Annotated[
+    ParallelGripperSpec | GenericManipulatorSpec, Field(discriminator="type")
+]
+
+
+class FieldOfViewSpec(_Model):
+    """Angles in radians."""
+
+    horizontal: float
+    vertical: float
+
+
+class CameraSpec(_Model):
+    """A camera on ``body``; fields missing here are taken from ``preset`` (templates)."""
+
+    type: Literal["camera"]
+    body: Name
+    preset: Name | None = Field(default=None, description="a camera model from templates/")
+    forward_facing_axis: tuple[float, float, float] | None = None
+    field_of_view: FieldOfViewSpec | None = None
+    minimal_height: float | None = None
+    maximal_height: float | None = None
+    default: bool = Field(default=False, description="the robot's default camera")
+
+
+class GenericSensorSpec(_Model):
+    """Any other sensor attached to a body."""
+
+    type: Literal["generic"]
+    body: Name
+    kind: Name | None = Field(default=None, description="free-form, e.g. 'lidar' or 'ft'")
+
+
+SensorSpec = Annotated[CameraSpec | GenericSensorSpec, Field(discriminator="type")]
+
+
+class ChainSpec(_Model):
+    """A kinematic chain, by ``root``/``tip`` or by SRDF ``group`` name."""
+
+    kind: Literal["arm", "chain"] = "arm"
+    root: Name | None = None
+    tip: Name | None = None
+    group: Name | None = Field(default=None, description="an SRDF group with one chain")
+    manipulator: Name | None = None
+    sensors: list[Name] = Field(default_factory=list)
+    states: States = Field(default_factory=dict)
+
+
+class TorsoSpec(_Model):
+    """The chain that connects the base to the other chains."""
+
+    root: Name
+    tip: Name
+    states: States = Field(default_factory=dict)
+
+
+class NeckSpec(_Model):
+    """The chain carrying the head sensors; pitch and yaw bodies are optional."""
+
+    root: Name
+    tip: Name
+    pitch_body: Name | None = None
+    yaw_body: Name | None = None
+    sensors: list[Name] = Field(default_factory=list)
+    states: States = Field(default_factory=dict)
+
+
+class VelocityLimitsSpec(_Model):
+    """Velocity caps (rad/s or m/s); they only tighten the URDF's limits, of the robot's joints."""
+
+    default: float | None = Field(default=None, gt=0)
+    joints: dict[Name, Annotated[float, Field(gt=0)]] = Field(default_factory=dict)
+
+
+class CollisionSpec(_Model):
+    """Self-collision configuration (the seed's ``default_collision_config``)."""
+
+    buffer_distance: float = Field(default=0.05, ge=0)
+    violated_distance: float = Field(default=0.0, ge=0)
+    disabled_bodies: list[Name] = Field(default_factory=list)
+    use_srdf: bool = Field(default=True, description="apply the SRDF's disabled pairs")
+
+
+class RobotSpec(_Model):
+    """A robot: its files, its root, and its semantic parts."""
+
+    robotspec: Literal[1] = Field(default=1, description="spec format version")
+    name: Name
+    extends: Name | None = Field(default=None, description="a base spec this one modifies")
+    description: DescriptionSpec
+    root: Name
+    drive: DriveSpec | None = None
+    torso: TorsoSpec | None = None
+    neck: NeckSpec | None = None
+    chains: dict[Name, ChainSpec] = Field(default_factory=dict)
+    manipulators: dict[Name, ManipulatorSpec] = Field(default_factory=dict)
+    sensors: dict[Name, SensorSpec] = Field(default_factory=dict)
+    velocity_limits: VelocityLimitsSpec = Field(default_factory=VelocityLimitsSpec)
+    controlled_joints: list[Name] | None = Field(
+        default=None, description="default: every actuated, non-mimic joint of the robot"
+    )
+    collision: CollisionSpec = Field(default_factory=CollisionSpec)
+    import_srdf_group_states: bool = Field(
+        default=False, description="add the SRDF's group states as named joint states"
+    )
+    states: States = Field(default_factory=dict, description="robot-level named joint states")
+
+
+@dataclass(frozen=True)
+class LoadedSpec:
+    """A validated spec with where it came from, for located errors and relative paths."""
+
+    spec: RobotSpec
+    file: Path
+    documents: tuple[LocatedYaml, ...]
+
+    def position(self, loc: tuple[str | int, ...]) -> tuple[str, int | None, int | None]:
+        """``(file, line, column)`` of a spec node, looking in the extending file first."""
+        for doc in self.documents:
+            if loc in doc.marks:
+                line, col = doc.marks[loc]
+                return doc.file, line, col
+        # Fall back to the nearest ancestor that exists in some document.
+        for cut in range(len(loc) - 1, -1, -1):
+            for doc in self.documents:
+                if loc[:cut] in doc.marks:
+                    line, col = doc.marks[loc[:cut]]
+                    return doc.file, line, col
+        return str(self.file), None, None
+
+    @property
+    def folder(self) -> Path:
+        """The folder relative paths in the spec are resolved against."""
+        return self.file.parent
+
+
+def _merge(base: Any, child: Any) -> Any:
+    if isinstance(base, Mapping) and isinstance(child, Mapping):
+        out = dict(base)
+        for k, v in child.items():
+            out[k] = _merge(base[k], v) if k in base else v
+        return out
+    return child
+
+
+def _absolutize(data: dict[str, Any], folder: Path) -> None:
+    """Rewrite a base spec's relative file paths so they stay right inside the child spec."""
+    desc = data.get("description")
+    if not isinstance(desc, dict):
+        return
+    for key in ("urdf", "srdf"):
+        value = desc.get(key)
+        if isinstance(value, str) and "://" not in value and not Path(value).is_absolute():
+            desc[key] = str((folder / value).resolve())
+    paths = desc.get("package_paths")
+    if isinstance(paths, list):
+        desc["package_paths"] = [
+            str((folder / v).resolve()) if not Path(v).is_absolute() else v for v in paths
+        ]
+
+
+def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
+    """Read, merge (``extends``) and validate a spec file; every problem raised at once."""
+    p = Path(path).resolve()
+    if p in _seen:
+        chain = " -> ".join(x.name for x in (*_seen, p))
+        raise SpecError(f"'extends' forms a cycle: {chain}", file=str(path))
+    doc = load_yaml(path)
+    if not isinstance(doc.data, Mapping):
+        raise SpecError("a spec must be a YAML mapping", file=doc.file, line=1)
+    data: Any = doc.data
+    documents: tuple[LocatedYaml, ...] = (doc,)
+    base_file = data.get("extends")
+    if isinstance(base_file, str):
+        base_path = (p.parent / base_file).resolve()
+        if not base_path.is_file():
+            line, col = doc.position(("extends",))
+            raise SpecError(
+                f"extends: spec '{base_file}' not found", file=doc.file, line=line, column=col
+            )
+        base = load_spec(base_path, _seen=(*_seen, p))
+        base_data = base.spec.model_dump(mode="json", exclude_unset=True, by_alias=True)
+        base_data.pop("extends", None)
+        _absolutize(base_data, base.folder)
+        data = _merge(base_data, {k: v for k, v in data.items() if k != "extends"})
+        data["extends"] = base_file
+        documents = (doc, *base.documents)
+    try:
+        spec = RobotSpec.model_validate(data)
+    except ValidationError as exc:
+        raise validation_errors(exc, doc, RobotSpec, SpecError) from None
+    return LoadedSpec(spec=spec, file=p, documents=documents)
+
+
+def json_schema() -> dict[str, Any]:
+    """The JSON Schema of the spec format, for editors (the YAML language server)."""
+    schema = RobotSpec.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "robotspec robot spec"
+    return schema
+
+
+def json_schema_text() -> str:
+    """The schema as stable, pretty JSON text (what ships in the package)."""
+    return json.dumps(json_schema(), indent=2, sort_keys=True) + "\n"

@@ -55,6 +55,12 @@ class LocatedYaml:
         return self.position(path)
 
 
+_PLAIN_TAGS = frozenset(
+    f"tag:yaml.org,2002:{t}"
+    for t in ("map", "seq", "str", "int", "float", "bool", "null", "timestamp", "merge")
+)
+
+
 class _SafeComposer(yaml.SafeLoader):
     """SafeLoader used only to compose nodes; no Python objects are constructed from tags."""
 
@@ -75,6 +81,14 @@ def _build(
     if depth > 100:
         raise RobotSpecError("YAML nested too deeply", file=file, line=node.start_mark.line + 1)
     marks[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
+    if node.tag not in _PLAIN_TAGS:
+        raise RobotSpecError(
+            f"unsupported YAML tag '{node.tag}' (only plain YAML data is read)",
+            file=file,
+            line=node.start_mark.line + 1,
+            column=node.start_mark.column + 1,
+            name=node.tag,
+        )
     if isinstance(node, yaml.MappingNode):
         loader.flatten_mapping(node)
         out: dict[Any, Any] = {}
@@ -238,6 +252,20 @@ def validation_errors(
             )
             continue
         line, col = doc.position(real_loc)
+        if kind == "missing" and real_loc:
+            parent = _loc_text((*loc_prefix, *real_loc[:-1])) or "(document)"
+            errors.append(
+                error_type(
+                    f"{parent}: missing required key '{real_loc[-1]}'",
+                    file=doc.file,
+                    line=line,
+                    column=col,
+                    kind="key",
+                    name=str(real_loc[-1]),
+                    location=full_loc,
+                )
+            )
+            continue
         msg = str(err["msg"])
         if msg.startswith("Value error, "):
             msg = msg[len("Value error, ") :]
@@ -254,6 +282,7 @@ def validation_errors(
                 location=full_loc,
             )
         )
+    errors.sort(key=lambda e: (e.line or 0, e.column or 0))
     if len(errors) == 1:
         return errors[0]
     return RobotSpecErrors(errors, summary=f"{doc.file}: {len(errors)} problems")

@@ -5,19 +5,16 @@ from __future__ import annotations
 import os
 import sys
 import traceback
-from collections.abc import Callable, Sequence
-from typing import TypeVar
+from collections.abc import Sequence
 
-import click
 import typer
 
 from robotspec.errors import RobotSpecError
 
-T = TypeVar("T")
-
 EXIT_OK = 0
 EXIT_INVALID = 1
 EXIT_USAGE = 2
+EXIT_INTERNAL = 3
 
 
 def print_error(err: RobotSpecError) -> None:
@@ -26,43 +23,32 @@ def print_error(err: RobotSpecError) -> None:
         sys.stderr.write(detail.render() + "\n")
 
 
+def _verbose(argv: Sequence[str]) -> bool:
+    return "--verbose" in argv or "-v" in argv or bool(os.environ.get("ROBOTSPEC_VERBOSE"))
+
+
 def run_app(app: typer.Typer, argv: Sequence[str] | None) -> int:
-    """Run the typer app in standalone=False mode and map outcomes to exit codes."""
-    verbose = "--verbose" in (argv or sys.argv[1:]) or "-v" in (argv or sys.argv[1:])
+    """Run the app; typer handles usage errors (exit 2), robotspec errors exit 1."""
+    args = list(sys.argv[1:] if argv is None else argv)
     try:
-        result = app(args=list(argv) if argv is not None else None, standalone_mode=False)
-    except click.exceptions.UsageError as exc:
-        exc.show()
-        return EXIT_USAGE
-    except click.exceptions.Abort:
-        sys.stderr.write("Aborted.\n")
-        return 130
-    except click.exceptions.Exit as exc:
-        return int(exc.exit_code)
+        app(args=args, prog_name="robotspec", standalone_mode=True)
+    except SystemExit as exc:
+        code = exc.code
+        return code if isinstance(code, int) else (0 if code is None else EXIT_INVALID)
     except RobotSpecError as exc:
-        if verbose or os.environ.get("ROBOTSPEC_VERBOSE"):
+        if _verbose(args):
             traceback.print_exc()
         print_error(exc)
         return EXIT_INVALID
     except KeyboardInterrupt:
         sys.stderr.write("Interrupted.\n")
         return 130
-    except click.exceptions.ClickException as exc:
-        exc.show()
-        return EXIT_INVALID
     except Exception as exc:  # a bug: say so plainly, traceback only on request
-        if verbose or os.environ.get("ROBOTSPEC_VERBOSE"):
+        if _verbose(args):
             traceback.print_exc()
         sys.stderr.write(
             f"internal error: {type(exc).__name__}: {exc}\n"
             "This is a bug in robotspec; rerun with --verbose and report the traceback.\n"
         )
-        return 3
-    if isinstance(result, int):
-        return result
+        return EXIT_INTERNAL
     return EXIT_OK
-
-
-def guarded(fn: Callable[[], T]) -> T:
-    """Run ``fn``; used by commands that want to catch errors themselves and continue."""
-    return fn()

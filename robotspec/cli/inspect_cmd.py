@@ -1,0 +1,367 @@
+"""``robotspec inspect``: tables of a compiled robot's chains, tree, parts, joints and SRDF."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from typing import TYPE_CHECKING, Any
+
+import typer
+
+from robotspec.cli.app import app
+from robotspec.cli.options import JsonFlag, PackagePath, SpecArg
+from robotspec.cli.table import render_table
+
+if TYPE_CHECKING:
+    from robotspec.semantic import AbstractRobot, KinematicChain
+
+inspect_app = typer.Typer(help="Show what a spec compiles to.", no_args_is_help=True)
+app.add_typer(inspect_app, name="inspect")
+
+
+def _robot(spec: str, package_path: list[Any] | None) -> AbstractRobot:
+    from robotspec.compiler import compile_robot
+
+    return compile_robot(spec, package_paths=package_path or ())
+
+
+def _emit(data: Any, headers: list[str], rows: list[list[Any]], as_json: bool) -> None:
+    if as_json:
+        sys.stdout.write(json.dumps(data, indent=2) + "\n")
+    else:
+        sys.stdout.write(render_table(headers, rows) + "\n")
+
+
+def _kind(robot: AbstractRobot, chain: KinematicChain) -> str:
+    if chain is robot.torso:
+        return "torso"
+    if chain is robot.neck:
+        return "neck"
+    from robotspec.semantic import Finger
+
+    if isinstance(chain, Finger):
+        return "finger"
+    return "arm" if chain.manipulator is not None else "chain"
+
+
+def _chain_row(robot: AbstractRobot, c: KinematicChain) -> dict[str, Any]:
+    return {
+        "name": c.name,
+        "kind": _kind(robot, c),
+        "root": c.root.name,
+        "tip": c.tip.name,
+        "joints": len(c.connections),
+        "dof": len(c.degrees_of_freedom),
+        "manipulator": None if c.manipulator is None else c.manipulator.name,
+        "sensors": [s.name for s in c.sensors],
+    }
+
+
+@inspect_app.command("chains")
+def chains(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
+    """The robot's kinematic chains: kind, root, tip, joints, DOF, manipulator, sensors."""
+    from robotspec.semantic import ParallelGripper
+
+    robot = _robot(spec, package_path)
+    items = [_chain_row(robot, c) for c in robot.all_chains]
+    for m in robot.manipulators:
+        if isinstance(m, ParallelGripper):
+            items += [_chain_row(robot, m.thumb), _chain_row(robot, m.finger)]
+    rows = [
+        [
+            i["name"],
+            i["kind"],
+            i["root"],
+            i["tip"],
+            i["joints"],
+            i["dof"],
+            i["manipulator"],
+            ", ".join(i["sensors"]) or None,
+        ]
+        for i in items
+    ]
+    headers = ["chain", "kind", "root", "tip", "joints", "dof", "manipulator", "sensors"]
+    _emit(items, headers, rows, as_json)
+
+
+@inspect_app.command("manipulators")
+def manipulators(
+    spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None
+) -> None:
+    """Manipulators: root, tool frame, front-facing orientation and axis, fingers, states."""
+    from robotspec.semantic import ParallelGripper
+
+    robot = _robot(spec, package_path)
+    items = []
+    for m in robot.manipulators:
+        item = {
+            "name": m.name,
+            "type": "parallel_gripper" if isinstance(m, ParallelGripper) else "generic",
+            "root": m.root.name,
+            "tool_frame": m.tool_frame.name,
+            "front_facing_orientation": list(m.front_facing_orientation),
+            "front_facing_axis": list(m.front_facing_axis),
+            "thumb": m.thumb.tip.name if isinstance(m, ParallelGripper) else None,
+            "finger": m.finger.tip.name if isinstance(m, ParallelGripper) else None,
+            "states": sorted(m.states),
+        }
+        items.append(item)
+    rows = [
+        [
+            i["name"],
+            i["type"],
+            i["root"],
+            i["tool_frame"],
+            _vec(i["front_facing_orientation"]),
+            _vec(i["front_facing_axis"]),
+            ", ".join(i["states"]) or None,
+        ]
+        for i in items
+    ]
+    headers = [
+        "manipulator",
+        "type",
+        "root",
+        "tool frame",
+        "front orientation",
+        "front axis",
+        "states",
+    ]
+    _emit(items, headers, rows, as_json)
+
+
+@inspect_app.command("sensors")
+def sensors(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
+    """Sensors: body, viewing axis, field of view and height range of cameras."""
+    from robotspec.semantic import Camera
+
+    robot = _robot(spec, package_path)
+    items = []
+    for s in robot.sensors:
+        item: dict[str, Any] = {
+            "name": s.name,
+            "type": type(s).__name__.lower(),
+            "body": s.root.name,
+        }
+        if isinstance(s, Camera):
+            item |= {
+                "forward_facing_axis": list(s.forward_facing_axis),
+                "field_of_view": {
+                    "horizontal": s.field_of_view.horizontal_angle,
+                    "vertical": s.field_of_view.vertical_angle,
+                },
+                "minimal_height": s.minimal_height,
+                "maximal_height": s.maximal_height,
+                "default": s.default_camera,
+            }
+        items.append(item)
+    rows = []
+    for i in items:
+        fov = i.get("field_of_view")
+        rows.append(
+            [
+                i["name"] + (" *" if i.get("default") else ""),
+                i["type"],
+                i["body"],
+                _vec(i["forward_facing_axis"]) if "forward_facing_axis" in i else None,
+                f"{fov['horizontal']:.4g} x {fov['vertical']:.4g}" if fov else None,
+                f"{i['minimal_height']:g}-{i['maximal_height']:g}" if fov else None,
+            ]
+        )
+    _emit(items, ["sensor", "type", "body", "axis", "fov (rad)", "height (m)"], rows, as_json)
+
+
+@inspect_app.command("joints")
+def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
+    """The robot's moving joints with limits; velocities tightened by the spec end in '*'."""
+    robot = _robot(spec, package_path)
+    from robotspec.urdf import load_urdf  # noqa: F401  (keeps import cost inside the command)
+
+    w = robot.world
+    original = _urdf_velocities(robot)
+    items = []
+    for c in robot.connections:
+        if c.is_fixed:
+            continue
+        dof = w.degrees_of_freedom[c.dofs[0]] if c.dofs else None
+        item = {
+            "name": c.name,
+            "type": c.type.value,
+            "mimic": None if c.mimic is None else c.mimic.leader,
+            "lower": None if dof is None or c.mimic else _num(dof.lower),
+            "upper": None if dof is None or c.mimic else _num(dof.upper),
+            "velocity": None if dof is None or c.mimic else _num(dof.velocity),
+            "tightened": bool(
+                dof is not None and not c.mimic and dof.velocity < original.get(dof.name, math.inf)
+            ),
+            "controlled": c in robot.controlled_connections,
+        }
+        items.append(item)
+    rows = [
+        [
+            i["name"],
+            i["type"] + (f" (mimics {i['mimic']})" if i["mimic"] else ""),
+            i["lower"],
+            i["upper"],
+            None
+            if i["velocity"] is None
+            else f"{i['velocity']:g}" + ("*" if i["tightened"] else ""),
+        ]
+        for i in items
+    ]
+    _emit(items, ["joint", "type", "lower", "upper", "velocity"], rows, as_json)
+
+
+def _urdf_velocities(robot: AbstractRobot) -> dict[str, float]:
+    """Velocity limits before the spec tightened them (from the compiler's record)."""
+    return dict(getattr(robot, "urdf_velocity_limits", {}) or {})
+
+
+@inspect_app.command("groups")
+def groups(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
+    """The SRDF's groups, end effectors and group states."""
+    robot = _robot(spec, package_path)
+    srdf = robot.srdf
+    if srdf is None:
+        sys.stdout.write("this robot has no SRDF\n")
+        return
+    items = {
+        "groups": [
+            {
+                "name": g.name,
+                "chains": [[c.base_link, c.tip_link] for c in g.chains],
+                "joints": list(g.joints),
+                "links": list(g.links),
+                "subgroups": list(g.subgroups),
+            }
+            for g in srdf.groups
+        ],
+        "end_effectors": [
+            {"name": e.name, "parent_link": e.parent_link, "group": e.group}
+            for e in srdf.end_effectors
+        ],
+        "group_states": [{"name": s.name, "group": s.group} for s in srdf.group_states],
+    }
+    rows = [["group", g["name"], _group_text(g)] for g in items["groups"]]
+    rows += [
+        ["end_effector", e["name"], f"{e['parent_link']} (group {e['group']})"]
+        for e in items["end_effectors"]
+    ]
+    rows += [["group_state", s["name"], f"group {s['group']}"] for s in items["group_states"]]
+    _emit(items, ["element", "name", "content"], rows, as_json)
+
+
+def _group_text(g: dict[str, Any]) -> str:
+    parts = [f"chain {a} -> {b}" for a, b in g["chains"]]
+    if g["joints"]:
+        parts.append(f"{len(g['joints'])} joints")
+    if g["links"]:
+        parts.append(f"{len(g['links'])} links")
+    if g["subgroups"]:
+        parts.append("groups " + ", ".join(g["subgroups"]))
+    return "; ".join(parts) or "(empty)"
+
+
+@inspect_app.command("collisions")
+def collisions(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
+    """Disabled collision pairs (by SRDF reason) and disabled bodies."""
+    robot = _robot(spec, package_path)
+    reasons: dict[str, int] = {}
+    if robot.srdf is not None:
+        for d in robot.srdf.disabled_collisions:
+            if frozenset((d.link1, d.link2)) in robot.disabled_collision_pairs:
+                reasons[d.reason or "(none)"] = reasons.get(d.reason or "(none)", 0) + 1
+    items = {
+        "disabled_pairs": len(robot.disabled_collision_pairs),
+        "by_reason": reasons,
+        "disabled_bodies": sorted(robot.disabled_collision_bodies),
+        "buffer_distance": robot.default_collision_config.buffer_zone_distance,
+    }
+    rows = [["reason " + k, v] for k, v in sorted(reasons.items())]
+    rows.append(["disabled pairs (total)", items["disabled_pairs"]])
+    rows.append(["disabled bodies", ", ".join(items["disabled_bodies"]) or None])
+    rows.append(["buffer distance (m)", items["buffer_distance"]])
+    _emit(items, ["what", "value"], rows, as_json)
+
+
+@inspect_app.command("tree")
+def tree(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
+    """The kinematic tree with joint types, limits and semantic labels."""
+    robot = _robot(spec, package_path)
+    w = robot.world
+    labels: dict[str, list[str]] = {}
+
+    def label(body: str, text: str) -> None:
+        labels.setdefault(body, []).append(text)
+
+    label(robot.root.name, "robot root")
+    for c in robot.all_chains:
+        label(c.root.name, f"{c.name} root")
+        label(c.tip.name, f"{c.name} tip")
+    for m in robot.manipulators:
+        label(m.tool_frame.name, f"{m.name} tool frame")
+    for s in robot.sensors:
+        label(s.root.name, f"sensor {s.name}")
+    if as_json:
+        nodes = []
+        for b in w.bodies:
+            c = w.parent_connection(b)
+            nodes.append(
+                {
+                    "body": b.name,
+                    "parent": None if c is None else w.bodies[c.parent].name,
+                    "joint": None if c is None else c.name,
+                    "type": None if c is None else c.type.value,
+                    "labels": labels.get(b.name, []),
+                }
+            )
+        sys.stdout.write(json.dumps(nodes, indent=2) + "\n")
+        return
+    sys.stdout.write(
+        f"{robot.name}: {len(w.bodies)} bodies, {len(w.connections)} joints, "
+        f"{len(w.degrees_of_freedom)} degrees of freedom\n"
+    )
+    sys.stdout.write(tree_text(w, labels) + "\n")
+
+
+def tree_text(w: Any, labels: dict[str, list[str]]) -> str:
+    """An indented tree drawing of a world, one body per line."""
+    lines: list[str] = []
+
+    def joint_text(b: Any) -> str:
+        c = w.parent_connection(b)
+        if c is None:
+            return ""
+        text = c.type.value
+        if c.mimic is not None:
+            text += f", mimics {c.mimic.leader}"
+        elif c.dofs and c.type.dof_count == 1:
+            d = w.degrees_of_freedom[c.dofs[0]]
+            if math.isfinite(d.lower):
+                text += f" [{d.lower:.4g}, {d.upper:.4g}]"
+        return f"  ({c.name}: {text})"
+
+    def walk(b: Any, prefix: str, last: bool, top: bool) -> None:
+        tag = "" if b.name not in labels else "  <" + "; ".join(labels[b.name]) + ">"
+        branch = "" if top else ("└── " if last else "├── ")
+        lines.append(f"{prefix}{branch}{b.name}{joint_text(b)}{tag}")
+        kids = w.child_bodies(b)
+        for i, k in enumerate(kids):
+            walk(
+                k,
+                prefix if top else prefix + ("    " if last else "│   "),
+                i == len(kids) - 1,
+                False,
+            )
+
+    walk(w.root, "", True, True)
+    return "\n".join(lines)
+
+
+def _vec(v: list[float]) -> str:
+    return "[" + ", ".join(f"{x:.4g}" for x in v) + "]"
+
+
+def _num(x: float) -> float | None:
+    return x if math.isfinite(x) else None

@@ -1,0 +1,41 @@
+"""``robotspec list`` and ``robotspec schema``."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from robotspec.cli.app import app
+from robotspec.cli.table import render_table
+
+
+@app.command("list")
+def list_robots() -> None:
+    """The robots shipped with robotspec and the description each is built from."""
+    from robotspec.compiler import shipped_specs
+    from robotspec.spec import load_spec
+
+    rows = []
+    for name, path in shipped_specs().items():
+        spec = load_spec(path).spec
+        rows.append([name, spec.name, spec.description.urdf])
+    sys.stdout.write(render_table(["name", "robot", "description"], rows) + "\n")
+
+
+@app.command()
+def schema(
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write to this file instead of stdout.")
+    ] = None,
+) -> None:
+    """The JSON Schema of the spec format, for editors (YAML language server)."""
+    from robotspec.spec import json_schema_text
+
+    text = json_schema_text()
+    if output is None:
+        sys.stdout.write(text)
+    else:
+        output.write_text(text)

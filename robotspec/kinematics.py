@@ -34,6 +34,8 @@ _PRISMATIC = 2
 _SMALL_BATCH = 16
 _FIXED_PLAN = 0
 _MULTI_PLAN = 3
+_AXIS_REVOLUTE = 4
+_AXIS_PRISMATIC = 5
 
 
 @dataclass(frozen=True)
@@ -209,7 +211,23 @@ class Kinematics:
                 continue
             dof, mul, off = data[1]
             v = q[:, dof] * mul + off
-            if kind == _REVOLUTE:
+            if kind == _AXIS_REVOLUTE:
+                # Rotation about a frame axis only mixes two columns of the pose.
+                i, j, sign = data[2]
+                res = poses[child]
+                np.matmul(p, data[0], out=flat[child])
+                c = np.cos(v)[:, None]
+                sn = np.sin(v)[:, None] * sign
+                ai = res[:, :, i].copy()
+                aj = res[:, :, j]
+                res[:, :, i] = c * ai + sn * aj
+                res[:, :, j] = c * aj - sn * ai
+            elif kind == _AXIS_PRISMATIC:
+                k, sign = data[2]
+                res = poses[child]
+                np.matmul(p, data[0], out=flat[child])
+                res[:, :, 3] += (v * sign)[:, None] * res[:, :, k]
+            elif kind == _REVOLUTE:
                 s = np.sin(v)[:, None, None]
                 c1 = (1.0 - np.cos(v))[:, None, None]
                 res = poses[child]
@@ -259,6 +277,13 @@ def _plan_entry(c: Connection) -> tuple[int, int, int, tuple[Any, ...]]:
     m = _motions(c)[0]
     axis = np.asarray(m.axis, dtype=np.float64)
     scal = (m.dof, m.multiplier, m.offset)
+    k = int(np.argmax(np.abs(axis)))
+    if abs(abs(axis[k]) - 1.0) < 1e-12:
+        sign = float(np.sign(axis[k]))
+        if m.kind == _REVOLUTE:
+            i, j = {0: (1, 2), 1: (2, 0), 2: (0, 1)}[k]
+            return (_AXIS_REVOLUTE, c.parent, c.child, (o, scal, (i, j, sign)))
+        return (_AXIS_PRISMATIC, c.parent, c.child, (o, scal, (k, sign)))
     if m.kind == _REVOLUTE:
         k4 = np.zeros((4, 4))
         k4[:3, :3] = _skew(axis)

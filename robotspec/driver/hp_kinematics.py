@@ -1,0 +1,303 @@
+"""Forward kinematics and Jacobians of H/P chains (general-robotics-toolbox convention).
+
+Every joint frame is parallel to the base frame at q = 0; ``H[i]`` is joint i's axis and ``P[i]``
+the offset from joint i-1 to joint i, all in base coordinates at q = 0; ``P[n]`` reaches the chain
+end, then ``flange_pose`` and the tool's TCP transform follow. See the reference note §1(c).
+
+Why written here and not taken from the toolbox: it is a small numpy routine, the toolbox is not a
+dependency, and the loop calls it every step (1 kHz), so it works on preallocated arrays and
+computes the pose and the Jacobian in one pass.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "HPChain",
+    "quat_to_rot",
+    "rot_to_quat",
+]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def quat_to_rot(q: Sequence[float] | FloatArray) -> FloatArray:
+    """Rotation matrix of a unit quaternion ``(w, x, y, z)`` (normalised first)."""
+    w, x, y, z = (float(v) for v in q)
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    if n == 0.0:
+        return np.eye(3)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def rot_to_quat(r: FloatArray) -> FloatArray:
+    """Unit quaternion ``(w, x, y, z)`` of a rotation matrix, with w >= 0."""
+    m00, m01, m02 = float(r[0, 0]), float(r[0, 1]), float(r[0, 2])
+    m10, m11, m12 = float(r[1, 0]), float(r[1, 1]), float(r[1, 2])
+    m20, m21, m22 = float(r[2, 0]), float(r[2, 1]), float(r[2, 2])
+    tr = m00 + m11 + m22
+    if tr > 0.0:
+        s = math.sqrt(tr + 1.0) * 2.0
+        q = (0.25 * s, (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s)
+    elif m00 > m11 and m00 > m22:
+        s = math.sqrt(1.0 + m00 - m11 - m22) * 2.0
+        q = ((m21 - m12) / s, 0.25 * s, (m01 + m10) / s, (m02 + m20) / s)
+    elif m11 > m22:
+        s = math.sqrt(1.0 + m11 - m00 - m22) * 2.0
+        q = ((m02 - m20) / s, (m01 + m10) / s, 0.25 * s, (m12 + m21) / s)
+    else:
+        s = math.sqrt(1.0 + m22 - m00 - m11) * 2.0
+        q = ((m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s)
+    out = np.array(q)
+    if out[0] < 0.0:
+        out = -out
+    return np.asarray(out / np.linalg.norm(out), dtype=np.float64)
+
+
+Pose3 = tuple[tuple[float, ...], tuple[float, float, float]]
+
+
+def rot_to_quat_tuple(r: Sequence[float]) -> tuple[float, float, float, float]:
+    """Unit quaternion ``(w, x, y, z)``, w >= 0, of a row-major 9-tuple rotation (no numpy)."""
+    m00, m01, m02, m10, m11, m12, m20, m21, m22 = r
+    tr = m00 + m11 + m22
+    if tr > 0.0:
+        s = math.sqrt(tr + 1.0) * 2.0
+        w, x, y, z = 0.25 * s, (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s
+    elif m00 > m11 and m00 > m22:
+        s = math.sqrt(1.0 + m00 - m11 - m22) * 2.0
+        w, x, y, z = (m21 - m12) / s, 0.25 * s, (m01 + m10) / s, (m02 + m20) / s
+    elif m11 > m22:
+        s = math.sqrt(1.0 + m11 - m00 - m22) * 2.0
+        w, x, y, z = (m02 - m20) / s, (m01 + m10) / s, 0.25 * s, (m12 + m21) / s
+    else:
+        s = math.sqrt(1.0 + m22 - m00 - m11) * 2.0
+        w, x, y, z = (m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    if w < 0.0:
+        n = -n
+    return (w / n, x / n, y / n, z / n)
+
+
+def _skew(v: FloatArray) -> FloatArray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+class HPChain:
+    """One serial chain in H/P form, with a flange transform and an optional tool transform.
+
+    Args:
+        h: ``(n, 3)`` unit joint axes.
+        p: ``(n + 1, 3)`` link offsets.
+        prismatic: ``(n,)`` True for prismatic joints.
+        flange_rotation: ``(3, 3)`` flange orientation relative to the end of ``P``.
+        flange_position: ``(3,)`` flange offset relative to the end of ``P``.
+    """
+
+    def __init__(
+        self,
+        h: FloatArray,
+        p: FloatArray,
+        prismatic: Sequence[bool] | None = None,
+        flange_rotation: FloatArray | None = None,
+        flange_position: FloatArray | None = None,
+    ) -> None:
+        self.h = np.asarray(h, dtype=np.float64).reshape(-1, 3)
+        self.p = np.asarray(p, dtype=np.float64).reshape(-1, 3)
+        self.n = self.h.shape[0]
+        if self.p.shape[0] != self.n + 1:
+            raise ValueError(f"P needs {self.n + 1} vectors, got {self.p.shape[0]}")
+        self.prismatic = np.zeros(self.n, dtype=bool) if prismatic is None else np.array(prismatic)
+        self.flange_r = np.eye(3) if flange_rotation is None else np.asarray(flange_rotation)
+        self.flange_p = np.zeros(3) if flange_position is None else np.asarray(flange_position)
+        self._k = np.stack([_skew(a) for a in self.h]) if self.n else np.zeros((0, 3, 3))
+        self._k2 = np.einsum("nij,njk->nik", self._k, self._k)
+        self._rev = ~self.prismatic
+        # Plain-float copies for the per-step path (faster than numpy on 3-vectors).
+        self._h_list = [tuple(float(x) for x in a) for a in self.h]
+        self._p_list = [tuple(float(x) for x in a) for a in self.p]
+        self._pris_list = [bool(x) for x in self.prismatic]
+        self._flange_r_list = tuple(float(x) for x in self.flange_r.reshape(9))
+        self._flange_p_list = tuple(float(x) for x in self.flange_p)
+        # Preallocated work arrays: the loop calls fk_jacobian every step.
+        self._axes = np.zeros((self.n, 3))
+        self._origins = np.zeros((self.n, 3))
+        self._jac = np.zeros((6, self.n))
+
+    def _joint_rotations(self, q: FloatArray) -> FloatArray:
+        s = np.where(self._rev, np.sin(q), 0.0)
+        c = np.where(self._rev, 1.0 - np.cos(q), 0.0)
+        out: FloatArray = np.eye(3) + s[:, None, None] * self._k + c[:, None, None] * self._k2
+        return out
+
+    def tcp_state(
+        self,
+        q: Sequence[float],
+        qd: Sequence[float] | None,
+        tool_rotation: Sequence[float] | None = None,
+        tool_position: Sequence[float] | None = None,
+    ) -> tuple[tuple[float, ...], tuple[float, float, float], tuple[float, ...]]:
+        """TCP rotation (row-major 9-tuple), position and spatial velocity, in plain floats.
+
+        Why a second implementation: the loop needs the pose and ``J(q) qd`` of every chain each
+        step; on 3-vectors, Python floats are several times faster than numpy calls. The numpy
+        :meth:`fk_jacobian` (same maths) is the one tests compare against.
+        """
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+        px, py, pz = self._p_list[0]
+        axes: list[tuple[float, float, float]] = []
+        origins: list[tuple[float, float, float]] = []
+        cos, sin = math.cos, math.sin
+        for i in range(self.n):
+            hx, hy, hz = self._h_list[i]
+            ax = r00 * hx + r01 * hy + r02 * hz
+            ay = r10 * hx + r11 * hy + r12 * hz
+            az = r20 * hx + r21 * hy + r22 * hz
+            axes.append((ax, ay, az))
+            origins.append((px, py, pz))
+            qi = q[i]
+            if self._pris_list[i]:
+                px += qi * ax
+                py += qi * ay
+                pz += qi * az
+            else:
+                c = cos(qi)
+                s_ = sin(qi)
+                v = 1.0 - c
+                # Rodrigues: rot(h, q) = c I + s [h]x + (1 - c) h h^T
+                a00 = c + v * hx * hx
+                a01 = v * hx * hy - s_ * hz
+                a02 = v * hx * hz + s_ * hy
+                a10 = v * hx * hy + s_ * hz
+                a11 = c + v * hy * hy
+                a12 = v * hy * hz - s_ * hx
+                a20 = v * hx * hz - s_ * hy
+                a21 = v * hy * hz + s_ * hx
+                a22 = c + v * hz * hz
+                r00, r01, r02, r10, r11, r12, r20, r21, r22 = (
+                    r00 * a00 + r01 * a10 + r02 * a20,
+                    r00 * a01 + r01 * a11 + r02 * a21,
+                    r00 * a02 + r01 * a12 + r02 * a22,
+                    r10 * a00 + r11 * a10 + r12 * a20,
+                    r10 * a01 + r11 * a11 + r12 * a21,
+                    r10 * a02 + r11 * a12 + r12 * a22,
+                    r20 * a00 + r21 * a10 + r22 * a20,
+                    r20 * a01 + r21 * a11 + r22 * a21,
+                    r20 * a02 + r21 * a12 + r22 * a22,
+                )
+            bx, by, bz = self._p_list[i + 1]
+            px += r00 * bx + r01 * by + r02 * bz
+            py += r10 * bx + r11 * by + r12 * bz
+            pz += r20 * bx + r21 * by + r22 * bz
+        frames = [(self._flange_r_list, self._flange_p_list)]
+        if tool_rotation is not None and tool_position is not None:
+            frames.append((tuple(tool_rotation), tuple(tool_position)))
+        for fr, fp in frames:
+            bx, by, bz = fp
+            px += r00 * bx + r01 * by + r02 * bz
+            py += r10 * bx + r11 * by + r12 * bz
+            pz += r20 * bx + r21 * by + r22 * bz
+            a00, a01, a02, a10, a11, a12, a20, a21, a22 = fr
+            r00, r01, r02, r10, r11, r12, r20, r21, r22 = (
+                r00 * a00 + r01 * a10 + r02 * a20,
+                r00 * a01 + r01 * a11 + r02 * a21,
+                r00 * a02 + r01 * a12 + r02 * a22,
+                r10 * a00 + r11 * a10 + r12 * a20,
+                r10 * a01 + r11 * a11 + r12 * a21,
+                r10 * a02 + r11 * a12 + r12 * a22,
+                r20 * a00 + r21 * a10 + r22 * a20,
+                r20 * a01 + r21 * a11 + r22 * a21,
+                r20 * a02 + r21 * a12 + r22 * a22,
+            )
+        wx = wy = wz = vx = vy = vz = 0.0
+        if qd is not None:
+            for i in range(self.n):
+                qdi = qd[i]
+                if qdi == 0.0:
+                    continue
+                ax, ay, az = axes[i]
+                if self._pris_list[i]:
+                    vx += qdi * ax
+                    vy += qdi * ay
+                    vz += qdi * az
+                    continue
+                ox, oy, oz = origins[i]
+                dx, dy, dz = px - ox, py - oy, pz - oz
+                wx += qdi * ax
+                wy += qdi * ay
+                wz += qdi * az
+                vx += qdi * (ay * dz - az * dy)
+                vy += qdi * (az * dx - ax * dz)
+                vz += qdi * (ax * dy - ay * dx)
+        rot = (r00, r01, r02, r10, r11, r12, r20, r21, r22)
+        return rot, (px, py, pz), (wx, wy, wz, vx, vy, vz)
+
+    def fk(
+        self,
+        q: FloatArray,
+        tool_rotation: FloatArray | None = None,
+        tool_position: FloatArray | None = None,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Rotation and position of the flange (or of the tool TCP when given) at ``q``."""
+        r, p, _ = self._walk(np.asarray(q, dtype=np.float64), tool_rotation, tool_position, False)
+        return r, p
+
+    def fk_jacobian(
+        self,
+        q: FloatArray,
+        tool_rotation: FloatArray | None = None,
+        tool_position: FloatArray | None = None,
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Pose and ``(6, n)`` Jacobian (angular rows first) at the flange or tool TCP.
+
+        The Jacobian maps joint velocities to the TCP's spatial velocity in the base frame:
+        angular velocity, then the linear velocity of the TCP point.
+        """
+        return self._walk(np.asarray(q, dtype=np.float64), tool_rotation, tool_position, True)
+
+    def _walk(
+        self,
+        q: FloatArray,
+        tool_rotation: FloatArray | None,
+        tool_position: FloatArray | None,
+        with_jacobian: bool,
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        rj = self._joint_rotations(q)
+        r = np.eye(3)
+        p = self.p[0].copy()
+        axes, origins = self._axes, self._origins
+        for i in range(self.n):
+            origins[i] = p
+            axes[i] = r @ self.h[i]
+            if self.prismatic[i]:
+                p = p + q[i] * axes[i]
+            else:
+                r = r @ rj[i]
+            p = p + r @ self.p[i + 1]
+        p = p + r @ self.flange_p
+        r = r @ self.flange_r
+        if tool_rotation is not None and tool_position is not None:
+            p = p + r @ tool_position
+            r = r @ tool_rotation
+        jac = self._jac
+        if with_jacobian and self.n:
+            d = p - origins
+            lin = np.empty_like(d)
+            lin[:, 0] = axes[:, 1] * d[:, 2] - axes[:, 2] * d[:, 1]
+            lin[:, 1] = axes[:, 2] * d[:, 0] - axes[:, 0] * d[:, 2]
+            lin[:, 2] = axes[:, 0] * d[:, 1] - axes[:, 1] * d[:, 0]
+            jac[:3, :] = np.where(self._rev[None, :], axes.T, 0.0)
+            jac[3:, :] = np.where(self._rev[None, :], lin.T, axes.T)
+        return r, p, jac.copy() if with_jacobian else jac

@@ -1,0 +1,1563 @@
+"""The driver base class: the seed's members, its timestep pipeline and its state machine.
+
+:class:`RobotDriver` follows ``robotraconteur_abstract_robot.AbstractRobot`` 0.2.2 (the seed
+document is the contract; the reference note records its behaviour). Each timestep runs, in order:
+feedback (``_read_feedback``, the subclass), communication check, robot state check, command fill,
+the command guard, state fill, and ``_send_robot_command`` (the subclass). The state machine is the
+reference's (§1.2 of the note), rule for rule.
+
+Time comes from a :class:`~robotspec.driver.clock.Clock`. With a simulated clock and no loop
+thread, blocking calls (a ``wait=True`` jog, a trajectory ``Next()``) step the loop themselves
+until they finish, so tests run deterministically in simulated time with no sleeping.
+
+Deliberate deviations from the reference (its defects, §1.11 of the note), each tested:
+
+1. An exception inside a step never kills the loop: the driver enters ``invalid_state`` with the
+   message in ``current_errors`` and the ``error`` flag, keeps publishing, and recovers after
+   ``reset_errors()`` or ``command_mode = halt``.
+2. ``halt()``, ``home()``, and the ``operational_mode``, ``controller_state`` and
+   ``current_errors`` properties work.
+3. Limits: ``jog_joint`` checks ``|velocity|`` (both signs) against the limit of the operational
+   mode; ``jog_freespace`` refuses targets outside the joint limits; jogs brake before a joint
+   limit; the position stream is clamped to the limits; every command passes
+   :class:`~robotspec.driver.commands.CommandGuard`. NaN and infinity are refused everywhere.
+   A speed ratio above 1 never raises jog speed or acceleration beyond the joint limits.
+4. Trajectories: the final waypoint is commanded exactly; a tracking failure fails the task with
+   OperationFailed, clears ``trajectory_running``, cancels the queue and drops to ``halt``;
+   ``running`` status reports the real trajectory time and waypoint; each outcome is delivered
+   once; a queued task cancelled before it starts raises OperationAborted "Trajectory cancelled
+   by controller before start" from ``Next()``; ``Close()`` on a finished task is a no-op; the
+   100 ms gap rule uses the unscaled times; messages carry the waypoint index; the tracking check
+   compares the measured position with the setpoint sent the step before (not the new one, which
+   tripped at high speed).
+5. Messages: "Robot must be in trajectory mode to execute trajectory"; "Position command must be
+   within 1000 degrees from current position".
+6. Tools: ``tool_detached`` accepts the attached tool's name (or ""); tools and payloads work on
+   every chain; ``robot_info.config_seqno`` follows the attachments.
+7. A waiting jog interrupted by halt, an error, an e-stop or lost communication raises
+   OperationAborted instead of returning success; ``Abort()`` takes the lock; leaving a motion
+   mode for ``halt`` brakes at the acceleration limits instead of stopping dead.
+8. Capabilities are checked: ``trajectory_command`` for trajectory mode (also on the homing route
+   out of ``invalid_state``), ``software_enable`` for ``enable()``/``disable()``,
+   ``software_reset_errors`` for ``reset_errors()`` (a driver-internal fault can always be reset).
+   ``speed_ratio`` and ``trajectory_queueing`` are *not* enforced: none of the real RobotInfo
+   files declares them, yet every reference driver honours both.
+9. ``velocity_command`` mode works (the reference's loop thread dies on the first command); it
+   scales by the speed ratio and sets ``valid_velocity_command``.
+10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import threading
+from abc import ABC, abstractmethod
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robotspec.driver.clock import Clock, RealClock
+from robotspec.driver.commands import (
+    CommandGuard,
+    JointLimitArrays,
+    check_speed_ratio,
+    finite_scalar,
+    joint_array,
+)
+from robotspec.driver.errors import (
+    InvalidArgumentError,
+    InvalidOperationError,
+    NotImplementedDriverError,
+    OperationAbortedError,
+    OperationFailedError,
+)
+from robotspec.driver.hp_kinematics import HPChain, quat_to_rot, rot_to_quat_tuple
+from robotspec.driver.profiles import JogMotion
+from robotspec.driver.robot_info import (
+    DeviceInfo,
+    PayloadInfo,
+    Pose,
+    RobotCapability,
+    RobotInfo,
+    ToolInfo,
+)
+from robotspec.driver.state import (
+    ESTOP_SOURCE_FLAGS,
+    ActionStatus,
+    CommandMode,
+    ControllerState,
+    OperationalMode,
+    RobotState,
+    StateFlags,
+    TcpPose,
+    frozen_array,
+)
+from robotspec.driver.trajectory import JointTrajectory, TrajectoryInterpolator, load_trajectory
+from robotspec.errors import DriverError
+
+__all__ = [
+    "Completion",
+    "RobotDriver",
+    "RobotJointCommand",
+    "TrajectoryGenerator",
+    "TrajectoryStatus",
+]
+
+FloatArray = npt.NDArray[np.float64]
+
+#: Position-stream commands more than this many state seqnos old are ignored (reference: 10).
+STREAM_STALE_SEQNOS = 10
+#: ``Next()`` returns ``running`` after this long without an outcome (reference: 5 s).
+NEXT_TIMEOUT_S = 5.0
+#: A blocking call in manual stepping mode gives up after this much (simulated) time.
+MAX_WAIT_S = 3600.0
+
+_POSITION_UNITS = {
+    "implicit": 1.0,
+    "radian": 1.0,
+    "meter": 1.0,
+    "degree": math.pi / 180.0,
+    "ticks_rot": 2.0 * math.pi / 2**20,
+    "nanoticks_rot": 2.0 * math.pi / (2**20 * 1e9),
+}
+_VELOCITY_UNITS = {
+    "implicit": 1.0,
+    "radian_second": 1.0,
+    "meter_second": 1.0,
+    "degree_second": math.pi / 180.0,
+}
+
+
+@dataclass(frozen=True)
+class RobotJointCommand:
+    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""
+
+    seqno: int
+    state_seqno: int
+    command: Sequence[float]
+    units: Sequence[str] = ()
+
+
+@dataclass(frozen=True)
+class TrajectoryStatus:
+    """What ``Next()`` returns: action status, trajectory time and current waypoint."""
+
+    action_status: ActionStatus
+    trajectory_time: float = 0.0
+    current_waypoint: int = 0
+    seqno: int = 0
+
+
+class Completion:
+    """The outcome of an asynchronous driver operation (a jog, homing), set exactly once."""
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+        self.error: DriverError | None = None
+
+    @property
+    def done(self) -> bool:
+        """Whether the operation has finished (either way)."""
+        return self._event.is_set()
+
+    def succeed(self) -> None:
+        """Finish successfully (ignored if already finished)."""
+        if not self._event.is_set():
+            self._event.set()
+
+    def fail(self, error: DriverError) -> None:
+        """Finish with ``error`` (ignored if already finished)."""
+        if not self._event.is_set():
+            self.error = error
+            self._event.set()
+
+    def wait_event(self, timeout: float | None) -> bool:
+        """Block on the event (loop-thread mode)."""
+        return self._event.wait(timeout)
+
+
+class _TrajectoryTask:
+    """One trajectory's life: queued, ready (awaiting the first Next), running, finished."""
+
+    def __init__(self, interp: TrajectoryInterpolator) -> None:
+        self.interp = interp
+        self.next_called = False
+        self.started = False
+        self.start_time = 0.0
+        self.time = 0.0
+        self.waypoint = 0
+        self.last_setpoint: FloatArray | None = None
+        self.complete = False
+        self.error: DriverError | None = None
+        self.outcome_reported = False
+
+    @property
+    def finished(self) -> bool:
+        return self.complete or self.error is not None
+
+    def fail(self, error: DriverError) -> None:
+        if not self.finished:
+            self.error = error
+
+
+class TrajectoryGenerator:
+    """The generator ``execute_trajectory`` returns: call ``Next()`` until StopIteration.
+
+    ``Next()`` blocks until the trajectory completes, fails, or 5 s pass (then ``running``).
+    ``Abort()`` stops the robot (mode ``halt``); ``Close()`` cancels this trajectory only.
+    Also a Python iterator: ``for status in gen: ...``.
+    """
+
+    def __init__(self, driver: RobotDriver, task: _TrajectoryTask) -> None:
+        self._driver = driver
+        self._task = task
+
+    def Next(self) -> TrajectoryStatus:  # noqa: N802 - the Robot Raconteur generator API
+        """Advance: start (first call), then wait for an outcome; StopIteration when done."""
+        d = self._driver
+        task = self._task
+        with d._lock:
+            if task.outcome_reported:
+                raise StopIteration
+            if task.error is not None:
+                task.outcome_reported = True
+                raise task.error
+            if task.complete:
+                task.outcome_reported = True
+                return self._status(ActionStatus.complete)
+            queued = task is not d._traj_active
+            first = not task.next_called
+            task.next_called = True
+            if queued and first:
+                return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
+
+        def outcome() -> bool:
+            # A queued task reports ``running`` as soon as it becomes active (as the reference).
+            return task.finished or (queued and task is d._traj_active)
+
+        d._wait_for(outcome, NEXT_TIMEOUT_S)
+        with d._lock:
+            if task.error is not None:
+                task.outcome_reported = True
+                raise task.error
+            if task.complete:
+                task.outcome_reported = True
+                return self._status(ActionStatus.complete)
+            if task is not d._traj_active:
+                return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
+            return self._status(ActionStatus.running)
+
+    def _status(self, status: ActionStatus) -> TrajectoryStatus:
+        t = self._task
+        return TrajectoryStatus(status, t.time, t.waypoint, self._driver._state_seqno)
+
+    def Abort(self) -> None:  # noqa: N802
+        """Stop the robot: mode becomes ``halt``; ``Next()`` fails with OperationAborted."""
+        d = self._driver
+        with d._lock:
+            if self._task.finished:
+                return
+            self._task.fail(OperationAbortedError("Trajectory execution aborted"))
+            d._abort_trajectory(self._task)
+
+    def Close(self) -> None:  # noqa: N802
+        """Cancel this trajectory (the whole queue if it is active); the mode stays."""
+        d = self._driver
+        with d._lock:
+            if self._task.finished:
+                return
+            self._task.fail(OperationAbortedError("Trajectory execution cancelled"))
+            d._cancel_trajectory(self._task)
+
+    def __iter__(self) -> Iterator[TrajectoryStatus]:
+        return self
+
+    def __next__(self) -> TrajectoryStatus:
+        return self.Next()
+
+
+class RobotDriver(ABC):
+    """Base class of robot drivers (the seed's ``AbstractRobot``), with its real-time loop.
+
+    A subclass fills feedback in :meth:`_read_feedback` and implements
+    :meth:`_send_robot_command`, :meth:`_send_enable`, :meth:`_send_disable` and
+    :meth:`_send_reset_errors` (and :meth:`_start_homing` if it homes).
+
+    Args:
+        robot_info: the validated RobotInfo.
+        default_joint_count: unused when ``robot_info`` names the joints (kept for the seed API).
+        clock: real (default) or simulated time.
+        update_period: the loop period in seconds (reference default 10 ms).
+    """
+
+    def __init__(
+        self,
+        robot_info: RobotInfo,
+        default_joint_count: int = 0,
+        *,
+        clock: Clock | None = None,
+        update_period: float = 0.01,
+    ) -> None:
+        if not (math.isfinite(update_period) and update_period > 0):
+            raise InvalidArgumentError("update period must be a positive number of seconds")
+        self._robot_info = robot_info
+        self._joint_names: tuple[str, ...] = robot_info.joint_names
+        self._joint_count = len(self._joint_names) or default_joint_count
+        self._robot_uuid = robot_info.device_info.device.uuid
+        self._robot_caps = robot_info.capability_bits
+        self._uses_homing = robot_info.has(RobotCapability.homing_command)
+        self._has_position_command = robot_info.has(RobotCapability.position_command)
+        self._has_velocity_command = robot_info.has(RobotCapability.velocity_command)
+        self._has_jog_command = robot_info.has(RobotCapability.jog_command)
+        self._has_trajectory_command = robot_info.has(RobotCapability.trajectory_command)
+        self._limits = JointLimitArrays.from_info(robot_info)
+        n = self._joint_count
+        chains = robot_info.chains
+        self._chain_joints = [np.array(c.joint_numbers, dtype=np.intp) for c in chains]
+        self._hp: list[HPChain] = []
+        for c in chains:
+            fp = c.flange_pose or Pose()
+            self._hp.append(
+                HPChain(
+                    np.array([h.as_tuple() for h in c.H]),
+                    np.array([p.as_tuple() for p in c.P]),
+                    prismatic=[bool(self._limits.prismatic[j]) for j in c.joint_numbers],
+                    flange_rotation=quat_to_rot(fp.orientation.as_tuple()),
+                    flange_position=np.array(fp.position.as_tuple()),
+                )
+            )
+        self._current_tool: list[ToolInfo | None] = [c.current_tool for c in chains]
+        self._current_payload: list[PayloadInfo | None] = [c.current_payload for c in chains]
+        self._current_payload_pose: list[Pose | None] = [None for _ in chains]
+        self._tool_tf: list[tuple[FloatArray, FloatArray] | None] = [
+            _tool_transform(t) for t in self._current_tool
+        ]
+        self._tool_tf_lists = [_as_lists(t) for t in self._tool_tf]
+        self._chain_idx_list = [list(c.joint_numbers) for c in chains]
+        self._endpoint_key: tuple[bytes, bytes, int] | None = None
+        self._endpoint_cache: tuple[list[TcpPose], list[FloatArray]] | None = None
+        self._keep_going = False
+        self._update_period = update_period
+        self._speed_ratio = 1.0
+        self._jog_joint_limit = math.radians(1000.0)
+        self._trajectory_error_tol = math.radians(5.0)
+        self._command_mode = CommandMode.halt
+        self._operational_mode = OperationalMode.manual_reduced_speed
+        self._controller_state = ControllerState.undefined
+        self._joint_position: FloatArray = np.zeros(0)
+        self._joint_velocity: FloatArray = np.zeros(0)
+        self._joint_effort: FloatArray = np.zeros(0)
+        self._position_command: FloatArray | None = None
+        self._velocity_command: FloatArray | None = None
+        self._endpoint_pose: list[TcpPose] | None = None
+        self._endpoint_vel: list[FloatArray] | None = None
+        self._last_robot_state = -math.inf
+        self._last_joint_state = -math.inf
+        self._last_endpoint_state = -math.inf
+        self._state_seqno = 0
+        self._homed = False
+        self._ready = False
+        self._enabled = False
+        self._stopped = False
+        self._error = False
+        self._estop_source = 0
+        self._communication_failure = True
+        self._communication_timeout = 0.25
+        self._config_seqno = 1
+        self._base_set_operational_mode = True
+        self._base_set_controller_state = True
+        self._lock = threading.RLock()
+        self._clock: Clock = clock if clock is not None else RealClock()
+        # --- internals beyond the seed ---
+        self._guard = CommandGuard(self._limits, update_period)
+        self._fault_message = ""
+        self._flags = StateFlags.none
+        self._flags_int = -1
+        self._prev_mode = CommandMode.halt
+        self._jog: JogMotion | None = None
+        self._jog_waiter: Completion | None = None
+        self._jog_cartesian: tuple[int, FloatArray] | None = None
+        self._halt_ramp: JogMotion | None = None
+        self._homing: Completion | None = None
+        self._traj_active: _TrajectoryTask | None = None
+        self._traj_queue: deque[_TrajectoryTask] = deque()
+        self._traj_failed_this_step = False
+        self._stream_position: RobotJointCommand | None = None
+        self._stream_velocity: RobotJointCommand | None = None
+        self._stream_last_seqno = -1
+        self._stream_valid = StateFlags.none
+        self._last_sent: FloatArray | None = None
+        self._last_sent_velocity = np.zeros(n)
+        self._sent_last_step = False
+        self._epoch = self._clock.now()
+        self._next_deadline = self._epoch
+        self._thread: threading.Thread | None = None
+        self._step_done = threading.Condition(self._lock)
+        self._scheduled: list[tuple[float, int, Callable[[], None]]] = []
+        self._scheduled_count = 0
+        self._listeners: list[Callable[[RobotState], None]] = []
+        self._state = RobotState(
+            ts=0.0,
+            seqno=0,
+            command_mode=self._command_mode,
+            operational_mode=self._operational_mode,
+            controller_state=self._controller_state,
+            flags=StateFlags.communication_failure,
+        )
+        #: (event, chain, name) of tool_changed / payload_changed, in order.
+        self.events: list[tuple[str, int, str]] = []
+
+    # ------------------------------------------------------------------ abstract (subclass)
+
+    def _read_feedback(self, now: float) -> None:  # noqa: B027 - optional hook
+        """Step 1: fill feedback fields from the robot (override, or update under ``_lock``)."""
+
+    @abstractmethod
+    def _send_robot_command(
+        self, now: float, joint_pos_cmd: FloatArray | None, joint_vel_cmd: FloatArray | None
+    ) -> None:
+        """Step 6: send a position or velocity command (both None: no command this step)."""
+
+    @abstractmethod
+    def _send_enable(self) -> None:
+        """Ask the robot to enable its drives."""
+
+    @abstractmethod
+    def _send_disable(self) -> None:
+        """Ask the robot to disable its drives."""
+
+    @abstractmethod
+    def _send_reset_errors(self) -> None:
+        """Ask the robot to clear its errors."""
+
+    def _start_homing(self, completion: Completion) -> None:
+        """Start homing; call ``completion.succeed()`` when homed. Override if the robot homes."""
+        completion.fail(NotImplementedDriverError("Homing is not implemented by this driver"))
+
+    # ------------------------------------------------------------------ loop and time
+
+    def _perf_counter(self) -> float:
+        """The clock's monotonic seconds."""
+        return self._clock.now()
+
+    def _stopwatch_ellapsed_s(self) -> float:
+        """Seconds since the loop's epoch (the ``now`` every step receives)."""
+        return self._clock.now() - self._epoch
+
+    def step(self) -> RobotState:
+        """Wait for the next period boundary and run one timestep; return the new state.
+
+        Why public: with a simulated clock, tests and scripts drive the loop step by step.
+        Missed deadlines are skipped, not caught up (as the reference does).
+        """
+        self._clock.sleep_until(self._next_deadline)
+        t = self._clock.now()
+        self._next_deadline += self._update_period
+        if t > self._next_deadline:
+            missed = math.floor((t - self._next_deadline) / self._update_period) + 1
+            self._next_deadline += missed * self._update_period
+        now = t - self._epoch
+        self._run_scheduled(now)
+        self._run_timestep(now)
+        return self._state
+
+    def run_for(self, seconds: float) -> RobotState:
+        """Step the loop for ``seconds`` of (clock) time."""
+        end = self._stopwatch_ellapsed_s() + seconds
+        while self._stopwatch_ellapsed_s() + 1e-12 < end:
+            self.step()
+        return self._state
+
+    def at(self, t: float, action: Callable[[], None]) -> None:
+        """Run ``action`` just before the first timestep at stopwatch time >= ``t``.
+
+        Why: lets a test or scenario inject an event (a halt, a fault) while a blocking call is
+        stepping the loop, without threads.
+        """
+        with self._lock:
+            self._scheduled_count += 1
+            heapq.heappush(self._scheduled, (t, self._scheduled_count, action))
+
+    def _run_scheduled(self, now: float) -> None:
+        while self._scheduled and self._scheduled[0][0] <= now + 1e-12:
+            _, _, action = heapq.heappop(self._scheduled)
+            action()
+
+    def _start_robot(self) -> None:
+        """Start the loop thread (real-time use); blocking calls then wait on it."""
+        if self._thread is not None:
+            return
+        self._keep_going = True
+        self._thread = threading.Thread(target=self._loop_thread_func, daemon=True)
+        self._thread.start()
+
+    def _loop_thread_func(self) -> None:
+        """Loop thread body: step until ``_keep_going`` is cleared."""
+        while self._keep_going:
+            self.step()
+
+    def _stop_robot(self) -> None:
+        """Stop the loop thread and wait for it."""
+        self._keep_going = False
+        thread, self._thread = self._thread, None
+        if thread is not None and thread is not threading.current_thread():
+            thread.join()
+
+    def _close(self) -> None:
+        """Close the driver: stop the loop."""
+        self._stop_robot()
+
+    def _wait_for(self, predicate: Callable[[], bool], timeout: float) -> None:
+        """Block until ``predicate()`` or ``timeout`` seconds of clock time.
+
+        With a loop thread the caller waits on it; without one the caller steps the loop itself,
+        which is what makes simulated-time tests deterministic.
+        """
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            deadline = self._clock.now() + timeout
+            with self._step_done:
+                while not predicate():
+                    remaining = deadline - self._clock.now()
+                    if remaining <= 0 or self._thread is None:
+                        return
+                    self._step_done.wait(min(remaining, 0.1))
+            return
+        end = self._stopwatch_ellapsed_s() + timeout
+        while not predicate() and self._stopwatch_ellapsed_s() < end:
+            self.step()
+
+    def _wait_completion(self, completion: Completion) -> None:
+        self._wait_for(lambda: completion.done, MAX_WAIT_S)
+        if not completion.done:
+            completion.fail(OperationFailedError("Operation timed out"))
+        if completion.error is not None:
+            raise completion.error
+
+    # ------------------------------------------------------------------ the timestep
+
+    def _run_timestep(self, now: float) -> None:
+        """One timestep: feedback, checks, command, states, send. Never raises.
+
+        Why the guard around everything: in the reference an exception here kills the loop
+        thread silently and clients read a frozen state forever. Here the driver reports an
+        error state and keeps running.
+        """
+        try:
+            self._read_feedback(now)
+            with self._lock:
+                self._state_seqno += 1
+                self._stream_valid = StateFlags.none
+                self._traj_failed_this_step = False
+                res = self._verify_communication(now) and self._verify_robot_state(now)
+                ok, pos, vel = self._fill_robot_command(now)
+                res = res and ok
+                pos, vel = self._guard_command(pos, vel)
+                self._fill_states(now)
+            if res:
+                self._send_robot_command(now, pos, vel)
+                self._record_sent(pos, vel)
+            else:
+                self._record_sent(None, None)
+        except Exception as exc:  # noqa: BLE001 - the loop must survive anything
+            self._step_failed(now, exc)
+        self._publish()
+
+    def _record_sent(self, pos: FloatArray | None, vel: FloatArray | None) -> None:
+        if pos is not None:
+            if self._last_sent is not None and self._sent_last_step:
+                self._last_sent_velocity = (pos - self._last_sent) / self._update_period
+            else:
+                self._last_sent_velocity = np.zeros(self._joint_count)
+            self._last_sent = pos
+            self._sent_last_step = True
+        elif vel is not None:
+            self._last_sent_velocity = vel
+            self._last_sent = None
+            self._sent_last_step = False
+        else:
+            self._sent_last_step = False
+            self._last_sent_velocity = np.zeros(self._joint_count)
+
+    def _step_failed(self, now: float, exc: BaseException) -> None:
+        with self._lock:
+            self._fault_message = f"driver step failed: {type(exc).__name__}: {exc}"
+            self._command_mode = CommandMode.invalid_state
+            self._end_motion(OperationAbortedError(f"Interrupted: {self._fault_message}"))
+            try:
+                self._fill_states(now)
+            except Exception:  # noqa: BLE001 - fall back to a minimal state
+                self._state = RobotState(
+                    ts=now,
+                    seqno=self._state_seqno,
+                    command_mode=self._command_mode,
+                    operational_mode=self._operational_mode,
+                    controller_state=self._controller_state,
+                    flags=StateFlags.error,
+                    error_message=self._fault_message,
+                )
+
+    def _publish(self) -> None:
+        with self._step_done:
+            self._step_done.notify_all()
+        for listener in list(self._listeners):
+            try:
+                listener(self._state)
+            except Exception:  # noqa: BLE001 - a bad listener must not stop the loop
+                self._listeners.remove(listener)
+
+    def add_state_listener(self, listener: Callable[[RobotState], None]) -> None:
+        """Call ``listener(state)`` after every step (loggers, status views)."""
+        self._listeners.append(listener)
+
+    # ------------------------------------------------------------------ steps 2 and 3
+
+    def _verify_communication(self, now: float) -> bool:
+        """Step 2: communication has failed if any feedback stamp is older than the timeout."""
+        timeout = self._communication_timeout
+        if (
+            now - self._last_robot_state > timeout
+            or now - self._last_joint_state > timeout
+            or now - self._last_endpoint_state > timeout
+        ):
+            self._communication_failure = True
+            self._command_mode = CommandMode.invalid_state
+            if self._base_set_operational_mode:
+                self._operational_mode = OperationalMode.undefined
+                self._controller_state = ControllerState.undefined
+            self._joint_position = np.zeros(0)
+            self._joint_velocity = np.zeros(0)
+            self._joint_effort = np.zeros(0)
+            self._endpoint_pose = None
+            self._endpoint_vel = None
+            return False
+        self._communication_failure = False
+        if self._base_set_operational_mode:
+            self._operational_mode = OperationalMode.cobot
+        return True
+
+    def _verify_robot_state(self, now: float) -> bool:
+        """Step 3: the reference's rules, first match wins (note §1.2)."""
+        error = self._error or bool(self._fault_message)
+        if (
+            self._command_mode is CommandMode.homing
+            and self._enabled
+            and not error
+            and not self._communication_failure
+        ):
+            if self._base_set_controller_state:
+                self._controller_state = ControllerState.motor_off
+            return True
+        if not self._ready or error or self._communication_failure:
+            if self._base_set_controller_state:
+                if self._stopped:
+                    self._controller_state = ControllerState.emergency_stop
+                elif error:
+                    self._controller_state = ControllerState.guard_stop
+                else:
+                    self._controller_state = ControllerState.motor_off
+            if error or self._command_mode is not CommandMode.halt:
+                self._command_mode = CommandMode.invalid_state
+            return False
+        if not self._enabled:
+            if self._base_set_controller_state:
+                self._controller_state = ControllerState.motor_off
+            if self._command_mode is not CommandMode.halt:
+                self._command_mode = CommandMode.invalid_state
+            return False
+        if self._command_mode is CommandMode.invalid_state:
+            self._command_mode = CommandMode.halt
+        if self._base_set_controller_state:
+            self._controller_state = ControllerState.motor_on
+        return True
+
+    # ------------------------------------------------------------------ step 4
+
+    def _interruption(self) -> OperationAbortedError:
+        if self._communication_failure:
+            why = "communication with the robot lost"
+        elif self._stopped:
+            why = "emergency stop"
+        elif self._error or self._fault_message:
+            why = "robot error"
+        elif not self._enabled or not self._ready:
+            why = "robot not ready"
+        else:
+            why = f"command mode changed to {self._command_mode.name}"
+        return OperationAbortedError(f"Operation interrupted: {why}")
+
+    def _end_motion(self, error: DriverError) -> None:
+        """Fail every pending motion (jog waiter, trajectories) with ``error``."""
+        if self._jog_waiter is not None:
+            self._jog_waiter.fail(error)
+            self._jog_waiter = None
+        self._jog = None
+        self._jog_cartesian = None
+        if self._traj_active is not None:
+            self._traj_active.fail(error)
+            self._traj_active = None
+        while self._traj_queue:
+            self._traj_queue.popleft().fail(
+                OperationAbortedError("Trajectory cancelled by controller before start")
+            )
+        if self._homing is not None:
+            self._homing.fail(error)
+            self._homing = None
+
+    def _fill_robot_command(self, now: float) -> tuple[bool, FloatArray | None, FloatArray | None]:
+        """Step 4: the command for this step from the mode and the client's requests."""
+        mode = self._command_mode
+        prev, self._prev_mode = self._prev_mode, mode
+        if mode is not CommandMode.trajectory and (
+            self._traj_active is not None or self._traj_queue
+        ):
+            if self._traj_active is not None:
+                reason = self._interruption()
+                self._traj_active.fail(
+                    OperationAbortedError(f"Invalid mode for trajectory execution ({reason})")
+                )
+                self._traj_active = None
+            while self._traj_queue:
+                self._traj_queue.popleft().fail(
+                    OperationAbortedError("Trajectory cancelled by controller before start")
+                )
+        if mode is not CommandMode.jog and (self._jog is not None or self._jog_waiter):
+            if self._jog_waiter is not None:
+                self._jog_waiter.fail(self._interruption())
+                self._jog_waiter = None
+            self._jog = None
+            self._jog_cartesian = None
+        if mode is not CommandMode.homing and self._homing is not None:
+            self._homing.fail(self._interruption())
+            self._homing = None
+        if mode is not CommandMode.position_command:
+            self._stream_position = None
+            self._stream_last_seqno = -1
+        if mode is not CommandMode.velocity_command:
+            self._stream_velocity = None
+        if mode is CommandMode.halt:
+            if prev in _MOTION_MODES and self._sent_last_step and self._last_sent is not None:
+                self._halt_ramp = self._new_motion(self._last_sent, self._last_sent_velocity)
+                self._halt_ramp.at_velocity(np.zeros(self._joint_count), 0.0)
+            if self._halt_ramp is not None:
+                q = self._halt_ramp.step()
+                if self._halt_ramp.done:
+                    self._halt_ramp = None
+                return True, q, None
+            return True, None, None
+        self._halt_ramp = None
+        if mode is CommandMode.jog:
+            return True, self._fill_jog(), None
+        if mode is CommandMode.trajectory:
+            return True, self._fill_trajectory(now), None
+        if mode is CommandMode.position_command:
+            return True, self._fill_position_stream(), None
+        if mode is CommandMode.velocity_command:
+            return True, None, self._fill_velocity_stream()
+        if mode is CommandMode.homing:
+            return True, None, None
+        return False, None, None
+
+    def _start_point(self) -> tuple[FloatArray, FloatArray]:
+        """Where a new jog starts: the last command if one went out last step, else measured."""
+        if self._sent_last_step and self._last_sent is not None:
+            return self._last_sent.copy(), self._last_sent_velocity.copy()
+        return self._joint_position.copy(), np.zeros(self._joint_count)
+
+    def _new_motion(self, q: FloatArray, v: FloatArray) -> JogMotion:
+        vlim, alim = self._jog_limits()
+        return JogMotion(
+            q, v, vlim, alim, self._limits.lower, self._limits.upper, self._update_period
+        )
+
+    def _fill_jog(self) -> FloatArray | None:
+        motion = self._jog
+        if motion is None:
+            return None
+        if self._jog_cartesian is not None:
+            self._update_cartesian_jog(motion)
+        q = motion.step()
+        if motion.done:
+            self._jog = None
+            self._jog_cartesian = None
+            if self._jog_waiter is not None:
+                self._jog_waiter.succeed()
+                self._jog_waiter = None
+        return q
+
+    def _update_cartesian_jog(self, motion: JogMotion) -> None:
+        assert self._jog_cartesian is not None
+        chain, twist = self._jog_cartesian
+        idx = self._chain_joints[chain]
+        tf = self._tool_tf[chain]
+        _, _, jac = self._hp[chain].fk_jacobian(
+            motion.q[idx], None if tf is None else tf[0], None if tf is None else tf[1]
+        )
+        lam = 0.01
+        jjt = jac @ jac.T + lam * lam * np.eye(6)
+        qd_chain = jac.T @ np.linalg.solve(jjt, twist)
+        vlim = self._jog_limits()[0][idx]
+        scale = float(np.max(np.abs(qd_chain) / vlim)) if qd_chain.size else 0.0
+        if scale > 1.0:
+            qd_chain = qd_chain / scale
+        qd = np.zeros(self._joint_count)
+        qd[idx] = qd_chain
+        if motion.target_velocity is not None:
+            motion.target_velocity = qd
+
+    def _fill_trajectory(self, now: float) -> FloatArray | None:
+        task = self._traj_active
+        if task is None:
+            return None
+        if not task.started:
+            if not task.next_called:
+                return None
+            task.started = True
+            task.start_time = now
+        t = now - task.start_time
+        measured = self._joint_position
+        if task.last_setpoint is not None and measured.shape == task.last_setpoint.shape:
+            err = np.abs(measured - task.last_setpoint)
+            if np.any(err > self._trajectory_error_tol):
+                task.fail(OperationFailedError("Trajectory tolerance failure"))
+                self._traj_active = None
+                self._traj_failed_this_step = True
+                while self._traj_queue:
+                    self._traj_queue.popleft().fail(
+                        OperationAbortedError("Trajectory cancelled by controller before start")
+                    )
+                self._command_mode = CommandMode.halt
+                self._prev_mode = CommandMode.halt
+                return None
+        setpoint, wp = task.interp.evaluate(t)
+        task.time = min(t, task.interp.max_time)
+        task.waypoint = wp
+        q = setpoint.copy()
+        task.last_setpoint = q
+        if t >= task.interp.max_time:
+            task.complete = True
+            self._traj_active = self._traj_queue.popleft() if self._traj_queue else None
+            if self._traj_active is not None and self._traj_active.next_called:
+                self._traj_active.started = True
+                self._traj_active.start_time = now + self._update_period
+        return q
+
+    def _fill_position_stream(self) -> FloatArray | None:
+        cmd = self._stream_position
+        if cmd is None:
+            return None
+        if cmd.seqno < self._stream_last_seqno:
+            return None
+        if abs(cmd.state_seqno - self._state_seqno) > STREAM_STALE_SEQNOS:
+            return None
+        q = _convert(cmd, self._joint_count, _POSITION_UNITS)
+        if q is None:
+            return None
+        self._stream_last_seqno = cmd.seqno
+        self._stream_valid = StateFlags.valid_position_command
+        return q
+
+    def _fill_velocity_stream(self) -> FloatArray | None:
+        cmd = self._stream_velocity
+        if cmd is None:
+            return None
+        if abs(cmd.state_seqno - self._state_seqno) > STREAM_STALE_SEQNOS:
+            return None
+        v = _convert(cmd, self._joint_count, _VELOCITY_UNITS)
+        if v is None:
+            return None
+        self._stream_valid = StateFlags.valid_velocity_command
+        return v * self._speed_ratio
+
+    def _guard_command(
+        self, pos: FloatArray | None, vel: FloatArray | None
+    ) -> tuple[FloatArray | None, FloatArray | None]:
+        """Every outgoing command passes the guard (limits, rate, finiteness)."""
+        if pos is not None:
+            ref = (
+                self._last_sent if (self._sent_last_step and self._last_sent is not None) else None
+            )
+            if ref is None:
+                if self._joint_position.shape[0] != self._joint_count:
+                    return None, None
+                ref = self._joint_position
+            out = self._guard.position(pos, ref)
+            if out is None:
+                self._fault_message = "non-finite joint position command refused"
+            return out, None
+        if vel is not None:
+            if self._joint_position.shape[0] != self._joint_count:
+                return None, None
+            outv = self._guard.velocity(vel, self._joint_position)
+            if outv is None:
+                self._fault_message = "non-finite joint velocity command refused"
+            return None, outv
+        return None, None
+
+    # ------------------------------------------------------------------ step 5
+
+    def _fill_state_flags(self, now: float) -> None:
+        """The ``robot_state_flags`` word; communication failure is reported alone."""
+        if self._communication_failure:
+            self._flags = StateFlags.communication_failure
+            self._flags_int = int(StateFlags.communication_failure)
+            return
+        f = 0
+        if self._error or self._fault_message:
+            f |= _F_ERROR
+        if self._stopped:
+            f |= _F_ESTOP | int(ESTOP_SOURCE_FLAGS.get(self._estop_source, 0))
+        if self._enabled:
+            f |= _F_ENABLED
+        if self._ready:
+            f |= _F_READY
+        if self._uses_homing:
+            f |= _F_HOMED if self._homed else _F_HOMING_REQUIRED
+        f |= int(self._stream_valid)
+        if self._traj_active is not None and not self._traj_failed_this_step:
+            f |= _F_TRAJ
+        if f != self._flags_int:
+            self._flags_int = f
+            self._flags = StateFlags(f)
+
+    def _calc_endpoint_poses(self) -> list[TcpPose]:
+        """TCP pose of every chain (tool applied), base frame; also the TCP velocities.
+
+        Cached on (q, qd, tools): an idle robot costs nothing here.
+        """
+        q = self._joint_position
+        qd = self._joint_velocity
+        key = (q.tobytes(), qd.tobytes(), self._config_seqno)
+        if key == self._endpoint_key and self._endpoint_cache is not None:
+            poses, vels = self._endpoint_cache
+            self._endpoint_vel = vels
+            return poses
+        poses = []
+        vels = []
+        q_list = q.tolist()
+        qd_list = qd.tolist() if qd.shape[0] == self._joint_count else None
+        for c, hp in enumerate(self._hp):
+            idx = self._chain_idx_list[c]
+            tf = self._tool_tf_lists[c]
+            rot, pos, twist = hp.tcp_state(
+                [q_list[i] for i in idx],
+                None if qd_list is None else [qd_list[i] for i in idx],
+                None if tf is None else tf[0],
+                None if tf is None else tf[1],
+            )
+            poses.append(
+                TcpPose(
+                    position=_ro(np.array(pos)), orientation=_ro(np.array(rot_to_quat_tuple(rot)))
+                )
+            )
+            vels.append(_ro(np.array(twist)))
+        self._endpoint_key = key
+        self._endpoint_cache = (poses, vels)
+        self._endpoint_vel = vels
+        return poses
+
+    def _calc_endpoint_pose(self, chain: int) -> TcpPose:
+        """TCP pose of ``chain`` (tool applied)."""
+        poses = self._endpoint_pose or self._calc_endpoint_poses()
+        return poses[chain]
+
+    def _calc_endpoint_vels(self) -> list[FloatArray]:
+        """TCP spatial velocity ``[angular, linear]`` of every chain."""
+        if self._endpoint_vel is None:
+            self._calc_endpoint_poses()
+        return list(self._endpoint_vel or [])
+
+    def _calc_endpoint_vel(self, chain: int) -> FloatArray:
+        """TCP spatial velocity of ``chain``."""
+        return self._calc_endpoint_vels()[chain]
+
+    def _fill_states(self, now: float) -> None:
+        """Step 5: flags, endpoint poses and velocities, and the published snapshot."""
+        self._fill_state_flags(now)
+        comm_ok = not self._communication_failure
+        have_q = self._joint_position.shape[0] == self._joint_count
+        if comm_ok and have_q:
+            self._endpoint_pose = self._calc_endpoint_poses()
+        else:
+            self._endpoint_pose = None
+            self._endpoint_vel = None
+        task = self._traj_active
+        self._state = RobotState(
+            ts=now,
+            seqno=self._state_seqno,
+            command_mode=self._command_mode,
+            operational_mode=self._operational_mode,
+            controller_state=self._controller_state,
+            flags=self._flags,
+            joint_position=frozen_array(self._joint_position),
+            joint_velocity=frozen_array(self._joint_velocity),
+            joint_effort=frozen_array(self._joint_effort),
+            position_command=frozen_array(self._position_command),
+            velocity_command=frozen_array(self._velocity_command),
+            kin_chain_tcp=tuple(self._endpoint_pose or ()),
+            kin_chain_tcp_vel=tuple(self._endpoint_vel or ()),
+            trajectory_running=bool(self._flags & StateFlags.trajectory_running),
+            trajectory_time=0.0 if task is None else task.time,
+            trajectory_max_time=0.0 if task is None else task.interp.max_time,
+            trajectory_current_waypoint=0 if task is None else task.waypoint,
+            config_seqno=self._config_seqno,
+            speed_ratio=self._speed_ratio,
+            error_message=self._fault_message,
+        )
+
+    # ------------------------------------------------------------------ client API: modes
+
+    @property
+    def robot_state(self) -> RobotState:
+        """The state published by the last step."""
+        return self._state
+
+    @property
+    def command_mode(self) -> CommandMode:
+        """The current command mode."""
+        return self._command_mode
+
+    @command_mode.setter
+    def command_mode(self, value: CommandMode | int | str) -> None:
+        self.set_command_mode(value)
+
+    def set_command_mode(self, value: CommandMode | int | str) -> None:
+        """Request a command mode; the reference's checks, in its order (note §1.2)."""
+        mode = _parse_mode(value)
+        with self._lock:
+            current = self._command_mode
+            comm_ok = not self._communication_failure
+            error = self._error or bool(self._fault_message)
+            if mode is CommandMode.halt and self._fault_message and not self._error:
+                # A driver-internal fault is cleared by switching to halt (escalation level 1).
+                self._fault_message = ""
+                self._command_mode = CommandMode.halt
+                return
+            if current is CommandMode.invalid_state:
+                if mode is CommandMode.homing:
+                    if self._enabled and comm_ok and self._uses_homing:
+                        self._command_mode = mode
+                        return
+                    raise InvalidOperationError("Cannot set homing command mode in current state")
+                if mode is CommandMode.halt and self._enabled and not error and comm_ok:
+                    self._command_mode = mode
+                    return
+            if not comm_ok:
+                raise InvalidOperationError("Cannot set robot command mode in current state")
+            if not self._ready and mode is not CommandMode.halt:
+                if not (mode is CommandMode.homing and self._enabled and not error):
+                    raise InvalidOperationError("Cannot set robot command mode in current state")
+            if current is not CommandMode.halt and mode is not CommandMode.halt:
+                raise InvalidOperationError('Must switch to "halt" before selecting new mode')
+            if mode is CommandMode.jog:
+                if not self._has_jog_command:
+                    raise InvalidOperationError("Robot does not support jog command mode")
+                self._jog = None
+            elif mode is CommandMode.trajectory:
+                if not self._has_trajectory_command:
+                    raise InvalidOperationError("Robot does not support trajectory command mode")
+            elif mode is CommandMode.position_command:
+                if not self._has_position_command:
+                    raise InvalidOperationError("Robot does not support position command mode")
+            elif mode is CommandMode.velocity_command:
+                if not self._has_velocity_command:
+                    raise InvalidOperationError("Robot does not support velocity command mode")
+            elif mode is CommandMode.homing:
+                if not self._uses_homing:
+                    raise InvalidOperationError("Robot does not support homing command mode")
+            elif mode is not CommandMode.halt:
+                raise InvalidOperationError("Invalid command mode specified")
+            self._command_mode = mode
+
+    def halt(self) -> None:
+        """Stop motion: command mode ``halt`` (the reference lacks this robdef function)."""
+        self.set_command_mode(CommandMode.halt)
+
+    @property
+    def operational_mode(self) -> OperationalMode:
+        """The controller's operational mode."""
+        return self._operational_mode
+
+    @property
+    def controller_state(self) -> ControllerState:
+        """The controller's state."""
+        return self._controller_state
+
+    @property
+    def current_errors(self) -> tuple[str, ...]:
+        """Human-readable current errors (empty when healthy)."""
+        out: list[str] = []
+        if self._communication_failure:
+            out.append("communication failure")
+        if self._fault_message:
+            out.append(self._fault_message)
+        if self._error:
+            out.append("robot error")
+        if self._stopped:
+            out.append("emergency stop")
+        return tuple(out)
+
+    @property
+    def speed_ratio(self) -> float:
+        """The speed ratio in [0.1, 10]."""
+        return self._speed_ratio
+
+    @speed_ratio.setter
+    def speed_ratio(self, value: float) -> None:
+        self._speed_ratio = check_speed_ratio(value)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Joint names in global order."""
+        return self._joint_names
+
+    @property
+    def limits(self) -> JointLimitArrays:
+        """Joint limits as arrays."""
+        return self._limits
+
+    @property
+    def update_period(self) -> float:
+        """The loop period in seconds."""
+        return self._update_period
+
+    @property
+    def isoch_info(self) -> dict[str, float]:
+        """``IsochInfo``: update rate, max downsample and epoch."""
+        return {
+            "update_rate": 1.0 / self._update_period,
+            "max_downsample": 1000.0,
+            "isoch_epoch": self._epoch,
+        }
+
+    @property
+    def robot_info(self) -> RobotInfo:
+        """The RobotInfo with current tools and payloads and the live ``config_seqno``."""
+        with self._lock:
+            chains = tuple(
+                c.model_copy(
+                    update={
+                        "current_tool": self._current_tool[i],
+                        "current_payload": self._current_payload[i],
+                    }
+                )
+                for i, c in enumerate(self._robot_info.chains)
+            )
+            return self._robot_info.model_copy(
+                update={"chains": chains, "config_seqno": self._config_seqno}
+            )
+
+    @property
+    def device_info(self) -> DeviceInfo:
+        """The RobotInfo's DeviceInfo."""
+        return self._robot_info.device_info
+
+    # ------------------------------------------------------------------ enable, errors, homing
+
+    def enable(self) -> None:
+        """Enable the drives (needs ``software_enable``)."""
+        if not self._robot_info.has(RobotCapability.software_enable):
+            raise InvalidOperationError("Robot does not support software enable")
+        self._send_enable()
+
+    def disable(self) -> None:
+        """Disable the drives (needs ``software_enable``)."""
+        if not self._robot_info.has(RobotCapability.software_enable):
+            raise InvalidOperationError("Robot does not support software enable")
+        self._send_disable()
+
+    def reset_errors(self) -> None:
+        """Clear a driver fault, and the robot's errors (needs ``software_reset_errors``)."""
+        with self._lock:
+            had_fault = bool(self._fault_message)
+            self._fault_message = ""
+        if self._robot_info.has(RobotCapability.software_reset_errors):
+            self._send_reset_errors()
+        elif not had_fault:
+            raise InvalidOperationError("Robot does not support software reset errors")
+
+    def home(self, wait: bool = True) -> Completion:
+        """Home the robot (mode ``homing``); with ``wait`` return when homed."""
+        with self._lock:
+            if self._command_mode is not CommandMode.homing:
+                raise InvalidOperationError("Robot must be in homing command mode to home")
+            if self._homing is not None:
+                raise InvalidOperationError("Homing already in progress")
+            completion = Completion()
+            self._homing = completion
+            self._start_homing(completion)
+        if wait:
+            self._wait_completion(completion)
+        return completion
+
+    def _homing_finished(self, success: bool, message: str = "") -> None:
+        """Called by the subclass when homing ends."""
+        with self._lock:
+            if self._homing is None:
+                return
+            if success:
+                self._homing.succeed()
+            else:
+                self._homing.fail(OperationFailedError(message or "Homing failed"))
+            self._homing = None
+
+    # ------------------------------------------------------------------ jogging
+
+    def _jog_limits(self) -> tuple[FloatArray, FloatArray]:
+        op = self._operational_mode
+        if op is OperationalMode.manual_reduced_speed:
+            return self._limits.reduced_velocity, self._limits.reduced_acceleration
+        if op in (OperationalMode.manual_full_speed, OperationalMode.cobot):
+            return self._limits.velocity, self._limits.acceleration
+        raise InvalidOperationError("Invalid operation mode for jog")
+
+    def _jog_preamble(self, not_ready: type[DriverError]) -> None:
+        if self._command_mode is not CommandMode.jog:
+            raise InvalidOperationError("Robot not in jog mode")
+        if not self._ready or self._communication_failure:
+            raise not_ready("Robot not ready")
+
+    def _install_jog(self, motion: JogMotion, wait: bool) -> Completion | None:
+        if self._jog_waiter is not None:
+            self._jog_waiter.fail(OperationAbortedError("Operation interrupted by new jog command"))
+        self._jog = motion
+        waiter = Completion() if wait else None
+        self._jog_waiter = waiter
+        return waiter
+
+    def jog_freespace(self, joint_position: Any, max_velocity: Any, wait: bool = False) -> None:
+        """Jog to ``joint_position`` (rad/m) at up to ``max_velocity``; ``wait`` for arrival."""
+        n = self._joint_count
+        with self._lock:
+            self._jog_preamble(InvalidOperationError)
+            target = joint_array("joint_position", joint_position, n)
+            vmax = joint_array("max_velocity", max_velocity, n)
+            if np.any(vmax <= 0.0):
+                raise InvalidArgumentError("max_velocity must be greater than zero")
+            vlim, alim = self._jog_limits()
+            for i in range(n):
+                if vmax[i] > vlim[i]:
+                    raise InvalidArgumentError(
+                        f"max_velocity[{i}] is greater than joint limits ({vlim[i]:.4g})"
+                    )
+            measured = self._joint_position
+            if np.any(np.abs(target - measured) > self._jog_joint_limit):
+                raise InvalidArgumentError(
+                    "Position command must be within "
+                    f"{math.degrees(self._jog_joint_limit):.0f} degrees from current position"
+                )
+            lo, hi = self._limits.lower, self._limits.upper
+            for i in range(n):
+                if not lo[i] <= target[i] <= hi[i]:
+                    raise InvalidArgumentError(
+                        f"joint_position[{i}] = {target[i]:.4g} is outside the joint limits "
+                        f"[{lo[i]:.4g}, {hi[i]:.4g}]"
+                    )
+            ratio = self._speed_ratio
+            existing = self._jog
+            if existing is None:
+                q0, v0 = self._start_point()
+                motion = self._new_motion(q0, v0)
+            else:
+                motion = existing
+            motion.vmax = np.minimum(vmax * ratio, vlim)
+            motion.amax = np.minimum(alim * ratio, alim)
+            motion.to_position(target, synchronize=existing is None)
+            self._jog_cartesian = None
+            waiter = self._install_jog(motion, wait)
+        if waiter is not None:
+            self._wait_completion(waiter)
+
+    def jog_joint(self, joint_velocity: Any, timeout: float, wait: bool = False) -> None:
+        """Jog at ``joint_velocity`` for ``timeout`` seconds, then stop; ``wait`` for the stop."""
+        n = self._joint_count
+        with self._lock:
+            self._jog_preamble(OperationAbortedError)
+            qd = joint_array("joint_velocity", joint_velocity, n)
+            t = finite_scalar("timeout", timeout)
+            if t <= 0.0:
+                raise InvalidArgumentError("Invalid jog timeout specified")
+            vlim, alim = self._jog_limits()
+            if np.any(np.abs(qd) > vlim):
+                raise InvalidArgumentError("Joint velocity exceeds joint limits")
+            waiter = self._velocity_jog(qd, t, wait, vlim, alim)
+        if waiter is not None:
+            self._wait_completion(waiter)
+
+    def _velocity_jog(
+        self, qd: FloatArray, timeout: float, wait: bool, vlim: FloatArray, alim: FloatArray
+    ) -> Completion | None:
+        existing = self._jog
+        if existing is None:
+            q0, v0 = self._start_point()
+            motion = self._new_motion(q0, v0)
+        else:
+            motion = existing
+        motion.vmax = vlim.copy()
+        motion.amax = np.minimum(alim * self._speed_ratio, alim)
+        motion.t = 0.0
+        motion.at_velocity(qd, timeout)
+        return self._install_jog(motion, wait)
+
+    def jog_cartesian(
+        self, velocity: Any, timeout: float, wait: bool = False, chain: int = 0
+    ) -> None:
+        """Jog a chain's TCP at spatial ``velocity`` ``[wx, wy, wz, vx, vy, vz]`` (base frame).
+
+        The joint velocities come from the chain's Jacobian (damped least squares), scaled down
+        together when one would exceed its limit, recomputed every step.
+        """
+        with self._lock:
+            self._jog_preamble(OperationAbortedError)
+            twist = joint_array("velocity", _twist(velocity), 6)
+            t = finite_scalar("timeout", timeout)
+            if t <= 0.0:
+                raise InvalidArgumentError("Invalid jog timeout specified")
+            self._check_chain(chain, "jog")
+            vlim, alim = self._jog_limits()
+            waiter = self._velocity_jog(np.zeros(self._joint_count), t, wait, vlim, alim)
+            self._jog_cartesian = (chain, twist)
+        if waiter is not None:
+            self._wait_completion(waiter)
+
+    # ------------------------------------------------------------------ trajectories
+
+    def execute_trajectory(self, trajectory: JointTrajectory) -> TrajectoryGenerator:
+        """Check and queue a trajectory; drive it by calling ``Next()`` on the generator."""
+        with self._lock:
+            interp = load_trajectory(trajectory, self._joint_names, self._limits, self._speed_ratio)
+            measured = self._joint_position
+            if measured.shape[0] != self._joint_count or np.any(
+                np.abs(measured - interp.positions[0]) > self._trajectory_error_tol
+            ):
+                raise InvalidArgumentError("Starting waypoint too far from current joint positions")
+            if self._command_mode is not CommandMode.trajectory:
+                raise InvalidOperationError(
+                    "Robot must be in trajectory mode to execute trajectory"
+                )
+            task = _TrajectoryTask(interp)
+            if self._traj_active is None:
+                self._traj_active = task
+            else:
+                self._traj_queue.append(task)
+            return TrajectoryGenerator(self, task)
+
+    def _abort_trajectory(self, task: _TrajectoryTask) -> None:
+        """Abort: drop to ``halt`` (which ends every trajectory on the next step)."""
+        with self._lock:
+            if self._command_mode is CommandMode.trajectory:
+                self._command_mode = CommandMode.halt
+            if self._traj_active is task:
+                self._traj_active = None
+            if task in self._traj_queue:
+                self._traj_queue.remove(task)
+
+    def _cancel_trajectory(self, task: _TrajectoryTask) -> None:
+        """Close: remove one task; closing the active one cancels the queue too."""
+        with self._lock:
+            if self._traj_active is task:
+                self._traj_active = None
+                while self._traj_queue:
+                    self._traj_queue.popleft().fail(
+                        OperationAbortedError("Trajectory cancelled by controller before start")
+                    )
+            elif task in self._traj_queue:
+                self._traj_queue.remove(task)
+
+    # ------------------------------------------------------------------ streaming
+
+    def set_position_command(self, command: RobotJointCommand) -> None:
+        """Write the position-command wire (used in ``position_command`` mode only)."""
+        with self._lock:
+            if self._command_mode is CommandMode.position_command:
+                self._stream_position = command
+
+    def set_velocity_command(self, command: RobotJointCommand) -> None:
+        """Write the velocity-command wire (used in ``velocity_command`` mode only)."""
+        with self._lock:
+            if self._command_mode is CommandMode.velocity_command:
+                self._stream_velocity = command
+
+    # ------------------------------------------------------------------ tools and payloads
+
+    def _check_chain(self, chain: int, what: str) -> None:
+        if not (isinstance(chain, int) and 0 <= chain < len(self._hp)):
+            raise InvalidArgumentError(f"Invalid kinematic chain {chain} for {what}")
+
+    def tool_attached(self, chain: int, tool: ToolInfo | None) -> None:
+        """A tool was attached to ``chain``: its TCP now defines the endpoint."""
+        if tool is None:
+            raise InvalidArgumentError("Tool cannot be null")
+        with self._lock:
+            self._check_chain(chain, "tool")
+            if self._current_tool[chain] is not None:
+                raise InvalidArgumentError(f"Tool already attached to kinematic chain {chain}")
+            self._current_tool[chain] = tool
+            self._tool_tf[chain] = _tool_transform(tool)
+            self._tool_tf_lists[chain] = _as_lists(self._tool_tf[chain])
+            self._config_seqno += 1
+            self.events.append(("tool_changed", chain, tool.name))
+
+    def tool_detached(self, chain: int, tool_name: str) -> None:
+        """The tool named ``tool_name`` (or "" for any) was detached from ``chain``."""
+        with self._lock:
+            self._check_chain(chain, "tool")
+            tool = self._current_tool[chain]
+            if tool is None:
+                raise InvalidArgumentError(f"Tool not attached to kinematic chain {chain}")
+            if self._current_payload[chain] is not None:
+                raise InvalidArgumentError("Cannot remove tool while payload attached")
+            if tool_name not in ("", tool.name):
+                raise InvalidArgumentError(
+                    f"Invalid tool name to detach: '{tool_name}' (attached: '{tool.name}')"
+                )
+            self._current_tool[chain] = None
+            self._tool_tf[chain] = None
+            self._tool_tf_lists[chain] = None
+            self._config_seqno += 1
+            self.events.append(("tool_changed", chain, ""))
+
+    def payload_attached(self, chain: int, payload: PayloadInfo | None, pose: Pose | None) -> None:
+        """A payload was attached to the tool of ``chain`` at ``pose`` relative to the TCP."""
+        if payload is None:
+            raise InvalidArgumentError("Payload cannot be null")
+        with self._lock:
+            self._check_chain(chain, "payload")
+            if self._current_tool[chain] is None:
+                raise InvalidArgumentError(
+                    f"No tool attached to kinematic chain {chain}, cannot attach payload"
+                )
+            if self._current_payload[chain] is not None:
+                raise InvalidArgumentError(f"Payload already attached to kinematic chain {chain}")
+            self._current_payload[chain] = payload
+            self._current_payload_pose[chain] = pose or Pose()
+            self._config_seqno += 1
+            self.events.append(("payload_changed", chain, payload.name))
+
+    def payload_detached(self, chain: int, payload_name: str) -> None:
+        """The payload named ``payload_name`` (or "") was detached from ``chain``."""
+        with self._lock:
+            self._check_chain(chain, "payload")
+            payload = self._current_payload[chain]
+            if payload is None:
+                raise InvalidArgumentError(f"Payload not attached to kinematic chain {chain}")
+            if payload_name not in ("", payload.name):
+                raise InvalidArgumentError(
+                    f"Invalid payload name to detach: '{payload_name}' (attached: '{payload.name}')"
+                )
+            self._current_payload[chain] = None
+            self._current_payload_pose[chain] = None
+            self._config_seqno += 1
+            self.events.append(("payload_changed", chain, ""))
+
+    # ------------------------------------------------------------------ parameters and signals
+
+    def getf_param(self, param_name: str) -> Any:
+        """No parameters in the base driver."""
+        raise InvalidArgumentError("Invalid parameter")
+
+    def setf_param(self, param_name: str, value: Any) -> None:
+        """No parameters in the base driver."""
+        raise InvalidArgumentError("Invalid parameter")
+
+    def getf_signal(self, signal_name: str) -> Any:
+        """Signals are not implemented by the base driver."""
+        raise NotImplementedDriverError("Not implemented")
+
+    def setf_signal(self, signal_name: str, value: Any) -> None:
+        """Signals are not implemented by the base driver."""
+        raise NotImplementedDriverError("Not implemented")
+
+
+_F_ERROR = int(StateFlags.error)
+_F_ESTOP = int(StateFlags.estop)
+_F_ENABLED = int(StateFlags.enabled)
+_F_READY = int(StateFlags.ready)
+_F_HOMED = int(StateFlags.homed)
+_F_HOMING_REQUIRED = int(StateFlags.homing_required)
+_F_TRAJ = int(StateFlags.trajectory_running)
+
+_MOTION_MODES = frozenset(
+    {
+        CommandMode.jog,
+        CommandMode.trajectory,
+        CommandMode.position_command,
+        CommandMode.velocity_command,
+    }
+)
+
+
+def _parse_mode(value: CommandMode | int | str) -> CommandMode:
+    if isinstance(value, CommandMode):
+        return value
+    if isinstance(value, str):
+        try:
+            return CommandMode[value]
+        except KeyError:
+            raise InvalidOperationError("Invalid command mode specified") from None
+    try:
+        mode = CommandMode(int(value))
+    except (ValueError, TypeError):
+        raise InvalidOperationError("Invalid command mode specified") from None
+    if mode is CommandMode.invalid_state:
+        raise InvalidOperationError("Invalid command mode specified")
+    return mode
+
+
+def _tool_transform(tool: ToolInfo | None) -> tuple[FloatArray, FloatArray] | None:
+    if tool is None:
+        return None
+    return (
+        quat_to_rot(tool.tcp.rotation.as_tuple()),
+        np.array(tool.tcp.translation.as_tuple()),
+    )
+
+
+def _as_lists(
+    tf: tuple[FloatArray, FloatArray] | None,
+) -> tuple[list[float], list[float]] | None:
+    if tf is None:
+        return None
+    return [float(x) for x in tf[0].reshape(9)], [float(x) for x in tf[1]]
+
+
+def _ro(a: FloatArray) -> FloatArray:
+    a.flags.writeable = False
+    return a
+
+
+def _twist(velocity: Any) -> Any:
+    """A spatial velocity from ``{angular: {x,y,z}, linear: {x,y,z}}`` or a 6-sequence."""
+    if isinstance(velocity, dict):
+        try:
+            a, lin = velocity["angular"], velocity["linear"]
+            return [a["x"], a["y"], a["z"], lin["x"], lin["y"], lin["z"]]
+        except (KeyError, TypeError):
+            raise InvalidArgumentError(
+                "velocity must be {angular: {x, y, z}, linear: {x, y, z}}"
+            ) from None
+    return velocity
+
+
+def _convert(cmd: RobotJointCommand, n: int, units: dict[str, float]) -> FloatArray | None:
+    """A streamed command in SI units, or None when it must be ignored."""
+    try:
+        values = np.array(cmd.command, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        return None
+    if values.shape[0] != n or not np.all(np.isfinite(values)):
+        return None
+    if len(cmd.units) not in (0, n):
+        return None
+    if cmd.units:
+        try:
+            scale = np.array([units[u] for u in cmd.units])
+        except KeyError:
+            return None
+        values = values * scale
+    return values

@@ -1,0 +1,223 @@
+"""The simulated robot: joints that track commands within the limits, and injectable faults.
+
+Why a physical model rather than perfect tracking: client code must see what a real arm does --
+one period of lag, velocity and acceleration saturation, hard stops at the joint limits, an
+instant stop on e-stop -- and must be testable against faults (lost feedback, e-stop, drive
+error, disabled drives) without a robot.
+
+The command sent in one step is applied over the following period, and feedback read at the next
+step reports the result (``_read_feedback`` integrates, then reports).
+"""
+
+from __future__ import annotations
+
+from enum import StrEnum
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robotspec.driver.clock import Clock
+from robotspec.driver.loop import Completion, RobotDriver
+from robotspec.driver.robot_info import RobotInfo
+from robotspec.driver.state import EstopSource
+
+__all__ = ["Fault", "SimRobot"]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+class Fault(StrEnum):
+    """Faults a test (or a scenario) can inject into the simulated robot."""
+
+    lost_feedback = "lost_feedback"
+    estop = "estop"
+    drive_error = "drive_error"
+    disabled = "disabled"
+    frozen = "frozen"
+    step_exception = "step_exception"
+
+
+class SimRobot(RobotDriver):
+    """A :class:`RobotDriver` whose robot is simulated in-process.
+
+    Args:
+        robot_info: the robot.
+        clock: time source (use :class:`~robotspec.driver.clock.SimClock` in tests).
+        update_period: loop period in seconds.
+        initial_position: starting joint positions (default: ``home`` clipped to the limits).
+        homing_speed: fraction of the velocity limit used while homing.
+    """
+
+    def __init__(
+        self,
+        robot_info: RobotInfo,
+        *,
+        clock: Clock | None = None,
+        update_period: float = 0.01,
+        initial_position: Any = None,
+        homing_speed: float = 0.25,
+    ) -> None:
+        super().__init__(robot_info, clock=clock, update_period=update_period)
+        lim = self._limits
+        n = self._joint_count
+        q0 = lim.home if initial_position is None else np.asarray(initial_position, dtype=float)
+        self._q = np.clip(np.array(q0, dtype=np.float64).reshape(n), lim.lower, lim.upper)
+        self._v = np.zeros(n)
+        self._zeros = np.zeros(n)
+        self._neg_vmax = -lim.velocity
+        self._pending_pos: FloatArray | None = None
+        self._pending_vel: FloatArray | None = None
+        self._sim_enabled = True
+        self._sim_error = False
+        self._sim_estop = EstopSource.none
+        self._feedback_lost = False
+        self._frozen = False
+        self._raise_in_step = False
+        self._sim_homed = False
+        self._homing_target: FloatArray | None = None
+        self._homing_completion: Completion | None = None
+        self._homing_speed = homing_speed
+        self._sim_last_t: float | None = None
+        #: Every command actually sent, as (now, position or None, velocity or None); only kept
+        #: when ``record_commands`` is True (tests check invariants on it).
+        self.record_commands = False
+        self.sent: list[tuple[float, FloatArray | None, FloatArray | None]] = []
+
+    # ------------------------------------------------------------------ the simulated arm
+
+    @property
+    def sim_position(self) -> FloatArray:
+        """The simulated arm's true joint positions (a copy)."""
+        return self._q.copy()
+
+    def _integrate(self, now: float) -> None:
+        last = self._sim_last_t
+        self._sim_last_t = now
+        if last is None:
+            return
+        dt = min(max(now - last, 0.0), 10.0 * self._update_period)
+        if dt <= 0.0:
+            return
+        lim = self._limits
+        stopped = self._sim_estop != EstopSource.none or self._sim_error or not self._sim_enabled
+        if stopped or self._frozen:
+            self._v[:] = 0.0
+            self._pending_pos = self._pending_vel = None
+            return
+        if self._homing_target is not None:
+            cap = lim.velocity * self._homing_speed
+            v_des = np.minimum(np.maximum((self._homing_target - self._q) / dt, -cap), cap)
+        elif self._pending_pos is not None:
+            v_des = (self._pending_pos - self._q) / dt
+        elif self._pending_vel is not None:
+            v_des = self._pending_vel
+        else:
+            v_des = self._zeros
+        v_des = np.minimum(np.maximum(v_des, self._neg_vmax), lim.velocity)
+        amax_dt = lim.acceleration * dt
+        dv = np.minimum(np.maximum(v_des - self._v, -amax_dt), amax_dt)
+        self._v += dv
+        self._q += self._v * dt
+        if (self._q < lim.lower).any() or (self._q > lim.upper).any():
+            hit = (self._q < lim.lower) | (self._q > lim.upper)
+            np.clip(self._q, lim.lower, lim.upper, out=self._q)
+            self._v[hit] = 0.0
+        if self._homing_target is not None and np.allclose(self._q, self._homing_target, atol=1e-9):
+            self._q[:] = self._homing_target
+            self._v[:] = 0.0
+            self._homing_target = None
+            self._sim_homed = True
+            self._homing_finished(True)
+
+    def _read_feedback(self, now: float) -> None:
+        """Integrate the arm over the last period, then report it (unless feedback is lost)."""
+        if self._raise_in_step:
+            raise RuntimeError("injected fault in the driver step")
+        self._integrate(now)
+        if self._feedback_lost:
+            return
+        n = self._joint_count
+        if self._joint_position.shape[0] != n:
+            self._joint_position = np.zeros(n)
+            self._joint_velocity = np.zeros(n)
+            self._joint_effort = np.zeros(n)
+        self._joint_position[:] = self._q
+        self._joint_velocity[:] = self._v
+        estop = self._sim_estop != EstopSource.none
+        self._enabled = self._sim_enabled
+        self._stopped = estop
+        self._estop_source = int(self._sim_estop)
+        self._error = self._sim_error
+        self._ready = self._sim_enabled and not self._sim_error and not estop
+        self._homed = self._sim_homed
+        self._last_robot_state = now
+        self._last_joint_state = now
+        self._last_endpoint_state = now
+
+    def _send_robot_command(
+        self, now: float, joint_pos_cmd: FloatArray | None, joint_vel_cmd: FloatArray | None
+    ) -> None:
+        self._pending_pos = joint_pos_cmd
+        self._pending_vel = joint_vel_cmd
+        if joint_pos_cmd is not None:
+            self._position_command = joint_pos_cmd
+            self._velocity_command = None
+        elif joint_vel_cmd is not None:
+            self._velocity_command = joint_vel_cmd
+            self._position_command = None
+        else:
+            self._position_command = None
+            self._velocity_command = None
+        if self.record_commands:
+            self.sent.append((now, joint_pos_cmd, joint_vel_cmd))
+
+    def _send_enable(self) -> None:
+        self._sim_enabled = True
+
+    def _send_disable(self) -> None:
+        self._sim_enabled = False
+
+    def _send_reset_errors(self) -> None:
+        # The simulated operator clears the drive error and releases the e-stop.
+        self._sim_error = False
+        self._sim_estop = EstopSource.none
+
+    def _start_homing(self, completion: Completion) -> None:
+        self._homing_target = self._limits.home.copy()
+        self._homing_completion = completion
+
+    # ------------------------------------------------------------------ fault injection
+
+    def inject_fault(self, fault: Fault | str, source: int = EstopSource.button1) -> None:
+        """Inject ``fault`` (see :class:`Fault`); ``source`` is the e-stop source code."""
+        f = Fault(fault)
+        if f is Fault.lost_feedback:
+            self._feedback_lost = True
+        elif f is Fault.estop:
+            self._sim_estop = EstopSource(source)
+        elif f is Fault.drive_error:
+            self._sim_error = True
+        elif f is Fault.disabled:
+            self._sim_enabled = False
+        elif f is Fault.frozen:
+            self._frozen = True
+        elif f is Fault.step_exception:
+            self._raise_in_step = True
+
+    def clear_fault(self, fault: Fault | str | None = None) -> None:
+        """Clear one fault, or all of them (the operator fixes the robot at the controller)."""
+        faults = list(Fault) if fault is None else [Fault(fault)]
+        for f in faults:
+            if f is Fault.lost_feedback:
+                self._feedback_lost = False
+            elif f is Fault.estop:
+                self._sim_estop = EstopSource.none
+            elif f is Fault.drive_error:
+                self._sim_error = False
+            elif f is Fault.disabled:
+                self._sim_enabled = True
+            elif f is Fault.frozen:
+                self._frozen = False
+            elif f is Fault.step_exception:
+                self._raise_in_step = False

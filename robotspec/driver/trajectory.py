@@ -1,0 +1,201 @@
+"""Joint trajectories: the acceptance checks and the interpolation the loop samples.
+
+The checks follow the reference's ``JointTrajectoryInterpolator`` in order, with its messages,
+except where the reference is defective (documented in :mod:`robotspec.driver.loop`):
+
+* messages carry the real waypoint index (the reference prints a literal ``{i}``);
+* the 100 ms gap rule applies to the trajectory as written, not to the times stretched by a speed
+  ratio below 1 (the reference rejects at 0.4 what it accepts at 1.0);
+* NaN or infinite values are refused.
+
+Interpolation is a monotone piecewise-cubic Hermite (PCHIP) with zero velocity at both ends,
+instead of the reference's not-a-knot cubic spline. Why: PCHIP never overshoots between waypoints,
+so a trajectory whose waypoints are within the joint limits stays within them, and it starts and
+ends at rest.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robotspec.driver.commands import JointLimitArrays
+from robotspec.driver.errors import InvalidArgumentError
+
+__all__ = [
+    "JointTrajectory",
+    "TrajectoryInterpolator",
+    "Waypoint",
+    "load_trajectory",
+    "MIN_WAYPOINTS",
+    "MAX_WAYPOINT_GAP",
+]
+
+FloatArray = npt.NDArray[np.float64]
+
+MIN_WAYPOINTS = 5
+MAX_WAYPOINT_GAP = 0.1
+_TIME_EPS = 1e-9
+
+
+@dataclass(frozen=True)
+class Waypoint:
+    """One ``JointTrajectoryWaypoint``: positions (rad or m) at ``time_from_start`` (s)."""
+
+    joint_position: tuple[float, ...]
+    time_from_start: float
+    joint_velocity: tuple[float, ...] = ()
+    position_tolerance: tuple[float, ...] = ()
+    velocity_tolerance: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class JointTrajectory:
+    """A ``JointTrajectory``: joint names (empty means "the robot's order") and waypoints."""
+
+    joint_names: tuple[str, ...] = ()
+    waypoints: tuple[Waypoint, ...] | None = field(default_factory=tuple)
+
+    @classmethod
+    def from_arrays(
+        cls, times: Sequence[float], positions: Any, joint_names: Sequence[str] = ()
+    ) -> JointTrajectory:
+        """A trajectory from a time list and a ``(m, n)`` position array."""
+        pos = np.asarray(positions, dtype=np.float64)
+        return cls(
+            joint_names=tuple(joint_names),
+            waypoints=tuple(
+                Waypoint(joint_position=tuple(float(x) for x in pos[i]), time_from_start=float(t))
+                for i, t in enumerate(times)
+            ),
+        )
+
+    @classmethod
+    def smooth_move(
+        cls, start: Any, end: Any, duration: float, spacing: float = 0.05
+    ) -> JointTrajectory:
+        """A rest-to-rest quintic move from ``start`` to ``end`` in ``duration`` seconds."""
+        a = np.asarray(start, dtype=np.float64)
+        b = np.asarray(end, dtype=np.float64)
+        m = max(MIN_WAYPOINTS, int(math.ceil(duration / spacing)) + 1)
+        times = np.linspace(0.0, duration, m)
+        s = times / duration
+        blend = 10 * s**3 - 15 * s**4 + 6 * s**5
+        return cls.from_arrays(times.tolist(), a[None, :] + blend[:, None] * (b - a)[None, :])
+
+
+class TrajectoryInterpolator:
+    """Samples a checked trajectory at any time with preallocated buffers (PCHIP)."""
+
+    def __init__(self, times: FloatArray, positions: FloatArray) -> None:
+        self.times = times
+        self.positions = positions
+        self.max_time = float(times[-1])
+        self.n_waypoints = int(times.shape[0])
+        h = np.diff(times)
+        delta = np.diff(positions, axis=0) / h[:, None]
+        d = np.zeros_like(positions)
+        if positions.shape[0] > 2:
+            h0 = h[:-1, None]
+            h1 = h[1:, None]
+            w1 = 2.0 * h1 + h0
+            w2 = h1 + 2.0 * h0
+            d0, d1 = delta[:-1], delta[1:]
+            same = d0 * d1 > 0.0
+            with np.errstate(divide="ignore", invalid="ignore"):
+                hm = (w1 + w2) / (w1 / d0 + w2 / d1)
+            d[1:-1] = np.where(same, hm, 0.0)
+        self._h = h
+        self._slopes = d
+        self._out = np.zeros(positions.shape[1])
+
+    def evaluate(self, t: float) -> tuple[FloatArray, int]:
+        """Position at time ``t`` (clamped to the ends) and the index of the segment's start."""
+        if t >= self.max_time:
+            self._out[:] = self.positions[-1]
+            return self._out, self.n_waypoints - 1
+        if t <= 0.0:
+            self._out[:] = self.positions[0]
+            return self._out, 0
+        k = int(np.searchsorted(self.times, t, side="right")) - 1
+        h = float(self._h[k])
+        s = (t - float(self.times[k])) / h
+        s2 = s * s
+        s3 = s2 * s
+        h00 = 2 * s3 - 3 * s2 + 1
+        h10 = s3 - 2 * s2 + s
+        h01 = -2 * s3 + 3 * s2
+        h11 = s3 - s2
+        p0, p1 = self.positions[k], self.positions[k + 1]
+        m0, m1 = self._slopes[k], self._slopes[k + 1]
+        np.multiply(p0, h00, out=self._out)
+        self._out += h10 * h * m0 + h01 * p1 + h11 * h * m1
+        return self._out, k
+
+
+def load_trajectory(
+    traj: JointTrajectory,
+    joint_names: Sequence[str],
+    limits: JointLimitArrays,
+    speed_ratio: float,
+) -> TrajectoryInterpolator:
+    """Check ``traj`` against the robot and build its interpolator, on times ÷ ``speed_ratio``.
+
+    Raises:
+        InvalidArgumentError: with the reference's message for the first failed check.
+    """
+    n = len(joint_names)
+    if traj.joint_names and tuple(traj.joint_names) != tuple(joint_names):
+        raise InvalidArgumentError("Joint names in trajectory must match robot joint names")
+    if traj.waypoints is None:
+        raise InvalidArgumentError("Waypoint list must not be null")
+    wps = traj.waypoints
+    if len(wps) < MIN_WAYPOINTS:
+        raise InvalidArgumentError(
+            f"Waypoint list must contain five or more waypoints (got {len(wps)})"
+        )
+    if wps[0].time_from_start != 0.0:
+        raise InvalidArgumentError("Trajectory time_from_start must equal zero for first waypoint")
+    m = len(wps)
+    times = np.zeros(m)
+    pos = np.zeros((m, n))
+    for i, w in enumerate(wps):
+        if len(w.joint_position) != n:
+            raise InvalidArgumentError(f"Waypoint {i} invalid joint array length")
+        for what, arr in (
+            ("joint_velocity", w.joint_velocity),
+            ("position_tolerance", w.position_tolerance),
+            ("velocity_tolerance", w.velocity_tolerance),
+        ):
+            if len(arr) not in (0, n):
+                raise InvalidArgumentError(f"Waypoint {i} invalid {what} array length")
+        q = np.array(w.joint_position, dtype=np.float64)
+        if not (np.all(np.isfinite(q)) and math.isfinite(w.time_from_start)) or not all(
+            math.isfinite(v) for v in w.joint_velocity
+        ):
+            raise InvalidArgumentError(f"Waypoint {i} contains NaN or infinite values")
+        t = w.time_from_start / speed_ratio
+        if i > 0:
+            prev_raw = wps[i - 1].time_from_start
+            if t <= times[i - 1]:
+                raise InvalidArgumentError(f"Waypoint {i} time_from_start must be increasing")
+            if w.time_from_start - prev_raw > MAX_WAYPOINT_GAP + _TIME_EPS:
+                raise InvalidArgumentError(f"Waypoint {i} more than 100 ms from previous waypoint")
+        if np.any(q < limits.lower) or np.any(q > limits.upper):
+            raise InvalidArgumentError(f"Waypoint {i} exceeds joint limits")
+        if w.joint_velocity and np.any(
+            np.abs(np.array(w.joint_velocity) * speed_ratio) > limits.velocity
+        ):
+            raise InvalidArgumentError(f"Waypoint {i} exceeds joint velocity limits")
+        if i > 0:
+            fd = np.abs(q - pos[i - 1]) / (t - times[i - 1])
+            if np.any(fd > limits.velocity):
+                raise InvalidArgumentError(f"Waypoint {i} exceeds joint velocity limits")
+        times[i] = t
+        pos[i] = q
+    return TrajectoryInterpolator(times, pos)

@@ -195,6 +195,7 @@ class _TrajectoryTask:
         self.complete = False
         self.error: DriverError | None = None
         self.outcome_reported = False
+        self.reported_queued = False
 
     @property
     def finished(self) -> bool:
@@ -234,7 +235,12 @@ class TrajectoryGenerator:
             first = not task.next_called
             task.next_called = True
             if queued and first:
+                task.reported_queued = True
                 return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
+            if task.reported_queued and not queued:
+                # It started since the client last heard "queued": say so at once.
+                task.reported_queued = False
+                return self._status(ActionStatus.running)
 
         def outcome() -> bool:
             # A queued task reports ``running`` as soon as it becomes active (as the reference).
@@ -250,6 +256,7 @@ class TrajectoryGenerator:
                 return self._status(ActionStatus.complete)
             if task is not d._traj_active:
                 return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
+            task.reported_queued = False
             return self._status(ActionStatus.running)
 
     def _status(self, status: ActionStatus) -> TrajectoryStatus:
@@ -548,10 +555,11 @@ class RobotDriver(ABC):
         thread silently and clients read a frozen state forever. Here the driver reports an
         error state and keeps running.
         """
+        with self._lock:
+            self._state_seqno += 1
         try:
             self._read_feedback(now)
             with self._lock:
-                self._state_seqno += 1
                 self._stream_valid = StateFlags.none
                 self._traj_failed_this_step = False
                 res = self._verify_communication(now) and self._verify_robot_state(now)
@@ -661,7 +669,7 @@ class RobotDriver(ABC):
                     self._controller_state = ControllerState.guard_stop
                 else:
                     self._controller_state = ControllerState.motor_off
-            if error or self._command_mode is not CommandMode.halt:
+            if error or self._stopped or self._command_mode is not CommandMode.halt:
                 self._command_mode = CommandMode.invalid_state
             return False
         if not self._enabled:

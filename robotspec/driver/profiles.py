@@ -14,6 +14,11 @@ import numpy.typing as npt
 
 __all__ = ["JogMotion", "rest_to_rest_time"]
 
+#: Braking is planned at this fraction of the acceleration limit. Why: the discrete braking curve
+#: is exact only on its own grid; the spare 10 % lets the last step land exactly on the target
+#: without ever exceeding the acceleration limit.
+BRAKING_MARGIN = 0.9
+
 FloatArray = npt.NDArray[np.float64]
 
 
@@ -102,14 +107,17 @@ class JogMotion:
         dt = self.dt
         if self.target_position is not None:
             dist = self.target_position - self.q
-            v_des = np.clip(_braking_velocity(dist, self.amax, dt), -self.vmax, self.vmax)
+            v_des = np.clip(
+                _braking_velocity(dist, self.amax * BRAKING_MARGIN, dt), -self.vmax, self.vmax
+            )
         elif self.target_velocity is not None and self.t < self.velocity_until:
             v_des = self.target_velocity
         else:
             v_des = np.zeros_like(self.q)
         # Never plan past a joint limit: brake so as to stop on it.
-        v_hi = np.maximum(_braking_velocity(self.upper - self.q, self.amax, dt), 0.0)
-        v_lo = np.minimum(_braking_velocity(self.lower - self.q, self.amax, dt), 0.0)
+        a_brake = self.amax * BRAKING_MARGIN
+        v_hi = np.maximum(_braking_velocity(self.upper - self.q, a_brake, dt), 0.0)
+        v_lo = np.minimum(_braking_velocity(self.lower - self.q, a_brake, dt), 0.0)
         v_des = np.clip(v_des, v_lo, v_hi)
         dv = np.clip(v_des - self.v, -self.amax * dt, self.amax * dt)
         v_new = self.v + dv
@@ -119,7 +127,9 @@ class JogMotion:
             tgt = self.target_position
             crossed = (tgt - self.q) * (tgt - q_new) <= 0.0
             slow = np.abs(v_new) <= self.amax * dt * 1.0001
-            land = crossed & slow
+            # Landing implies the velocity (tgt - q) / dt; only land when that is reachable.
+            feasible = np.abs((tgt - self.q) / dt - self.v) <= self.amax * dt * (1 + 1e-9)
+            land = crossed & slow & feasible
             q_new = np.where(land, tgt, q_new)
             v_new = np.where(land, 0.0, v_new)
             self.done = bool(np.all(q_new == tgt) and not np.any(v_new))

@@ -32,7 +32,8 @@ def shared_robotinfo_files() -> list[Path]:
 
 def make_sim(path: Path, period: float = 0.01, **kw: object) -> SimRobot:
     """A simulated robot on simulated time, stepped twice so it is healthy and reporting."""
-    robot = SimRobot(load_robot_info(path), clock=SimClock(), update_period=period, **kw)  # type: ignore[arg-type]
+    kw.setdefault("clock", SimClock())
+    robot = SimRobot(load_robot_info(path), update_period=period, **kw)  # type: ignore[arg-type]
     robot.step()
     robot.step()
     return robot

@@ -32,8 +32,13 @@ def _root(
 
 def _register() -> None:
     # Each command module adds its commands to ``app`` on import; the modules import nothing heavy.
-    from robotspec.cli import demo_cmd, inspect_cmd, misc_cmd, validate_cmd  # noqa: F401
-    from robotspec.cli import drive_cmd  # noqa: F401
+    from robotspec.cli import (  # noqa: F401
+        demo_cmd,
+        drive_cmd,  # noqa: F401
+        inspect_cmd,
+        misc_cmd,
+        validate_cmd,
+    )
 
 
 def main(argv: list[str] | None = None) -> None:

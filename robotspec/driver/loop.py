@@ -394,6 +394,8 @@ class RobotDriver(ABC):
         self._traj_active: _TrajectoryTask | None = None
         self._traj_queue: deque[_TrajectoryTask] = deque()
         self._traj_failed_this_step = False
+        self._traj_hold: FloatArray | None = None
+        self._jog_hold: FloatArray | None = None
         self._stream_position: RobotJointCommand | None = None
         self._stream_velocity: RobotJointCommand | None = None
         self._stream_last_seqno = -1
@@ -721,6 +723,10 @@ class RobotDriver(ABC):
         """Step 4: the command for this step from the mode and the client's requests."""
         mode = self._command_mode
         prev, self._prev_mode = self._prev_mode, mode
+        if mode is not CommandMode.trajectory:
+            self._traj_hold = None
+        if mode is not CommandMode.jog:
+            self._jog_hold = None
         if mode is not CommandMode.trajectory and (
             self._traj_active is not None or self._traj_queue
         ):
@@ -786,10 +792,12 @@ class RobotDriver(ABC):
     def _fill_jog(self) -> FloatArray | None:
         motion = self._jog
         if motion is None:
-            return None
+            # Hold where the last jog ended, so a lagging arm settles there instead of braking.
+            return self._jog_hold
         if self._jog_cartesian is not None:
             self._update_cartesian_jog(motion)
         q = motion.step()
+        self._jog_hold = q.copy()
         if motion.done:
             self._jog = None
             self._jog_cartesian = None
@@ -821,7 +829,8 @@ class RobotDriver(ABC):
     def _fill_trajectory(self, now: float) -> FloatArray | None:
         task = self._traj_active
         if task is None:
-            return None
+            # Hold the end of the last trajectory: an arm that lagged still reaches it.
+            return self._traj_hold
         if not task.started:
             if not task.next_called:
                 return None
@@ -847,6 +856,7 @@ class RobotDriver(ABC):
         task.waypoint = wp
         q = setpoint.copy()
         task.last_setpoint = q
+        self._traj_hold = q
         if t >= task.interp.max_time:
             task.complete = True
             self._traj_active = self._traj_queue.popleft() if self._traj_queue else None

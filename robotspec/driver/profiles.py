@@ -115,9 +115,9 @@ class JogMotion:
         else:
             v_des = np.zeros_like(self.q)
         # Never plan past a joint limit: brake so as to stop on it.
-        a_brake = self.amax * BRAKING_MARGIN
-        v_hi = np.maximum(_braking_velocity(self.upper - self.q, a_brake, dt), 0.0)
-        v_lo = np.minimum(_braking_velocity(self.lower - self.q, a_brake, dt), 0.0)
+        # (At the full deceleration: a target on the limit is then governed by its own braking.)
+        v_hi = np.maximum(_braking_velocity(self.upper - self.q, self.amax, dt), 0.0)
+        v_lo = np.minimum(_braking_velocity(self.lower - self.q, self.amax, dt), 0.0)
         v_des = np.clip(v_des, v_lo, v_hi)
         dv = np.clip(v_des - self.v, -self.amax * dt, self.amax * dt)
         v_new = self.v + dv
@@ -129,7 +129,12 @@ class JogMotion:
             slow = np.abs(v_new) <= self.amax * dt * 1.0001
             # Landing implies the velocity (tgt - q) / dt; only land when that is reachable.
             feasible = np.abs((tgt - self.q) / dt - self.v) <= self.amax * dt * (1 + 1e-9)
-            land = crossed & slow & feasible
+            land = (crossed & slow & feasible) | (np.abs(tgt - q_new) < 1e-12) & slow
+            # Crossing but unable to land this step: brake as hard as allowed; the overshoot is
+            # below a_max * dt^2 and is taken back on the next step.
+            brake = crossed & slow & ~feasible
+            v_new = np.where(brake, self.v - np.sign(self.v) * self.amax * dt, v_new)
+            q_new = np.where(brake, self.q + v_new * dt, q_new)
             q_new = np.where(land, tgt, q_new)
             v_new = np.where(land, 0.0, v_new)
             self.done = bool(np.all(q_new == tgt) and not np.any(v_new))

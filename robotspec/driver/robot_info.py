@@ -527,7 +527,8 @@ def _semantic_checks(
     n_joints = len(info.joint_info)
 
     def err(msg: str, loc: tuple[str | int, ...], *, warn: bool = False) -> None:
-        line, col = doc.position(loc)
+        # Point at the key when the problem is the whole value (a list of the wrong length).
+        line, col = doc.key_position(loc) if isinstance(loc[-1], str) else doc.position(loc)
         e = RobotInfoError(
             msg,
             file=doc.file,

@@ -67,6 +67,7 @@ class SimRobot(RobotDriver):
         self._zeros = np.zeros(n)
         self._neg_vmax = -lim.velocity
         self._pending_pos: FloatArray | None = None
+        self._settle_on: FloatArray | None = None
         self._pending_vel: FloatArray | None = None
         self._sim_enabled = True
         self._sim_error = False
@@ -109,7 +110,15 @@ class SimRobot(RobotDriver):
             cap = lim.velocity * self._homing_speed
             v_des = np.minimum(np.maximum((self._homing_target - self._q) / dt, -cap), cap)
         elif self._pending_pos is not None:
-            v_des = (self._pending_pos - self._q) / dt
+            err = self._pending_pos - self._q
+            v_des = err / dt
+            if self._settle_on is not None and np.array_equal(self._pending_pos, self._settle_on):
+                # A command held still: brake so as to land on it (discrete-time braking
+                # curve). Without this, short steps make the servo ring around the target.
+                a_dt = lim.acceleration * dt
+                v_cap = a_dt * (np.sqrt(0.25 + 2.0 * np.abs(err) / (a_dt * dt)) - 0.5)
+                v_des = np.clip(v_des, -v_cap, v_cap)
+            self._settle_on = self._pending_pos.copy()
         elif self._pending_vel is not None:
             v_des = self._pending_vel
         else:

@@ -107,9 +107,9 @@ class TrajectoryInterpolator:
             w2 = h1 + 2.0 * h0
             d0, d1 = delta[:-1], delta[1:]
             same = d0 * d1 > 0.0
-            with np.errstate(divide="ignore", invalid="ignore"):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 hm = (w1 + w2) / (w1 / d0 + w2 / d1)
-            d[1:-1] = np.where(same, hm, 0.0)
+            d[1:-1] = np.where(same & np.isfinite(hm), hm, 0.0)
         self._h = h
         self._slopes = d
         self._out = np.zeros(positions.shape[1])

@@ -1,0 +1,112 @@
+"""Joint-level checks: named joint states and velocity limits."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+from robotspec.compiler.context import Build
+from robotspec.compiler.diagnostics import Loc
+from robotspec.semantic import JointState
+from robotspec.world import Connection
+
+__all__ = ["check_states", "check_velocity"]
+
+
+def check_states(
+    b: Build,
+    loc: Loc,
+    part: str,
+    states: Mapping[str, Mapping[str, float]],
+    allowed: set[str] | None,
+) -> dict[str, JointState]:
+    """Joint states: existing, actuated joints within limits, belonging to the part."""
+    out: dict[str, JointState] = {}
+    for state_name, values in states.items():
+        ok = True
+        for joint_name, value in values.items():
+            jloc = (*loc, state_name, joint_name)
+            c = b.joint(jloc, joint_name)
+            if c is None:
+                ok = False
+                continue
+            if c.is_fixed:
+                b.diag.error(
+                    jloc,
+                    f"joint '{joint_name}' is fixed; a state can only set joints that move",
+                    name=joint_name,
+                )
+                ok = False
+                continue
+            if c.mimic is not None:
+                leader = c.mimic.leader
+                b.diag.error(
+                    jloc,
+                    f"joint '{joint_name}' mimics '{leader}' (x{c.mimic.multiplier:g}"
+                    f"{c.mimic.offset:+g}); set '{leader}' instead",
+                    name=joint_name,
+                    suggestions=(leader,),
+                )
+                ok = False
+                continue
+            if c.type.dof_count != 1:
+                b.diag.error(
+                    jloc,
+                    f"joint '{joint_name}' has {c.type.dof_count} degrees of "
+                    "freedom; states set 1-DOF joints",
+                    name=joint_name,
+                )
+                ok = False
+                continue
+            dof = b.world.degrees_of_freedom[c.dofs[0]]
+            if not math.isfinite(value):
+                b.diag.error(jloc, f"value of '{joint_name}' must be finite", name=joint_name)
+                ok = False
+            elif not (dof.lower - 1e-9 <= value <= dof.upper + 1e-9):
+                b.diag.error(
+                    jloc,
+                    f"{value:g} is outside the limits of '{joint_name}' "
+                    f"[{dof.lower:g}, {dof.upper:g}]",
+                    name=joint_name,
+                )
+                ok = False
+            if allowed is not None and c.name not in allowed:
+                b.diag.error(jloc, f"joint '{joint_name}' does not move {part}", name=joint_name)
+                ok = False
+        if ok:
+            out[state_name] = JointState(
+                name=state_name, part=part, joints=tuple((j, float(v)) for j, v in values.items())
+            )
+    return out
+
+
+def check_velocity(b: Build, robot_joints: list[Connection]) -> dict[str, float]:
+    """Per-DOF velocity caps; an unknown, fixed or mimic joint is an error."""
+    vl = b.spec.velocity_limits
+    one_dof = {c.name: c for c in robot_joints if c.is_1dof and c.is_active}
+    caps: dict[str, float] = {}
+    if vl.default is not None:
+        caps = {b.world.degrees_of_freedom[c.dofs[0]].name: vl.default for c in one_dof.values()}
+    for j, v in vl.joints.items():
+        loc: Loc = ("velocity_limits", "joints", j)
+        if j not in one_dof:
+            c = b.world.get_connection_by_name(j) if b.world.has_connection(j) else None
+            if c is not None and c.mimic is not None:
+                b.diag.error(
+                    loc,
+                    f"joint '{j}' mimics '{c.mimic.leader}'; limit the leader",
+                    name=j,
+                    suggestions=(c.mimic.leader,),
+                )
+            else:
+                b.diag.not_found(loc, "actuated 1-DOF joint", j, one_dof, f"robot '{b.spec.name}'")
+            continue
+        dof = b.world.degrees_of_freedom[one_dof[j].dofs[0]]
+        if v > dof.velocity:
+            b.diag.warning(
+                loc,
+                f"{v:g} is above the URDF's velocity limit {dof.velocity:g} of "
+                f"'{j}'; limits only tighten, so it has no effect",
+            )
+        caps[dof.name] = v
+    return caps

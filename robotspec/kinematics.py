@@ -178,7 +178,8 @@ class Kinematics:
     def forward(self, q: object) -> F64:
         """``root_T_body`` for every body (B, 4, 4) at configuration ``q`` (D,)."""
         arr = self._check_q(q, batch=False)
-        return self._compose(arr[None, :])[0]
+        poses: F64 = self._compose(arr[None, :])[0]
+        return poses
 
     def forward_batch(self, q: object) -> F64:
         """``root_T_body`` for every body of every sample: (N, B, 4, 4) from ``q`` (N, D).
@@ -253,7 +254,8 @@ class Kinematics:
         poses = self.forward(q)
         b = self.world.get_body_by_name(body).index
         if relative_to is None:
-            return poses[b]
+            pose: F64 = poses[b]
+            return pose
         r = self.world.get_body_by_name(relative_to).index
         return np.linalg.solve(poses[r], poses[b])
 

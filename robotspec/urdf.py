@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from robotspec.packages import PackageResolver
 from robotspec.urdf_check import check_urdf_tree, geometry_element, parse_floats
 from robotspec.world import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic, World
-from robotspec.xmlsafe import parse_xml_bytes
+from robotspec.xmlsafe import line_of, parse_xml_bytes
 
 __all__ = ["MeshPolicy", "is_xacro", "load_urdf", "read_description_xml", "world_from_urdf_xml"]
 
@@ -116,7 +116,7 @@ def world_from_urdf_xml(
         # The tree passed our checks, so this is a construct we do not check for yet.
         raise DescriptionError(f"cannot interpret URDF: {exc}", file=file) from None
     link_el = {el.get("name"): el for el in root.iterfind("link")}
-    joint_el = {el.get("name"): el for el in root.iterfind("joint")}
+    joint_el = {el.get("name", ""): el for el in root.iterfind("joint")}
     problems: list[RobotSpecError] = []
     bodies: list[Body] = []
     body_index: dict[str, int] = {}
@@ -140,7 +140,7 @@ def world_from_urdf_xml(
                 visuals=visuals,
                 collisions=collisions,
                 mass=mass,
-                line=el.sourceline,
+                line=line_of(el),
             )
         )
     raise_collected(problems)
@@ -182,7 +182,7 @@ def world_from_urdf_xml(
                         f"joint '{j.name}' mimics '{leader}', a {joints[leader].type} joint; "
                         "only revolute, continuous and prismatic joints can be mimicked",
                         file=file,
-                        line=joint_el[j.name].sourceline,
+                        line=line_of(joint_el[j.name]),
                         kind="joint",
                         name=j.name,
                     )
@@ -202,7 +202,7 @@ def world_from_urdf_xml(
                 axis=(float(axis[0]), float(axis[1]), float(axis[2])),
                 dofs=dof_idx,
                 mimic=mimic,
-                line=joint_el[j.name].sourceline,
+                line=line_of(joint_el[j.name]),
             )
         )
     raise_collected(problems)
@@ -253,7 +253,7 @@ def _resolve_mimics(
                 raise DescriptionError(
                     f"mimic joints form a cycle through joint '{name}'",
                     file=file,
-                    line=joint_el[name].sourceline,
+                    line=line_of(joint_el[name]),
                     kind="joint",
                     name=name,
                 )
@@ -289,7 +289,7 @@ def _shapes(
                 geometry=geometry,
                 origin=frozen_array(origin),
                 name=rec.name,
-                line=el.sourceline,
+                line=line_of(el),
                 rgba=rgba,
             )
         )
@@ -306,7 +306,7 @@ def _geometry(
     problems: list[RobotSpecError],
 ) -> GeometryShape | None:
     if el.tag == "capsule":
-        return Capsule(radius=float(el.get("radius")), length=float(el.get("length")))
+        return Capsule(radius=float(el.get("radius", "nan")), length=float(el.get("length", "nan")))
     if g.box is not None:
         s = g.box.size
         return Box(size=(float(s[0]), float(s[1]), float(s[2])))
@@ -328,7 +328,7 @@ def _geometry(
             raise ValueError("resolving meshes needs a PackageResolver")
         report = meshes == "report"
         try:
-            resolved = resolver.resolve(uri, relative_to=base, file=file, line=el.sourceline)
+            resolved = resolver.resolve(uri, relative_to=base, file=file, line=line_of(el))
         except RobotSpecError as exc:
             problems.append(exc.with_severity("warning") if report else exc)
             return Mesh(uri=uri, path=None, scale=scale) if report else None
@@ -337,7 +337,7 @@ def _geometry(
                 DescriptionError(
                     f"mesh '{uri}' resolves to '{resolved}', which does not exist",
                     file=file,
-                    line=el.sourceline,
+                    line=line_of(el),
                     kind="mesh",
                     name=uri,
                     severity="warning" if report else "error",

@@ -20,6 +20,7 @@ from robotspec.errors import (
     RobotSpecError,
     raise_collected,
 )
+from robotspec.xmlsafe import line_of
 
 __all__ = ["JOINT_TYPES", "check_urdf_tree", "geometry_element", "parse_floats"]
 
@@ -31,13 +32,13 @@ def parse_floats(
 ) -> list[float]:
     """Parse exactly ``count`` finite numbers from an attribute value, or raise a located error."""
     if text is None:
-        raise DescriptionError(f"{what} is missing", file=file, line=el.sourceline)
+        raise DescriptionError(f"{what} is missing", file=file, line=line_of(el))
     parts = text.replace(",", " ").split()
     if len(parts) != count:
         raise DescriptionError(
             f"{what} must have {count} number{'s' if count != 1 else ''}, got '{text}'",
             file=file,
-            line=el.sourceline,
+            line=line_of(el),
         )
     out: list[float] = []
     for p in parts:
@@ -45,12 +46,10 @@ def parse_floats(
             v = float(p)
         except ValueError:
             raise DescriptionError(
-                f"{what}: '{p}' is not a number", file=file, line=el.sourceline
+                f"{what}: '{p}' is not a number", file=file, line=line_of(el)
             ) from None
         if not math.isfinite(v):
-            raise DescriptionError(
-                f"{what} must be finite, got '{p}'", file=file, line=el.sourceline
-            )
+            raise DescriptionError(f"{what} must be finite, got '{p}'", file=file, line=line_of(el))
         out.append(v)
     return out
 
@@ -68,8 +67,12 @@ class _Collector:
     def add(self, err: RobotSpecError) -> None:
         self.errors.append(err)
 
-    def error(self, message: str, el: etree._Element, **kw: str) -> None:
-        self.errors.append(DescriptionError(message, file=self.file, line=el.sourceline, **kw))
+    def error(
+        self, message: str, el: etree._Element, *, kind: str | None = None, name: str | None = None
+    ) -> None:
+        self.errors.append(
+            DescriptionError(message, file=self.file, line=line_of(el), kind=kind, name=name)
+        )
 
     def floats(self, el: etree._Element, attr: str, count: int, what: str) -> list[float] | None:
         try:
@@ -94,7 +97,7 @@ def check_urdf_tree(root: etree._Element, file: str) -> None:
     col = _Collector(file)
     if root.tag != "robot":
         raise DescriptionError(
-            f"root element must be <robot>, got <{root.tag}>", file=file, line=root.sourceline
+            f"root element must be <robot>, got <{root.tag}>", file=file, line=line_of(root)
         )
     if not (root.get("name") or "").strip():
         col.error("<robot> has no name attribute", root, kind="robot")
@@ -109,13 +112,13 @@ def check_urdf_tree(root: etree._Element, file: str) -> None:
                 DuplicateNameError(
                     f"link '{name}' is defined twice (first on line {links[name]})",
                     file=file,
-                    line=el.sourceline,
+                    line=line_of(el),
                     kind="link",
                     name=name,
                 )
             )
             continue
-        links[name] = el.sourceline or 0
+        links[name] = line_of(el) or 0
         _check_link(el, name, col)
     if not links:
         col.error("the robot has no <link>", root, kind="link")
@@ -128,9 +131,9 @@ def check_urdf_tree(root: etree._Element, file: str) -> None:
         if name in joints:
             col.add(
                 DuplicateNameError(
-                    f"joint '{name}' is defined twice (first on line {joints[name].sourceline})",
+                    f"joint '{name}' is defined twice (first on line {line_of(joints[name])})",
                     file=file,
-                    line=el.sourceline,
+                    line=line_of(el),
                     kind="joint",
                     name=name,
                 )
@@ -152,7 +155,7 @@ def check_urdf_tree(root: etree._Element, file: str) -> None:
                         joints,
                         where=f"{_short(file)} (mimicked by joint '{name}')",
                         file=file,
-                        line=mimic.sourceline,
+                        line=line_of(mimic),
                     )
                 )
             elif leader == name:
@@ -234,7 +237,7 @@ def _check_joint(el: etree._Element, name: str, links: dict[str, int], col: _Col
             DescriptionError(
                 f"joint '{name}' has type '{jtype}'; expected one of {', '.join(JOINT_TYPES)}",
                 file=col.file,
-                line=el.sourceline,
+                line=line_of(el),
                 kind="joint",
                 name=name,
             )
@@ -252,7 +255,7 @@ def _check_joint(el: etree._Element, name: str, links: dict[str, int], col: _Col
                     links,
                     where=f"{_short(col.file)} ({role} of joint '{name}')",
                     file=col.file,
-                    line=(ref.sourceline if ref is not None else el.sourceline),
+                    line=line_of(ref if ref is not None else el),
                 )
             )
     _check_origin(el, col, f"joint '{name}'")

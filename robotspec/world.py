@@ -615,9 +615,9 @@ def _check_indices(
         for d in c.dofs:
             if not 0 <= d < len(dofs):
                 raise ValueError(f"connection '{c.name}' refers to a dof index out of range")
-    for i, d in enumerate(dofs):
-        if d.index != i:
-            raise ValueError(f"dof '{d.name}' has index {d.index}, expected {i}")
+    for i, dof in enumerate(dofs):
+        if dof.index != i:
+            raise ValueError(f"dof '{dof.name}' has index {dof.index}, expected {i}")
     raise_collected(problems)
 
 

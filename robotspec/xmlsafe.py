@@ -33,13 +33,19 @@ def safe_parser() -> etree.XMLParser:
     )
 
 
+def line_of(el: etree._Element) -> int | None:
+    """The element's source line; lxml-stubs mistype ``sourceline``, lxml gives int or None."""
+    line: object = el.sourceline
+    return line if isinstance(line, int) else None
+
+
 def _check_no_entities(root: etree._Element, file: str) -> None:
     """Refuse documents that declare entities at all (billion laughs, external entities)."""
     tree = root.getroottree()
     docinfo = tree.docinfo
     internal = docinfo.internalDTD
     if internal is not None:
-        for decl in internal.iterentities():
+        for decl in internal.iterentities():  # type: ignore[attr-defined]
             raise DescriptionError(
                 f"XML entity declarations are not allowed (found '{decl.name}')",
                 file=file,
@@ -51,7 +57,7 @@ def _check_no_entities(root: etree._Element, file: str) -> None:
             raise DescriptionError(
                 f"XML entity references are not allowed (found '&{el.name};')",
                 file=file,
-                line=el.sourceline,
+                line=line_of(el),
                 kind="entity",
                 name=el.name,
             )
@@ -79,7 +85,7 @@ def parse_xml_bytes(
                 name=shown,
             )
     try:
-        root = etree.fromstring(data, parser=safe_parser(), base_url=None)
+        root: etree._Element | None = etree.fromstring(data, parser=safe_parser())
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if exc.lineno and exc.lineno > 0 else None
         col = exc.offset if exc.offset and exc.offset > 0 else None

@@ -95,7 +95,7 @@ def manipulators(
     robot = _robot(spec, package_path)
     items = []
     for m in robot.manipulators:
-        item = {
+        item: dict[str, Any] = {
             "name": m.name,
             "type": "parallel_gripper" if isinstance(m, ParallelGripper) else "generic",
             "root": m.root.name,
@@ -185,7 +185,7 @@ def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
         if c.is_fixed:
             continue
         dof = w.degrees_of_freedom[c.dofs[0]] if c.dofs else None
-        item = {
+        item: dict[str, Any] = {
             "name": c.name,
             "type": c.type.value,
             "mimic": None if c.mimic is None else c.mimic.leader,
@@ -226,7 +226,7 @@ def groups(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
     if srdf is None:
         sys.stdout.write("this robot has no SRDF\n")
         return
-    items = {
+    items: dict[str, list[dict[str, Any]]] = {
         "groups": [
             {
                 "name": g.name,
@@ -272,7 +272,7 @@ def collisions(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePa
         for d in robot.srdf.disabled_collisions:
             if frozenset((d.link1, d.link2)) in robot.disabled_collision_pairs:
                 reasons[d.reason or "(none)"] = reasons.get(d.reason or "(none)", 0) + 1
-    items = {
+    items: dict[str, Any] = {
         "disabled_pairs": len(robot.disabled_collision_pairs),
         "by_reason": reasons,
         "disabled_bodies": sorted(robot.disabled_collision_bodies),
@@ -296,9 +296,9 @@ def tree(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = N
         labels.setdefault(body, []).append(text)
 
     label(robot.root.name, "robot root")
-    for c in robot.all_chains:
-        label(c.root.name, f"{c.name} root")
-        label(c.tip.name, f"{c.name} tip")
+    for chain in robot.all_chains:
+        label(chain.root.name, f"{chain.name} root")
+        label(chain.tip.name, f"{chain.name} tip")
     for m in robot.manipulators:
         label(m.tool_frame.name, f"{m.name} tool frame")
     for s in robot.sensors:

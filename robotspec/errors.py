@@ -16,6 +16,7 @@ import difflib
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 __all__ = [
     "CollisionError",
@@ -93,6 +94,13 @@ class ErrorDetail:
         return f"{head}{self.severity}: {self.message}"
 
 
+def _rebuild(cls: type[RobotSpecError], args: tuple[object, ...]) -> RobotSpecError:
+    """Unpickling helper: an instance without calling ``__init__`` (state restored after)."""
+    err = cls.__new__(cls)
+    err.args = args
+    return err
+
+
 class RobotSpecError(Exception):
     """Base of every error robotspec raises for a user's input.
 
@@ -166,6 +174,11 @@ class RobotSpecError(Exception):
     def severity(self) -> str:
         """``error`` or ``warning``."""
         return self.detail.severity
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Subclasses take other constructor arguments (NotFoundError: kind, name, candidates),
+        # so copies and pickles (worker processes) rebuild from the state, not from ``args``.
+        return (_rebuild, (type(self), self.args), self.__dict__)
 
     def with_severity(self, severity: str) -> RobotSpecError:
         """A copy of this error with another severity (a warning that strict mode may promote)."""

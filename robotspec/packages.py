@@ -1,0 +1,373 @@
+"""Find ROS packages and resolve description URIs without ROS, inside a fenced set of folders.
+
+Why: URDF, xacro and SRDF files name other files as ``package://PKG/...``, ``$(find PKG)``,
+``file://...`` or plain paths. Users rarely have a sourced ROS workspace, so robotspec keeps its
+own package search path, built from explicit folders, the ROS environment variables, the folders
+around the description file and the ``example-robot-data`` wheel. The same object also fences
+reads: robot files come from anywhere, and a description must not be able to make robotspec read
+``/etc/passwd`` through ``package://pkg/../../..`` or a symlink, so every resolved path (symlinks
+followed) must lie inside the allowed roots.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import os
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from urllib.parse import unquote
+
+from robotspec.errors import (
+    DescriptionError,
+    PackageNotFoundError,
+    PathOutsideRootsError,
+    RobotSpecError,
+    closest_names,
+)
+
+__all__ = ["PackageResolver"]
+
+#: How deep below a search folder the crawl looks for ``package.xml`` (rospack crawls without a
+#: bound; a bound keeps a stray ``/`` or home folder on the path from scanning the disk).
+MAX_CRAWL_DEPTH = 3
+
+#: How many folders above the description's folder are checked for enclosing packages.
+MAX_WALK_UP = 4
+
+#: Marker files that make colcon, catkin and ament skip a folder; the crawl honours them too.
+IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
+
+_SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.\-]*)://")
+_PACKAGE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\-]*$")
+
+
+def _did_you_mean(suggestions: Sequence[str]) -> str:
+    if not suggestions:
+        return ""
+    quoted = [f"'{s}'" for s in suggestions]
+    if len(quoted) == 1:
+        return f"; did you mean {quoted[0]}?"
+    return f"; did you mean {', '.join(quoted[:-1])} or {quoted[-1]}?"
+
+
+def _declared_name(folder: Path) -> str:
+    """The ``<name>`` a ``package.xml`` declares, or the folder name when it cannot be read.
+
+    Why the fallback: a broken manifest should not hide a package whose folder is named right,
+    which is the usual case.
+    """
+    from robotspec.xmlsafe import parse_xml_file
+
+    try:
+        root = parse_xml_file(folder / "package.xml")
+    except RobotSpecError:
+        return folder.name
+    text = (root.findtext("name") or "").strip()
+    return text if _PACKAGE_NAME.match(text) else folder.name
+
+
+def _is_ignored(folder: Path) -> bool:
+    return any((folder / marker).exists() for marker in IGNORE_MARKERS)
+
+
+def _crawl(
+    folder: Path, depth: int, declared: dict[str, Path], named: dict[str, Path], *, bare: bool
+) -> None:
+    """Collect packages below ``folder``: ``declared`` by manifest name, ``named`` by folder name.
+
+    ``named`` holds every package folder's own name and, when ``bare``, the direct children
+    without a manifest (``example-robot-data``'s ``robots/pr2_description``); they rank below
+    declared names.
+
+    Why not descend into packages: rospack stops at a package too, so a package's test data or
+    vendored copies never shadow real packages.
+    """
+    try:
+        entries = sorted(os.scandir(folder), key=lambda e: e.name)
+    except OSError:
+        return
+    for entry in entries:
+        if entry.name.startswith("."):
+            continue
+        try:
+            if not entry.is_dir():
+                continue
+        except OSError:
+            continue
+        child = Path(entry.path)
+        if _is_ignored(child):
+            continue
+        if (child / "package.xml").is_file():
+            declared.setdefault(_declared_name(child), child)
+            # The folder name is an alias too: pinocchio and example-robot-data's URDFs use
+            # ``package://example-robot-data`` for a manifest named ``example_robot_descriptions``.
+            named.setdefault(entry.name, child)
+            continue
+        if bare and depth == 1 and _PACKAGE_NAME.match(entry.name):
+            named.setdefault(entry.name, child)
+        if depth < MAX_CRAWL_DEPTH:
+            _crawl(child, depth + 1, declared, named, bare=bare)
+
+
+def _folder_packages(folder: Path, *, bare: bool) -> dict[str, Path]:
+    """The packages one search folder provides, declared names before bare folder names."""
+    if (folder / "package.xml").is_file():
+        return {_declared_name(folder): folder, folder.name: folder}
+    declared: dict[str, Path] = {}
+    named: dict[str, Path] = {}
+    _crawl(folder, 1, declared, named, bare=bare)
+    for name, path in named.items():
+        declared.setdefault(name, path)
+    return declared
+
+
+def _split_path_list(value: str | None) -> list[Path]:
+    if not value:
+        return []
+    return [Path(p) for p in value.split(os.pathsep) if p.strip()]
+
+
+def _example_robot_data_folders() -> list[Path]:
+    """The ``example-robot-data`` wheel's robots folder and cmeel share folder, if installed."""
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        return []
+    share = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data")))
+    if not share.is_dir():
+        return []
+    return [share / "robots", share.parent]
+
+
+def _walk_up(description_folder: Path) -> tuple[list[Path], list[Path]]:
+    """Search folders and package roots found around a description file.
+
+    Why walk up: a description usually sits inside its own package (``pkg/urdf/robot.urdf``)
+    whose siblings (``pkg_meshes``) are what ``package://`` names, exactly as in a catkin
+    ``src`` folder.
+    """
+    home = Path(os.path.normpath(Path.home().absolute()))
+    search = [description_folder]
+    roots: list[Path] = []
+    folder = description_folder
+    for _ in range(MAX_WALK_UP):
+        if folder == home or folder.parent == folder:
+            break
+        if (folder / "package.xml").is_file():
+            roots.append(folder)
+            if folder.parent not in (home, Path(folder.anchor)):
+                search.append(folder.parent)
+        folder = folder.parent
+    return search, roots
+
+
+def _unique(paths: Iterable[Path]) -> tuple[Path, ...]:
+    return tuple(dict.fromkeys(paths))
+
+
+@dataclass(frozen=True, slots=True)
+class PackageResolver:
+    """One package search path and the folders reads are confined to.
+
+    Build it with :meth:`create`. The package index is crawled lazily on the first lookup and
+    kept in the instance (never in module state), so two resolvers never share results.
+
+    Attributes:
+        search_folders: Folders searched for packages, highest priority first.
+        roots: Folders (absolute, not symlink-resolved) every resolved path must lie in.
+        description: The description file the resolver was made for, if any.
+        bare_name_folders: Search folders whose children count as packages even without a
+            ``package.xml`` (the explicit, environment and example-robot-data folders; not the
+            description's surroundings, where ``meshes/`` or ``inc/`` are no packages).
+    """
+
+    search_folders: tuple[Path, ...]
+    roots: tuple[Path, ...]
+    description: Path | None = None
+    bare_name_folders: tuple[Path, ...] = ()
+    _index: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
+    _real_roots: list[Path] = field(default_factory=list, compare=False, repr=False)
+
+    @classmethod
+    def create(
+        cls,
+        description: str | Path | None,
+        *,
+        extra_paths: Sequence[str | Path] = (),
+        use_environment: bool = True,
+        use_example_robot_data: bool = True,
+        extra_allowed_roots: Sequence[str | Path] = (),
+        environ: Mapping[str, str] | None = None,
+    ) -> PackageResolver:
+        """A resolver for ``description`` (a URDF/xacro/SRDF path, or ``None``).
+
+        Search folders, highest priority first: ``extra_paths``; ``ROS_PACKAGE_PATH``;
+        ``AMENT_PREFIX_PATH`` entries' ``share`` folders; the description's folder and the
+        parents of packages enclosing it; ``example-robot-data``'s robots and share folders.
+        Folders that do not exist are dropped quietly (environment variables often list stale
+        entries).
+
+        Args:
+            description: The file whose references are resolved; its folder is always allowed.
+            extra_paths: Folders that are packages or contain packages, searched first.
+            use_environment: Read ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH``.
+            use_example_robot_data: Search the installed ``example-robot-data`` wheel.
+            extra_allowed_roots: More folders reads may reach (e.g. a symlink-install's
+                source tree) without being searched for packages.
+            environ: The environment to read instead of ``os.environ`` (tests, servers).
+        """
+        env = os.environ if environ is None else environ
+        folders: list[Path] = [Path(p).absolute() for p in extra_paths]
+        if use_environment:
+            folders += [p.absolute() for p in _split_path_list(env.get("ROS_PACKAGE_PATH"))]
+            folders += [
+                p.absolute() / "share" for p in _split_path_list(env.get("AMENT_PREFIX_PATH"))
+            ]
+        bare = list(folders)
+        desc: Path | None = None
+        roots: list[Path] = []
+        if description is not None:
+            desc = Path(description).absolute()
+            near, package_roots = _walk_up(Path(os.path.normpath(desc.parent)))
+            folders += near
+            roots += [Path(os.path.normpath(desc.parent)), *package_roots]
+        if use_example_robot_data:
+            erd = _example_robot_data_folders()
+            folders += erd
+            bare += erd
+        search = _unique(Path(os.path.normpath(f)) for f in folders if f.is_dir())
+        roots += [Path(p).absolute() for p in extra_allowed_roots]
+        all_roots = _unique(Path(os.path.normpath(r)) for r in [*search, *roots])
+        return cls(
+            search_folders=search,
+            roots=all_roots,
+            description=desc,
+            bare_name_folders=_unique(Path(os.path.normpath(f)) for f in bare if f.is_dir()),
+        )
+
+    @property
+    def allowed_roots(self) -> tuple[Path, ...]:
+        """The folders (as given, and symlink-resolved) every resolved path must lie in."""
+        return _unique([*self.roots, *self._resolved_roots()])
+
+    def _resolved_roots(self) -> list[Path]:
+        if not self._real_roots:
+            self._real_roots.extend(_unique(Path(os.path.realpath(r)) for r in self.roots))
+        return self._real_roots
+
+    def packages(self) -> dict[str, Path]:
+        """Every package the search folders provide, name to folder (first found wins).
+
+        Within one search folder, ``package.xml`` names rank above folder names (a package
+        folder's own name, or a child folder without a manifest); across folders, the search
+        order decides.
+        """
+        if not self._index:
+            index: dict[str, Path] = {}
+            for folder in self.search_folders:
+                bare = folder in self.bare_name_folders
+                for name, path in _folder_packages(folder, bare=bare).items():
+                    index.setdefault(name, path)
+            self._index.update(index)
+        return dict(self._index)
+
+    def find_package(self, name: str, *, file: str | None = None, line: int | None = None) -> Path:
+        """The folder of package ``name``; unknown names suggest the closest known ones."""
+        index = self.packages()
+        found = index.get(name) if _PACKAGE_NAME.match(name) else None
+        if found is not None:
+            return found
+        # One suggestion per package folder: its declared name, not also its folder alias.
+        by_folder: dict[Path, str] = {}
+        for known, folder in index.items():
+            by_folder.setdefault(folder, known)
+        suggestions = closest_names(name, by_folder.values())
+        searched = ", ".join(str(f) for f in self.search_folders) or "(no folders)"
+        raise PackageNotFoundError(
+            f"package '{name}' not found; searched: {searched}{_did_you_mean(suggestions)}",
+            file=file,
+            line=line,
+            kind="package",
+            name=name,
+            suggestions=suggestions,
+        )
+
+    def is_allowed(self, path: str | Path) -> bool:
+        """Whether ``path``, symlinks followed, lies inside one of the allowed roots."""
+        real = Path(os.path.realpath(path))
+        return any(real == r or real.is_relative_to(r) for r in self._resolved_roots())
+
+    def check_allowed(
+        self,
+        path: str | Path,
+        *,
+        uri: str | None = None,
+        file: str | None = None,
+        line: int | None = None,
+    ) -> Path:
+        """The real path of ``path`` if it is allowed, else :class:`PathOutsideRootsError`."""
+        real = Path(os.path.realpath(path))
+        if not self.is_allowed(real):
+            shown = ", ".join(str(r) for r in self.roots) or "none"
+            raise PathOutsideRootsError(
+                f"'{uri if uri is not None else path}' resolves to {real}, "
+                f"outside the allowed folders ({shown})",
+                file=file,
+                line=line,
+                kind="path",
+                name=str(uri if uri is not None else path),
+            )
+        return real
+
+    def resolve(
+        self,
+        uri: str,
+        *,
+        relative_to: Path | None = None,
+        file: str | None = None,
+        line: int | None = None,
+    ) -> Path:
+        """The real path ``uri`` names: ``package://``, ``file://``, absolute or relative.
+
+        The file need not exist (callers report missing meshes their own way), but the path,
+        symlinks followed, must lie inside :attr:`allowed_roots`.
+
+        Args:
+            uri: The reference as written in the description.
+            relative_to: The folder relative paths (and ``file://relative``) start from;
+                the current folder when ``None``.
+            file: The file the reference appears in, for error positions.
+            line: The line of the reference in ``file``.
+        """
+        text = uri.strip()
+        if not text:
+            raise DescriptionError("empty file reference", file=file, line=line, kind="path")
+        base = relative_to if relative_to is not None else Path.cwd()
+        match = _SCHEME.match(text)
+        if match is None:
+            candidate = Path(text) if os.path.isabs(text) else base / text
+        else:
+            scheme = match.group(1).lower()
+            rest = text[match.end() :]
+            if scheme == "package":
+                name, _, inner = rest.partition("/")
+                root = self.find_package(name, file=file, line=line)
+                # Joined as text: an absolute-looking rest must not replace the package root.
+                candidate = Path(f"{root}/{inner}") if inner else root
+            elif scheme == "file":
+                path = unquote(rest)
+                if path.startswith("localhost/"):
+                    path = path[len("localhost") :]
+                candidate = Path(path) if path.startswith("/") else base / path
+            else:
+                raise DescriptionError(
+                    f"unsupported URI scheme '{match.group(1)}' in '{uri}'; "
+                    "robotspec reads only package://, file:// and paths",
+                    file=file,
+                    line=line,
+                    kind="uri",
+                    name=uri,
+                )
+        return self.check_allowed(candidate, uri=uri, file=file, line=line)

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from robotspec.errors import DescriptionError, RobotSpecError
+from robotspec.errors import DescriptionError, RobotSpecError, missing_file
 from robotspec.urdf import MeshPolicy, read_description_xml, world_from_urdf_xml
 from robotspec.world import ConnectionType, World
 
@@ -77,7 +77,7 @@ def load_description(
     else:
         urdf_path = Path(urdf_ref) if Path(urdf_ref).is_absolute() else base / urdf_ref
     if not urdf_path.is_file():
-        raise DescriptionError("file not found", file=str(urdf_path))
+        raise missing_file(urdf_path, DescriptionError)
     resolver = PackageResolver.create(urdf_path, extra_paths=extra)
     root = read_description_xml(urdf_path, resolver, xacro_args)
     issues: list[RobotSpecError] = []

@@ -298,3 +298,22 @@ def raise_collected(errors: Sequence[RobotSpecError], *, summary: str | None = N
     if len(errors) == 1:
         raise errors[0]
     raise RobotSpecErrors(errors, summary=summary)
+
+
+def missing_file(
+    path: str | Path, error_type: type[RobotSpecError] = RobotSpecError
+) -> RobotSpecError:
+    """'file not found', naming the closest files of the same folder (a typo is likeliest)."""
+    p = Path(path)
+    try:
+        siblings = [c.name for c in p.parent.iterdir() if c.is_file()]
+    except OSError:
+        siblings = []
+    suggestions = closest_names(p.name, siblings)
+    return error_type(
+        f"file not found{_did_you_mean(suggestions)}",
+        file=str(path),
+        kind="file",
+        name=p.name,
+        suggestions=suggestions,
+    )

@@ -337,3 +337,8 @@ def json_schema() -> dict[str, Any]:
 def json_schema_text() -> str:
     """The schema as stable, pretty JSON text (what ships in the package)."""
     return json.dumps(json_schema(), indent=2, sort_keys=True) + "\n"
+
+
+def shipped_schema_path() -> Path:
+    """Where the installed package keeps the schema (specs written by robotspec point here)."""
+    return Path(__file__).resolve().parent / "data" / "robotspec.schema.json"

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from lxml import etree
 
-from robotspec.errors import DescriptionError, RobotSpecError, raise_collected
+from robotspec.errors import DescriptionError, RobotSpecError, missing_file, raise_collected
 from robotspec.geometry import (
     Box,
     Capsule,
@@ -59,7 +59,7 @@ def read_description_xml(
     try:
         data = path.read_bytes()
     except FileNotFoundError:
-        raise DescriptionError("file not found", file=str(path)) from None
+        raise missing_file(path, DescriptionError) from None
     except IsADirectoryError:
         raise DescriptionError("is a directory, not a URDF file", file=str(path)) from None
     except OSError as exc:

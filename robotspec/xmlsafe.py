@@ -11,7 +11,7 @@ from pathlib import Path
 
 from lxml import etree
 
-from robotspec.errors import DescriptionError, RobotSpecError
+from robotspec.errors import DescriptionError, RobotSpecError, missing_file
 
 __all__ = ["parse_xml_bytes", "parse_xml_file", "safe_parser"]
 
@@ -107,7 +107,7 @@ def parse_xml_file(
     try:
         data = p.read_bytes()
     except FileNotFoundError:
-        raise error_type("file not found", file=str(path)) from None
+        raise missing_file(path, error_type) from None
     except IsADirectoryError:
         raise error_type("is a directory, not an XML file", file=str(path)) from None
     except OSError as exc:

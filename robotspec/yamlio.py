@@ -18,7 +18,7 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names
+from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names, missing_file
 
 __all__ = ["LocatedYaml", "load_yaml", "load_yaml_text", "validation_errors"]
 
@@ -160,7 +160,7 @@ def load_yaml(path: str | Path) -> LocatedYaml:
     try:
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise RobotSpecError("file not found", file=str(path)) from None
+        raise missing_file(path) from None
     except IsADirectoryError:
         raise RobotSpecError("is a directory, not a YAML file", file=str(path)) from None
     except UnicodeDecodeError as exc:

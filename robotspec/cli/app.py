@@ -34,7 +34,8 @@ def _register() -> None:
     # Each command module adds its commands to ``app`` on import; the modules import nothing heavy.
     from robotspec.cli import (  # noqa: F401
         demo_cmd,
-        drive_cmd,  # noqa: F401
+        drive_cmd,
+        init_cmd,
         inspect_cmd,
         misc_cmd,
         validate_cmd,

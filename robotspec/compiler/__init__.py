@@ -15,7 +15,7 @@ from typing import Any
 
 from robotspec.compiler.build import Build, build_robot
 from robotspec.compiler.diagnostics import Diagnostics
-from robotspec.errors import RobotSpecError, SpecError
+from robotspec.errors import RobotSpecError, SpecError, missing_file
 from robotspec.geometry import pose_from_xyz_quaternion, pose_from_xyz_rpy
 from robotspec.semantic import AbstractRobot
 from robotspec.spec import LoadedSpec, load_spec
@@ -60,7 +60,7 @@ def resolve_spec(ref: str | Path) -> Path:
     if key in shipped:
         return shipped[key]
     if p.suffix in (".yaml", ".yml") or "/" in str(ref):
-        raise SpecError("file not found", file=str(ref))
+        raise missing_file(ref, SpecError)
     from robotspec.errors import NotFoundError
 
     raise NotFoundError("robot or spec file", str(ref), shipped, where="the shipped robots")

@@ -6,10 +6,11 @@ import os
 import sys
 import traceback
 from collections.abc import Sequence
+from typing import TextIO
 
 import typer
 
-from robotspec.errors import RobotSpecError
+from robotspec.errors import ErrorDetail, RobotSpecError
 
 EXIT_OK = 0
 EXIT_INVALID = 1
@@ -17,10 +18,40 @@ EXIT_USAGE = 2
 EXIT_INTERNAL = 3
 
 
+_COLOURS = {"error": "\x1b[1;31m", "warning": "\x1b[1;33m"}
+_BOLD, _RESET = "\x1b[1m", "\x1b[0m"
+
+
+def use_colour(stream: TextIO) -> bool:
+    """Colour only for a person at a terminal: never when piped, never with NO_COLOR set."""
+    if os.environ.get("NO_COLOR"):
+        return False
+    if os.environ.get("FORCE_COLOR"):
+        return True
+    isatty = getattr(stream, "isatty", None)
+    return bool(isatty and isatty()) and os.environ.get("TERM") != "dumb"
+
+
+def styled(detail: ErrorDetail, stream: TextIO) -> str:
+    """``file:line:col: error: message``, with the position bold and the severity coloured."""
+    text = detail.render()
+    if not use_colour(stream):
+        return text
+    marker = f": {detail.severity}: "
+    head, sep, tail = text.partition(marker)
+    if not sep:
+        if text.startswith(f"{detail.severity}: "):
+            n = len(detail.severity)
+            return f"{_COLOURS.get(detail.severity, _BOLD)}{text[:n]}{_RESET}{text[n:]}"
+        return text
+    colour = _COLOURS.get(detail.severity, _BOLD)
+    return f"{_BOLD}{head}{_RESET}: {colour}{detail.severity}{_RESET}: {tail}"
+
+
 def print_error(err: RobotSpecError) -> None:
     """Print every problem an error stands for, one ``file:line:col: error: message`` per line."""
     for detail in err.details:
-        sys.stderr.write(detail.render() + "\n")
+        sys.stderr.write(styled(detail, sys.stderr) + "\n")
 
 
 def _verbose(argv: Sequence[str]) -> bool:

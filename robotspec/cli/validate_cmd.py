@@ -11,6 +11,7 @@ import typer
 
 from robotspec.cli.app import app
 from robotspec.cli.options import PackagePath
+from robotspec.cli.render import styled
 
 
 class Format(StrEnum):
@@ -57,7 +58,7 @@ def validate(
     else:
         for r in results:
             for d in (*r["errors"], *r["warnings"]):
-                sys.stdout.write(d.render() + "\n")
+                sys.stdout.write(styled(d, sys.stdout) + "\n")
         n_specs = len(results)
         bad = sum(1 for r in results if not r["valid"])
         summary = (

@@ -89,7 +89,7 @@ def load_description(
         from robotspec.srdf import load_srdf
 
         srdf_path = resolve_file(str(srdf), base, resolver)
-        srdf_data = load_srdf(srdf_path)
+        srdf_data = load_srdf(srdf_path, strict=False)
     return Description(
         world=world,
         urdf_file=urdf_path,

@@ -150,7 +150,7 @@ def _compile(
     strict: bool = False,
 ) -> CompileResult:
     from robotspec.description import load_description, resolve_file
-    from robotspec.srdf import check_srdf_against
+    from robotspec.srdf import check_srdf_against, check_srdf_references
 
     spec = loaded.spec
     diag = Diagnostics(loaded)
@@ -174,17 +174,22 @@ def _compile(
         from robotspec.srdf import load_srdf
 
         try:
-            srdf = load_srdf(resolve_file(spec.description.srdf, loaded.folder, desc.resolver))
+            srdf = load_srdf(
+                resolve_file(spec.description.srdf, loaded.folder, desc.resolver), strict=False
+            )
         except RobotSpecError as exc:
             diag.add(exc, ("description", "srdf"))
     base_world = world if world is not None else desc.world
     if srdf is not None:
-        for err in check_srdf_against(
-            srdf,
-            base_world.body_names,
-            base_world.connection_names,
-            urdf_name=desc.urdf_file.name,
-        ):
+        for err in [
+            *check_srdf_references(srdf),
+            *check_srdf_against(
+                srdf,
+                base_world.body_names,
+                base_world.connection_names,
+                urdf_name=desc.urdf_file.name,
+            ),
+        ]:
             # An SRDF often outlives its URDF (HSRB's names odom_x/y/t); like MoveIt, warn and
             # ignore the element. A spec that *uses* a stale name still fails on its own line.
             diag.add(err.with_severity("warning"))

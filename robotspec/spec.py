@@ -17,7 +17,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from robotspec.errors import SpecError
+from robotspec.errors import NotFoundError, SpecError
 from robotspec.yamlio import LocatedYaml, load_yaml, validation_errors
 
 __all__ = [
@@ -307,10 +307,21 @@ def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
     base_file = data.get("extends")
     if isinstance(base_file, str):
         base_path = (p.parent / base_file).resolve()
+        shipped = shipped_spec_files()
+        if not base_path.is_file() and base_file.lower() in shipped:
+            base_path = shipped[base_file.lower()]  # a shipped robot, by name
         if not base_path.is_file():
             line, col = doc.position(("extends",))
-            raise SpecError(
-                f"extends: spec '{base_file}' not found", file=doc.file, line=line, column=col
+            siblings = [f.name for f in p.parent.glob("*.y*ml")]
+            raise NotFoundError(
+                "spec",
+                base_file,
+                [*siblings, *shipped],
+                where="this folder or the shipped robots",
+                file=doc.file,
+                line=line,
+                column=col,
+                location=("extends",),
             )
         base = load_spec(base_path, _seen=(*_seen, p))
         base_data = base.spec.model_dump(mode="json", exclude_unset=True, by_alias=True)
@@ -337,6 +348,12 @@ def json_schema() -> dict[str, Any]:
 def json_schema_text() -> str:
     """The schema as stable, pretty JSON text (what ships in the package)."""
     return json.dumps(json_schema(), indent=2, sort_keys=True) + "\n"
+
+
+def shipped_spec_files() -> dict[str, Path]:
+    """The robots shipped with robotspec: name -> spec file (``extends: pr2`` works)."""
+    folder = Path(__file__).resolve().parent / "specs"
+    return {f.stem: f for f in sorted(folder.glob("*.yaml"))}
 
 
 def shipped_schema_path() -> Path:

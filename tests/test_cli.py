@@ -1,0 +1,285 @@
+"""The command line as a user runs it: exact output, exit codes (0 ok, 1 invalid, 2 usage)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from robotspec.cli.app import _register, app
+from robotspec.cli.render import run_app
+from robotspec.compiler import check_spec
+from robotspec.spec import json_schema_text, shipped_schema_path
+
+from .conftest import erd_robots, shared_path
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    """Run ``robotspec ARGV`` in-process; returns (exit code, stdout, stderr)."""
+    _register()
+    code = run_app(app, list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+PR2_CHAINS = """\
+chain                 kind    root                     tip                          joints  dof  manipulator    sensors
+torso                 torso   base_link                torso_lift_link              1       1    -              -
+neck                  neck    torso_lift_link          head_tilt_link               2       2    -              kinect
+left_arm              arm     torso_lift_link          l_wrist_roll_link            9       7    left_gripper   -
+right_arm             arm     torso_lift_link          r_wrist_roll_link            9       7    right_gripper  -
+left_gripper_thumb    finger  l_gripper_l_finger_link  l_gripper_l_finger_tip_link  1       1    -              -
+left_gripper_finger   finger  l_gripper_r_finger_link  l_gripper_r_finger_tip_link  1       1    -              -
+right_gripper_thumb   finger  r_gripper_l_finger_link  r_gripper_l_finger_tip_link  1       1    -              -
+right_gripper_finger  finger  r_gripper_r_finger_link  r_gripper_r_finger_tip_link  1       1    -              -
+"""  # noqa: E501
+
+
+def test_help_lists_every_command(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "--help")
+    assert code == 0
+    for command in ("validate", "inspect", "list", "schema", "init", "drive", "demo"):
+        assert f" {command} " in out
+
+
+def test_cli_import_is_light() -> None:
+    # `robotspec --help` must start fast: the app module imports no numeric or XML stack.
+    code = (
+        "import sys, importlib; importlib.import_module('robotspec.cli.app')._register(); "
+        "print(sorted({m.split('.')[0] for m in sys.modules} & "
+        "{'numpy', 'lxml', 'pydantic', 'yaml', 'yourdfpy', 'coal', 'trimesh'}))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+def test_validate_pr2(capsys: pytest.CaptureFixture[str]) -> None:
+    erd_robots()
+    code, out, err = run(capsys, "validate", "pr2")
+    assert (code, out, err) == (0, "1 of 1 spec valid; 0 errors, 0 warnings\n", "")
+
+
+def test_inspect_chains_pr2_exact(capsys: pytest.CaptureFixture[str]) -> None:
+    erd_robots()
+    code, out, _ = run(capsys, "inspect", "chains", "pr2")
+    assert code == 0
+    assert out == PR2_CHAINS
+
+
+def test_inspect_json_outputs_parse(capsys: pytest.CaptureFixture[str]) -> None:
+    erd_robots()
+    for what in ("chains", "manipulators", "sensors", "joints", "groups", "collisions", "tree"):
+        code, out, _ = run(capsys, "inspect", what, "pr2", "--json")
+        assert code == 0, what
+        json.loads(out)
+    _, out, _ = run(capsys, "inspect", "manipulators", "pr2", "--json")
+    grippers = {m["name"]: m for m in json.loads(out)}
+    assert grippers["right_gripper"]["tool_frame"] == "r_gripper_tool_frame"
+    assert grippers["right_gripper"]["type"] == "parallel_gripper"
+    _, out, _ = run(capsys, "inspect", "joints", "pr2", "--json")
+    joints = {j["name"]: j for j in json.loads(out)}
+    # The spec tightens the right shoulder like the reference (0.15 rad/s), marked as tightened.
+    assert joints["r_shoulder_pan_joint"]["velocity"] == pytest.approx(0.15)
+    assert joints["r_shoulder_pan_joint"]["tightened"] is True
+
+
+def test_validate_reports_every_problem_with_position(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    erd_robots()
+    spec = tmp_path / "bad.yaml"
+    spec.write_text(
+        "robotspec: 1\n"
+        "name: Broken\n"
+        "extends: pr2\n"
+        "chains:\n"
+        "  right_arm:\n"
+        "    root: torso_lift_link\n"
+        "    tip: r_wrist_roll_lnk\n"
+        "    manipulator: right_gripper\n"
+        "torso:\n"
+        "  root: base_link\n"
+        "  tip: torso_lift_lnk\n"
+    )
+    code, out, err = run(capsys, "validate", str(spec))
+    assert code == 1, err
+    lines = out.splitlines()
+    assert lines == [
+        f"{spec}:7:10: error: link 'r_wrist_roll_lnk' not found in pr2.urdf; did you mean "
+        "'r_wrist_roll_link', 'l_wrist_roll_link' or 'r_wrist_flex_link'?",
+        f"{spec}:11:8: error: link 'torso_lift_lnk' not found in pr2.urdf; did you mean "
+        "'torso_lift_link', 'r_shoulder_lift_link' or 'l_shoulder_lift_link'?",
+        "0 of 1 spec valid; 2 errors, 0 warnings",
+    ]
+    code, out, _ = run(capsys, "validate", str(spec), "--format", "json")
+    assert code == 1
+    (result,) = json.loads(out)
+    assert [p["name"] for p in result["problems"]] == ["r_wrist_roll_lnk", "torso_lift_lnk"]
+    assert result["problems"][0]["suggestions"][0] == "r_wrist_roll_link"
+    assert (result["problems"][0]["line"], result["problems"][0]["column"]) == (7, 10)
+
+
+def test_usage_errors_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
+    assert run(capsys, "validate")[0] == 2
+    assert run(capsys, "validate", "pr2", "--no-such-option")[0] == 2
+    assert run(capsys, "no-such-command")[0] == 2
+    assert run(capsys, "inspect", "nothing", "pr2")[0] == 2
+
+
+def test_unknown_robot_and_missing_file(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    code, out, _ = run(capsys, "validate", "pr3")
+    assert code == 1
+    assert "'pr3' not found in the shipped robots; did you mean 'pr2'?" in out
+    (tmp_path / "robot.yaml").write_text("robotspec: 1\n")
+    code, _, err = run(capsys, "inspect", "chains", str(tmp_path / "robt.yaml"))
+    assert code == 1
+    assert err == f"{tmp_path / 'robt.yaml'}: error: file not found; did you mean 'robot.yaml'?\n"
+
+
+def test_yaml_tags_are_refused_without_traceback(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    spec = tmp_path / "evil.yaml"
+    spec.write_text("robotspec: 1\nname: !!python/object/apply:os.system ['echo pwned']\n")
+    code, out, err = run(capsys, "validate", str(spec))
+    assert code == 1
+    assert "Traceback" not in out + err
+    assert "pwned" not in out + err.replace("echo pwned", "")
+    assert f"{spec}:2:7: error:" in out
+
+
+def test_strict_turns_warnings_into_errors(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    erd_robots()
+    spec = tmp_path / "warn.yaml"
+    spec.write_text(
+        "robotspec: 1\nname: W\nextends: pr2\nchains:\n"
+        "  spare:\n    root: torso_lift_link\n    tip: l_elbow_flex_link\n"
+    )
+    code, out, _ = run(capsys, "validate", str(spec))
+    assert code == 0
+    warning = (
+        f"{spec}:6:5: warning: chains.spare: chain 'spare' has neither a manipulator nor a sensor"
+    )
+    assert out.splitlines() == [warning, "1 of 1 spec valid; 0 errors, 1 warning"]
+    code, out, _ = run(capsys, "validate", "--strict", str(spec))
+    assert code == 1
+    assert out.splitlines()[0] == warning.replace("warning:", "error:")
+
+
+def test_list_and_schema(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    code, out, _ = run(capsys, "list")
+    assert code == 0
+    names = [line.split()[0] for line in out.splitlines()[1:]]
+    assert names == ["hsrb", "panda", "pr2", "tiago", "ur5"]
+    code, out, _ = run(capsys, "schema")
+    assert code == 0
+    assert out == json_schema_text() == shipped_schema_path().read_text()
+    assert run(capsys, "schema", "-o", str(tmp_path / "s.json"))[0] == 0
+    assert json.loads((tmp_path / "s.json").read_text())["title"] == "robotspec robot spec"
+
+
+# ------------------------------------------------------------------------------------- init
+
+
+def _init(capsys: pytest.CaptureFixture[str], out: Path, *argv: str) -> dict[str, object]:
+    code, _, err = run(capsys, "init", *argv, "-o", str(out))
+    assert code == 0, err
+    text = out.read_text()
+    assert text.startswith(f"# yaml-language-server: $schema={shipped_schema_path().as_uri()}")
+    result = check_spec(out)  # the draft validates as written
+    assert result.robot is not None
+    data = yaml.safe_load(text)
+    assert isinstance(data, dict)
+    return data
+
+
+def test_init_pr2_from_srdf(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    robots = erd_robots()
+    out = tmp_path / "pr2.yaml"
+    data = _init(
+        capsys,
+        out,
+        str(robots / "pr2_description/urdf/pr2.urdf"),
+        "--srdf",
+        str(robots / "pr2_description/srdf/pr2.srdf"),
+    )
+    assert data["description"] == {
+        "urdf": "package://pr2_description/urdf/pr2.urdf",
+        "srdf": "package://pr2_description/srdf/pr2.srdf",
+    }
+    assert data["root"] == "base_footprint"
+    assert data["drive"] == {
+        "type": "omni",
+        "joint": "world_joint",
+        "parent_frame": "odom_combined",
+    }
+    chains = data["chains"]
+    assert isinstance(chains, dict)
+    assert chains["right_arm"] == {"group": "right_arm", "manipulator": "right_eef"}
+    assert chains["left_arm"] == {"group": "left_arm", "manipulator": "left_eef"}
+    assert data["manipulators"]["right_eef"]["tool_frame"] == "r_gripper_tool_frame"  # type: ignore[index]
+    assert data["manipulators"]["right_eef"]["root"] == "r_gripper_palm_link"  # type: ignore[index]
+    assert "wide_stereo" in data["sensors"]  # type: ignore[operator]
+    assert data["import_srdf_group_states"] is True
+    # A second run refuses to overwrite.
+    code, _, err = run(
+        capsys, "init", str(robots / "pr2_description/urdf/pr2.urdf"), "-o", str(out)
+    )
+    assert code == 1
+    assert err == f"{out}: error: the file exists; pass --force to overwrite it\n"
+
+
+def test_init_without_srdf_guesses_chains_and_tool(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    # UR5e: nobody wrote a spec for it; the chain and tool0 come from the tree alone.
+    urdf = shared_path("robots", "ur5e", "ur5e.urdf")
+    data = _init(capsys, tmp_path / "ur5e.yaml", str(urdf))
+    assert data["chains"] == {
+        "chain_1": {"root": "base_link", "tip": "wrist_3_link", "manipulator": "chain_1_tool"}
+    }
+    assert data["manipulators"]["chain_1_tool"]["tool_frame"] == "tool0"  # type: ignore[index]
+
+
+def test_init_fanuc_writes_package_paths(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    # FANUC (MoveIt resources): packages found beside the URDF must be findable from the spec.
+    fanuc = shared_path("robots", "fanuc")
+    data = _init(
+        capsys,
+        tmp_path / "fanuc.yaml",
+        str(fanuc / "moveit_resources_fanuc_description/urdf/fanuc.urdf"),
+        "--srdf",
+        str(fanuc / "moveit_resources_fanuc_moveit_config/config/fanuc.srdf"),
+    )
+    desc = data["description"]
+    assert isinstance(desc, dict)
+    assert desc["urdf"] == "package://moveit_resources_fanuc_description/urdf/fanuc.urdf"
+    assert len(desc["package_paths"]) == 1
+    assert (tmp_path / desc["package_paths"][0]).resolve() == fanuc.resolve()
+    assert data["chains"] == {
+        "manipulator": {"group": "manipulator", "manipulator": "manipulator_tool"}
+    }
+
+
+def test_init_talos_humanoid(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    robots = erd_robots()
+    data = _init(
+        capsys,
+        tmp_path / "talos.yaml",
+        str(robots / "talos_data/robots/talos_reduced.urdf"),
+        "--srdf",
+        str(robots / "talos_data/srdf/talos.srdf"),
+    )
+    chains = data["chains"]
+    assert isinstance(chains, dict)
+    tips = sorted(c["tip"] for c in chains.values())
+    # Arms and legs, guessed from the tree (the SRDF defines no chain groups).
+    assert tips == ["arm_left_7_link", "arm_right_7_link", "leg_left_6_link", "leg_right_6_link"]

@@ -18,7 +18,7 @@ from robotspec.compiler.diagnostics import Diagnostics
 from robotspec.errors import RobotSpecError, SpecError, missing_file
 from robotspec.geometry import pose_from_xyz_quaternion, pose_from_xyz_rpy
 from robotspec.semantic import AbstractRobot
-from robotspec.spec import LoadedSpec, load_spec
+from robotspec.spec import LoadedSpec, load_spec, shipped_spec_files
 from robotspec.world import ConnectionType, World
 
 __all__ = [
@@ -46,8 +46,7 @@ def _package_data(*parts: str) -> Path:
 
 def shipped_specs() -> dict[str, Path]:
     """The robots shipped with robotspec: name -> spec file."""
-    folder = _package_data("specs")
-    return {p.stem: p for p in sorted(folder.glob("*.yaml"))}
+    return shipped_spec_files()
 
 
 def resolve_spec(ref: str | Path) -> Path:
@@ -199,7 +198,9 @@ def _compile(
     )
     robot = build_robot(build, robot_class)
     diag.raise_if_failed(strict=strict)
-    return CompileResult(loaded=loaded, robot=robot, warnings=tuple(diag.warnings))
+    return CompileResult(
+        loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))
+    )
 
 
 def check_spec(

@@ -100,11 +100,28 @@ class Diagnostics:
         """Closest names, for messages built by hand."""
         return closest_names(name, candidates)
 
+    def in_file_order(self, problems: Iterable[RobotSpecError]) -> list[RobotSpecError]:
+        """Problems in reading order: the spec's own file first, then by line and column.
+
+        Checks run part by part (torso, neck, manipulators, ...), not in the order the file is
+        written; a user fixes a file top to bottom, so that is the order they are reported in.
+        """
+        main = str(self.loaded.file)
+        files = [d.file for d in self.loaded.documents]
+
+        def key(e: RobotSpecError) -> tuple[int, str, int, int]:
+            f = e.file or ""
+            rank = 0 if f == main or f == files[0] else (1 if f in files else 2)
+            return (rank, f, e.line or 0, e.column or 0)
+
+        return sorted(problems, key=key)
+
     def raise_if_failed(self, *, strict: bool = False) -> None:
         """Raise every error (and, in strict mode, every warning as an error) at once."""
         problems = list(self.errors)
         if strict:
             problems += [w.with_severity("error") for w in self.warnings]
+        problems = self.in_file_order(problems)
         if not problems:
             return
         if len(problems) == 1:

@@ -53,7 +53,7 @@ def closest_names(name: str, candidates: Iterable[str], n: int = 3) -> tuple[str
     return tuple(found)
 
 
-def _did_you_mean(suggestions: Sequence[str]) -> str:
+def did_you_mean(suggestions: Sequence[str]) -> str:
     if not suggestions:
         return ""
     quoted = [f"'{s}'" for s in suggestions]
@@ -219,7 +219,7 @@ class NotFoundError(RobotSpecError):
     ) -> None:
         suggestions = closest_names(name, candidates)
         scope = f" in {where}" if where else ""
-        message = f"{kind} '{name}' not found{scope}{_did_you_mean(suggestions)}"
+        message = f"{kind} '{name}' not found{scope}{did_you_mean(suggestions)}"
         super().__init__(
             message,
             file=file,
@@ -311,7 +311,7 @@ def missing_file(
         siblings = []
     suggestions = closest_names(p.name, siblings)
     return error_type(
-        f"file not found{_did_you_mean(suggestions)}",
+        f"file not found{did_you_mean(suggestions)}",
         file=str(path),
         kind="file",
         name=p.name,

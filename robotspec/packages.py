@@ -25,6 +25,7 @@ from robotspec.errors import (
     PathOutsideRootsError,
     RobotSpecError,
     closest_names,
+    did_you_mean,
 )
 
 __all__ = ["PackageResolver"]
@@ -41,15 +42,6 @@ IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
 
 _SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.\-]*)://")
 _PACKAGE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\-]*$")
-
-
-def _did_you_mean(suggestions: Sequence[str]) -> str:
-    if not suggestions:
-        return ""
-    quoted = [f"'{s}'" for s in suggestions]
-    if len(quoted) == 1:
-        return f"; did you mean {quoted[0]}?"
-    return f"; did you mean {', '.join(quoted[:-1])} or {quoted[-1]}?"
 
 
 def _declared_name(folder: Path) -> str:
@@ -286,7 +278,7 @@ class PackageResolver:
         suggestions = closest_names(name, by_folder.values())
         searched = ", ".join(str(f) for f in self.search_folders) or "(no folders)"
         raise PackageNotFoundError(
-            f"package '{name}' not found; searched: {searched}{_did_you_mean(suggestions)}",
+            f"package '{name}' not found; searched: {searched}{did_you_mean(suggestions)}",
             file=file,
             line=line,
             kind="package",

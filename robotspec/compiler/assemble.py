@@ -7,6 +7,7 @@ Nothing here checks anything; :func:`robotspec.compiler.build.build_robot` only 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypedDict
 
 from robotspec.compiler.context import Build
 from robotspec.compiler.parts import CameraValues
@@ -45,6 +46,18 @@ class Resolved:
     chains: dict[str, tuple[Body, Body]]
     cameras: dict[str, CameraValues]
     velocity: dict[str, float]
+
+
+class _ManipulatorFields(TypedDict):
+    """What every manipulator kind takes (typed, so ``**`` keeps mypy's checks)."""
+
+    name: str
+    root: Body
+    world: World
+    tool_frame: Body
+    front_facing_orientation: tuple[float, float, float, float]
+    front_facing_axis: tuple[float, float, float]
+    states: dict[str, JointState]
 
 
 def _part_states(b: Build, prefix: str) -> dict[str, JointState]:
@@ -88,29 +101,21 @@ def _manipulators(b: Build, r: Resolved) -> dict[str, Manipulator]:
         mroot, tool = r.manipulators[name]
         ax = spec.front_facing_axis or front_facing_axis_of(spec.front_facing_orientation)
         axis = (float(ax[0]), float(ax[1]), float(ax[2]))
-        states = _part_states(b, name)
+        common = _ManipulatorFields(
+            name=name,
+            root=mroot,
+            world=w,
+            tool_frame=tool,
+            front_facing_orientation=spec.front_facing_orientation,
+            front_facing_axis=axis,
+            states=_part_states(b, name),
+        )
         if isinstance(spec, ParallelGripperSpec):
-            out[name] = ParallelGripper(
-                name=name,
-                root=mroot,
-                world=w,
-                tool_frame=tool,
-                front_facing_orientation=spec.front_facing_orientation,
-                front_facing_axis=axis,
-                states=states,
-                finger=_finger(w, f"{name}_finger", spec.finger),
-                thumb=_finger(w, f"{name}_thumb", spec.thumb),
-            )
+            thumb = _finger(w, f"{name}_thumb", spec.thumb)
+            finger = _finger(w, f"{name}_finger", spec.finger)
+            out[name] = ParallelGripper(**common, finger=finger, thumb=thumb)
         else:
-            out[name] = GenericManipulator(
-                name=name,
-                root=mroot,
-                world=w,
-                tool_frame=tool,
-                front_facing_orientation=spec.front_facing_orientation,
-                front_facing_axis=axis,
-                states=states,
-            )
+            out[name] = GenericManipulator(**common)
     return out
 
 

@@ -44,13 +44,11 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
         if b.chain_ok(("torso",), "torso", tr, tt) and tr is not None and tt is not None:
             torso_ends = (tr, tt)
             conns = b.world.compute_chain_of_connections(tr, tt)
-            b.states.update(
-                {
-                    f"torso.{k}": v
-                    for k, v in check_states(
-                        b, ("torso", "states"), "the torso", t.states, moved_by(b.world, conns)
-                    ).items()
-                }
+            b.add_states(
+                "torso",
+                check_states(
+                    b, ("torso", "states"), "the torso", t.states, moved_by(b.world, conns)
+                ),
             )
     if spec.neck is not None:
         n = spec.neck
@@ -71,13 +69,9 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
         if b.chain_ok(("neck",), "neck", nr, nt) and nr is not None and nt is not None:
             neck_ends = (nr, nt)
             conns = b.world.compute_chain_of_connections(nr, nt)
-            b.states.update(
-                {
-                    f"neck.{k}": v
-                    for k, v in check_states(
-                        b, ("neck", "states"), "the neck", n.states, moved_by(b.world, conns)
-                    ).items()
-                }
+            b.add_states(
+                "neck",
+                check_states(b, ("neck", "states"), "the neck", n.states, moved_by(b.world, conns)),
             )
         if not n.sensors:
             diag.error(("neck",), "a neck must carry at least one sensor")
@@ -107,13 +101,11 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
         if ends is not None and b.chain_ok(loc, f"chain '{name}'", *ends):
             chain_ends_by_name[name] = ends
             conns = b.world.compute_chain_of_connections(*ends)
-            b.states.update(
-                {
-                    f"{name}.{k}": v
-                    for k, v in check_states(
-                        b, (*loc, "states"), f"chain '{name}'", c.states, moved_by(b.world, conns)
-                    ).items()
-                }
+            b.add_states(
+                name,
+                check_states(
+                    b, (*loc, "states"), f"chain '{name}'", c.states, moved_by(b.world, conns)
+                ),
             )
         if c.manipulator is not None:
             if c.manipulator not in spec.manipulators:
@@ -177,18 +169,18 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
             )
     if b.srdf is not None and spec.import_srdf_group_states:
         for gs in b.srdf.group_states:
+            if gs.group is None:
+                continue  # a group-less state (lenient SRDF read) belongs to no part
             single = {j: v[0] for j, v in gs.joint_values if len(v) == 1}
-            b.states.update(
-                {
-                    f"{gs.group}.{k}": v
-                    for k, v in check_states(
-                        b,
-                        ("import_srdf_group_states",),
-                        f"SRDF group '{gs.group}'",
-                        {gs.name: single},
-                        None,
-                    ).items()
-                }
+            b.add_states(
+                gs.group,
+                check_states(
+                    b,
+                    ("import_srdf_group_states",),
+                    f"SRDF group '{gs.group}'",
+                    {gs.name: single},
+                    None,
+                ),
             )
     diag.raise_if_failed()
     assert root is not None  # no errors means the root resolved

@@ -85,6 +85,10 @@ class Build:
         )
         return False
 
+    def add_states(self, prefix: str, states: Mapping[str, JointState]) -> None:
+        """Record a part's checked states under ``prefix.name`` (robot-level: no prefix)."""
+        self.states.update({f"{prefix}.{k}" if prefix else k: v for k, v in states.items()})
+
     def joint(self, loc: Loc, name: str) -> Connection | None:
         """The connection called ``name`` or a located 'not found' error."""
         if self.world.has_connection(name):

@@ -60,12 +60,22 @@ def _declared_name(folder: Path) -> str:
     return text if _PACKAGE_NAME.match(text) else folder.name
 
 
-def _is_ignored(folder: Path) -> bool:
-    return any((folder / marker).exists() for marker in IGNORE_MARKERS)
+def _listing(folder: Path) -> list[os.DirEntry[str]] | None:
+    try:
+        with os.scandir(folder) as it:
+            return sorted(it, key=lambda e: e.name)
+    except OSError:
+        return None
 
 
 def _crawl(
-    folder: Path, depth: int, declared: dict[str, Path], named: dict[str, Path], *, bare: bool
+    folder: Path,
+    entries: list[os.DirEntry[str]],
+    depth: int,
+    declared: dict[str, Path],
+    named: dict[str, Path],
+    *,
+    bare: bool,
 ) -> None:
     """Collect packages below ``folder``: ``declared`` by manifest name, ``named`` by folder name.
 
@@ -74,12 +84,9 @@ def _crawl(
     declared names.
 
     Why not descend into packages: rospack stops at a package too, so a package's test data or
-    vendored copies never shadow real packages.
+    vendored copies never shadow real packages. Each folder is listed once (no per-marker
+    ``stat``): the crawl runs for every description loaded.
     """
-    try:
-        entries = sorted(os.scandir(folder), key=lambda e: e.name)
-    except OSError:
-        return
     for entry in entries:
         if entry.name.startswith("."):
             continue
@@ -89,9 +96,13 @@ def _crawl(
         except OSError:
             continue
         child = Path(entry.path)
-        if _is_ignored(child):
+        listing = _listing(child)
+        if listing is None:
             continue
-        if (child / "package.xml").is_file():
+        names = {e.name for e in listing}
+        if names.intersection(IGNORE_MARKERS):
+            continue
+        if "package.xml" in names:
             declared.setdefault(_declared_name(child), child)
             # The folder name is an alias too: pinocchio and example-robot-data's URDFs use
             # ``package://example-robot-data`` for a manifest named ``example_robot_descriptions``.
@@ -100,7 +111,7 @@ def _crawl(
         if bare and depth == 1 and _PACKAGE_NAME.match(entry.name):
             named.setdefault(entry.name, child)
         if depth < MAX_CRAWL_DEPTH:
-            _crawl(child, depth + 1, declared, named, bare=bare)
+            _crawl(child, listing, depth + 1, declared, named, bare=bare)
 
 
 def _folder_packages(folder: Path, *, bare: bool) -> dict[str, Path]:
@@ -109,7 +120,7 @@ def _folder_packages(folder: Path, *, bare: bool) -> dict[str, Path]:
         return {_declared_name(folder): folder, folder.name: folder}
     declared: dict[str, Path] = {}
     named: dict[str, Path] = {}
-    _crawl(folder, 1, declared, named, bare=bare)
+    _crawl(folder, _listing(folder) or [], 1, declared, named, bare=bare)
     for name, path in named.items():
         declared.setdefault(name, path)
     return declared
@@ -181,6 +192,7 @@ class PackageResolver:
     bare_name_folders: tuple[Path, ...] = ()
     _index: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
     _real_roots: list[Path] = field(default_factory=list, compare=False, repr=False)
+    _real_dirs: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
     def create(
@@ -286,10 +298,31 @@ class PackageResolver:
             suggestions=suggestions,
         )
 
+    def _realpath(self, path: str | Path) -> Path:
+        """``os.path.realpath``, with each folder resolved once per resolver.
+
+        Why: a robot names dozens of meshes in a few folders; resolving every component of every
+        path again costs more than parsing the URDF. Only the last component is checked per file
+        (a symlinked mesh is still followed).
+        """
+        text = os.path.abspath(path)  # abspath normalizes '..' lexically: check the raw path
+        if ".." in Path(path).parts or ".." in Path(text).parts:
+            return Path(os.path.realpath(path))  # the OS follows a symlink before '..'
+        parent, name = os.path.split(text)
+        if not name or os.path.islink(text):
+            return Path(os.path.realpath(text))
+        real_parent = self._real_dirs.get(parent)
+        if real_parent is None:
+            real_parent = os.path.realpath(parent)
+            self._real_dirs[parent] = real_parent
+        return Path(real_parent, name)
+
+    def _inside(self, real: Path) -> bool:
+        return any(real == r or real.is_relative_to(r) for r in self._resolved_roots())
+
     def is_allowed(self, path: str | Path) -> bool:
         """Whether ``path``, symlinks followed, lies inside one of the allowed roots."""
-        real = Path(os.path.realpath(path))
-        return any(real == r or real.is_relative_to(r) for r in self._resolved_roots())
+        return self._inside(self._realpath(path))
 
     def check_allowed(
         self,
@@ -300,8 +333,8 @@ class PackageResolver:
         line: int | None = None,
     ) -> Path:
         """The real path of ``path`` if it is allowed, else :class:`PathOutsideRootsError`."""
-        real = Path(os.path.realpath(path))
-        if not self.is_allowed(real):
+        real = self._realpath(path)
+        if not self._inside(real):
             shown = ", ".join(str(r) for r in self.roots) or "none"
             raise PathOutsideRootsError(
                 f"'{uri if uri is not None else path}' resolves to {real}, "

@@ -219,6 +219,24 @@ def test_symlink_escaping_the_roots_is_refused(tmp_path: Path) -> None:
     assert trusting.resolve("package://pkg/link.stl") == outside / "secret.stl"
 
 
+def test_dotdot_after_a_symlink_follows_the_link_like_the_os(tmp_path: Path) -> None:
+    # 'link/../x' is opened by the OS as '<link target>/../x', not as the lexical 'x'.
+    deep = tmp_path / "outside" / "deep"
+    deep.mkdir(parents=True)
+    (tmp_path / "outside" / "secret.stl").write_text("secret")
+    pkg = make_package(tmp_path / "ws" / "pkg", "pkg")
+    (pkg / "secret.stl").write_text("decoy inside the package")
+    (pkg / "link").symlink_to(deep, target_is_directory=True)
+    r = isolated(None, extra_paths=[tmp_path / "ws"])
+    with pytest.raises(PathOutsideRootsError, match="outside the allowed folders"):
+        r.resolve("package://pkg/link/../secret.stl")
+    assert not r.is_allowed(pkg / "link" / ".." / "secret.stl")
+    # Repeated lookups in one folder (the per-folder cache) still see a symlinked file.
+    assert r.is_allowed(pkg / "secret.stl")
+    (pkg / "late.stl").symlink_to(tmp_path / "outside" / "secret.stl")
+    assert not r.is_allowed(pkg / "late.stl")
+
+
 @pytest.mark.parametrize("scheme", ["http", "https", "ftp", "model"])
 def test_other_schemes_are_refused(scheme: str) -> None:
     uri = f"{scheme}://example.com/robot/mesh.stl"

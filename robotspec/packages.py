@@ -76,6 +76,7 @@ def _crawl(
     named: dict[str, Path],
     *,
     bare: bool,
+    flat: bool = False,
 ) -> None:
     """Collect packages below ``folder``: ``declared`` by manifest name, ``named`` by folder name.
 
@@ -110,17 +111,19 @@ def _crawl(
             continue
         if bare and depth == 1 and _PACKAGE_NAME.match(entry.name):
             named.setdefault(entry.name, child)
+            if flat:
+                continue  # a flat folder's children are its packages; nothing nests in them
         if depth < MAX_CRAWL_DEPTH:
-            _crawl(child, listing, depth + 1, declared, named, bare=bare)
+            _crawl(child, listing, depth + 1, declared, named, bare=bare, flat=flat)
 
 
-def _folder_packages(folder: Path, *, bare: bool) -> dict[str, Path]:
+def _folder_packages(folder: Path, *, bare: bool, flat: bool = False) -> dict[str, Path]:
     """The packages one search folder provides, declared names before bare folder names."""
     if (folder / "package.xml").is_file():
         return {_declared_name(folder): folder, folder.name: folder}
     declared: dict[str, Path] = {}
     named: dict[str, Path] = {}
-    _crawl(folder, _listing(folder) or [], 1, declared, named, bare=bare)
+    _crawl(folder, _listing(folder) or [], 1, declared, named, bare=bare, flat=flat)
     for name, path in named.items():
         declared.setdefault(name, path)
     return declared
@@ -190,6 +193,8 @@ class PackageResolver:
     roots: tuple[Path, ...]
     description: Path | None = None
     bare_name_folders: tuple[Path, ...] = ()
+    #: Folders whose children are packages and are not crawled into (example-robot-data's).
+    flat_folders: tuple[Path, ...] = ()
     _index: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
     _real_roots: list[Path] = field(default_factory=list, compare=False, repr=False)
     _real_dirs: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
@@ -237,8 +242,10 @@ class PackageResolver:
             near, package_roots = _walk_up(Path(os.path.normpath(desc.parent)))
             folders += near
             roots += [Path(os.path.normpath(desc.parent)), *package_roots]
+        flat: list[Path] = []
         if use_example_robot_data:
             erd = _example_robot_data_folders()
+            flat += erd
             folders += erd
             bare += erd
         search = _unique(Path(os.path.normpath(f)) for f in folders if f.is_dir())
@@ -249,6 +256,7 @@ class PackageResolver:
             roots=all_roots,
             description=desc,
             bare_name_folders=_unique(Path(os.path.normpath(f)) for f in bare if f.is_dir()),
+            flat_folders=_unique(Path(os.path.normpath(f)) for f in flat if f.is_dir()),
         )
 
     @property
@@ -272,7 +280,8 @@ class PackageResolver:
             index: dict[str, Path] = {}
             for folder in self.search_folders:
                 bare = folder in self.bare_name_folders
-                for name, path in _folder_packages(folder, bare=bare).items():
+                flat = folder in self.flat_folders
+                for name, path in _folder_packages(folder, bare=bare, flat=flat).items():
                     index.setdefault(name, path)
             self._index.update(index)
         return dict(self._index)

@@ -7,6 +7,7 @@ then resolve and check every part (``build``). All problems of one spec are repo
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -65,12 +66,23 @@ def resolve_spec(ref: str | Path) -> Path:
     raise NotFoundError("robot or spec file", str(ref), shipped, where="the shipped robots")
 
 
+_PRESETS: dict[tuple[str, int], dict[str, dict[str, Any]]] = {}
+
+
 def load_camera_presets() -> dict[str, dict[str, Any]]:
-    """Camera models from ``templates/cameras.yaml``."""
+    """Camera models from ``templates/cameras.yaml`` (a fresh copy for each caller).
+
+    Parsed once per version of the file: every compilation needs them, and parsing the YAML
+    again cost more than the compiler's own checks.
+    """
     from robotspec.yamlio import load_yaml
 
-    doc = load_yaml(_package_data("templates", "cameras.yaml"))
-    return dict(doc.data or {})
+    file = _package_data("templates", "cameras.yaml")
+    key = (str(file), file.stat().st_mtime_ns)
+    if key not in _PRESETS:
+        _PRESETS.clear()
+        _PRESETS[key] = dict(load_yaml(file).data or {})
+    return copy.deepcopy(_PRESETS[key])
 
 
 def _frame_pose(frame: Any) -> Any:
@@ -154,31 +166,45 @@ def _compile(
     spec = loaded.spec
     diag = Diagnostics(loaded)
     paths = [*spec.description.package_paths, *map(str, package_paths)]
-    try:
-        desc = load_description(
-            spec.description.urdf,
-            srdf=None,
-            package_paths=paths,
-            xacro_args=spec.description.xacro_args,
-            base_folder=loaded.folder,
+    if world is None:
+        try:
+            desc = load_description(
+                spec.description.urdf,
+                srdf=None,
+                package_paths=paths,
+                xacro_args=spec.description.xacro_args,
+                base_folder=loaded.folder,
+            )
+        except RobotSpecError as exc:
+            diag.add(exc, ("description", "urdf"))
+            diag.raise_if_failed()
+            raise
+        for w in desc.warnings:
+            diag.add(w)
+        base_world, resolver, urdf_name = desc.world, desc.resolver, desc.urdf_file.name
+    else:
+        # from_world: the caller's world is the description; the spec's URDF is not read
+        # again (it may not even be on this machine's package path). The SRDF is found next
+        # to the world's source file or on the package path.
+        from robotspec.packages import PackageResolver
+
+        source = Path(world.source) if world.source else None
+        folder = loaded.folder
+        extra = [p if Path(p).is_absolute() else folder / p for p in paths]
+        resolver = PackageResolver.create(
+            source if source is not None and source.is_file() else None, extra_paths=extra
         )
-    except RobotSpecError as exc:
-        diag.add(exc, ("description", "urdf"))
-        diag.raise_if_failed()
-        raise
-    for w in desc.warnings:
-        diag.add(w)
+        base_world, urdf_name = world, (world.source or world.name).rsplit("/", 1)[-1]
     srdf = None
     if spec.description.srdf is not None:
         from robotspec.srdf import load_srdf
 
         try:
             srdf = load_srdf(
-                resolve_file(spec.description.srdf, loaded.folder, desc.resolver), strict=False
+                resolve_file(spec.description.srdf, loaded.folder, resolver), strict=False
             )
         except RobotSpecError as exc:
             diag.add(exc, ("description", "srdf"))
-    base_world = world if world is not None else desc.world
     if srdf is not None:
         for err in [
             *check_srdf_references(srdf),
@@ -186,7 +212,7 @@ def _compile(
                 srdf,
                 base_world.body_names,
                 base_world.connection_names,
-                urdf_name=desc.urdf_file.name,
+                urdf_name=urdf_name,
             ),
         ]:
             # An SRDF often outlives its URDF (HSRB's names odom_x/y/t); like MoveIt, warn and

@@ -91,12 +91,29 @@ def check_velocity(b: Build, robot_joints: list[Connection]) -> dict[str, float]
         loc: Loc = ("velocity_limits", "joints", j)
         if j not in one_dof:
             c = b.world.get_connection_by_name(j) if b.world.has_connection(j) else None
+            own = {r.name for r in robot_joints}
             if c is not None and c.mimic is not None:
                 b.diag.error(
                     loc,
                     f"joint '{j}' mimics '{c.mimic.leader}'; limit the leader",
                     name=j,
                     suggestions=(c.mimic.leader,),
+                )
+            elif c is not None and c.name not in own and b.robot_root is not None:
+                b.diag.error(
+                    loc,
+                    f"joint '{j}' is not a joint of robot '{b.spec.name}' (it is not below "
+                    f"the root '{b.robot_root.name}'); limits apply to the robot's own joints",
+                    name=j,
+                )
+            elif c is not None and c.is_fixed:
+                b.diag.error(loc, f"joint '{j}' is fixed; it has no velocity to limit", name=j)
+            elif c is not None:
+                b.diag.error(
+                    loc,
+                    f"joint '{j}' has {c.type.dof_count} degrees of freedom; velocity limits "
+                    "apply to 1-DOF joints",
+                    name=j,
                 )
             else:
                 b.diag.not_found(loc, "actuated 1-DOF joint", j, one_dof, f"robot '{b.spec.name}'")

@@ -84,13 +84,8 @@ def check_manipulator(
     if root is None or tool is None:
         return None
     allowed = moved_by(b.world, subtree_joints(b.world, root))
-    b.states.update(
-        {
-            f"{name}.{k}": v
-            for k, v in check_states(
-                b, (*loc, "states"), f"manipulator '{name}'", m.states, allowed
-            ).items()
-        }
+    b.add_states(
+        name, check_states(b, (*loc, "states"), f"manipulator '{name}'", m.states, allowed)
     )
     return root, tool
 
@@ -125,11 +120,13 @@ def camera_values(b: Build, name: str, s: CameraSpec) -> CameraValues | None:
     """Merge preset and spec; None (after recording why) when the camera is unusable."""
     loc: Loc = ("sensors", name)
     preset: Mapping[str, object] = {}
+    preset_missing = False
     if s.preset is not None:
         if s.preset not in b.presets:
             b.diag.not_found(
                 (*loc, "preset"), "camera preset", s.preset, b.presets, "templates/cameras.yaml"
             )
+            preset_missing = True
         else:
             preset = b.presets[s.preset]
     fov_h = fov_v = None
@@ -141,7 +138,9 @@ def camera_values(b: Build, name: str, s: CameraSpec) -> CameraValues | None:
         fov_h, fov_v = _float(pf.get("horizontal"), 0.0), _float(pf.get("vertical"), 0.0)
     ok = True
     if fov_h is None or fov_v is None:
-        b.diag.error(loc, f"camera '{name}' has no field_of_view (give it or a preset)")
+        # An unknown preset was already reported; its missing values are not a second problem.
+        if not preset_missing:
+            b.diag.error(loc, f"camera '{name}' has no field_of_view (give it or a preset)")
         ok = False
     else:
         for key, a in (("horizontal", fov_h), ("vertical", fov_v)):

@@ -100,10 +100,15 @@ class AbstractRobot:
 
     @property
     def controlled_connections(self) -> list[Connection]:
-        """The joints a controller commands: by default every actuated, non-mimic joint."""
+        """The joints a controller commands: by default every actuated, non-mimic joint.
+
+        Actuated excludes the SRDF's ``passive_joint`` entries (HSRB's caster wheels, bumpers
+        and spring joints move but have no motor); a spec's ``controlled_joints`` overrides.
+        """
         own = [c for c in self.connections if c.is_active]
         if self.controlled_joint_names is None:
-            return own
+            passive = set() if self.srdf is None else {p.name for p in self.srdf.passive_joints}
+            return [c for c in own if c.name not in passive]
         wanted = set(self.controlled_joint_names)
         return [c for c in own if c.name in wanted]
 

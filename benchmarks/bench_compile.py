@@ -1,0 +1,101 @@
+"""Compiling the PR2 spec end to end, against pinocchio building the same model, in one run.
+
+robotspec: spec YAML -> URDF world + SRDF + every semantic part, checks and collision pairs
+(``compile_robot("pr2")``). pinocchio: ``buildModelFromUrdf`` + ``buildGeomFromUrdf``
+(COLLISION, with package dirs) + ``addAllCollisionPairs`` + ``removeCollisionPairs`` (the SRDF).
+Neither side caches anything between runs. Target: robotspec no slower than pinocchio.
+
+Run: ``python benchmarks/bench_compile.py [--repeat N] [--profile]`` (needs the dev extra:
+example-robot-data, pin). Prints medians and the ratio pinocchio / robotspec (above 1 means
+robotspec is faster); ``--profile`` adds robotspec's top costs (cProfile, cumulative).
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import importlib.metadata as md
+import io
+import pstats
+import statistics
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+
+def median_time(fn: Callable[[], object], repeat: int) -> float:
+    """Median wall time of ``repeat`` calls (seconds), after one warm-up call."""
+    fn()
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return statistics.median(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--repeat", type=int, default=15)
+    parser.add_argument("--profile", action="store_true", help="cProfile robotspec's compile")
+    args = parser.parse_args()
+
+    import pinocchio as pin
+
+    from robotspec.compiler import compile_robot
+
+    share = Path(
+        str(
+            md.distribution("example-robot-data").locate_file(
+                "cmeel.prefix/share/example-robot-data"
+            )
+        )
+    )
+    pr2 = share / "robots" / "pr2_description"
+    urdf, srdf = pr2 / "urdf" / "pr2.urdf", pr2 / "srdf" / "pr2.srdf"
+    package_dirs = [str(share / "robots"), str(share.parent)]
+
+    def ours() -> object:
+        return compile_robot("pr2")
+
+    def pinocchio() -> object:
+        model = pin.buildModelFromUrdf(str(urdf))
+        geom = pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION, package_dirs)
+        geom.addAllCollisionPairs()
+        pin.removeCollisionPairs(model, geom, str(srdf))
+        return model, geom
+
+    robot = ours()
+    model, geom = pinocchio()  # type: ignore[misc]
+    print(
+        f"robotspec: {len(robot.bodies)} bodies, {len(robot.kinematic_chains)} chains, "  # type: ignore[attr-defined]
+        f"{len(robot.disabled_collision_pairs)} disabled pairs (with geometry)"  # type: ignore[attr-defined]
+    )
+    print(
+        f"pinocchio: {model.njoints} joints, {geom.ngeoms} collision geometries, "
+        f"{len(geom.collisionPairs)} collision pairs after the SRDF"
+    )
+    t_ours = median_time(ours, args.repeat)
+    t_pin = median_time(pinocchio, args.repeat)
+    print(f"{'robotspec compile_robot(pr2)':<40}{t_ours * 1e3:9.1f} ms")
+    print(f"{'pinocchio model+geom+SRDF pairs':<40}{t_pin * 1e3:9.1f} ms")
+    ratio = t_pin / t_ours
+    verdict = "robotspec faster" if ratio >= 1 else "robotspec SLOWER"
+    print(f"ratio pinocchio/robotspec: {ratio:.2f} ({verdict}; median of {args.repeat})")
+
+    if args.profile:
+        prof = cProfile.Profile()
+        prof.enable()
+        for _ in range(5):
+            ours()
+        prof.disable()
+        out = io.StringIO()
+        pstats.Stats(prof, stream=out).sort_stats("cumulative").print_stats(25)
+        print(out.getvalue())
+        out = io.StringIO()
+        pstats.Stats(prof, stream=out).sort_stats("tottime").print_stats(15)
+        print(out.getvalue())
+
+
+if __name__ == "__main__":
+    main()

@@ -10,10 +10,11 @@ location maps back to ``file:line:column``.
 from __future__ import annotations
 
 import math
+import types
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Union, get_args, get_origin
 
 import yaml
 from pydantic import BaseModel, ValidationError
@@ -61,8 +62,16 @@ _PLAIN_TAGS = frozenset(
 )
 
 
-class _SafeComposer(yaml.SafeLoader):
+# libyaml's loader when PyYAML was built with it (ten times faster; same marks), else pure Python.
+_BaseLoader: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+class _SafeComposer(_BaseLoader):  # type: ignore[valid-type,misc]
     """SafeLoader used only to compose nodes; no Python objects are constructed from tags."""
+
+
+class _PySafeComposer(yaml.SafeLoader):
+    """The pure-Python loader, for its clearer syntax-error messages."""
 
 
 def _scalar(node: yaml.ScalarNode, loader: yaml.SafeLoader) -> Any:
@@ -128,30 +137,49 @@ def load_yaml_text(text: str, file: str = "<string>") -> LocatedYaml:
     """Parse one YAML document from ``text`` safely, keeping node positions."""
     if len(text.encode("utf-8", errors="replace")) > MAX_YAML_BYTES:
         raise RobotSpecError(f"YAML file larger than {MAX_YAML_BYTES} bytes", file=file)
-    loader = _SafeComposer(text)
     try:
+        return _compose(_SafeComposer, text, file)
+    except yaml.YAMLError as fast_error:
+        if _SafeComposer.__mro__[1] is yaml.SafeLoader:
+            raise _yaml_error(fast_error, file) from None
+        # libyaml's messages are terser ("did not find expected ','"); the pure-Python parser
+        # says what it found instead. Errors are rare, so parse again for the better message.
+        try:
+            _compose(_PySafeComposer, text, file)
+        except yaml.YAMLError as slow_error:
+            raise _yaml_error(slow_error, file) from None
+        raise _yaml_error(fast_error, file) from None
+    except RecursionError:
+        raise RobotSpecError("YAML nested too deeply", file=file) from None
+
+
+def _compose(loader_type: type[yaml.SafeLoader], text: str, file: str) -> LocatedYaml:
+    loader: yaml.SafeLoader | None = None
+    try:
+        loader = loader_type(text)  # the reader checks characters as it is made
         node = loader.get_single_node()
         if node is None:
             return LocatedYaml(data=None, file=file)
         marks: dict[Loc, tuple[int, int]] = {}
         key_marks: dict[Loc, tuple[int, int]] = {}
         data = _build(node, loader, (), marks, key_marks, file, 0)
-    except yaml.MarkedYAMLError as exc:
+    finally:
+        if loader is not None:
+            loader.dispose()
+    return LocatedYaml(data=data, file=file, marks=marks, key_marks=key_marks)
+
+
+def _yaml_error(exc: yaml.YAMLError, file: str) -> RobotSpecError:
+    if isinstance(exc, yaml.MarkedYAMLError):
         mark = exc.problem_mark or exc.context_mark
         problem = exc.problem or exc.context or "invalid YAML"
-        raise RobotSpecError(
+        return RobotSpecError(
             f"invalid YAML: {problem}",
             file=file,
             line=None if mark is None else mark.line + 1,
             column=None if mark is None else mark.column + 1,
-        ) from None
-    except yaml.YAMLError as exc:
-        raise RobotSpecError(f"invalid YAML: {exc}", file=file) from None
-    except RecursionError:
-        raise RobotSpecError("YAML nested too deeply", file=file) from None
-    finally:
-        loader.dispose()
-    return LocatedYaml(data=data, file=file, marks=marks, key_marks=key_marks)
+        )
+    return RobotSpecError(f"invalid YAML: {exc}", file=file)
 
 
 def load_yaml(path: str | Path) -> LocatedYaml:
@@ -180,36 +208,47 @@ def _loc_text(loc: Sequence[str | int]) -> str:
     return out
 
 
+def _leaves(annotation: Any) -> list[Any]:
+    """An annotation without its wrappers: Annotated, Optional and unions flattened."""
+    origin = get_origin(annotation)
+    if origin is Annotated:
+        return _leaves(get_args(annotation)[0])
+    if origin is Union or origin is types.UnionType:
+        return [leaf for arg in get_args(annotation) for leaf in _leaves(arg)]
+    return [annotation]
+
+
+def _is_model(ann: Any) -> bool:
+    return isinstance(ann, type) and issubclass(ann, BaseModel)
+
+
 def _model_fields_at(model: type[BaseModel], loc: Sequence[str | int]) -> list[str]:
-    """Best-effort list of the field names valid at ``loc`` (for unknown-key suggestions)."""
-    current: Any = model
+    """The keys valid in the mapping at ``loc`` (for unknown-key suggestions).
+
+    Why the walk by annotation: a part's name (``chains.left_arm``) is a dict key, not a field,
+    so each step either names a field of the current models or enters a dict value or list item.
+    """
+    current: list[Any] = [model]
     for part in loc:
-        if isinstance(part, int) or not (
-            isinstance(current, type) and issubclass(current, BaseModel)
-        ):
-            # Lists and dicts: step into the item type when it is a model.
-            args = getattr(current, "__args__", ())
-            models = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
-            if models:
-                current = models[-1]
-            if isinstance(part, int):
-                continue
-        if isinstance(current, type) and issubclass(current, BaseModel):
-            fld = current.model_fields.get(part)
-            if fld is None:
-                return []
-            current = fld.annotation
-            args = getattr(current, "__args__", ())
-            models = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
-            if models and not (isinstance(current, type) and issubclass(current, BaseModel)):
-                current = models[-1]
-    if isinstance(current, type) and issubclass(current, BaseModel):
-        return [f.alias or n for n, f in current.model_fields.items()]
-    args = getattr(current, "__args__", ())
-    models = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
-    if models:
-        return [f.alias or n for n, f in models[-1].model_fields.items()]
-    return []
+        step: list[Any] = []
+        for ann in (leaf for a in current for leaf in _leaves(a)):
+            if _is_model(ann):
+                for name, fld in ann.model_fields.items():
+                    if part in (name, fld.alias):
+                        step.append(fld.annotation)
+            elif get_origin(ann) in (dict, Mapping) and get_args(ann):
+                step.append(get_args(ann)[-1])
+            elif get_origin(ann) in (list, tuple, Sequence) and isinstance(part, int):
+                step.extend(get_args(ann)[:1])
+        current = step
+    names: list[str] = []
+    for ann in (leaf for a in current for leaf in _leaves(a)):
+        if _is_model(ann):
+            for name, fld in ann.model_fields.items():
+                key = fld.alias or name
+                if key not in names:
+                    names.append(key)
+    return names
 
 
 def validation_errors(
@@ -295,17 +334,19 @@ def _is_short_scalar(value: Any) -> bool:
 
 
 def _strip_to_document(loc: Loc, doc: LocatedYaml) -> Loc:
-    """Drop pydantic's union/validator tags that are not keys of the document."""
+    """Drop pydantic's union/validator tags that are not keys of the document.
+
+    Every part but the last exists in the document (validation reached it); a part that does
+    not is a tag, such as a discriminated union's member name ('parallel_gripper'). The last
+    part may be a key the document lacks (a missing key), so only tag-shaped ones go.
+    """
     out: list[str | int] = []
-    for part in loc:
+    for i, part in enumerate(loc):
         candidate = (*out, part)
-        if candidate in doc.marks or candidate in doc.key_marks:
+        last = i == len(loc) - 1
+        if candidate in doc.marks or candidate in doc.key_marks or isinstance(part, int):
             out.append(part)
-        elif isinstance(part, int):
-            out.append(part)
-        elif _is_tag(part):
-            continue
-        else:
+        elif last and not _is_tag(part):
             out.append(part)
     return tuple(out)
 

@@ -283,3 +283,25 @@ def test_init_talos_humanoid(capsys: pytest.CaptureFixture[str], tmp_path: Path)
     tips = sorted(c["tip"] for c in chains.values())
     # Arms and legs, guessed from the tree (the SRDF defines no chain groups).
     assert tips == ["arm_left_7_link", "arm_right_7_link", "leg_left_6_link", "leg_right_6_link"]
+
+
+def test_shell_completion_of_commands_and_specs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "robots").mkdir()
+    (tmp_path / "robots" / "mine.yaml").write_text("robotspec: 1\n")
+    env = {"_ROBOTSPEC_COMPLETE": "complete_bash", "COMP_CWORD": "1"}
+
+    def complete(words: str, cword: int) -> list[str]:
+        out = subprocess.run(
+            [sys.executable, "-m", "robotspec"],
+            env={**env, "COMP_WORDS": words, "COMP_CWORD": str(cword), "PATH": ""},
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+        )
+        return out.stdout.split()
+
+    assert complete("robotspec ins", 1) == ["inspect"]
+    assert complete("robotspec inspect chains p", 3) == ["panda", "pr2"]
+    assert complete("robotspec validate robots/", 2) == ["robots/mine.yaml"]

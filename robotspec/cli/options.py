@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Annotated
 
@@ -17,6 +18,28 @@ PackagePath = Annotated[
     ),
 ]
 JsonFlag = Annotated[bool, typer.Option("--json", help="Print JSON instead of a table.")]
+
+
+def complete_spec(incomplete: str) -> list[str]:
+    """Shell completion of a spec argument: shipped robot names, then YAML files here."""
+    shipped = Path(__file__).resolve().parents[1] / "specs"
+    names = sorted(p.stem for p in shipped.glob("*.yaml"))
+    head = os.path.dirname(incomplete)
+    try:
+        files = sorted(
+            os.path.join(head, p.name) + ("/" if p.is_dir() else "")
+            for p in Path(head or ".").iterdir()
+            if p.suffix in (".yaml", ".yml") or p.is_dir()
+        )
+    except OSError:
+        files = []
+    return [c for c in (*names, *files) if c.startswith(incomplete)]
+
+
 SpecArg = Annotated[
-    str, typer.Argument(help="A spec file, or the name of a shipped robot (see `robotspec list`).")
+    str,
+    typer.Argument(
+        help="A spec file, or the name of a shipped robot (see `robotspec list`).",
+        autocompletion=complete_spec,
+    ),
 ]

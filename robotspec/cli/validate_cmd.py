@@ -10,7 +10,7 @@ from typing import Annotated, Any
 import typer
 
 from robotspec.cli.app import app
-from robotspec.cli.options import PackagePath
+from robotspec.cli.options import PackagePath, complete_spec
 from robotspec.cli.render import styled
 
 
@@ -23,7 +23,10 @@ class Format(StrEnum):
 
 @app.command()
 def validate(
-    specs: Annotated[list[str], typer.Argument(help="Spec files or shipped robot names.")],
+    specs: Annotated[
+        list[str],
+        typer.Argument(help="Spec files or shipped robot names.", autocompletion=complete_spec),
+    ],
     strict: Annotated[bool, typer.Option("--strict", help="Treat warnings as errors.")] = False,
     format: Annotated[Format, typer.Option("--format", help="text or json.")] = Format.text,
     package_path: PackagePath = None,

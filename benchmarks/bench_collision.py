@@ -1,0 +1,180 @@
+"""Self-collision checking and collision matrix generation on the PR2, against pinocchio, one run.
+
+Run: ``python benchmarks/bench_collision.py`` (needs the dev extra: example-robot-data, pin, coal).
+Both sides check the same pairs (the SRDF's active pairs) on the same random configurations with
+the same coal geometry; the answers are compared before anything is timed. Ratios are peer time /
+robotspec time: above 1 means robotspec is faster.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.metadata as md
+import statistics
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+
+def median_time(fn: Callable[[], object], repeat: int) -> float:
+    """Median wall time of ``repeat`` calls (seconds); interleave peers to share machine noise."""
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return statistics.median(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--configs", type=int, default=2000, help="configurations per check run")
+    parser.add_argument("--samples", type=int, default=10_000, help="matrix generation samples")
+    parser.add_argument("--jobs", type=int, default=None, help="processes for the matrix")
+    args = parser.parse_args()
+
+    import pinocchio as pin
+
+    from robotspec.collision import (
+        CollisionRules,
+        SelfCollisionChecker,
+        compare_pairs,
+        generate_for_robot,
+        random_configurations,
+    )
+    from robotspec.compiler import check_spec
+    from robotspec.urdf import load_urdf
+
+    share = Path(str(md.distribution("example-robot-data").locate_file("cmeel.prefix/share")))
+    urdf = share / "example-robot-data/robots/pr2_description/urdf/pr2.urdf"
+    robot = check_spec("pr2").robot
+    assert robot is not None and robot.srdf is not None
+    world = load_urdf(urdf)
+    checker = SelfCollisionChecker(world, CollisionRules.for_world(world, srdf=robot.srdf))
+    pairs = checker.active_pairs
+
+    model, gmodel, _ = pin.buildModelsFromUrdf(str(urdf), package_dirs=[str(share)])
+    data = model.createData()
+    link = [model.frames[g.parentFrame].name for g in gmodel.geometryObjects]
+    index = {frozenset(p): k for k, p in enumerate(pairs)}
+    owner = []
+    for i in range(len(link)):
+        for j in range(i + 1, len(link)):
+            k = index.get(frozenset((link[i], link[j])))
+            if k is not None:
+                gmodel.addCollisionPair(pin.CollisionPair(i, j))
+                owner.append(k)
+    gdata = pin.GeometryData(gmodel)
+
+    qs = random_configurations(world, args.configs, seed=0)
+    # robotspec configuration -> pinocchio configuration (continuous joints are cos/sin).
+    pq = []
+    for q in qs:
+        v = pin.neutral(model)
+        for jid in range(1, model.njoints):
+            c = world.get_connection_by_name(model.names[jid])
+            jm = model.joints[jid]
+            x = q[c.dofs[0]] * (c.mimic.multiplier if c.mimic else 1.0) + (
+                c.mimic.offset if c.mimic else 0.0
+            )
+            if jm.nq == 2:
+                v[jm.idx_q : jm.idx_q + 2] = (np.cos(x), np.sin(x))
+            else:
+                v[jm.idx_q] = x
+        pq.append(v)
+
+    def pin_all() -> np.ndarray:
+        out = np.zeros((len(pq), len(pairs)), dtype=bool)
+        for n, v in enumerate(pq):
+            pin.computeCollisions(model, data, gmodel, gdata, v, False)
+            for k, res in zip(owner, gdata.collisionResults, strict=True):
+                if res.isCollision():
+                    out[n, k] = True
+        return out
+
+    def pin_all_noread() -> None:
+        for v in pq:
+            pin.computeCollisions(model, data, gmodel, gdata, v, False)
+
+    def pin_any() -> np.ndarray:
+        return np.array([pin.computeCollisions(model, data, gmodel, gdata, v, True) for v in pq])
+
+    ours_all = checker.collisions_batch(qs)
+    assert np.array_equal(ours_all, pin_all()), "robotspec and pinocchio disagree"
+    assert np.array_equal(checker.in_collision_batch(qs), pin_any())
+
+    rows: list[tuple[str, float, str, float]] = []
+    n = len(qs)
+    t_ours, t_pin, t_pin_bare = [], [], []
+    for _ in range(5):  # interleaved, so both sides see the same machine load
+        t_ours.append(median_time(lambda: checker.collisions_batch(qs), 1))
+        t_pin.append(median_time(pin_all, 1))
+        t_pin_bare.append(median_time(pin_all_noread, 1))
+    ours = statistics.median(t_ours) / n
+    rows.append(
+        ("all colliding pairs, batch", ours, "computeCollisions + read results", _m(t_pin) / n)
+    )
+    rows.append(("all colliding pairs, batch", ours, "computeCollisions only", _m(t_pin_bare) / n))
+    t_ours, t_pin = [], []
+    for _ in range(5):
+        t_ours.append(median_time(lambda: checker.in_collision_batch(qs), 1))
+        t_pin.append(median_time(pin_any, 1))
+    rows.append(
+        ("in collision? (first hit), batch", _m(t_ours) / n, "stop at first", _m(t_pin) / n)
+    )
+    few = qs[:200]
+    t_single = median_time(lambda: [checker.colliding_pairs(q) for q in few], 3) / len(few)
+    rows.append(
+        (
+            "all colliding pairs, one call per config",
+            t_single,
+            "computeCollisions only",
+            _m(t_pin_bare) / n,
+        )
+    )
+
+    print(
+        f"PR2 (example-robot-data): {len(pairs)} checked body pairs "
+        f"({len(owner)} geometry pairs), {n} random configurations; answers identical\n"
+    )
+    print(
+        f"{'robotspec':42} {'per config':>10}   {'pinocchio':34} {'per config':>10}  {'ratio':>6}"
+    )
+    for name, a, peer, b in rows:
+        print(f"{name:42} {_fmt(a):>10}   {peer:34} {_fmt(b):>10}  {b / a:6.2f}")
+
+    t = time.perf_counter()
+    matrix = generate_for_robot(robot, samples=args.samples, seed=0, processes=args.jobs)
+    wall = time.perf_counter() - t
+    geometry = set(matrix.bodies)
+    reference = frozenset(
+        frozenset((d.link1, d.link2))
+        for d in robot.srdf.disabled_collisions
+        if d.link1 in geometry and d.link2 in geometry
+    )
+    precision, recall = compare_pairs(matrix.disabled_pairs(), reference)
+    counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
+    print(
+        f"\ncollision matrix, {args.samples} samples, {matrix.processes} processes: "
+        f"{wall:.1f} s wall (target < 30 s)\n  {counts}; {len(matrix.checked)} pairs stay checked"
+        f"\n  against the shipped pr2.srdf ({len(reference)} pairs between bodies with geometry): "
+        f"precision {precision:.3f}, recall {recall:.3f}"
+    )
+
+
+def _m(values: list[float]) -> float:
+    return statistics.median(values)
+
+
+def _fmt(t: float) -> str:
+    if t < 1e-3:
+        return f"{t * 1e6:.1f} us"
+    if t < 1:
+        return f"{t * 1e3:.2f} ms"
+    return f"{t:.2f} s"
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,229 @@
+"""``robotspec collisions``: self-collision checks and collision matrix generation."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+
+from robotspec.cli.app import app
+from robotspec.cli.options import JsonFlag, PackagePath, SpecArg
+from robotspec.cli.table import render_table
+from robotspec.errors import CollisionError
+
+if TYPE_CHECKING:
+    from robotspec.semantic import AbstractRobot
+
+collisions_app = typer.Typer(
+    help="Self-collision checks and collision matrices (coal).", no_args_is_help=True
+)
+app.add_typer(collisions_app, name="collisions")
+
+StateOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--state",
+        "-s",
+        help="A named joint state (left_arm.park, park = every part's park, or an SRDF group "
+        "state); repeatable, applied in order.",
+        show_default=False,
+    ),
+]
+QOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--q",
+        help="A joint value JOINT=VALUE (rad or m), applied after the states; repeatable.",
+        show_default=False,
+    ),
+]
+SkipMeshes = Annotated[
+    bool,
+    typer.Option(
+        "--skip-missing-meshes",
+        help="Leave out missing or unreadable meshes (each is reported) instead of failing.",
+    ),
+]
+
+
+def _robot(spec: str, package_path: list[Any] | None) -> AbstractRobot:
+    from robotspec.compiler import compile_robot
+
+    return compile_robot(spec, package_paths=package_path or ())
+
+
+def _values(items: list[str] | None) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for item in items or ():
+        name, sep, text = item.partition("=")
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not sep or not name.strip() or not math.isfinite(value):
+            raise CollisionError(
+                f"--q '{item}': expected JOINT=VALUE with a finite number", kind="option"
+            )
+        out[name.strip()] = value
+    return out
+
+
+def _warn_skipped(skipped: tuple[Any, ...]) -> None:
+    from robotspec.cli.render import print_error
+
+    for err in skipped:
+        print_error(err)
+
+
+@collisions_app.command("check")
+def check(
+    spec: SpecArg,
+    state: StateOpt = None,
+    q: QOpt = None,
+    distances: Annotated[
+        bool, typer.Option("--distances", help="Also list every checked pair's distance.")
+    ] = False,
+    as_json: JsonFlag = False,
+    skip_missing_meshes: SkipMeshes = False,
+    package_path: PackagePath = None,
+) -> None:
+    """Is the robot in self-collision at a configuration? Exit code 1 when it is.
+
+    The configuration is the default pose (0, or mid-range), then --state, then --q.
+    Pairs closer than the spec's buffer distance are listed as warnings.
+    """
+    from robotspec.collision import SelfCollisionChecker
+
+    robot = _robot(spec, package_path)
+    checker = SelfCollisionChecker.from_robot(
+        robot, on_missing_mesh="skip" if skip_missing_meshes else "error"
+    )
+    config = checker.configuration(state or (), _values(q))
+    colliding = checker.colliding_pairs(config)
+    _warn_skipped(checker.skipped)
+    buffer = checker.rules.buffer_distance
+    near = [p for p in checker.buffer_violations(config) if p not in colliding] if buffer else []
+    pair_d = checker.distances(config) if distances else ()
+    if as_json:
+        doc: dict[str, Any] = {
+            "in_collision": bool(colliding),
+            "colliding_pairs": [list(p) for p in colliding],
+            "within_buffer": [list(p) for p in near],
+            "buffer_distance": buffer,
+            "checked_pairs": len(checker.active_pairs),
+        }
+        if distances:
+            doc["distances"] = [
+                {
+                    "link1": d.link1,
+                    "link2": d.link2,
+                    "distance": d.distance if math.isfinite(d.distance) else None,
+                    "point1": list(d.point1),
+                    "point2": list(d.point2),
+                }
+                for d in pair_d
+            ]
+        sys.stdout.write(json.dumps(doc, indent=2) + "\n")
+    else:
+        n = len(checker.active_pairs)
+        if colliding:
+            sys.stdout.write(f"IN COLLISION: {len(colliding)} of {n} checked pairs\n")
+            sys.stdout.write(render_table(["link1", "link2"], [list(p) for p in colliding]) + "\n")
+        else:
+            sys.stdout.write(f"collision-free ({n} pairs checked)\n")
+        if near:
+            sys.stdout.write(f"within the buffer distance ({buffer:g} m):\n")
+            sys.stdout.write(render_table(["link1", "link2"], [list(p) for p in near]) + "\n")
+        if distances:
+            rows = [[d.link1, d.link2, f"{d.distance:.6f}"] for d in pair_d]
+            sys.stdout.write(render_table(["link1", "link2", "distance (m)"], rows) + "\n")
+    if colliding:
+        raise typer.Exit(1)
+
+
+@collisions_app.command("generate")
+def generate(
+    spec: SpecArg,
+    samples: Annotated[
+        int, typer.Option("--samples", "-n", min=0, help="Random configurations to sample.")
+    ] = 10_000,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the sampler.")] = 0,
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write the SRDF here (default: stdout).")
+    ] = None,
+    merge: Annotated[
+        bool,
+        typer.Option(
+            "--merge", help="Add the pairs to the robot's SRDF (its own entries are kept)."
+        ),
+    ] = False,
+    jobs: Annotated[
+        int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes (default: CPUs).")
+    ] = None,
+    progress: Annotated[
+        bool | None,
+        typer.Option(
+            "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
+        ),
+    ] = None,
+    skip_missing_meshes: SkipMeshes = False,
+    package_path: PackagePath = None,
+) -> None:
+    """Compute the disabled collision pairs (Adjacent, Default, Always, Never) as SRDF.
+
+    Without --merge the SRDF holds only the disable_collisions; with it, the robot's SRDF with
+    the new pairs added. A summary (and, when the robot has an SRDF, precision and recall against
+    it) goes to stderr.
+    """
+    from robotspec.collision import Progress, compare_pairs, generate_for_robot
+    from robotspec.srdf import write_srdf
+
+    robot = _robot(spec, package_path)
+    if merge and robot.srdf is None:
+        raise CollisionError(f"--merge: robot '{robot.name}' has no SRDF to merge into")
+    bar = Progress(0, "collision matrix", enabled=progress)
+
+    def report(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done - bar.done)
+
+    with bar:
+        matrix = generate_for_robot(
+            robot,
+            samples=samples,
+            seed=seed,
+            processes=jobs,
+            progress=report,
+            on_missing_mesh="skip" if skip_missing_meshes else "error",
+        )
+    _warn_skipped(matrix.skipped)
+    text = write_srdf(matrix.to_srdf(robot.srdf if merge else None, merge=True))
+    if output is None:
+        sys.stdout.write(text)
+    else:
+        output.write_text(text, encoding="utf-8")
+    counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
+    lines = [
+        f"{len(matrix.disabled)} pairs disabled ({counts}); {len(matrix.checked)} stay checked; "
+        f"{matrix.samples} samples, seed {matrix.seed}, {matrix.processes} processes, "
+        f"{matrix.seconds:.1f} s"
+    ]
+    if robot.srdf is not None:
+        geometry = set(matrix.bodies)
+        reference = frozenset(
+            frozenset((d.link1, d.link2))
+            for d in robot.srdf.disabled_collisions
+            if d.link1 in geometry and d.link2 in geometry and d.link1 != d.link2
+        )
+        precision, recall = compare_pairs(matrix.disabled_pairs(), reference)
+        lines.append(
+            f"against {Path(robot.srdf.file or 'the SRDF').name}: precision {precision:.3f}, "
+            f"recall {recall:.3f} ({len(reference)} pairs there)"
+        )
+    if output is not None:
+        lines.append(f"wrote {output}")
+    sys.stderr.write("\n".join(lines) + "\n")

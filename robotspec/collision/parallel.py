@@ -1,0 +1,132 @@
+"""Worker processes for sampling-heavy collision work (the matrix generator's "Never" pass).
+
+Why rebuild in the worker: coal objects cannot be shared between processes, and a worker started
+with ``spawn`` or ``forkserver`` shares nothing with its parent anyway. A worker gets
+:class:`CheckerInputs` (plain frozen records: the world's bodies, joints and DOFs, and the pairs)
+and builds its own checker once, so the same code runs under every start method.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from collections import deque
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from multiprocessing.pool import AsyncResult
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from robotspec.collision.checker import SelfCollisionChecker
+from robotspec.collision.rules import CollisionRules
+from robotspec.collision.shapes import MissingMeshPolicy
+from robotspec.world import Body, Connection, DegreeOfFreedom, World
+
+__all__ = ["CheckerInputs", "default_processes", "ever_colliding_parallel"]
+
+Bools = NDArray[np.bool_]
+F64 = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class CheckerInputs:
+    """Everything a worker needs to rebuild a checker; picklable."""
+
+    name: str
+    source: str | None
+    bodies: tuple[Body, ...]
+    connections: tuple[Connection, ...]
+    dofs: tuple[DegreeOfFreedom, ...]
+    pairs: tuple[tuple[str, str], ...]
+    on_missing_mesh: MissingMeshPolicy = "error"
+
+    @classmethod
+    def of(cls, checker: SelfCollisionChecker, on_missing_mesh: MissingMeshPolicy) -> CheckerInputs:
+        """The inputs that rebuild ``checker`` (its world and its pairs, no rules needed)."""
+        w = checker.world
+        return cls(
+            name=w.name,
+            source=w.source,
+            bodies=w.bodies,
+            connections=w.connections,
+            dofs=w.degrees_of_freedom,
+            pairs=checker.active_pairs,
+            on_missing_mesh=on_missing_mesh,
+        )
+
+    def build(self) -> SelfCollisionChecker:
+        """A checker equal to the one the inputs were taken from."""
+        world = World(self.name, self.bodies, self.connections, self.dofs, source=self.source)
+        bodies = tuple(dict.fromkeys(b for p in self.pairs for b in p))
+        return SelfCollisionChecker(
+            world,
+            CollisionRules(bodies=bodies),
+            pairs=self.pairs,
+            on_missing_mesh=self.on_missing_mesh,
+        )
+
+
+#: One checker per worker process, built by the pool initializer. Only worker processes write
+#: it; the parent never reads it.
+_WORKER_STATE: dict[str, SelfCollisionChecker] = {}
+
+
+def _init_worker(inputs: CheckerInputs) -> None:
+    _WORKER_STATE["checker"] = inputs.build()
+
+
+def _ever_colliding_task(qs: F64, mask: Bools, margin: float) -> Bools:
+    return _WORKER_STATE["checker"].ever_colliding(qs, pair_mask=mask, margin=margin)
+
+
+def default_processes() -> int:
+    """The CPUs this process may run on."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def ever_colliding_parallel(
+    checker: SelfCollisionChecker,
+    qs: F64,
+    mask: Bools,
+    *,
+    processes: int,
+    chunk: int = 500,
+    margin: float = 0.0,
+    on_missing_mesh: MissingMeshPolicy = "error",
+    start_method: str | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> Bools:
+    """Per pair: whether it collides in any configuration of ``qs``, among pairs in ``mask``.
+
+    Chunks go to ``processes`` workers; each chunk is sent with the pairs not yet seen colliding,
+    so the work shrinks as the run goes. The answer is a union over chunks, so it does not depend
+    on the number of processes or on the order chunks finish in.
+    """
+    ever = np.zeros(len(checker.active_pairs), dtype=np.bool_)
+    chunks: Sequence[F64] = [qs[i : i + chunk] for i in range(0, len(qs), chunk)]
+    if processes <= 1 or len(chunks) <= 1:
+        for block in chunks:
+            ever |= checker.ever_colliding(block, pair_mask=mask & ~ever, margin=margin)
+            if progress is not None:
+                progress(len(block))
+        return ever
+    ctx = multiprocessing.get_context(start_method)
+    inputs = CheckerInputs.of(checker, on_missing_mesh)
+    pending: deque[tuple[int, AsyncResult[Any]]] = deque()
+    with ctx.Pool(processes, initializer=_init_worker, initargs=(inputs,)) as pool:
+        todo = deque(chunks)
+        while todo or pending:
+            while todo and len(pending) < 2 * processes:
+                block = todo.popleft()
+                task = pool.apply_async(_ever_colliding_task, (block, mask & ~ever, margin))
+                pending.append((len(block), task))
+            size, task = pending.popleft()
+            ever |= task.get()
+            if progress is not None:
+                progress(size)
+    return ever

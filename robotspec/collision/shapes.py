@@ -1,0 +1,270 @@
+"""Collision geometry: a world's collision elements as coal objects, built lazily and once.
+
+Why trimesh for meshes: it reads STL, OBJ and (with pycollada) DAE from Python, so a mesh that
+cannot be read becomes a :class:`~robotspec.errors.CollisionError` naming the body and the file,
+rather than a crash inside a C++ loader. Triangles are taken as the file stores them (no merging,
+no repair), which is what coal's own assimp loader (and so pinocchio) does, so distances agree to
+rounding. Each mesh file is read once per :class:`MeshLibrary`, however many bodies use it.
+
+Every geometry also gets an axis-aligned box in its body's frame: the checker's broad phase moves
+those boxes with the body poses in numpy and calls coal only for pairs whose boxes overlap.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from robotspec.errors import CollisionError, RobotSpecError
+from robotspec.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
+from robotspec.world import Body, World
+
+if TYPE_CHECKING:
+    import coal
+
+__all__ = [
+    "CollisionGeometry",
+    "GeometryModel",
+    "MeshLibrary",
+    "MissingMeshPolicy",
+    "build_geometry_model",
+    "import_coal",
+]
+
+F64 = NDArray[np.float64]
+
+MissingMeshPolicy = Literal["error", "skip"]
+"""``error``: a missing or unreadable mesh raises a CollisionError naming the body and the path.
+``skip``: the element is left out and the error is kept (as a warning) in
+:attr:`GeometryModel.skipped`, for the caller to report; never a silent skip."""
+
+
+def import_coal() -> Any:
+    """The ``coal`` module, or a CollisionError saying how to install it.
+
+    Why lazily: the rest of robotspec (validation, inspection, the driver) must work without the
+    collision library installed.
+    """
+    try:
+        import coal
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise CollisionError(
+            f"collision checking needs the 'coal' package ({exc}); install it with "
+            "`pip install coal`",
+            kind="dependency",
+            name="coal",
+        ) from None
+    return coal
+
+
+@dataclass(frozen=True)
+class CollisionGeometry:
+    """One collision element of a body, ready for coal.
+
+    ``body_T_geometry`` is the element's origin in its body frame; ``aabb_center`` and
+    ``aabb_half`` bound the element in the body frame (a box that moves with the body).
+    """
+
+    body: str
+    body_index: int
+    element: int
+    geometry: Any = field(repr=False, compare=False)
+    body_T_geometry: F64 = field(repr=False, compare=False)
+    aabb_center: F64 = field(repr=False, compare=False)
+    aabb_half: F64 = field(repr=False, compare=False)
+    kind: str = "mesh"
+
+
+@dataclass(frozen=True)
+class GeometryModel:
+    """All collision geometries of a world, body by body, with what was skipped and why."""
+
+    geometries: tuple[CollisionGeometry, ...]
+    skipped: tuple[RobotSpecError, ...] = ()
+
+    @property
+    def bodies(self) -> tuple[str, ...]:
+        """Names of the bodies that have at least one geometry, in world order."""
+        return tuple(dict.fromkeys(g.body for g in self.geometries))
+
+    def of_body(self, body: str) -> tuple[CollisionGeometry, ...]:
+        """The geometries of one body (empty if it has none)."""
+        return tuple(g for g in self.geometries if g.body == body)
+
+
+class MeshLibrary:
+    """Mesh files read into coal BVH models, each (file, scale) once.
+
+    Why an object rather than a module cache: no global state; a caller that builds several
+    checkers (tests, the matrix generator's workers) passes one library to share the loads.
+    """
+
+    def __init__(self) -> None:
+        self._cache: dict[tuple[str, tuple[float, float, float]], tuple[Any, F64]] = {}
+
+    def __len__(self) -> int:
+        return len(self._cache)
+
+    def load(self, path: str, scale: tuple[float, float, float]) -> tuple[Any, F64]:
+        """The BVH model of ``path`` scaled by ``scale`` and its vertices (V, 3).
+
+        Raises a bare CollisionError (the caller adds the body) when the file cannot be read or
+        holds no triangles.
+        """
+        key = (path, scale)
+        hit = self._cache.get(key)
+        if hit is not None:
+            return hit
+        vertices, faces = _read_mesh(path)
+        vertices = vertices * np.asarray(scale, dtype=np.float64)
+        coal = import_coal()
+        model = coal.BVHModelOBBRSS()
+        model.beginModel(len(faces), len(vertices))
+        model.addVertices(vertices)
+        model.addTriangles(faces)
+        model.endModel()
+        model.computeLocalAABB()
+        self._cache[key] = (model, vertices)
+        return model, vertices
+
+
+def _read_mesh(path: str) -> tuple[F64, NDArray[np.int64]]:
+    import trimesh
+
+    suffix = path.rsplit(".", 1)[-1].lower() if "." in path else ""
+    try:
+        with open(path, "rb") as f:
+            mesh = trimesh.load(f, file_type=suffix, force="mesh", process=False)
+    except FileNotFoundError:
+        raise CollisionError("mesh file not found", file=path, kind="mesh") from None
+    except OSError as exc:
+        raise CollisionError(f"cannot read mesh: {exc.strerror}", file=path, kind="mesh") from None
+    except Exception as exc:  # trimesh and its readers raise anything on a corrupt file
+        raise CollisionError(
+            f"cannot read mesh: {type(exc).__name__}: {exc}", file=path, kind="mesh"
+        ) from None
+    vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
+    if faces.ndim != 2 or len(faces) == 0 or faces.shape[1] != 3:
+        raise CollisionError("mesh has no triangles", file=path, kind="mesh")
+    if not np.all(np.isfinite(vertices)):
+        raise CollisionError("mesh has non-finite vertices", file=path, kind="mesh")
+    return vertices, faces
+
+
+def _primitive(shape: Shape, coal: Any) -> tuple[Any, F64, str]:
+    """A coal primitive and its half extents in its own frame."""
+    g = shape.geometry
+    if isinstance(g, Box):
+        sx, sy, sz = g.size
+        return coal.Box(sx, sy, sz), np.array([sx, sy, sz]) / 2.0, "box"
+    if isinstance(g, Cylinder):
+        r = g.radius
+        return coal.Cylinder(r, g.length), np.array([r, r, g.length / 2.0]), "cylinder"
+    if isinstance(g, Sphere):
+        r = g.radius
+        return coal.Sphere(r), np.array([r, r, r]), "sphere"
+    if isinstance(g, Capsule):
+        r = g.radius
+        return coal.Capsule(r, g.length), np.array([r, r, g.length / 2.0 + r]), "capsule"
+    raise TypeError(f"not a primitive: {g!r}")  # pragma: no cover
+
+
+def _check_dimensions(shape: Shape, body: Body, file: str | None) -> None:
+    g = shape.geometry
+    values: Sequence[float]
+    if isinstance(g, Box):
+        values = g.size
+    elif isinstance(g, Cylinder | Capsule):
+        values = (g.radius, g.length)
+    elif isinstance(g, Sphere):
+        values = (g.radius,)
+    else:
+        values = g.scale
+    if not all(math.isfinite(v) and v > 0 for v in values):
+        raise CollisionError(
+            f"link '{body.name}': collision {type(g).__name__.lower()} has a non-positive or "
+            f"non-finite dimension {tuple(values)}",
+            file=file,
+            line=shape.line,
+            kind="link",
+            name=body.name,
+        )
+
+
+def build_geometry_model(
+    world: World,
+    bodies: Sequence[str] | None = None,
+    *,
+    meshes: MeshLibrary | None = None,
+    on_missing_mesh: MissingMeshPolicy = "error",
+) -> GeometryModel:
+    """Coal geometries of the collision elements of ``bodies`` (default: every body).
+
+    A mesh that is unresolved (``Mesh.path is None``), missing or unreadable raises a
+    CollisionError naming the body and the file; with ``on_missing_mesh="skip"`` it is left out
+    and listed in ``skipped`` instead.
+    """
+    coal = import_coal()
+    library = meshes if meshes is not None else MeshLibrary()
+    wanted = None if bodies is None else set(bodies)
+    out: list[CollisionGeometry] = []
+    skipped: list[RobotSpecError] = []
+    for body in world.bodies:
+        if not body.collisions or (wanted is not None and body.name not in wanted):
+            continue
+        for k, shape in enumerate(body.collisions):
+            _check_dimensions(shape, body, world.source)
+            origin = np.asarray(shape.origin, dtype=np.float64)
+            rot, trans = origin[:3, :3], origin[:3, 3]
+            if isinstance(shape.geometry, Mesh):
+                try:
+                    geom, vertices = _load_mesh(library, shape.geometry, body)
+                except CollisionError as exc:
+                    if on_missing_mesh == "error":
+                        raise
+                    skipped.append(exc.with_severity("warning"))
+                    continue
+                in_body = vertices @ rot.T + trans
+                lo, hi = in_body.min(axis=0), in_body.max(axis=0)
+                center, half, kind = (lo + hi) / 2.0, (hi - lo) / 2.0, "mesh"
+            else:
+                geom, local_half, kind = _primitive(shape, coal)
+                center, half = trans.copy(), np.abs(rot) @ local_half
+            out.append(
+                CollisionGeometry(
+                    body=body.name,
+                    body_index=body.index,
+                    element=k,
+                    geometry=geom,
+                    body_T_geometry=origin.copy(),
+                    aabb_center=center,
+                    aabb_half=half,
+                    kind=kind,
+                )
+            )
+    return GeometryModel(geometries=tuple(out), skipped=tuple(skipped))
+
+
+def _load_mesh(library: MeshLibrary, mesh: Mesh, body: Body) -> tuple[coal.BVHModelOBBRSS, F64]:
+    if mesh.path is None:
+        raise CollisionError(
+            f"link '{body.name}': collision mesh '{mesh.uri}' was not resolved to a file",
+            kind="mesh",
+            name=body.name,
+            file=mesh.uri,
+        )
+    try:
+        return library.load(mesh.path, mesh.scale)
+    except CollisionError as exc:
+        raise CollisionError(
+            f"link '{body.name}': {exc.message} ('{mesh.path}')",
+            file=mesh.path,
+            kind="mesh",
+            name=body.name,
+        ) from None

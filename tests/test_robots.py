@@ -617,3 +617,10 @@ def test_users_own_spec_extending_pr2(
     # ... and by a path relative to the working directory
     monkeypatch.chdir(tmp_path)
     assert compile_robot("my_pr2.yaml").name == "my_pr2"
+
+
+def test_panda_grasps_along_the_tcp_z_axis() -> None:
+    # The TCP's z axis points out of the hand between the fingers; the spec once wrote the
+    # opposite rotation, whose axis (R^T x) is -z.
+    (hand,) = compile_robot("panda").manipulators
+    assert hand.front_facing_axis == pytest.approx((0.0, 0.0, 1.0), abs=1e-6)

@@ -176,7 +176,9 @@ def _compile(
                 base_folder=loaded.folder,
             )
         except RobotSpecError as exc:
-            diag.add(exc, ("description", "urdf"))
+            diag.add(
+                _at_spec_if_missing(exc, diag, ("description", "urdf")), ("description", "urdf")
+            )
             diag.raise_if_failed()
             raise
         for w in desc.warnings:
@@ -204,7 +206,9 @@ def _compile(
                 resolve_file(spec.description.srdf, loaded.folder, resolver), strict=False
             )
         except RobotSpecError as exc:
-            diag.add(exc, ("description", "srdf"))
+            diag.add(
+                _at_spec_if_missing(exc, diag, ("description", "srdf")), ("description", "srdf")
+            )
     if srdf is not None:
         for err in [
             *check_srdf_references(srdf),
@@ -226,6 +230,25 @@ def _compile(
     diag.raise_if_failed(strict=strict)
     return CompileResult(
         loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))
+    )
+
+
+def _at_spec_if_missing(
+    err: RobotSpecError, diag: Diagnostics, loc: tuple[str, ...]
+) -> RobotSpecError:
+    """A missing description file is the spec's mistake: point at the line that names it."""
+    if err.detail.kind != "file" or err.file is None:
+        return err
+    file, line, col = diag.loaded.position(loc)
+    return RobotSpecError(
+        f"{err.file}: {err.message}",
+        file=file,
+        line=line,
+        column=col,
+        kind="file",
+        name=err.detail.name,
+        suggestions=err.detail.suggestions,
+        location=loc,
     )
 
 

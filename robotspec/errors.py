@@ -31,6 +31,7 @@ __all__ = [
     "RobotInfoError",
     "RobotSpecError",
     "RobotSpecErrors",
+    "ServiceError",
     "SpecError",
     "SrdfError",
     "closest_names",
@@ -270,6 +271,10 @@ class RobotInfoError(RobotSpecError):
 
 class DriverError(RobotSpecError):
     """A driver command is refused (wrong mode, out of limits, not finite)."""
+
+
+class ServiceError(RobotSpecError):
+    """A network service cannot start or run (port taken, node or device name in use)."""
 
 
 class RobotSpecErrors(RobotSpecError):

@@ -36,6 +36,7 @@ def _register() -> None:
         collisions_cmd,
         demo_cmd,
         drive_cmd,
+        export_cmd,
         init_cmd,
         inspect_cmd,
         misc_cmd,

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from robotspec.cli.app import app
+from robotspec.cli.options import PackagePath
 
 if TYPE_CHECKING:
     from robotspec.driver.state import RobotState
@@ -49,6 +50,25 @@ def drive(
         bool,
         typer.Option("--virtual-time", help="Run on a simulated clock, as fast as possible."),
     ] = False,
+    package_path: PackagePath = None,
+    serve: Annotated[
+        bool,
+        typer.Option("--serve", help="Serve the robot over Robot Raconteur (loopback only)."),
+    ] = False,
+    port: Annotated[
+        int | None,
+        typer.Option("--port", help="TCP port for --serve (default 58660; 0 picks a free one)."),
+    ] = None,
+    public: Annotated[
+        bool, typer.Option("--public", help="With --serve: listen on all interfaces, discoverable.")
+    ] = False,
+    node_name: Annotated[
+        str | None, typer.Option("--node-name", help="With --serve: the RR node name.")
+    ] = None,
+    state_dir: Annotated[
+        Path | None,
+        typer.Option("--state-dir", help="With --serve: folder for the node's UUID and locks."),
+    ] = None,
 ) -> None:
     """Run a simulated robot driver loop (Robot Raconteur AbstractRobot semantics)."""
     if sim is None and spec is None:
@@ -61,32 +81,49 @@ def drive(
         raise typer.BadParameter(
             f"unknown log format '{log.suffix}' (use .csv or .jsonl)", param_hint="--log"
         )
+    from robotspec.service.cli import serve_option_problem
 
-    from robotspec.errors import RobotSpecError, RobotSpecErrors
-
-    if spec is not None:
-        compiler = Path(__file__).resolve().parents[1] / "compiler.py"
-        if not compiler.exists():
-            raise RobotSpecError(
-                f"--spec {spec} --chain {chain}: driving a compiled spec is not yet available "
-                "(it needs the spec compiler's RobotInfo export); use --sim ROBOTINFO.yaml"
-            )
-        raise RobotSpecError("--spec: RobotInfo export from a spec is not implemented yet")
+    problem = serve_option_problem(
+        serve=serve,
+        port=port,
+        public=public,
+        node_name=node_name,
+        state_dir=state_dir,
+        script=script,
+        virtual_time=virtual_time,
+    )
+    if problem:
+        raise typer.BadParameter(problem)
 
     from robotspec.driver.clock import RealClock, SimClock
-    from robotspec.driver.robot_info import read_robot_info
     from robotspec.driver.script import load_scenario, mismatch_errors, run_scenario
     from robotspec.driver.sim import SimRobot
     from robotspec.driver.statelog import StateLog
+    from robotspec.errors import RobotSpecError, RobotSpecErrors
 
-    assert sim is not None
-    loaded_info = read_robot_info(sim)
-    for w in loaded_info.warnings:
-        sys.stderr.write(w.detail.render() + "\n")
+    if spec is not None:
+        # Export the chain in memory (H/P, limits, flange) and drive that: every robot
+        # robotspec can compile can be driven, not only those that ship a RobotInfo.
+        from robotspec.cli.export_cmd import export_spec_chain
+
+        assert chain is not None
+        exported = export_spec_chain(spec, chain, package_path)
+        for note in exported.notes:
+            sys.stderr.write(f"note: {note}\n")
+        info = exported.info
+        fallback_name = f"{spec}_{chain}"
+    else:
+        from robotspec.driver.robot_info import read_robot_info
+
+        assert sim is not None
+        loaded_info = read_robot_info(sim)
+        for w in loaded_info.warnings:
+            sys.stderr.write(w.detail.render() + "\n")
+        info = loaded_info.info
+        fallback_name = sim.stem
     scenario = load_scenario(script) if script is not None else None
     clock = SimClock() if virtual_time else RealClock()
-    driver = SimRobot(loaded_info.info, clock=clock, update_period=1.0 / rate)
-    info = loaded_info.info
+    driver = SimRobot(info, clock=clock, update_period=1.0 / rate)
     statelog = None
     if log is not None:
         statelog = StateLog(log, info.joint_names, len(info.chains))
@@ -94,7 +131,7 @@ def drive(
     tty = sys.stdout.isatty()
     status = _StatusLine(tty)
     driver.add_state_listener(status)
-    name = info.device_info.device.name or sim.stem
+    name = info.device_info.device.name or fallback_name
     sys.stderr.write(
         f"driving {name} ({len(info.joint_info)} joints, {len(info.chains)} "
         f"chain{'s' if len(info.chains) != 1 else ''}) in simulation at {rate:g} Hz"
@@ -105,7 +142,20 @@ def drive(
     wall0 = time.perf_counter()
     try:
         driver.step()
-        if scenario is not None:
+        if serve:
+            from robotspec.service.cli import serve_driver
+
+            serve_driver(
+                driver,
+                info,
+                port=port,
+                public=public,
+                node_name=node_name,
+                state_dir=state_dir,
+                duration=duration,
+                fallback_name=fallback_name,
+            )
+        elif scenario is not None:
 
             def report(r: object) -> None:
                 from robotspec.driver.script import StepResult

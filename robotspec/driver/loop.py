@@ -598,6 +598,15 @@ class RobotDriver(ABC):
         with self._lock:
             self._fault_message = f"driver step failed: {type(exc).__name__}: {exc}"
             self._command_mode = CommandMode.invalid_state
+            # The step did not get to reset its per-step flags: a stale valid_position_command
+            # would otherwise be published beside invalid_state (found by the state machine).
+            self._stream_valid = StateFlags.none
+            self._traj_failed_this_step = False
+            # Nothing (reliably) went out this step: the next command must be rate-limited
+            # from the measured position, not from a command sent before the failure, which
+            # the arm may be far from by now (found by the state machine: 2.7 x the velocity
+            # limit relative to the arm on the first command after recovery).
+            self._record_sent(None, None)
             self._end_motion(OperationAbortedError(f"Interrupted: {self._fault_message}"))
             try:
                 self._fill_states(now)
@@ -654,10 +663,15 @@ class RobotDriver(ABC):
     def _verify_robot_state(self, now: float) -> bool:
         """Step 3: the reference's rules, first match wins (note §1.2)."""
         error = self._error or bool(self._fault_message)
+        # Deviation: an e-stop ends homing too. The reference keeps homing through an e-stop
+        # when the drives still report enabled (they do, flags 0x2000c), so the mode said
+        # "homing" on a stopped robot and the pending home() never failed (found by the
+        # state machine).
         if (
             self._command_mode is CommandMode.homing
             and self._enabled
             and not error
+            and not self._stopped
             and not self._communication_failure
         ):
             if self._base_set_controller_state:

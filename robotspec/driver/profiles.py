@@ -9,6 +9,8 @@ with the velocity and acceleration limits and a braking velocity that stops exac
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import numpy.typing as npt
 
@@ -88,9 +90,12 @@ class JogMotion:
         self.done = False
         if synchronize and not np.any(self.v):
             dist = self.target_position - self.q
-            times = rest_to_rest_time(dist, self.vmax, self.amax)
+            # A denormal max_velocity (accepted: it is > 0) overflows the move time to inf;
+            # then no synchronisation (found by the state machine: NaN scale factors).
+            with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+                times = rest_to_rest_time(dist, self.vmax, self.amax)
             t_max = float(times.max()) if times.size else 0.0
-            if t_max > 0.0:
+            if 0.0 < t_max < math.inf:
                 lam = np.where(np.abs(dist) > 0, np.maximum(times / t_max, 1e-3), 1.0)
                 self.vmax = self.vmax * lam
                 self.amax = self.amax * lam * lam

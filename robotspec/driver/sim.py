@@ -106,6 +106,13 @@ class SimRobot(RobotDriver):
             self._v[:] = 0.0
             self._pending_pos = self._pending_vel = None
             return
+        if self._homing_target is not None and (
+            self._homing_completion is None or self._homing_completion.done
+        ):
+            # The driver ended homing (halt, error, e-stop): the controller stops homing too,
+            # instead of carrying on toward home on its own.
+            self._homing_target = None
+            self._homing_completion = None
         if self._homing_target is not None:
             cap = lim.velocity * self._homing_speed
             v_des = np.minimum(np.maximum((self._homing_target - self._q) / dt, -cap), cap)

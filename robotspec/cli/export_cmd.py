@@ -1,0 +1,82 @@
+"""``robotspec export``: write what a compiled spec means in other formats (a RobotInfo, ...)."""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from robotspec.cli.app import app
+from robotspec.cli.options import PackagePath, SpecArg
+
+if TYPE_CHECKING:
+    from robotspec.driver.export import ExportedRobotInfo
+
+export_app = typer.Typer(help="Export a compiled robot to other formats.", no_args_is_help=True)
+app.add_typer(export_app, name="export")
+
+
+def export_spec_chain(
+    spec: str, chain: str, package_paths: list[Path] | None = None
+) -> ExportedRobotInfo:
+    """Compile ``spec`` and export its chain ``chain`` as a RobotInfo (shared with ``drive``).
+
+    Why here and not in the driver package: it joins the compiler (spec → robot) with the export
+    (world chain → RobotInfo); the driver package stays free of the compiler.
+    """
+    from robotspec.compiler import compile_robot
+    from robotspec.driver.export import export_chain
+
+    robot = compile_robot(spec, package_paths=package_paths or ())
+    c = robot.get_chain(chain)
+    # Robot Raconteur device names must match ^[a-zA-Z][a-zA-Z0-9_.-]*$.
+    device = re.sub(r"[^A-Za-z0-9_.-]", "_", f"{robot.name}_{c.name}")
+    if not device[:1].isalpha():
+        device = f"robot_{device}"
+    return export_chain(
+        robot.world,
+        c.root,
+        c.tip,
+        device_name=device,
+        chain_name=c.name,
+        description=f"chain '{c.name}' of robot '{robot.name}'",
+    )
+
+
+@export_app.command("robotinfo")
+def robotinfo(
+    spec: SpecArg,
+    chain: Annotated[
+        str, typer.Option("--chain", "-c", help="The chain to export (see `inspect chains`).")
+    ],
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write to FILE instead of stdout.")
+    ] = None,
+    package_path: PackagePath = None,
+) -> None:
+    """A Robot Raconteur RobotInfo YAML of one chain: H/P kinematics, limits, flange pose.
+
+    URDF has no acceleration limits, so they default to 5 x the velocity limit; continuous joints
+    become revolute within +-2 pi. Each default used is reported on stderr.
+    """
+    from robotspec.driver.export import dump_robot_info_yaml
+
+    ex = export_spec_chain(spec, chain, package_path)
+    header = (
+        f"RobotInfo of chain '{chain}' of {spec}, exported by robotspec.\n"
+        "H/P in the frame of the chain root at q = 0; flange_pose holds the tip rotation."
+    )
+    text = dump_robot_info_yaml(ex.info, header=header)
+    for note in ex.notes:
+        sys.stderr.write(f"note: {note}\n")
+    if output is None:
+        sys.stdout.write(text)
+        return
+    output.write_text(text, encoding="utf-8")
+    sys.stderr.write(
+        f"wrote {output} ({len(ex.info.joint_info)} joints, chain "
+        f"{ex.info.chains[0].kin_chain_identifier.name})\n"
+    )

@@ -1,0 +1,399 @@
+"""A RobotInfo for any serial chain of a world: H/P kinematics, joint limits and the flange pose.
+
+Why: the driver runs from a RobotInfo, and only a handful of real robots ship one. Deriving it
+from the world model lets ``robotspec drive --spec SPEC --chain NAME`` drive every robot robotspec
+can load, with kinematics that agree with the world's own forward kinematics (tested to 1e-9).
+
+The conversion follows the general-robotics-toolbox / standard_robdef ``urdf_to_robotinfo.py``
+recipe (reference note §1(c)):
+
+* walk the connections from ``root`` to the flange body, keeping the accumulated rotation ``R``
+  (the frame orientation at q = 0) and the current offset ``P[k]``;
+* every connection adds ``R · origin.translation`` to ``P[k]`` and then turns ``R`` by the origin
+  rotation; a movable joint then records ``H[k] = R · axis`` and opens ``P[k + 1]``;
+* fixed connections therefore fold into ``P`` (and into the flange rotation when they follow the
+  last joint); what remains of ``R`` at the end is the flange orientation, emitted as
+  ``flange_pose`` with a zero position (the offset is already in ``P[n]``).
+
+Choices where URDF and RobotInfo disagree, all documented in :func:`export_chain`'s arguments:
+
+* URDF has no acceleration limit; RobotInfo requires one > 0. The default is
+  :data:`DEFAULT_ACCELERATION_FACTOR` times the velocity limit (full speed in 0.2 s).
+* Continuous joints become ``revolute`` with limits of ``±continuous_limit`` (the Robot Raconteur
+  Companion rejects the ``continuous`` type), unless ``keep_continuous`` is set.
+* A missing (infinite or zero) velocity limit becomes ``default_velocity``; an unknown effort
+  limit becomes 0, the robdef's "not given".
+* Mimic joints have no H/P form, and floating or planar joints no single axis: a chain containing
+  one is refused with a :class:`~robotspec.errors.RobotInfoError` naming the joint and its line.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+import yaml
+
+from robotspec.driver.hp_kinematics import rot_to_quat
+from robotspec.driver.robot_info import (
+    DeviceClass,
+    DeviceInfo,
+    Identifier,
+    JointEffortUnits,
+    JointInfo,
+    JointLimits,
+    JointPositionUnits,
+    JointType,
+    KinChainInfo,
+    Pose,
+    Quaternion,
+    RobotCapability,
+    RobotInfo,
+    RobotTypeCode,
+    Vector3,
+)
+from robotspec.errors import RobotInfoError
+from robotspec.world import Body, Connection, ConnectionType, World
+
+__all__ = [
+    "DEFAULT_ACCELERATION_FACTOR",
+    "DEFAULT_CAPABILITIES",
+    "ExportedRobotInfo",
+    "dump_robot_info_yaml",
+    "export_chain",
+    "robot_info_from_chain",
+]
+
+FloatArray = npt.NDArray[np.float64]
+
+#: Default acceleration limit = this factor times the velocity limit (full speed in 0.2 s).
+DEFAULT_ACCELERATION_FACTOR = 5.0
+#: What the simulated driver can do with an exported chain (it has no homing routine to export).
+DEFAULT_CAPABILITIES: tuple[RobotCapability, ...] = (
+    RobotCapability.jog_command,
+    RobotCapability.trajectory_command,
+    RobotCapability.position_command,
+    RobotCapability.velocity_command,
+)
+#: The Robot Raconteur standard UUID of the ``robot`` device class (as in the real files).
+_ROBOT_CLASS_UUID = "39b513e7-21b9-4b49-8654-7537473030eb"
+#: H vectors and the flange rotation are cleaned of round-off below this (exact zeros read well).
+_CLEAN_TOL = 1e-15
+
+
+@dataclass(frozen=True)
+class ExportedRobotInfo:
+    """The RobotInfo of a chain, and notes on every default that stood in for missing data.
+
+    Why the notes: a user driving an exported robot should learn that its acceleration limits
+    were invented, not discover it from a jog that is too gentle or too violent.
+    """
+
+    info: RobotInfo
+    notes: tuple[str, ...] = ()
+
+
+def _clean(v: FloatArray) -> FloatArray:
+    out = np.where(np.abs(v) < _CLEAN_TOL, 0.0, v)
+    return np.asarray(out + 0.0, dtype=np.float64)  # + 0.0 turns -0.0 into 0.0
+
+
+def _body(world: World, body: Body | str) -> Body:
+    return world.get_body_by_name(body) if isinstance(body, str) else body
+
+
+def _vec(v: FloatArray) -> Vector3:
+    return Vector3(x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+
+def _refuse(world: World, c: Connection, why: str) -> RobotInfoError:
+    return RobotInfoError(
+        f"joint '{c.name}' ({c.type.value}{', mimic' if c.is_mimic else ''}) {why}",
+        file=world.source,
+        line=c.line,
+        kind="joint",
+        name=c.name,
+    )
+
+
+def _positive(value: float, what: str) -> float:
+    if not (math.isfinite(value) and value > 0.0):
+        raise RobotInfoError(f"{what} must be a positive finite number, got {value!r}")
+    return float(value)
+
+
+def _per_joint(
+    value: float | Mapping[str, float] | None, names: Iterable[str], what: str
+) -> dict[str, float]:
+    """A per-joint override table; an unknown joint name is an error (not a silent no-op)."""
+    if value is None:
+        return {}
+    names = list(names)
+    if isinstance(value, Mapping):
+        unknown = sorted(set(value) - set(names))
+        if unknown:
+            raise RobotInfoError(
+                f"{what} names joints not in the chain: {', '.join(unknown)} "
+                f"(chain joints: {', '.join(names)})"
+            )
+        return {k: _positive(float(v), f"{what}['{k}']") for k, v in value.items()}
+    x = _positive(float(value), what)
+    return dict.fromkeys(names, x)
+
+
+def export_chain(
+    world: World,
+    root: Body | str,
+    tip: Body | str,
+    *,
+    device_name: str,
+    flange: Body | str | None = None,
+    chain_name: str | None = None,
+    acceleration: float | Mapping[str, float] | None = None,
+    default_velocity: float = 1.0,
+    continuous_limit: float = 2.0 * math.pi,
+    keep_continuous: bool = False,
+    capabilities: Iterable[RobotCapability | str] = DEFAULT_CAPABILITIES,
+    description: str = "",
+) -> ExportedRobotInfo:
+    """Build the RobotInfo of the serial chain ``root`` → ``tip`` of ``world``.
+
+    Args:
+        world: the kinematic tree.
+        root: the chain's base body; the RobotInfo base frame is its frame.
+        tip: the last body the chain's joints move.
+        device_name: ``device_info.device.name`` (the driver's identity).
+        flange: the flange body, at or below ``tip`` and joined to it by fixed connections only
+            (e.g. a ``tool0`` frame); default ``tip``.
+        chain_name: ``kin_chain_identifier`` (default: the device name).
+        acceleration: acceleration limit for every joint, or per joint name (others default);
+            default :data:`DEFAULT_ACCELERATION_FACTOR` × the velocity limit.
+        default_velocity: velocity limit for joints whose description gives none (rad/s, m/s).
+        continuous_limit: continuous joints get position limits ``±continuous_limit``.
+        keep_continuous: emit the ``continuous`` joint type instead of ``revolute`` (the
+            Robot Raconteur Companion refuses it; robotspec's driver accepts it with a warning).
+        capabilities: ``robot_capabilities`` to declare.
+        description: the chain's ``description``.
+
+    Returns:
+        The RobotInfo and notes on the defaults used.
+
+    Raises:
+        RobotInfoError: a mimic, floating or planar joint inside the chain, a moving joint between
+            ``tip`` and ``flange``, a chain without joints, or bad limits (each names the joint).
+        KinematicsError: ``root`` is not an ancestor of ``tip`` (or of ``flange``).
+    """
+    root_b = _body(world, root)
+    tip_b = _body(world, tip)
+    flange_b = tip_b if flange is None else _body(world, flange)
+    _positive(default_velocity, "default_velocity")
+    _positive(continuous_limit, "continuous_limit")
+    to_tip = world.compute_chain_of_connections(root_b, tip_b)
+    after_tip = world.compute_chain_of_connections(tip_b, flange_b)
+    for c in after_tip:
+        if not c.is_fixed:
+            raise _refuse(
+                world, c, f"moves the flange '{flange_b.name}' beyond the tip '{tip_b.name}'"
+            )
+
+    r_acc = np.eye(3)
+    p_list: list[FloatArray] = [np.zeros(3)]
+    h_list: list[FloatArray] = []
+    movable: list[Connection] = []
+    for c in [*to_tip, *after_tip]:
+        if c.is_mimic:
+            assert c.mimic is not None
+            raise _refuse(
+                world,
+                c,
+                f"mimics '{c.mimic.leader}' inside the chain '{root_b.name}' -> '{tip_b.name}'; "
+                "a RobotInfo chain has no mimic joints (end the chain before it)",
+            )
+        if c.type in (ConnectionType.FLOATING, ConnectionType.PLANAR):
+            raise _refuse(world, c, "has no single axis; a RobotInfo chain is serial 1-DOF joints")
+        origin = np.asarray(c.origin, dtype=np.float64)
+        p_list[-1] = p_list[-1] + r_acc @ origin[:3, 3]
+        r_acc = r_acc @ origin[:3, :3]
+        if c.is_fixed:
+            continue
+        axis = r_acc @ np.asarray(c.axis, dtype=np.float64)
+        norm = float(np.linalg.norm(axis))
+        if not norm > 0.0:
+            raise _refuse(world, c, "has a zero axis")
+        h_list.append(_clean(axis / norm))
+        p_list.append(np.zeros(3))
+        movable.append(c)
+    if not movable:
+        raise RobotInfoError(
+            f"the chain '{root_b.name}' -> '{tip_b.name}' has no movable joint",
+            file=world.source,
+            kind="chain",
+            name=tip_b.name,
+        )
+
+    names = [world.degrees_of_freedom[c.dofs[0]].name for c in movable]
+    accel = _per_joint(acceleration, names, "acceleration")
+    notes: list[str] = []
+    joints: list[JointInfo] = []
+    defaulted_accel: list[str] = []
+    for c, name in zip(movable, names, strict=True):
+        dof = world.degrees_of_freedom[c.dofs[0]]
+        prismatic = c.type is ConnectionType.PRISMATIC
+        lower, upper = float(dof.lower), float(dof.upper)
+        jtype = JointType.prismatic if prismatic else JointType.revolute
+        if c.type is ConnectionType.CONTINUOUS or not (
+            math.isfinite(lower) and math.isfinite(upper)
+        ):
+            if prismatic:
+                raise _refuse(world, c, "has no position limits; a RobotInfo joint needs them")
+            if c.type is ConnectionType.CONTINUOUS and keep_continuous:
+                jtype = JointType.continuous
+            lower = max(lower, -continuous_limit)
+            upper = min(upper, continuous_limit)
+            notes.append(
+                f"joint '{name}' ({c.type.value}) has no position limits: "
+                f"[{lower:.6g}, {upper:.6g}] used"
+            )
+        velocity = float(dof.velocity)
+        if not (math.isfinite(velocity) and velocity > 0.0):
+            notes.append(
+                f"joint '{name}' has no velocity limit: {default_velocity:g} "
+                f"{'m/s' if prismatic else 'rad/s'} used"
+            )
+            velocity = default_velocity
+        if name in accel:
+            acc = accel[name]
+        else:
+            acc = float(f"{DEFAULT_ACCELERATION_FACTOR * velocity:.12g}")
+            defaulted_accel.append(name)
+        effort = float(dof.effort) if math.isfinite(dof.effort) and dof.effort > 0 else 0.0
+        try:
+            limits = JointLimits(
+                lower=lower,
+                upper=upper,
+                home=min(max(0.0, lower), upper),
+                velocity=velocity,
+                acceleration=acc,
+                effort=effort,
+            )
+        except ValueError as exc:  # pydantic's ValidationError is a ValueError
+            raise _refuse(world, c, f"has unusable limits: {exc}") from None
+        joints.append(
+            JointInfo(
+                joint_identifier=Identifier(name=name),
+                joint_type=jtype,
+                joint_limits=limits,
+                default_units=JointPositionUnits.meter if prismatic else JointPositionUnits.radian,
+                default_effort_units=JointEffortUnits.newton
+                if prismatic
+                else JointEffortUnits.newton_meter,
+            )
+        )
+    if defaulted_accel:
+        notes.append(
+            f"the description gives no acceleration limits: {DEFAULT_ACCELERATION_FACTOR:g} x "
+            f"the velocity limit used for {', '.join(defaulted_accel)}"
+        )
+
+    q = rot_to_quat(_clean(r_acc))
+    flange_pose = Pose(
+        orientation=Quaternion(w=float(q[0]), x=float(q[1]), y=float(q[2]), z=float(q[3])),
+        position=Vector3(x=0.0, y=0.0, z=0.0),
+    )
+    link_ids = (
+        Identifier(name=root_b.name),
+        *(Identifier(name=world.bodies[c.child].name) for c in movable),
+    )
+    chain = KinChainInfo(
+        kin_chain_identifier=Identifier(name=chain_name or device_name),
+        H=tuple(_vec(h) for h in h_list),
+        P=tuple(_vec(_clean(p)) for p in p_list),
+        link_identifiers=link_ids,
+        joint_numbers=tuple(range(len(movable))),
+        flange_pose=flange_pose,
+        flange_identifier=Identifier(name=flange_b.name),
+        description=description,
+    )
+    info = RobotInfo(
+        device_info=DeviceInfo(
+            device=Identifier(name=device_name),
+            model=Identifier(name=world.name),
+            user_description=(
+                f"{world.name}: chain {root_b.name} -> {flange_b.name}, exported by robotspec"
+            ),
+            device_classes=(
+                DeviceClass(
+                    class_identifier=Identifier.model_validate(
+                        {"name": "robot", "uuid": _ROBOT_CLASS_UUID}
+                    ),
+                    subclasses=("serial",),
+                ),
+            ),
+            implemented_types=("com.robotraconteur.robotics.robot.Robot",),
+        ),
+        robot_type=RobotTypeCode.serial,
+        robot_capabilities=tuple(RobotCapability(x) for x in capabilities),
+        joint_info=tuple(joints),
+        chains=(chain,),
+    )
+    return ExportedRobotInfo(info=info, notes=tuple(notes))
+
+
+def robot_info_from_chain(
+    world: World,
+    root: Body | str,
+    tip: Body | str,
+    *,
+    device_name: str,
+    flange: Body | str | None = None,
+    **options: Any,
+) -> RobotInfo:
+    """The RobotInfo of ``root`` → ``tip`` (see :func:`export_chain` for the options)."""
+    return export_chain(world, root, tip, device_name=device_name, flange=flange, **options).info
+
+
+#: Joint limit keys the real files never write; left out when zero (zero means "not given").
+_ZERO_LIMIT_KEYS = frozenset(
+    {"jerk", "reduced_velocity", "reduced_acceleration", "reduced_jerk", "reduced_effort"}
+)
+
+
+def _prune(value: Any, key: str = "") -> Any:
+    """Drop empty strings, lists and maps, and unset optional limits, recursively."""
+    if isinstance(value, dict):
+        out: dict[str, Any] = {}
+        for k, v in value.items():
+            if key == "joint_limits" and k in _ZERO_LIMIT_KEYS and v == 0:
+                continue
+            if k == "config_seqno" and v == 0:
+                continue
+            pv = _prune(v, k)
+            if pv is None or pv == "" or pv == [] or pv == {}:
+                continue
+            out[k] = pv
+        return out
+    if isinstance(value, list):
+        return [_prune(v, key) for v in value]
+    return value
+
+
+def dump_robot_info_yaml(info: RobotInfo, *, header: str = "") -> str:
+    """The RobotInfo as YAML that :func:`~robotspec.driver.robot_info.load_robot_info` reads back.
+
+    Why not ``exclude_defaults``: the reference parser fills a missing key with the robdef's zero
+    value, not with robotspec's default, so ``joint_type``, ``default_units``, ``lower`` and
+    ``upper`` are always written (a missing ``joint_type`` would read as ``unknown`` there). Only
+    empty values and unset optional limits are left out. Floats are written with ``repr``
+    precision, so the round trip is exact. ``header`` becomes ``#`` comment lines at the top
+    (where the real files say where they come from).
+    """
+    data = _prune(info.model_dump(mode="json", exclude_none=True))
+    text = yaml.safe_dump(data, sort_keys=False, default_flow_style=False, width=100)
+    if header:
+        lines = "".join(f"# {line}\n".replace("# \n", "#\n") for line in header.splitlines())
+        text = lines + text
+    return text

@@ -1,0 +1,533 @@
+"""The simulated robot served over Robot Raconteur, driven by a real RR client on loopback.
+
+Each test starts its own server (an in-process node on a free loopback port, state in a temporary
+folder) around a real-time :class:`SimRobot`, and talks to it through a separate client node, as
+any client program would. The waits are bounded (a few seconds at most) and the assertions use
+the robot's own state, not timing.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+pytest.importorskip(
+    "RobotRaconteur",
+    reason="robotraconteur is not installed (pip install robotspec[robotraconteur])",
+)
+pytest.importorskip(
+    "RobotRaconteurCompanion",
+    reason="robotraconteurcompanion is not installed (pip install robotspec[robotraconteur])",
+)
+
+from robotspec.cli import render  # noqa: E402
+from robotspec.cli.app import _register, app  # noqa: E402
+from robotspec.driver.robot_info import load_robot_info  # noqa: E402
+from robotspec.driver.sim import Fault, SimRobot  # noqa: E402
+from robotspec.driver.state import CommandMode, StateFlags  # noqa: E402
+from robotspec.errors import ServiceError  # noqa: E402
+from robotspec.service.node import start_client_node  # noqa: E402
+from robotspec.service.server import RobotServer, ServeOptions  # noqa: E402
+
+from .driver_support import RRP  # noqa: E402
+
+PERIOD = 0.004
+WAIT = 5.0  # the longest any condition below is waited for, in seconds
+
+
+def wait_until(cond: Callable[[], bool], timeout: float = WAIT) -> None:
+    end = time.monotonic() + timeout
+    while not cond():
+        if time.monotonic() > end:
+            raise AssertionError("condition not met in time")
+        time.sleep(0.005)
+
+
+@pytest.fixture
+def short_tmp() -> Iterator[Path]:
+    """A temporary folder with a short path: the node's UNIX socket path must fit in 107 bytes,
+    and pytest's ``tmp_path`` can be long on some systems."""
+    path = Path(tempfile.mkdtemp(prefix="rs", dir="/tmp" if os.path.isdir("/tmp") else None))
+    yield path
+    shutil.rmtree(path, ignore_errors=True)
+
+
+@pytest.fixture(scope="module")
+def client_node(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
+    node = start_client_node(tmp_path_factory.mktemp("rr-client"))
+    yield node
+    node.Shutdown()
+
+
+class Served:
+    """A running server, its driver and a connected client object."""
+
+    def __init__(self, server: RobotServer, driver: SimRobot, node: Any, robot: Any) -> None:
+        self.server = server
+        self.driver = driver
+        self.node = node
+        self.robot = robot
+
+    def state(self) -> Any:
+        value, _ = self.robot.robot_state.PeekInValue()
+        return value
+
+    def q(self) -> np.ndarray:
+        return np.array(self.state().joint_position)
+
+    def struct(self, name: str) -> Any:
+        return self.node.GetStructureType(name, self.robot)()
+
+    def wait_mode(self, mode: CommandMode) -> None:
+        wait_until(lambda: self.state().command_mode == int(mode))
+
+    def trajectory(self, delta: np.ndarray, duration: float) -> Any:
+        q0 = self.q()
+        traj = self.struct("com.robotraconteur.robotics.trajectory.JointTrajectory")
+        traj.joint_names = list(self.driver.joint_names)
+        m = int(round(duration / 0.05)) + 1
+        wps = []
+        for i in range(m):
+            s = i / (m - 1)
+            w = self.struct("com.robotraconteur.robotics.trajectory.JointTrajectoryWaypoint")
+            w.joint_position = q0 + delta * (3 * s * s - 2 * s**3)
+            w.time_from_start = duration * s
+            wps.append(w)
+        traj.waypoints = wps
+        return traj
+
+
+@pytest.fixture
+def served(short_tmp: Path, client_node: Any) -> Iterator[Served]:
+    info = load_robot_info(RRP)
+    driver = SimRobot(info, update_period=PERIOD)
+    server = RobotServer(driver, info, ServeOptions(port=0, state_dir=short_tmp / "rr"))
+    with server:
+        robot = client_node.ConnectService(server.url)
+        try:
+            yield Served(server, driver, client_node, robot)
+        finally:
+            client_node.DisconnectService(robot)
+    assert server.service is None
+
+
+def rr_exception(name: str) -> type[BaseException]:
+    import RobotRaconteur as RR
+
+    cls: type[BaseException] = getattr(RR, name)
+    return cls
+
+
+def test_robot_info_and_state_wires(served: Served) -> None:
+    r = served.robot
+    info = r.robot_info
+    assert info.device_info.device.name == "rrp_test_arm"
+    # The device got a UUID for its name (kept in the state folder), not the all-zero one.
+    assert bytes(info.device_info.device.uuid[0]["uuid_bytes"]) != bytes(16)
+    assert [j.joint_identifier.name for j in info.joint_info] == ["base_yaw", "shoulder", "slide"]
+    assert len(info.chains) == 1 and list(info.chains[0].joint_numbers) == [0, 1, 2]
+    assert r.device_info.device.name == "rrp_test_arm"
+    assert r.isoch_info.update_rate == pytest.approx(1.0 / PERIOD)
+    assert r.operational_mode == 4 and r.controller_state == 2  # cobot, motor_on
+    assert list(r.current_errors) == []
+
+    # robot_state through a connected wire: fresh values, healthy flags, the driver's TCP.
+    wire = r.robot_state.Connect()
+    try:
+        wire.WaitInValueValid(WAIT)
+        first = wire.InValue.seqno
+        wait_until(lambda: wire.InValue.seqno >= first + 5)
+        st = wire.InValue
+        flags = StateFlags(int(st.robot_state_flags))
+        assert StateFlags.ready in flags and StateFlags.enabled in flags
+        assert st.command_mode == int(CommandMode.halt)
+        assert np.allclose(st.joint_position, served.driver.sim_position, atol=1e-9)
+        tcp = st.kin_chain_tcp[0]
+        ours = served.driver.robot_state.kin_chain_tcp[0]
+        assert np.allclose([tcp["position"][k] for k in "xyz"], ours.position)
+    finally:
+        wire.Close()
+
+    # advanced_robot_state: units per joint type (the slide is prismatic), config_seqno.
+    adv = r.advanced_robot_state.Connect()
+    try:
+        adv.WaitInValueValid(WAIT)
+        a = adv.InValue
+        assert list(a.joint_position_units) == [2, 2, 1]  # radian, radian, meter
+        assert a.config_seqno == 1
+    finally:
+        adv.Close()
+
+    # robot_state_sensor_data pipe: packets with a header and the advanced state.
+    pipe = r.robot_state_sensor_data.Connect(-1)
+    try:
+        wait_until(lambda: pipe.Available > 0)
+        packet = pipe.ReceivePacket()
+        assert packet.data_header.seqno == packet.robot_state.seqno
+        assert len(packet.robot_state.joint_position) == 3
+    finally:
+        pipe.Close()
+
+
+def test_enable_disable_reset_errors(served: Served) -> None:
+    r = served.robot
+    r.command_mode = int(CommandMode.jog)
+    r.disable()  # drops a motion mode to invalid_state (a disabled robot in halt stays in halt)
+    wait_until(lambda: not served.state().robot_state_flags & int(StateFlags.enabled))
+    assert served.state().command_mode == int(CommandMode.invalid_state)
+    with pytest.raises(rr_exception("InvalidOperationException")):
+        r.command_mode = int(CommandMode.jog)
+    r.enable()
+    served.wait_mode(CommandMode.halt)  # back to halt by itself once enabled
+    served.driver.inject_fault(Fault.drive_error)
+    wait_until(lambda: served.state().robot_state_flags & int(StateFlags.error))
+    r.reset_errors()
+    wait_until(lambda: not served.state().robot_state_flags & int(StateFlags.error))
+    served.wait_mode(CommandMode.halt)
+
+
+def test_jog_freespace_and_jog_joint(served: Served) -> None:
+    r = served.robot
+    q0 = served.q()
+    vmax = np.array([1.0, 1.0, 0.2])
+    with pytest.raises(rr_exception("InvalidOperationException"), match="not in jog mode"):
+        r.jog_freespace(q0, vmax, True)
+    r.command_mode = int(CommandMode.jog)
+    target = q0 + np.array([0.2, -0.1, 0.05])
+    r.jog_freespace(target, vmax, True)  # returns when the commanded motion has arrived
+    wait_until(lambda: np.allclose(served.state().joint_position_command, target, atol=1e-9))
+    wait_until(lambda: np.allclose(served.q(), target, atol=1e-4))  # the simulated arm settles
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="must have 3 elements"):
+        r.jog_freespace(target[:2], vmax[:2], True)
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="outside the joint limits"):
+        r.jog_freespace(q0 + np.array([0.0, 0.0, 1.0]), vmax, True)
+    before = served.q()
+    r.jog_joint(np.array([0.5, 0.0, 0.0]), 0.2, True)
+    moved = served.q() - before
+    assert moved[0] > 0.02 and abs(moved[1]) < 1e-6
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="exceeds joint limits"):
+        r.jog_joint(np.array([-10.0, 0.0, 0.0]), 0.2, True)  # negative over-speed is refused too
+
+
+def test_trajectory_runs_to_completion_through_next(served: Served) -> None:
+    r = served.robot
+    r.command_mode = int(CommandMode.trajectory)
+    delta = np.array([0.3, 0.2, 0.05])
+    q0 = served.q()
+    traj = served.trajectory(delta, 0.6)
+    adv = r.advanced_robot_state.Connect()
+    seen_running: list[bool] = []
+    adv.WireValueChanged += lambda _w, value, _ts: seen_running.append(
+        bool(value.robot_state_flags & int(StateFlags.trajectory_running))
+    )
+    try:
+        gen = r.execute_trajectory(traj)
+        statuses = []
+        with pytest.raises(rr_exception("StopIterationException")):
+            for _ in range(10):
+                statuses.append(gen.Next())
+        assert statuses[-1].action_status == 3  # complete
+        assert statuses[-1].trajectory_time == pytest.approx(0.6, abs=1e-6)
+        assert statuses[-1].current_waypoint == len(traj.waypoints) - 1
+        assert any(seen_running)
+    finally:
+        adv.Close()
+    wait_until(lambda: np.allclose(served.q(), q0 + delta, atol=1e-4))
+    wait_until(lambda: not served.state().trajectory_running)  # the wire may lag Next() by a step
+
+
+def test_trajectory_abort_and_close(served: Served) -> None:
+    r = served.robot
+    r.command_mode = int(CommandMode.trajectory)
+    gen = r.execute_trajectory(served.trajectory(np.array([0.4, 0.0, 0.0]), 2.0))
+    outcome: list[BaseException] = []
+
+    def next_in_background() -> None:
+        try:
+            gen.Next()
+        except Exception as exc:  # noqa: BLE001 - recorded for the assertion
+            outcome.append(exc)
+
+    t = threading.Thread(target=next_in_background)
+    t.start()
+    wait_until(lambda: served.state().trajectory_running and served.q()[0] > 0.12)
+    gen.Abort()
+    t.join(WAIT)
+    assert len(outcome) == 1
+    assert isinstance(outcome[0], rr_exception("OperationAbortedException"))
+    assert "aborted" in str(outcome[0])
+    served.wait_mode(CommandMode.halt)
+    wait_until(lambda: not served.state().trajectory_running)
+    assert served.q()[0] < 0.45  # stopped short of the end
+
+    # Close cancels a queued trajectory without leaving trajectory mode.
+    r.command_mode = int(CommandMode.trajectory)
+    gen2 = r.execute_trajectory(served.trajectory(np.array([0.1, 0.0, 0.0]), 0.5))
+    gen2.Close()
+    with pytest.raises(rr_exception("OperationAbortedException"), match="cancelled"):
+        gen2.Next()
+    assert r.command_mode == int(CommandMode.trajectory)
+
+
+def test_lost_communication_is_reported(served: Served) -> None:
+    r = served.robot
+    served.driver.inject_fault(Fault.lost_feedback)  # the sim's test hook: feedback stops
+    wait_until(lambda: served.state().robot_state_flags == int(StateFlags.communication_failure))
+    st = served.state()
+    assert st.command_mode == int(CommandMode.invalid_state)
+    assert len(st.joint_position) == 0 and len(st.kin_chain_tcp) == 0
+    assert any("communication" in m.message for m in r.current_errors)
+    with pytest.raises(rr_exception("InvalidOperationException")):
+        r.command_mode = int(CommandMode.jog)
+    served.driver.clear_fault(Fault.lost_feedback)
+    served.wait_mode(CommandMode.halt)  # recovers by itself when feedback resumes
+    assert StateFlags.ready in StateFlags(int(served.state().robot_state_flags))
+
+
+def test_waiting_jog_interrupted_by_lost_feedback_raises(served: Served) -> None:
+    r = served.robot
+    r.command_mode = int(CommandMode.jog)
+    outcome: list[BaseException] = []
+
+    def jog() -> None:
+        try:
+            r.jog_freespace(served.q() + np.array([2.0, 0.0, 0.0]), np.array([0.5, 1.0, 0.2]), True)
+        except Exception as exc:  # noqa: BLE001 - recorded for the assertion
+            outcome.append(exc)
+
+    t = threading.Thread(target=jog)
+    t.start()
+    wait_until(lambda: abs(served.driver.robot_state.joint_velocity[0]) > 0.1)
+    served.driver.inject_fault(Fault.lost_feedback)
+    t.join(WAIT)
+    assert len(outcome) == 1
+    assert isinstance(outcome[0], rr_exception("OperationAbortedException"))
+    assert "communication" in str(outcome[0])
+
+
+def test_tools_payloads_events_and_speed_ratio(served: Served) -> None:
+    r = served.robot
+    events: list[tuple[str, int, str]] = []
+    r.tool_changed += lambda chain, name: events.append(("tool", chain, name))
+    r.payload_changed += lambda chain, name: events.append(("payload", chain, name))
+    tool = served.struct("com.robotraconteur.robotics.tool.ToolInfo")
+    tool.device_info = served.struct("com.robotraconteur.device.DeviceInfo")
+    tool.device_info.device = served.struct("com.robotraconteur.identifier.Identifier")
+    tool.device_info.device.name = "probe"
+    tcp = np.zeros(
+        1, dtype=served.node.GetNamedArrayDType("com.robotraconteur.geometry.Transform", r)
+    )
+    tcp[0]["rotation"]["w"] = 1.0
+    tcp[0]["translation"]["z"] = 0.1
+    tool.tcp = tcp
+    tcp_before = served.driver.robot_state.kin_chain_tcp[0].position.copy()
+    r.tool_attached(0, tool)
+    wait_until(lambda: served.driver.robot_state.config_seqno == 2)
+    assert r.robot_info.config_seqno == 2
+    assert r.robot_info.chains[0].current_tool.device_info.device.name == "probe"
+    wait_until(
+        lambda: not np.allclose(served.driver.robot_state.kin_chain_tcp[0].position, tcp_before)
+    )
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="already attached"):
+        r.tool_attached(0, tool)
+    payload = served.struct("com.robotraconteur.robotics.payload.PayloadInfo")
+    payload.device_info = tool.device_info
+    pose = np.zeros(1, dtype=served.node.GetNamedArrayDType("com.robotraconteur.geometry.Pose", r))
+    r.payload_attached(0, payload, pose)
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="payload attached"):
+        r.tool_detached(0, "probe")
+    r.payload_detached(0, "probe")
+    r.tool_detached(0, "probe")  # by name (the reference refuses every non-empty name)
+    assert r.robot_info.chains[0].current_tool is None
+    wait_until(lambda: len(events) == 4)
+    assert events == [
+        ("tool", 0, "probe"),
+        ("payload", 0, "probe"),
+        ("payload", 0, ""),
+        ("tool", 0, ""),
+    ]
+    r.speed_ratio = 0.5
+    assert r.speed_ratio == 0.5
+    with pytest.raises(rr_exception("InvalidArgumentException")):
+        r.speed_ratio = 20.0
+
+
+def test_position_command_wire(served: Served) -> None:
+    r = served.robot
+    r.command_mode = int(CommandMode.position_command)
+    wire = r.position_command.Connect()
+    try:
+        target = served.q() + np.array([0.05, 0.0, 0.0])
+        cmd = served.struct("com.robotraconteur.robotics.robot.RobotJointCommand")
+        cmd.command = target
+        cmd.units = np.array([], dtype=np.uint8)
+        flagged = False
+        seqno = 0
+        end = time.monotonic() + WAIT
+        while time.monotonic() < end:
+            st = served.state()
+            flagged = flagged or bool(st.robot_state_flags & int(StateFlags.valid_position_command))
+            if flagged and np.allclose(st.joint_position, target, atol=1e-4):
+                break
+            seqno += 1
+            cmd.seqno = seqno
+            cmd.state_seqno = st.seqno  # a command is only used while it is this fresh
+            wire.OutValue = cmd
+            time.sleep(PERIOD)
+        assert flagged
+        assert np.allclose(served.q(), target, atol=1e-4)
+    finally:
+        wire.Close()
+
+
+def _busy_port() -> tuple[socket.socket, int]:
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    s.bind(("127.0.0.1", 0))
+    s.listen(1)
+    return s, int(s.getsockname()[1])
+
+
+def test_port_taken_and_name_in_use_are_clear_errors(short_tmp: Path, served: Served) -> None:
+    info = load_robot_info(RRP)
+    busy, port = _busy_port()
+    try:
+        other = RobotServer(
+            SimRobot(info),
+            info,
+            ServeOptions(port=port, node_name="other", state_dir=short_tmp / "a"),
+        )
+        with pytest.raises(ServiceError, match=f"TCP port {port} is already in use"):
+            other.start()
+    finally:
+        busy.close()
+    # A second driver for the same device (same node name, same state folder) is refused.
+    second = RobotServer(
+        SimRobot(info), info, ServeOptions(port=0, state_dir=served.server.state_dir)
+    )
+    with pytest.raises(ServiceError, match="'rrp_test_arm' is already running"):
+        second.start()
+    # The first one is unaffected.
+    assert served.robot.robot_info.device_info.device.name == "rrp_test_arm"
+
+
+def test_cli_port_taken_exits_1_without_traceback(
+    short_tmp: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    busy, port = _busy_port()
+    try:
+        _register()
+        code = render.run_app(
+            app,
+            [
+                "drive",
+                "--sim",
+                str(RRP),
+                "--serve",
+                "--port",
+                str(port),
+                "--state-dir",
+                str(short_tmp / "cli"),
+            ],
+        )
+    finally:
+        busy.close()
+    err = capsys.readouterr().err
+    assert code == 1
+    assert f"TCP port {port} is already in use" in err
+    assert "Traceback" not in err
+
+
+def test_cli_serves_a_client_and_keeps_files_in_the_user_cache(
+    short_tmp: Path, client_node: Any
+) -> None:
+    home = short_tmp
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("XDG_", "ROBOTRACONTEUR_"))}
+    env.update(HOME=str(home), XDG_CACHE_HOME=str(home / ".cache"))
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "robotspec",
+            "drive",
+            "--sim",
+            str(RRP),
+            "--serve",
+            "--port",
+            "0",
+            "--duration",
+            "4",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    try:
+        assert proc.stderr is not None
+        url = ""
+        seen: list[str] = []
+        deadline = time.monotonic() + 15
+        while not url and time.monotonic() < deadline:
+            line = proc.stderr.readline()
+            seen.append(line)
+            if not line:
+                break
+            if line.strip().startswith("url:"):
+                url = line.split("url:", 1)[1].strip()
+        if not url:
+            proc.kill()
+            out, rest = proc.communicate()
+            pytest.fail(f"no url (exit {proc.returncode}); stderr: {''.join(seen)}{rest}")
+        assert url.startswith("rr+tcp://127.0.0.1:"), url
+        robot = client_node.ConnectService(url)
+        assert robot.robot_info.device_info.device.name == "rrp_test_arm"
+        robot.command_mode = int(CommandMode.jog)
+        assert robot.command_mode == int(CommandMode.jog)
+        client_node.DisconnectService(robot)
+        out, err = proc.communicate(timeout=15)
+    finally:
+        if proc.poll() is None:
+            proc.kill()  # only our own child, by its handle
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert "final mode" in out
+    files = sorted(p.relative_to(home).as_posix() for p in home.rglob("*") if p.is_file())
+    assert files, "the node kept no state"
+    assert all(f.startswith(".cache/robotspec/rr/") for f in files), files
+
+
+def test_too_long_state_dir_is_a_clear_error(short_tmp: Path) -> None:
+    from robotspec.service.node import start_server_node
+
+    deep = short_tmp / ("x" * 90)
+    with pytest.raises(ServiceError, match="give a shorter --state-dir"):
+        start_server_node(node_name="deep", port=0, public=False, state_dir=deep)
+    assert not deep.exists()
+
+
+def test_isoch_downsample_per_client(served: Served) -> None:
+    r = served.robot
+    assert r.isoch_downsample == 0
+    r.isoch_downsample = 2  # this client now receives every third state
+    assert r.isoch_downsample == 2
+    wire = r.robot_state.Connect()
+    seqnos: list[int] = []
+    wire.WireValueChanged += lambda _w, value, _ts: seqnos.append(int(value.seqno))
+    try:
+        wait_until(lambda: len(seqnos) >= 6)
+    finally:
+        wire.Close()
+    steps = set(np.diff(seqnos[1:]).tolist())
+    assert steps == {3}, seqnos

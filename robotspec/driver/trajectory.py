@@ -86,7 +86,11 @@ class JointTrajectory:
         times = np.linspace(0.0, duration, m)
         s = times / duration
         blend = 10 * s**3 - 15 * s**4 + 6 * s**5
-        return cls.from_arrays(times.tolist(), a[None, :] + blend[:, None] * (b - a)[None, :])
+        q = a[None, :] + blend[:, None] * (b - a)[None, :]
+        # Exact ends: a + (b - a) can miss b by an ulp, which a target on a joint limit turns
+        # into "exceeds joint limits".
+        q[0], q[-1] = a, b
+        return cls.from_arrays(times.tolist(), q)
 
 
 class TrajectoryInterpolator:

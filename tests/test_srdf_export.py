@@ -6,9 +6,13 @@ MoveIt's own parser (srdfdom, C++) is on neither PyPI nor Debian here; pinocchio
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+from robotspec.cli.app import _register, app
+from robotspec.cli.render import run_app
 from robotspec.compiler import check_spec
 from robotspec.semantic import AbstractRobot
 from robotspec.srdf import (
@@ -128,3 +132,23 @@ def test_other_shipped_robots_export(name: str) -> None:
     srdf, _ = _export(robot)
     _moveit_rules(srdf, robot)
     assert any(g.chains for g in srdf.groups)
+
+
+def test_cli_export_srdf_round_trips_through_init(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    # spec -> SRDF (export) -> spec (init) -> the same arms and grippers.
+    robots = erd_robots()
+    _register()
+    out = tmp_path / "pr2_out.srdf"
+    assert run_app(app, ["export", "srdf", "pr2", "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert err == (f"wrote {out}: 6 groups, 2 end effectors, 9 group states, 257 disabled pairs\n")
+    draft = tmp_path / "again.yaml"
+    urdf = robots / "pr2_description/urdf/pr2.urdf"
+    assert run_app(app, ["init", str(urdf), "--srdf", str(out), "-o", str(draft)]) == 0
+    again = check_spec(draft).robot
+    arms = {c.name: (c.root.name, c.tip.name, c.manipulator) for c in again.kinematic_chains}
+    assert arms["right_arm"][:2] == ("torso_lift_link", "r_wrist_roll_link")
+    assert arms["right_arm"][2] is not None
+    assert arms["right_arm"][2].tool_frame.name == "r_gripper_tool_frame"

@@ -80,3 +80,34 @@ def robotinfo(
         f"wrote {output} ({len(ex.info.joint_info)} joints, chain "
         f"{ex.info.chains[0].kin_chain_identifier.name})\n"
     )
+
+
+@export_app.command("srdf")
+def srdf(
+    spec: SpecArg,
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write to FILE instead of stdout.")
+    ] = None,
+    package_path: PackagePath = None,
+) -> None:
+    """A MoveIt SRDF of the compiled robot: a group per chain, end effectors, group states.
+
+    Disabled collision pairs keep the reason of the SRDF they came from; the drive becomes the
+    virtual joint.
+    """
+    from robotspec.compiler import compile_robot
+    from robotspec.srdf import write_srdf
+    from robotspec.srdf_export import srdf_from_robot
+
+    robot = compile_robot(spec, package_paths=package_path or ())
+    exported = srdf_from_robot(robot)
+    text = write_srdf(exported)
+    if output is None:
+        sys.stdout.write(text)
+        return
+    output.write_text(text, encoding="utf-8")
+    sys.stderr.write(
+        f"wrote {output}: {len(exported.groups)} groups, {len(exported.end_effectors)} end "
+        f"effectors, {len(exported.group_states)} group states, "
+        f"{len(exported.disabled_collisions)} disabled pairs\n"
+    )

@@ -18,6 +18,7 @@ and Jacobian in its feedback step, as in the reference note's measurement).
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import os
 import subprocess
@@ -135,6 +136,8 @@ class StepTimer:
 
 def measure(timer: StepTimer, url: str, seconds: float, warmup: float) -> dict[str, Any]:
     _proc, result = run_client(url, seconds + warmup)
+    gc.collect()
+    gc.freeze()  # as ``robotspec drive --serve`` does; applied to both servers alike
     time.sleep(warmup)
     t0 = os.times()
     timer.recording = True
@@ -145,6 +148,7 @@ def measure(timer: StepTimer, url: str, seconds: float, warmup: float) -> dict[s
     proc_cpu = (t1.user - t0.user) + (t1.system - t0.system)
     out["process_cpu_per_step_ms"] = proc_cpu / max(1.0, out["steps"]) * 1e3
     out["client"] = result()
+    gc.unfreeze()
     return out
 
 

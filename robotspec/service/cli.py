@@ -7,6 +7,7 @@ one call: the driver it builds (the same one ``drive --sim`` runs) is handed to
 
 from __future__ import annotations
 
+import gc
 import sys
 import time
 from pathlib import Path
@@ -73,6 +74,11 @@ def serve_driver(
     )
     server = RobotServer(driver, info, options, fallback_name=fallback_name)
     with server:
+        # Everything loaded so far lives as long as the process: move it out of the cyclic
+        # collector's reach, so a full collection (tens of ms over all of pydantic, numpy and
+        # RR) does not stall the 250 Hz loop. This is the process's own CLI, so the global
+        # setting is ours to make.
+        gc.freeze()
         exposure = (
             "on every interface, discoverable"
             if public

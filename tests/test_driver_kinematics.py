@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robotspec.driver.conversions import tool_transform
 from robotspec.driver.hp_kinematics import HPChain, quat_to_rot, rot_to_quat, rot_to_quat_tuple
-from robotspec.driver.loop import _tool_transform
 from robotspec.driver.robot_info import Pose, load_robot_info
 from robotspec.driver.sim import SimRobot
 from tests.driver_support import RRP, robotinfo, shared_robotinfo_files
@@ -119,7 +119,7 @@ def test_fixture_fk_with_tool() -> None:
     (hp,) = robot._hp
     r, p = hp.fk(np.array([0.0, 0.0, 0.1]))
     np.testing.assert_allclose(p, [0.6, 0, 0.5], atol=1e-12)
-    tool = _tool_transform(
+    tool = tool_transform(
         robot.robot_info.chains[0].current_tool
         or __import__("robotspec.driver.robot_info", fromlist=["ToolInfo"]).ToolInfo.model_validate(
             {"tcp": {"translation": {"x": 0, "y": 0, "z": 0.2}}}

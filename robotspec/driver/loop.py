@@ -54,8 +54,7 @@ import math
 import threading
 from abc import ABC, abstractmethod
 from collections import deque
-from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -69,12 +68,29 @@ from robotspec.driver.commands import (
     finite_scalar,
     joint_array,
 )
+from robotspec.driver.conversions import (
+    POSITION_UNITS,
+    VELOCITY_UNITS,
+    as_lists,
+    convert_command,
+    parse_mode,
+    read_only,
+    tool_transform,
+    twist_vector,
+)
 from robotspec.driver.errors import (
     InvalidArgumentError,
     InvalidOperationError,
     NotImplementedDriverError,
     OperationAbortedError,
     OperationFailedError,
+)
+from robotspec.driver.handles import (
+    Completion,
+    RobotJointCommand,
+    TrajectoryGenerator,
+    TrajectoryStatus,
+    TrajectoryTask,
 )
 from robotspec.driver.hp_kinematics import HPChain, quat_to_rot, rot_to_quat_tuple
 from robotspec.driver.profiles import JogMotion
@@ -88,7 +104,6 @@ from robotspec.driver.robot_info import (
 )
 from robotspec.driver.state import (
     ESTOP_SOURCE_FLAGS,
-    ActionStatus,
     CommandMode,
     ControllerState,
     OperationalMode,
@@ -97,7 +112,7 @@ from robotspec.driver.state import (
     TcpPose,
     frozen_array,
 )
-from robotspec.driver.trajectory import JointTrajectory, TrajectoryInterpolator, load_trajectory
+from robotspec.driver.trajectory import JointTrajectory, load_trajectory
 from robotspec.errors import DriverError
 
 __all__ = [
@@ -112,180 +127,8 @@ FloatArray = npt.NDArray[np.float64]
 
 #: Position-stream commands more than this many state seqnos old are ignored (reference: 10).
 STREAM_STALE_SEQNOS = 10
-#: ``Next()`` returns ``running`` after this long without an outcome (reference: 5 s).
-NEXT_TIMEOUT_S = 5.0
 #: A blocking call in manual stepping mode gives up after this much (simulated) time.
 MAX_WAIT_S = 3600.0
-
-_POSITION_UNITS = {
-    "implicit": 1.0,
-    "radian": 1.0,
-    "meter": 1.0,
-    "degree": math.pi / 180.0,
-    "ticks_rot": 2.0 * math.pi / 2**20,
-    "nanoticks_rot": 2.0 * math.pi / (2**20 * 1e9),
-}
-_VELOCITY_UNITS = {
-    "implicit": 1.0,
-    "radian_second": 1.0,
-    "meter_second": 1.0,
-    "degree_second": math.pi / 180.0,
-}
-
-
-@dataclass(frozen=True)
-class RobotJointCommand:
-    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""
-
-    seqno: int
-    state_seqno: int
-    command: Sequence[float]
-    units: Sequence[str] = ()
-
-
-@dataclass(frozen=True)
-class TrajectoryStatus:
-    """What ``Next()`` returns: action status, trajectory time and current waypoint."""
-
-    action_status: ActionStatus
-    trajectory_time: float = 0.0
-    current_waypoint: int = 0
-    seqno: int = 0
-
-
-class Completion:
-    """The outcome of an asynchronous driver operation (a jog, homing), set exactly once."""
-
-    def __init__(self) -> None:
-        self._event = threading.Event()
-        self.error: DriverError | None = None
-
-    @property
-    def done(self) -> bool:
-        """Whether the operation has finished (either way)."""
-        return self._event.is_set()
-
-    def succeed(self) -> None:
-        """Finish successfully (ignored if already finished)."""
-        if not self._event.is_set():
-            self._event.set()
-
-    def fail(self, error: DriverError) -> None:
-        """Finish with ``error`` (ignored if already finished)."""
-        if not self._event.is_set():
-            self.error = error
-            self._event.set()
-
-    def wait_event(self, timeout: float | None) -> bool:
-        """Block on the event (loop-thread mode)."""
-        return self._event.wait(timeout)
-
-
-class _TrajectoryTask:
-    """One trajectory's life: queued, ready (awaiting the first Next), running, finished."""
-
-    def __init__(self, interp: TrajectoryInterpolator) -> None:
-        self.interp = interp
-        self.next_called = False
-        self.started = False
-        self.start_time = 0.0
-        self.time = 0.0
-        self.waypoint = 0
-        self.last_setpoint: FloatArray | None = None
-        self.complete = False
-        self.error: DriverError | None = None
-        self.outcome_reported = False
-        self.reported_queued = False
-
-    @property
-    def finished(self) -> bool:
-        return self.complete or self.error is not None
-
-    def fail(self, error: DriverError) -> None:
-        if not self.finished:
-            self.error = error
-
-
-class TrajectoryGenerator:
-    """The generator ``execute_trajectory`` returns: call ``Next()`` until StopIteration.
-
-    ``Next()`` blocks until the trajectory completes, fails, or 5 s pass (then ``running``).
-    ``Abort()`` stops the robot (mode ``halt``); ``Close()`` cancels this trajectory only.
-    Also a Python iterator: ``for status in gen: ...``.
-    """
-
-    def __init__(self, driver: RobotDriver, task: _TrajectoryTask) -> None:
-        self._driver = driver
-        self._task = task
-
-    def Next(self) -> TrajectoryStatus:  # noqa: N802 - the Robot Raconteur generator API
-        """Advance: start (first call), then wait for an outcome; StopIteration when done."""
-        d = self._driver
-        task = self._task
-        with d._lock:
-            if task.outcome_reported:
-                raise StopIteration
-            if task.error is not None:
-                task.outcome_reported = True
-                raise task.error
-            if task.complete:
-                task.outcome_reported = True
-                return self._status(ActionStatus.complete)
-            queued = task is not d._traj_active
-            first = not task.next_called
-            task.next_called = True
-            if queued and first:
-                task.reported_queued = True
-                return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
-            if task.reported_queued and not queued:
-                # It started since the client last heard "queued": say so at once.
-                task.reported_queued = False
-                return self._status(ActionStatus.running)
-
-        def outcome() -> bool:
-            # A queued task reports ``running`` as soon as it becomes active (as the reference).
-            return task.finished or (queued and task is d._traj_active)
-
-        d._wait_for(outcome, NEXT_TIMEOUT_S)
-        with d._lock:
-            if task.error is not None:
-                task.outcome_reported = True
-                raise task.error
-            if task.complete:
-                task.outcome_reported = True
-                return self._status(ActionStatus.complete)
-            if task is not d._traj_active:
-                return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
-            task.reported_queued = False
-            return self._status(ActionStatus.running)
-
-    def _status(self, status: ActionStatus) -> TrajectoryStatus:
-        t = self._task
-        return TrajectoryStatus(status, t.time, t.waypoint, self._driver._state_seqno)
-
-    def Abort(self) -> None:  # noqa: N802
-        """Stop the robot: mode becomes ``halt``; ``Next()`` fails with OperationAborted."""
-        d = self._driver
-        with d._lock:
-            if self._task.finished:
-                return
-            self._task.fail(OperationAbortedError("Trajectory execution aborted"))
-            d._abort_trajectory(self._task)
-
-    def Close(self) -> None:  # noqa: N802
-        """Cancel this trajectory (the whole queue if it is active); the mode stays."""
-        d = self._driver
-        with d._lock:
-            if self._task.finished:
-                return
-            self._task.fail(OperationAbortedError("Trajectory execution cancelled"))
-            d._cancel_trajectory(self._task)
-
-    def __iter__(self) -> Iterator[TrajectoryStatus]:
-        return self
-
-    def __next__(self) -> TrajectoryStatus:
-        return self.Next()
 
 
 class RobotDriver(ABC):
@@ -342,9 +185,9 @@ class RobotDriver(ABC):
         self._current_payload: list[PayloadInfo | None] = [c.current_payload for c in chains]
         self._current_payload_pose: list[Pose | None] = [None for _ in chains]
         self._tool_tf: list[tuple[FloatArray, FloatArray] | None] = [
-            _tool_transform(t) for t in self._current_tool
+            tool_transform(t) for t in self._current_tool
         ]
-        self._tool_tf_lists = [_as_lists(t) for t in self._tool_tf]
+        self._tool_tf_lists = [as_lists(t) for t in self._tool_tf]
         self._chain_idx_list = [list(c.joint_numbers) for c in chains]
         self._endpoint_key: tuple[bytes, bytes, int] | None = None
         self._endpoint_cache: tuple[list[TcpPose], list[FloatArray]] | None = None
@@ -391,8 +234,8 @@ class RobotDriver(ABC):
         self._jog_cartesian: tuple[int, FloatArray] | None = None
         self._halt_ramp: JogMotion | None = None
         self._homing: Completion | None = None
-        self._traj_active: _TrajectoryTask | None = None
-        self._traj_queue: deque[_TrajectoryTask] = deque()
+        self._traj_active: TrajectoryTask | None = None
+        self._traj_queue: deque[TrajectoryTask] = deque()
         self._traj_failed_this_step = False
         self._traj_hold: FloatArray | None = None
         self._jog_hold: FloatArray | None = None
@@ -887,7 +730,7 @@ class RobotDriver(ABC):
             return None
         if abs(cmd.state_seqno - self._state_seqno) > STREAM_STALE_SEQNOS:
             return None
-        q = _convert(cmd, self._joint_count, _POSITION_UNITS)
+        q = convert_command(cmd, self._joint_count, POSITION_UNITS)
         if q is None:
             return None
         self._stream_last_seqno = cmd.seqno
@@ -900,7 +743,7 @@ class RobotDriver(ABC):
             return None
         if abs(cmd.state_seqno - self._state_seqno) > STREAM_STALE_SEQNOS:
             return None
-        v = _convert(cmd, self._joint_count, _VELOCITY_UNITS)
+        v = convert_command(cmd, self._joint_count, VELOCITY_UNITS)
         if v is None:
             return None
         self._stream_valid = StateFlags.valid_velocity_command
@@ -984,10 +827,11 @@ class RobotDriver(ABC):
             )
             poses.append(
                 TcpPose(
-                    position=_ro(np.array(pos)), orientation=_ro(np.array(rot_to_quat_tuple(rot)))
+                    position=read_only(np.array(pos)),
+                    orientation=read_only(np.array(rot_to_quat_tuple(rot))),
                 )
             )
-            vels.append(_ro(np.array(twist)))
+            vels.append(read_only(np.array(twist)))
         self._endpoint_key = key
         self._endpoint_cache = (poses, vels)
         self._endpoint_vel = vels
@@ -1060,7 +904,7 @@ class RobotDriver(ABC):
 
     def set_command_mode(self, value: CommandMode | int | str) -> None:
         """Request a command mode; the reference's checks, in its order (note §1.2)."""
-        mode = _parse_mode(value)
+        mode = parse_mode(value)
         with self._lock:
             current = self._command_mode
             comm_ok = not self._communication_failure
@@ -1346,7 +1190,7 @@ class RobotDriver(ABC):
         """
         with self._lock:
             self._jog_preamble(OperationAbortedError)
-            twist = joint_array("velocity", _twist(velocity), 6)
+            twist = joint_array("velocity", twist_vector(velocity), 6)
             t = finite_scalar("timeout", timeout)
             if t <= 0.0:
                 raise InvalidArgumentError("Invalid jog timeout specified")
@@ -1372,14 +1216,14 @@ class RobotDriver(ABC):
                 raise InvalidOperationError(
                     "Robot must be in trajectory mode to execute trajectory"
                 )
-            task = _TrajectoryTask(interp)
+            task = TrajectoryTask(interp)
             if self._traj_active is None:
                 self._traj_active = task
             else:
                 self._traj_queue.append(task)
             return TrajectoryGenerator(self, task)
 
-    def _abort_trajectory(self, task: _TrajectoryTask) -> None:
+    def _abort_trajectory(self, task: TrajectoryTask) -> None:
         """Abort: drop to ``halt`` (which ends every trajectory on the next step)."""
         with self._lock:
             if self._command_mode is CommandMode.trajectory:
@@ -1389,7 +1233,7 @@ class RobotDriver(ABC):
             if task in self._traj_queue:
                 self._traj_queue.remove(task)
 
-    def _cancel_trajectory(self, task: _TrajectoryTask) -> None:
+    def _cancel_trajectory(self, task: TrajectoryTask) -> None:
         """Close: remove one task; closing the active one cancels the queue too."""
         with self._lock:
             if self._traj_active is task:
@@ -1430,8 +1274,8 @@ class RobotDriver(ABC):
             if self._current_tool[chain] is not None:
                 raise InvalidArgumentError(f"Tool already attached to kinematic chain {chain}")
             self._current_tool[chain] = tool
-            self._tool_tf[chain] = _tool_transform(tool)
-            self._tool_tf_lists[chain] = _as_lists(self._tool_tf[chain])
+            self._tool_tf[chain] = tool_transform(tool)
+            self._tool_tf_lists[chain] = as_lists(self._tool_tf[chain])
             self._config_seqno += 1
             self.events.append(("tool_changed", chain, tool.name))
 
@@ -1522,74 +1366,3 @@ _MOTION_MODES = frozenset(
         CommandMode.velocity_command,
     }
 )
-
-
-def _parse_mode(value: CommandMode | int | str) -> CommandMode:
-    if isinstance(value, CommandMode):
-        return value
-    if isinstance(value, str):
-        try:
-            return CommandMode[value]
-        except KeyError:
-            raise InvalidOperationError("Invalid command mode specified") from None
-    try:
-        mode = CommandMode(int(value))
-    except (ValueError, TypeError):
-        raise InvalidOperationError("Invalid command mode specified") from None
-    if mode is CommandMode.invalid_state:
-        raise InvalidOperationError("Invalid command mode specified")
-    return mode
-
-
-def _tool_transform(tool: ToolInfo | None) -> tuple[FloatArray, FloatArray] | None:
-    if tool is None:
-        return None
-    return (
-        quat_to_rot(tool.tcp.rotation.as_tuple()),
-        np.array(tool.tcp.translation.as_tuple()),
-    )
-
-
-def _as_lists(
-    tf: tuple[FloatArray, FloatArray] | None,
-) -> tuple[list[float], list[float]] | None:
-    if tf is None:
-        return None
-    return [float(x) for x in tf[0].reshape(9)], [float(x) for x in tf[1]]
-
-
-def _ro(a: FloatArray) -> FloatArray:
-    a.flags.writeable = False
-    return a
-
-
-def _twist(velocity: Any) -> Any:
-    """A spatial velocity from ``{angular: {x,y,z}, linear: {x,y,z}}`` or a 6-sequence."""
-    if isinstance(velocity, dict):
-        try:
-            a, lin = velocity["angular"], velocity["linear"]
-            return [a["x"], a["y"], a["z"], lin["x"], lin["y"], lin["z"]]
-        except (KeyError, TypeError):
-            raise InvalidArgumentError(
-                "velocity must be {angular: {x, y, z}, linear: {x, y, z}}"
-            ) from None
-    return velocity
-
-
-def _convert(cmd: RobotJointCommand, n: int, units: dict[str, float]) -> FloatArray | None:
-    """A streamed command in SI units, or None when it must be ignored."""
-    try:
-        values = np.array(cmd.command, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        return None
-    if values.shape[0] != n or not np.all(np.isfinite(values)):
-        return None
-    if len(cmd.units) not in (0, n):
-        return None
-    if cmd.units:
-        try:
-            scale = np.array([units[u] for u in cmd.units])
-        except KeyError:
-            return None
-        values = values * scale
-    return values

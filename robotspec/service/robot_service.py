@@ -29,12 +29,8 @@ from typing import Any
 from pydantic import ValidationError
 
 from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError, error_kind
-from robotspec.driver.loop import (
-    NEXT_TIMEOUT_S,
-    Completion,
-    RobotDriver,
-    TrajectoryGenerator,
-)
+from robotspec.driver.handles import NEXT_TIMEOUT_S, Completion, TrajectoryGenerator
+from robotspec.driver.loop import RobotDriver
 from robotspec.driver.robot_info import RobotCapability, RobotInfo
 from robotspec.driver.state import ActionStatus, RobotState
 from robotspec.errors import RobotSpecError

@@ -1,0 +1,107 @@
+"""Conversions at the client boundary: mode names, units of streamed commands, tool frames."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError
+from robotspec.driver.handles import RobotJointCommand
+from robotspec.driver.hp_kinematics import quat_to_rot
+from robotspec.driver.robot_info import ToolInfo
+from robotspec.driver.state import CommandMode
+
+FloatArray = npt.NDArray[np.float64]
+
+POSITION_UNITS = {
+    "implicit": 1.0,
+    "radian": 1.0,
+    "meter": 1.0,
+    "degree": math.pi / 180.0,
+    "ticks_rot": 2.0 * math.pi / 2**20,
+    "nanoticks_rot": 2.0 * math.pi / (2**20 * 1e9),
+}
+VELOCITY_UNITS = {
+    "implicit": 1.0,
+    "radian_second": 1.0,
+    "meter_second": 1.0,
+    "degree_second": math.pi / 180.0,
+}
+
+
+def parse_mode(value: CommandMode | int | str) -> CommandMode:
+    """A client's mode (enum, number or name); ``invalid_state`` cannot be requested."""
+    if isinstance(value, CommandMode):
+        return value
+    if isinstance(value, str):
+        try:
+            return CommandMode[value]
+        except KeyError:
+            raise InvalidOperationError("Invalid command mode specified") from None
+    try:
+        mode = CommandMode(int(value))
+    except (ValueError, TypeError):
+        raise InvalidOperationError("Invalid command mode specified") from None
+    if mode is CommandMode.invalid_state:
+        raise InvalidOperationError("Invalid command mode specified")
+    return mode
+
+
+def tool_transform(tool: ToolInfo | None) -> tuple[FloatArray, FloatArray] | None:
+    """A tool's TCP as (rotation, translation) in the flange frame; None without a tool."""
+    if tool is None:
+        return None
+    return (
+        quat_to_rot(tool.tcp.rotation.as_tuple()),
+        np.array(tool.tcp.translation.as_tuple()),
+    )
+
+
+def as_lists(
+    tf: tuple[FloatArray, FloatArray] | None,
+) -> tuple[list[float], list[float]] | None:
+    """A transform as plain lists (row-major rotation, translation), for frozen state."""
+    if tf is None:
+        return None
+    return [float(x) for x in tf[0].reshape(9)], [float(x) for x in tf[1]]
+
+
+def read_only(a: FloatArray) -> FloatArray:
+    """Mark an array read-only: published state is shared with every listener."""
+    a.flags.writeable = False
+    return a
+
+
+def twist_vector(velocity: Any) -> Any:
+    """A spatial velocity from ``{angular: {x,y,z}, linear: {x,y,z}}`` or a 6-sequence."""
+    if isinstance(velocity, dict):
+        try:
+            a, lin = velocity["angular"], velocity["linear"]
+            return [a["x"], a["y"], a["z"], lin["x"], lin["y"], lin["z"]]
+        except (KeyError, TypeError):
+            raise InvalidArgumentError(
+                "velocity must be {angular: {x, y, z}, linear: {x, y, z}}"
+            ) from None
+    return velocity
+
+
+def convert_command(cmd: RobotJointCommand, n: int, units: dict[str, float]) -> FloatArray | None:
+    """A streamed command in SI units, or None when it must be ignored."""
+    try:
+        values = np.array(cmd.command, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        return None
+    if values.shape[0] != n or not np.all(np.isfinite(values)):
+        return None
+    if len(cmd.units) not in (0, n):
+        return None
+    if cmd.units:
+        try:
+            scale = np.array([units[u] for u in cmd.units])
+        except KeyError:
+            return None
+        values = values * scale
+    return values

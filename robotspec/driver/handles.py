@@ -1,0 +1,187 @@
+"""What a client's call gets back: completions of blocking calls and trajectory generators.
+
+Kept apart from the loop so the service adapter and tests can name these without the loop's
+internals; the generator's methods step or wait on the driver that made it.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+from robotspec.driver.errors import (
+    OperationAbortedError,
+)
+from robotspec.driver.state import ActionStatus
+from robotspec.driver.trajectory import TrajectoryInterpolator
+from robotspec.errors import DriverError
+
+if TYPE_CHECKING:
+    from robotspec.driver.loop import RobotDriver
+
+__all__ = ["Completion", "RobotJointCommand", "TrajectoryGenerator", "TrajectoryStatus"]
+
+FloatArray = npt.NDArray[np.float64]
+
+#: ``Next()`` returns ``running`` after this long without an outcome (reference: 5 s).
+NEXT_TIMEOUT_S = 5.0
+
+
+@dataclass(frozen=True)
+class RobotJointCommand:
+    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""
+
+    seqno: int
+    state_seqno: int
+    command: Sequence[float]
+    units: Sequence[str] = ()
+
+
+@dataclass(frozen=True)
+class TrajectoryStatus:
+    """What ``Next()`` returns: action status, trajectory time and current waypoint."""
+
+    action_status: ActionStatus
+    trajectory_time: float = 0.0
+    current_waypoint: int = 0
+    seqno: int = 0
+
+
+class Completion:
+    """The outcome of an asynchronous driver operation (a jog, homing), set exactly once."""
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+        self.error: DriverError | None = None
+
+    @property
+    def done(self) -> bool:
+        """Whether the operation has finished (either way)."""
+        return self._event.is_set()
+
+    def succeed(self) -> None:
+        """Finish successfully (ignored if already finished)."""
+        if not self._event.is_set():
+            self._event.set()
+
+    def fail(self, error: DriverError) -> None:
+        """Finish with ``error`` (ignored if already finished)."""
+        if not self._event.is_set():
+            self.error = error
+            self._event.set()
+
+    def wait_event(self, timeout: float | None) -> bool:
+        """Block on the event (loop-thread mode)."""
+        return self._event.wait(timeout)
+
+
+class TrajectoryTask:
+    """One trajectory's life: queued, ready (awaiting the first Next), running, finished."""
+
+    def __init__(self, interp: TrajectoryInterpolator) -> None:
+        self.interp = interp
+        self.next_called = False
+        self.started = False
+        self.start_time = 0.0
+        self.time = 0.0
+        self.waypoint = 0
+        self.last_setpoint: FloatArray | None = None
+        self.complete = False
+        self.error: DriverError | None = None
+        self.outcome_reported = False
+        self.reported_queued = False
+
+    @property
+    def finished(self) -> bool:
+        return self.complete or self.error is not None
+
+    def fail(self, error: DriverError) -> None:
+        if not self.finished:
+            self.error = error
+
+
+class TrajectoryGenerator:
+    """The generator ``execute_trajectory`` returns: call ``Next()`` until StopIteration.
+
+    ``Next()`` blocks until the trajectory completes, fails, or 5 s pass (then ``running``).
+    ``Abort()`` stops the robot (mode ``halt``); ``Close()`` cancels this trajectory only.
+    Also a Python iterator: ``for status in gen: ...``.
+    """
+
+    def __init__(self, driver: RobotDriver, task: TrajectoryTask) -> None:
+        self._driver = driver
+        self._task = task
+
+    def Next(self) -> TrajectoryStatus:  # noqa: N802 - the Robot Raconteur generator API
+        """Advance: start (first call), then wait for an outcome; StopIteration when done."""
+        d = self._driver
+        task = self._task
+        with d._lock:
+            if task.outcome_reported:
+                raise StopIteration
+            if task.error is not None:
+                task.outcome_reported = True
+                raise task.error
+            if task.complete:
+                task.outcome_reported = True
+                return self._status(ActionStatus.complete)
+            queued = task is not d._traj_active
+            first = not task.next_called
+            task.next_called = True
+            if queued and first:
+                task.reported_queued = True
+                return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
+            if task.reported_queued and not queued:
+                # It started since the client last heard "queued": say so at once.
+                task.reported_queued = False
+                return self._status(ActionStatus.running)
+
+        def outcome() -> bool:
+            # A queued task reports ``running`` as soon as it becomes active (as the reference).
+            return task.finished or (queued and task is d._traj_active)
+
+        d._wait_for(outcome, NEXT_TIMEOUT_S)
+        with d._lock:
+            if task.error is not None:
+                task.outcome_reported = True
+                raise task.error
+            if task.complete:
+                task.outcome_reported = True
+                return self._status(ActionStatus.complete)
+            if task is not d._traj_active:
+                return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
+            task.reported_queued = False
+            return self._status(ActionStatus.running)
+
+    def _status(self, status: ActionStatus) -> TrajectoryStatus:
+        t = self._task
+        return TrajectoryStatus(status, t.time, t.waypoint, self._driver._state_seqno)
+
+    def Abort(self) -> None:  # noqa: N802
+        """Stop the robot: mode becomes ``halt``; ``Next()`` fails with OperationAborted."""
+        d = self._driver
+        with d._lock:
+            if self._task.finished:
+                return
+            self._task.fail(OperationAbortedError("Trajectory execution aborted"))
+            d._abort_trajectory(self._task)
+
+    def Close(self) -> None:  # noqa: N802
+        """Cancel this trajectory (the whole queue if it is active); the mode stays."""
+        d = self._driver
+        with d._lock:
+            if self._task.finished:
+                return
+            self._task.fail(OperationAbortedError("Trajectory execution cancelled"))
+            d._cancel_trajectory(self._task)
+
+    def __iter__(self) -> Iterator[TrajectoryStatus]:
+        return self
+
+    def __next__(self) -> TrajectoryStatus:
+        return self.Next()

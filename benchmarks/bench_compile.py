@@ -60,7 +60,9 @@ def main() -> None:
 
     def pinocchio() -> object:
         model = pin.buildModelFromUrdf(str(urdf))
-        geom = pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION, package_dirs)
+        geom = pin.buildGeomFromUrdf(
+        model, str(urdf), pin.GeometryType.COLLISION, package_dirs=package_dirs
+    )
         geom.addAllCollisionPairs()
         pin.removeCollisionPairs(model, geom, str(srdf))
         return model, geom

@@ -23,7 +23,6 @@ from robotspec.errors import (
     DescriptionError,
     PackageNotFoundError,
     PathOutsideRootsError,
-    RobotSpecError,
     closest_names,
     did_you_mean,
 )
@@ -41,6 +40,9 @@ MAX_WALK_UP = 4
 IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
 
 _SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.\-]*)://")
+_MANIFEST_NAME = re.compile(rb"<name>\s*([^<]*?)\s*</name>")
+_MANIFEST_HEAD = 16384
+_XML_COMMENT = re.compile(rb"<!--.*?-->", re.S)
 _PACKAGE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\-]*$")
 
 
@@ -50,13 +52,14 @@ def _declared_name(folder: Path) -> str:
     Why the fallback: a broken manifest should not hide a package whose folder is named right,
     which is the usual case.
     """
-    from robotspec.xmlsafe import parse_xml_file
-
     try:
-        root = parse_xml_file(folder / "package.xml")
-    except RobotSpecError:
+        data = (folder / "package.xml").read_bytes()[:_MANIFEST_HEAD]
+    except OSError:
         return folder.name
-    text = (root.findtext("name") or "").strip()
+    # A text search, not an XML parse: every search folder's manifests are read on each load,
+    # and the name is plain text near the top (no entities are expanded either way).
+    match = _MANIFEST_NAME.search(_XML_COMMENT.sub(b"", data))
+    text = match.group(1).decode("utf-8", "replace").strip() if match else ""
     return text if _PACKAGE_NAME.match(text) else folder.name
 
 
@@ -198,6 +201,7 @@ class PackageResolver:
     _index: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
     _real_roots: list[Path] = field(default_factory=list, compare=False, repr=False)
     _real_dirs: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
+    _resolved: dict[tuple[str, str], Path] = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
     def create(
@@ -379,6 +383,17 @@ class PackageResolver:
         if not text:
             raise DescriptionError("empty file reference", file=file, line=line, kind="path")
         base = relative_to if relative_to is not None else Path.cwd()
+        key = (text, str(base))
+        cached = self._resolved.get(key)
+        if cached is not None:  # robots name the same mesh many times (left and right arms)
+            return cached
+        found = self._resolve_uncached(uri, text, base, file, line)
+        self._resolved[key] = found
+        return found
+
+    def _resolve_uncached(
+        self, uri: str, text: str, base: Path, file: str | None, line: int | None
+    ) -> Path:
         match = _SCHEME.match(text)
         if match is None:
             candidate = Path(text) if os.path.isabs(text) else base / text

@@ -334,6 +334,9 @@ class _Reader:
     def __init__(self, file: str | None) -> None:
         self.file = file
         self.errors: list[RobotSpecError] = []
+        # The root's children by tag, with their document position: one pass over a file
+        # whose thousand ``disable_collisions`` would otherwise be walked once per element kind.
+        self._by_tag: dict[str, list[tuple[int, etree._Element]]] = {}
 
     def error(self, message: str, el: etree._Element, *, kind: str, name: str | None) -> None:
         self.errors.append(SrdfError(message, file=self.file, line=_line(el), kind=kind, name=name))
@@ -349,6 +352,9 @@ class _Reader:
         return value
 
     def read(self, root: etree._Element) -> Srdf:
+        for i, child in enumerate(root):
+            if isinstance(child.tag, str):
+                self._by_tag.setdefault(child.tag, []).append((i, child))
         robot_name = self.attr(root, "name", "<robot>", kind="robot") or ""
         return Srdf(
             robot_name=robot_name,
@@ -371,13 +377,17 @@ class _Reader:
             enabled_collisions=self._all(root, ("enable_collisions",), self.enabled),
         )
 
-    @staticmethod
     def _all(
+        self,
         root: etree._Element,
         tags: tuple[str, ...],
         read: Callable[[etree._Element], _T | None],
     ) -> tuple[_T, ...]:
-        out = [read(el) for el in _children(root, *tags)]
+        """Every root child with one of ``tags`` (aliases included), read in document order."""
+        found = [item for tag in tags for item in self._by_tag.get(tag, ())]
+        if len(tags) > 1:
+            found.sort(key=lambda item: item[0])
+        out = [read(el) for _, el in found]
         return tuple(r for r in out if r is not None)
 
     def _unique(self, records: tuple[_N, ...], kind: str) -> tuple[_N, ...]:

@@ -308,3 +308,14 @@ def test_example_robot_data_meshes_resolve() -> None:
     # Found from anywhere, not only next to the URDF.
     anywhere = PackageResolver.create(None, use_environment=False)
     assert anywhere.find_package("pr2_description") == robots / "pr2_description"
+
+
+def test_manifest_name_ignores_commented_out_names(tmp_path: Path) -> None:
+    pkg = tmp_path / "ws" / "folder"
+    pkg.mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<?xml version="1.0"?>\n<package format="3">\n'
+        "  <!-- renamed: <name>old_name</name> -->\n  <name>new_name</name>\n</package>\n"
+    )
+    names = set(isolated(None, extra_paths=[tmp_path / "ws"]).packages())
+    assert "new_name" in names and "old_name" not in names

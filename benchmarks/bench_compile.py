@@ -61,8 +61,8 @@ def main() -> None:
     def pinocchio() -> object:
         model = pin.buildModelFromUrdf(str(urdf))
         geom = pin.buildGeomFromUrdf(
-        model, str(urdf), pin.GeometryType.COLLISION, package_dirs=package_dirs
-    )
+            model, str(urdf), pin.GeometryType.COLLISION, package_dirs=package_dirs
+        )
         geom.addAllCollisionPairs()
         pin.removeCollisionPairs(model, geom, str(srdf))
         return model, geom

@@ -40,6 +40,7 @@ def _register() -> None:
         init_cmd,
         inspect_cmd,
         misc_cmd,
+        render_cmd,
         validate_cmd,
     )
 

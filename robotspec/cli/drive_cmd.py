@@ -46,6 +46,10 @@ def drive(
     log: Annotated[
         Path | None, typer.Option("--log", help="Write every state to FILE (.csv or .jsonl).")
     ] = None,
+    plot: Annotated[
+        Path | None,
+        typer.Option("--plot", help="After the run, plot joint positions and commands to a PNG."),
+    ] = None,
     virtual_time: Annotated[
         bool,
         typer.Option("--virtual-time", help="Run on a simulated clock, as fast as possible."),
@@ -131,6 +135,14 @@ def drive(
     tty = sys.stdout.isatty()
     status = _StatusLine(tty)
     driver.add_state_listener(status)
+    trace = None
+    if plot is not None:
+        from robotspec.render.deps import require
+        from robotspec.render.plot import JointTrace
+
+        require("matplotlib", "matplotlib", "--plot")
+        trace = JointTrace(info.joint_names)
+        driver.add_state_listener(trace)
     name = info.device_info.device.name or fallback_name
     sys.stderr.write(
         f"driving {name} ({len(info.joint_info)} joints, {len(info.chains)} "
@@ -191,6 +203,11 @@ def drive(
     sys.stdout.write(summary + "\n")
     if statelog is not None:
         sys.stdout.write(f"wrote {statelog.rows} states to {log}\n")
+    if trace is not None and plot is not None:
+        from robotspec.render.plot import plot_joint_trace
+
+        drawn = plot_joint_trace(trace, plot, title=f"{name}: positions (solid), commands (dashed)")
+        sys.stdout.write(f"wrote {plot} ({drawn.lines} lines, {drawn.samples} samples)\n")
     if scenario is not None:
         failed = mismatch_errors(scenario, results)
         n_run = len(results)

@@ -1,0 +1,133 @@
+"""``robotspec render`` and ``robotspec view``: a picture and a live 3D view of a compiled robot."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+
+from robotspec.cli.app import app
+from robotspec.cli.options import PackagePath, SpecArg
+
+if TYPE_CHECKING:
+    from robotspec.semantic import AbstractRobot
+
+StateOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--state",
+        "-s",
+        help="A named joint state (left_arm.park, park = every part's park, or an SRDF group "
+        "state); repeatable, applied in order over the default pose.",
+        show_default=False,
+    ),
+]
+SkipMeshes = Annotated[
+    bool,
+    typer.Option(
+        "--skip-missing-meshes",
+        help="Leave out missing or unreadable meshes (each is reported) instead of failing.",
+    ),
+]
+
+
+def _robot(spec: str, package_path: list[Any] | None) -> AbstractRobot:
+    from robotspec.compiler import compile_robot
+
+    return compile_robot(spec, package_paths=package_path or ())
+
+
+def _warn(skipped: tuple[Any, ...]) -> None:
+    from robotspec.cli.render import print_error
+
+    for err in skipped:
+        print_error(err)
+
+
+@app.command("render")
+def render(
+    spec: SpecArg,
+    state: StateOpt = None,
+    output: Annotated[Path, typer.Option("--output", "-o", help="The PNG file to write.")] = Path(
+        "robot.png"
+    ),
+    size: Annotated[
+        str, typer.Option("--size", help="Image size in pixels, WIDTHxHEIGHT.")
+    ] = "800x600",
+    view: Annotated[
+        str,
+        typer.Option(
+            "--view",
+            help="front (from the robot's front), side (from its right), top, or iso.",
+        ),
+    ] = "front",
+    skip_missing_meshes: SkipMeshes = False,
+    package_path: PackagePath = None,
+) -> None:
+    """Draw the robot at a joint state into a PNG: chains coloured, tool frames, cameras, drive.
+
+    Needs no display: the picture is rasterized in software (numpy) and written with Pillow.
+    """
+    from robotspec.collision.sampling import state_configuration
+    from robotspec.render import VIEWS, RenderOptions, build_scene, parse_size, render_scene
+    from robotspec.render.deps import require
+
+    require("PIL", "Pillow", "render")
+    width, height = parse_size(size)
+    if view not in VIEWS:
+        raise typer.BadParameter(f"'{view}' is not one of {', '.join(VIEWS)}", param_hint="--view")
+    robot = _robot(spec, package_path)
+    q = state_configuration(robot, state or ())
+    scene = build_scene(robot, on_missing_mesh="skip" if skip_missing_meshes else "error")
+    _warn(scene.skipped)
+    title = robot.name + (f" · {', '.join(state)}" if state else "")
+    picture = render_scene(
+        scene, q, RenderOptions(width=width, height=height, view=view, title=title)
+    )
+    picture.save(output)
+    sys.stdout.write(f"wrote {output} ({width}x{height}, {view} view)\n")
+
+
+@app.command("view")
+def view(
+    spec: SpecArg,
+    state: StateOpt = None,
+    host: Annotated[
+        str, typer.Option("--host", help="Interface to serve on (loopback by default).")
+    ] = "127.0.0.1",
+    port: Annotated[
+        int, typer.Option("--port", min=0, max=65535, help="TCP port (0 picks a free one).")
+    ] = 8080,
+    skip_missing_meshes: SkipMeshes = False,
+    package_path: PackagePath = None,
+) -> None:
+    """A live 3D view in the browser: joint sliders, states, collision geometry and pairs.
+
+    Serves on localhost and prints the URL to open; Ctrl-C stops.
+    """
+    from robotspec.collision.sampling import state_configuration
+    from robotspec.render.deps import require
+
+    require("viser", "viser", "view")
+    from robotspec.render.viewer import RobotViewer
+
+    robot = _robot(spec, package_path)
+    q = state_configuration(robot, state or ())
+    viewer = RobotViewer(
+        robot,
+        q,
+        host=host,
+        port=port,
+        on_missing_mesh="skip" if skip_missing_meshes else "error",
+    )
+    _warn(viewer.skipped)
+    sys.stdout.write(f"viewing {robot.name} at {viewer.url} ; Ctrl-C stops\n")
+    sys.stdout.flush()
+    try:
+        viewer.wait()
+    except KeyboardInterrupt:
+        sys.stdout.write("stopped\n")
+    finally:
+        viewer.stop()

@@ -373,13 +373,14 @@ def test_position_command_wire(served: Served) -> None:
         cmd = served.struct("com.robotraconteur.robotics.robot.RobotJointCommand")
         cmd.command = target
         cmd.units = np.array([], dtype=np.uint8)
-        flagged = False
+        flagged = reached = False
         seqno = 0
         end = time.monotonic() + WAIT
         while time.monotonic() < end:
             st = served.state()
             flagged = flagged or bool(st.robot_state_flags & int(StateFlags.valid_position_command))
             if flagged and np.allclose(st.joint_position, target, atol=1e-4):
+                reached = True
                 break
             seqno += 1
             cmd.seqno = seqno
@@ -387,7 +388,9 @@ def test_position_command_wire(served: Served) -> None:
             wire.OutValue = cmd
             time.sleep(PERIOD)
         assert flagged
-        assert np.allclose(served.q(), target, atol=1e-4)
+        # Judged on the state that arrived, not a second read: the servo may still settle
+        # by a fraction of a millimetre between the two.
+        assert reached, (served.q(), target)
     finally:
         wire.Close()
 

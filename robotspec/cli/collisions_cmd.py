@@ -11,12 +11,12 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from robotspec.cli.app import app
-from robotspec.cli.options import JsonFlag, PackagePath, SpecArg
+from robotspec.cli.options import JsonFlag, PackagePath, SkipMeshes, SpecArg, load_robot
 from robotspec.cli.table import render_table
 from robotspec.errors import CollisionError
 
 if TYPE_CHECKING:
-    from robotspec.semantic import AbstractRobot
+    pass
 
 collisions_app = typer.Typer(
     help="Self-collision checks and collision matrices (coal).", no_args_is_help=True
@@ -41,19 +41,6 @@ QOpt = Annotated[
         show_default=False,
     ),
 ]
-SkipMeshes = Annotated[
-    bool,
-    typer.Option(
-        "--skip-missing-meshes",
-        help="Leave out missing or unreadable meshes (each is reported) instead of failing.",
-    ),
-]
-
-
-def _robot(spec: str, package_path: list[Any] | None) -> AbstractRobot:
-    from robotspec.compiler import compile_robot
-
-    return compile_robot(spec, package_paths=package_path or ())
 
 
 def _values(items: list[str] | None) -> dict[str, float]:
@@ -98,7 +85,7 @@ def check(
     """
     from robotspec.collision import SelfCollisionChecker
 
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     checker = SelfCollisionChecker.from_robot(
         robot, on_missing_mesh="skip" if skip_missing_meshes else "error"
     )
@@ -182,7 +169,7 @@ def generate(
     from robotspec.collision import Progress, compare_pairs, generate_for_robot
     from robotspec.srdf import write_srdf
 
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     if merge and robot.srdf is None:
         raise CollisionError(f"--merge: robot '{robot.name}' has no SRDF to merge into")
     bar = Progress(0, "collision matrix", enabled=progress)

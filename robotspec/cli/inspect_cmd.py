@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from robotspec.cli.app import app
-from robotspec.cli.options import JsonFlag, PackagePath, SpecArg
+from robotspec.cli.options import JsonFlag, PackagePath, SpecArg, load_robot
 from robotspec.cli.table import render_table
 
 if TYPE_CHECKING:
@@ -18,12 +18,6 @@ if TYPE_CHECKING:
 
 inspect_app = typer.Typer(help="Show what a spec compiles to.", no_args_is_help=True)
 app.add_typer(inspect_app, name="inspect")
-
-
-def _robot(spec: str, package_path: list[Any] | None) -> AbstractRobot:
-    from robotspec.compiler import compile_robot
-
-    return compile_robot(spec, package_paths=package_path or ())
 
 
 def _emit(data: Any, headers: list[str], rows: list[list[Any]], as_json: bool) -> None:
@@ -63,7 +57,7 @@ def chains(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
     """The robot's kinematic chains: kind, root, tip, joints, DOF, manipulator, sensors."""
     from robotspec.semantic import ParallelGripper
 
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     items = [_chain_row(robot, c) for c in robot.all_chains]
     for m in robot.manipulators:
         if isinstance(m, ParallelGripper):
@@ -92,7 +86,7 @@ def manipulators(
     """Manipulators: root, tool frame, front-facing orientation and axis, fingers, states."""
     from robotspec.semantic import ParallelGripper
 
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     items = []
     for m in robot.manipulators:
         item: dict[str, Any] = {
@@ -136,7 +130,7 @@ def sensors(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath 
     """Sensors: body, viewing axis, field of view and height range of cameras."""
     from robotspec.semantic import Camera
 
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     items = []
     for s in robot.sensors:
         item: dict[str, Any] = {
@@ -175,7 +169,7 @@ def sensors(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath 
 @inspect_app.command("joints")
 def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """The robot's moving joints with limits; velocities tightened by the spec end in '*'."""
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     from robotspec.urdf import load_urdf  # noqa: F401  (keeps import cost inside the command)
 
     w = robot.world
@@ -221,7 +215,7 @@ def _urdf_velocities(robot: AbstractRobot) -> dict[str, float]:
 @inspect_app.command("groups")
 def groups(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """The SRDF's groups, end effectors and group states."""
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     srdf = robot.srdf
     if srdf is None:
         sys.stdout.write("this robot has no SRDF\n")
@@ -266,7 +260,7 @@ def _group_text(g: dict[str, Any]) -> str:
 @inspect_app.command("collisions")
 def collisions(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """Disabled collision pairs (by SRDF reason) and disabled bodies."""
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     reasons: dict[str, int] = {}
     if robot.srdf is not None:
         for d in robot.srdf.disabled_collisions:
@@ -288,7 +282,7 @@ def collisions(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePa
 @inspect_app.command("tree")
 def tree(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """The kinematic tree with joint types, limits and semantic labels."""
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     w = robot.world
     labels: dict[str, list[str]] = {}
 

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
+
+if TYPE_CHECKING:
+    from robotspec.semantic import AbstractRobot
 
 PackagePath = Annotated[
     list[Path] | None,
@@ -43,3 +46,18 @@ SpecArg = Annotated[
         autocompletion=complete_spec,
     ),
 ]
+
+SkipMeshes = Annotated[
+    bool,
+    typer.Option(
+        "--skip-missing-meshes",
+        help="Leave out missing or unreadable meshes (each is reported) instead of failing.",
+    ),
+]
+
+
+def load_robot(spec: str, package_path: list[Path] | None) -> AbstractRobot:
+    """Compile a spec (or shipped robot) for a command; imports the compiler only when called."""
+    from robotspec.compiler import compile_robot
+
+    return compile_robot(spec, package_paths=package_path or ())

@@ -9,10 +9,10 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from robotspec.cli.app import app
-from robotspec.cli.options import PackagePath, SpecArg
+from robotspec.cli.options import PackagePath, SkipMeshes, SpecArg, load_robot
 
 if TYPE_CHECKING:
-    from robotspec.semantic import AbstractRobot
+    pass
 
 StateOpt = Annotated[
     list[str] | None,
@@ -24,19 +24,6 @@ StateOpt = Annotated[
         show_default=False,
     ),
 ]
-SkipMeshes = Annotated[
-    bool,
-    typer.Option(
-        "--skip-missing-meshes",
-        help="Leave out missing or unreadable meshes (each is reported) instead of failing.",
-    ),
-]
-
-
-def _robot(spec: str, package_path: list[Any] | None) -> AbstractRobot:
-    from robotspec.compiler import compile_robot
-
-    return compile_robot(spec, package_paths=package_path or ())
 
 
 def _warn(skipped: tuple[Any, ...]) -> None:
@@ -78,7 +65,7 @@ def render(
     width, height = parse_size(size)
     if view not in VIEWS:
         raise typer.BadParameter(f"'{view}' is not one of {', '.join(VIEWS)}", param_hint="--view")
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     q = state_configuration(robot, state or ())
     scene = build_scene(robot, on_missing_mesh="skip" if skip_missing_meshes else "error")
     _warn(scene.skipped)
@@ -113,7 +100,7 @@ def view(
     require("viser", "viser", "view")
     from robotspec.render.viewer import RobotViewer
 
-    robot = _robot(spec, package_path)
+    robot = load_robot(spec, package_path)
     q = state_configuration(robot, state or ())
     viewer = RobotViewer(
         robot,

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from robotspec.errors import CollisionError, RobotSpecError
 from robotspec.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
+from robotspec.mesh_files import read_triangles
 from robotspec.world import Body, World
 
 if TYPE_CHECKING:
@@ -120,7 +121,7 @@ class MeshLibrary:
         hit = self._cache.get(key)
         if hit is not None:
             return hit
-        vertices, faces = _read_mesh(path)
+        vertices, faces = read_triangles(path, CollisionError)
         vertices = vertices * np.asarray(scale, dtype=np.float64)
         coal = import_coal()
         model = coal.BVHModelOBBRSS()
@@ -131,30 +132,6 @@ class MeshLibrary:
         model.computeLocalAABB()
         self._cache[key] = (model, vertices)
         return model, vertices
-
-
-def _read_mesh(path: str) -> tuple[F64, NDArray[np.int64]]:
-    import trimesh
-
-    suffix = path.rsplit(".", 1)[-1].lower() if "." in path else ""
-    try:
-        with open(path, "rb") as f:
-            mesh = trimesh.load(f, file_type=suffix, force="mesh", process=False)
-    except FileNotFoundError:
-        raise CollisionError("mesh file not found", file=path, kind="mesh") from None
-    except OSError as exc:
-        raise CollisionError(f"cannot read mesh: {exc.strerror}", file=path, kind="mesh") from None
-    except Exception as exc:  # trimesh and its readers raise anything on a corrupt file
-        raise CollisionError(
-            f"cannot read mesh: {type(exc).__name__}: {exc}", file=path, kind="mesh"
-        ) from None
-    vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
-    faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
-    if faces.ndim != 2 or len(faces) == 0 or faces.shape[1] != 3:
-        raise CollisionError("mesh has no triangles", file=path, kind="mesh")
-    if not np.all(np.isfinite(vertices)):
-        raise CollisionError("mesh has non-finite vertices", file=path, kind="mesh")
-    return vertices, faces
 
 
 def _primitive(shape: Shape, coal: Any) -> tuple[Any, F64, str]:

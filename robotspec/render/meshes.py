@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from robotspec.errors import DescriptionError, RobotSpecError
 from robotspec.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
+from robotspec.mesh_files import read_triangles
 from robotspec.world import Body
 
 __all__ = ["MissingMeshPolicy", "Triangles", "TriangleLibrary", "cluster_decimate"]
@@ -87,7 +88,7 @@ class TriangleLibrary:
         hit = self._cache.get(key)
         if hit is None:
             try:
-                vertices, faces = read_mesh(mesh.path)
+                vertices, faces = read_triangles(mesh.path, DescriptionError)
             except RobotSpecError as exc:
                 raise DescriptionError(
                     f"link '{body.name}': {exc.message}", file=exc.file, kind="mesh", name=body.name
@@ -97,33 +98,6 @@ class TriangleLibrary:
             hit = Triangles(vertices * np.asarray(mesh.scale, dtype=np.float64), faces)
             self._cache[key] = hit
         return hit
-
-
-def read_mesh(path: str) -> tuple[F64, I64]:
-    """Vertices and faces of a mesh file (STL, OBJ, DAE, ...), as the file stores them."""
-    import trimesh
-
-    suffix = path.rsplit(".", 1)[-1].lower() if "." in path else ""
-    try:
-        with open(path, "rb") as f:
-            loaded = trimesh.load(f, file_type=suffix, force="mesh", process=False)
-    except FileNotFoundError:
-        raise DescriptionError("mesh file not found", file=path, kind="mesh") from None
-    except OSError as exc:
-        raise DescriptionError(
-            f"cannot read mesh: {exc.strerror}", file=path, kind="mesh"
-        ) from None
-    except Exception as exc:  # trimesh and its readers raise anything on a corrupt file
-        raise DescriptionError(
-            f"cannot read mesh: {type(exc).__name__}: {exc}", file=path, kind="mesh"
-        ) from None
-    vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
-    faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.int64)
-    if faces.ndim != 2 or len(faces) == 0 or faces.shape[1] != 3:
-        raise DescriptionError("mesh has no triangles", file=path, kind="mesh")
-    if not np.all(np.isfinite(vertices)):
-        raise DescriptionError("mesh has non-finite vertices", file=path, kind="mesh")
-    return vertices, faces
 
 
 def cluster_decimate(vertices: F64, faces: I64, budget: int) -> tuple[F64, I64]:

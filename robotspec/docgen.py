@@ -78,6 +78,34 @@ FIELD_NOTES: dict[tuple[str, str], FieldNote] = {
     ("RobotSpec", "description"): FieldNote(
         "", "description: {urdf: robot.urdf}", "the robot's files"
     ),
+    ("RobotSpec", "parts"): FieldNote(
+        "",
+        "parts: {arm: {spec: ur5}, hand: {spec: hand.yaml, attach: {part: arm, link: tool0}}}",
+    ),
+    # PartSpec
+    ("PartSpec", "spec"): FieldNote("", "spec: ur5"),
+    ("PartSpec", "urdf"): FieldNote(
+        "", "urdf: package://example-robot-data/robots/b1_description/urdf/b1.urdf"
+    ),
+    ("PartSpec", "srdf"): FieldNote("", "srdf: ../config/base.srdf"),
+    ("PartSpec", "xacro_args"): FieldNote(
+        "", "xacro_args: {arm_id: left}", "arguments of a xacro file (with urdf only)"
+    ),
+    ("PartSpec", "package_paths"): FieldNote(
+        "", "package_paths: [../ros_ws/src]", "extra folders to search for ROS packages"
+    ),
+    ("PartSpec", "prefix"): FieldNote("", "prefix: left_"),
+    ("PartSpec", "attach"): FieldNote("", "attach: {part: base, link: trunk, xyz: [0.3, 0, 0.09]}"),
+    # AttachSpec
+    ("AttachSpec", "part"): FieldNote("", "part: base"),
+    ("AttachSpec", "link"): FieldNote("", "link: tool0"),
+    ("AttachSpec", "xyz"): FieldNote("m", "xyz: [0, 0, 0.095]", "position in the link"),
+    ("AttachSpec", "rpy"): FieldNote(
+        "rad", "rpy: [0, 0, 1.5708]", "roll, pitch, yaw (fixed axes, as in URDF)"
+    ),
+    ("AttachSpec", "quaternion"): FieldNote("", "quaternion: [0, 0, 0.7071068, 0.7071068]"),
+    ("AttachSpec", "joint"): FieldNote("", "joint: hand_mount"),
+    ("AttachSpec", "replace_root"): FieldNote("", "replace_root: true"),
     ("RobotSpec", "root"): FieldNote(
         "", "root: base_footprint", "the link the robot starts at; its subtree is the robot"
     ),

@@ -24,6 +24,7 @@ __all__ = [
     "frozen_array",
     "pose_from_xyz_quaternion",
     "pose_from_xyz_rpy",
+    "matrix_to_rpy",
     "quaternion_to_matrix",
     "rpy_to_matrix",
 ]
@@ -52,6 +53,23 @@ def rpy_to_matrix(roll: float, pitch: float, yaw: float) -> Matrix:
             [-sp, cp * sr, cp * cr],
         ]
     )
+
+
+def matrix_to_rpy(r: Matrix) -> tuple[float, float, float]:
+    """URDF roll/pitch/yaw of a rotation matrix (the inverse of :func:`rpy_to_matrix`).
+
+    At pitch +-90 degrees roll and yaw are not separable; roll is set to 0 there and yaw takes
+    the whole rotation about z, which gives the same matrix back.
+    """
+    sp = -float(r[2, 0])
+    pitch = math.asin(max(-1.0, min(1.0, sp)))
+    if abs(sp) < 1.0 - 1e-9:
+        roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
+        yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
+    else:
+        roll = 0.0
+        yaw = math.atan2(-float(r[0, 1]), float(r[1, 1]))
+    return roll, pitch, yaw
 
 
 def quaternion_to_matrix(x: float, y: float, z: float, w: float) -> Matrix:

@@ -13,7 +13,17 @@ from typing import ClassVar, TypeVar
 
 from robotspec.semantic import AbstractRobot
 
-__all__ = ["HSRB", "PR2", "Panda", "ShippedRobot", "Tiago", "UR5", "robot_class_for"]
+__all__ = [
+    "HSRB",
+    "PR2",
+    "B1UR5Allegro",
+    "DualPanda",
+    "Panda",
+    "ShippedRobot",
+    "Tiago",
+    "UR5",
+    "robot_class_for",
+]
 
 R = TypeVar("R", bound="ShippedRobot")
 
@@ -63,8 +73,22 @@ class UR5(ShippedRobot):
     spec_name = "ur5"
 
 
+class B1UR5Allegro(ShippedRobot):
+    """Composed: Unitree B1 legs, a UR5 on the trunk, an Allegro hand on the flange."""
+
+    spec_name = "b1_ur5_allegro"
+
+
+class DualPanda(ShippedRobot):
+    """Composed: two Panda arms with hands on a pedestal."""
+
+    spec_name = "dual_panda"
+
+
 _CLASSES: dict[str, type[ShippedRobot]] = {
-    c.spec_name: c for c in (PR2, HSRB, Tiago, Panda, UR5) if c.spec_name is not None
+    c.spec_name: c
+    for c in (PR2, HSRB, Tiago, Panda, UR5, B1UR5Allegro, DualPanda)
+    if c.spec_name is not None
 }
 
 

@@ -15,12 +15,21 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from robotspec.errors import NotFoundError, SpecError
+from robotspec.geometry import Matrix
 from robotspec.yamlio import LocatedYaml, load_yaml, validation_errors
 
 __all__ = [
+    "AttachSpec",
     "CameraSpec",
     "ChainSpec",
     "CollisionSpec",
@@ -34,6 +43,7 @@ __all__ = [
     "LoadedSpec",
     "NeckSpec",
     "ParallelGripperSpec",
+    "PartSpec",
     "RobotSpec",
     "SPEC_VERSION",
     "TorsoSpec",
@@ -73,6 +83,22 @@ class FrameSpec(_Model):
         lambda v: v if v is None else _finite(v)
     )
 
+    def pose(self) -> Matrix:
+        """The frame's pose in its parent (quaternion if given, else rpy, else identity)."""
+        return _pose(self.xyz, self.rpy, self.quaternion)
+
+
+def _pose(
+    xyz: tuple[float, float, float],
+    rpy: tuple[float, float, float] | None,
+    quaternion: tuple[float, float, float, float] | None,
+) -> Matrix:
+    from robotspec.geometry import pose_from_xyz_quaternion, pose_from_xyz_rpy
+
+    if quaternion is not None:
+        return pose_from_xyz_quaternion(xyz, quaternion)
+    return pose_from_xyz_rpy(xyz, rpy or (0.0, 0.0, 0.0))
+
 
 class DescriptionSpec(_Model):
     """Where the robot's files are: paths relative to the spec, absolute, or ``package://``."""
@@ -84,6 +110,67 @@ class DescriptionSpec(_Model):
         default_factory=list, description="extra folders to search for ROS packages"
     )
     frames: dict[Name, FrameSpec] = Field(default_factory=dict)
+
+
+class AttachSpec(_Model):
+    """Where a part is welded: a link of an earlier part, and the pose of the part's root there.
+
+    Names here are the parent part's own names (before its prefix), so renaming a part never
+    breaks the parts attached to it.
+    """
+
+    part: Name = Field(description="the part this one is attached to")
+    link: Name = Field(description="a link of that part, in its own (unprefixed) names")
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] | None = None
+    quaternion: tuple[float, float, float, float] | None = Field(
+        default=None, description="[x, y, z, w]; give rpy or quaternion, not both"
+    )
+    joint: Name | None = Field(
+        default=None, description="name of the fixed joint (default: '<part>_weld')"
+    )
+    replace_root: bool = Field(
+        default=False,
+        description="drop the part's root link: its children (and its geometry) move onto "
+        "'link', e.g. an arm's 'world' or a hand's mounting plate",
+    )
+
+    _check = field_validator("xyz", "rpy", "quaternion")(lambda v: v if v is None else _finite(v))
+
+    def pose(self) -> Matrix:
+        """The pose of the part's root link in ``link``."""
+        return _pose(self.xyz, self.rpy, self.quaternion)
+
+
+class PartSpec(_Model):
+    """One part of a composed robot: a description (URDF/xacro or a spec) and where it is welded."""
+
+    spec: Name | None = Field(
+        default=None, description="another spec (a path or a shipped robot's name)"
+    )
+    urdf: Name | None = Field(default=None, description="URDF or xacro file (without a spec)")
+    srdf: Name | None = Field(default=None, description="its SRDF (with urdf only)")
+    xacro_args: dict[Name, str] = Field(default_factory=dict)
+    package_paths: list[Name] = Field(default_factory=list)
+    prefix: str = Field(
+        default="",
+        max_length=128,
+        pattern=r"^[A-Za-z0-9_./-]*$",
+        description="put before every link, joint, group, state and part name of this part",
+    )
+    attach: AttachSpec | None = Field(
+        default=None, description="where the part is welded; the one part without it is the base"
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> PartSpec:
+        if (self.spec is None) == (self.urdf is None):
+            raise ValueError("a part needs either 'spec' or 'urdf' (not both)")
+        if self.spec is not None and (self.srdf or self.xacro_args or self.package_paths):
+            raise ValueError(
+                "'srdf', 'xacro_args' and 'package_paths' belong in the part's own spec"
+            )
+        return self
 
 
 class DriveSpec(_Model):
@@ -221,8 +308,15 @@ class RobotSpec(_Model):
     robotspec: Literal[1] = Field(default=1, description="spec format version")
     name: Name
     extends: Name | None = Field(default=None, description="a base spec this one modifies")
-    description: DescriptionSpec
-    root: Name
+    description: DescriptionSpec | None = Field(
+        default=None, description="the robot's files; a composed robot gives 'parts' instead"
+    )
+    parts: dict[Name, PartSpec] = Field(
+        default_factory=dict, description="a robot assembled from parts welded together"
+    )
+    root: Name | None = Field(
+        default=None, description="the robot's root link (composed robots: the base part's)"
+    )
     drive: DriveSpec | None = None
     torso: TorsoSpec | None = None
     neck: NeckSpec | None = None
@@ -238,6 +332,32 @@ class RobotSpec(_Model):
         default=False, description="add the SRDF's group states as named joint states"
     )
     states: States = Field(default_factory=dict, description="robot-level named joint states")
+
+    @model_validator(mode="after")
+    def _description_or_parts(self) -> RobotSpec:
+        if self.description is None and not self.parts:
+            raise ValueError("a spec needs 'description' (its files) or 'parts' (a composed robot)")
+        if self.description is not None and self.parts:
+            raise ValueError(
+                "give 'description' or 'parts', not both; put extra frames in a part's spec"
+            )
+        if self.description is not None and self.root is None:
+            raise ValueError("missing required key 'root' (the robot's root link)")
+        return self
+
+    @property
+    def files(self) -> DescriptionSpec:
+        """The description of a flat (not composed) spec; compilation flattens composed ones."""
+        if self.description is None:
+            raise SpecError(f"spec '{self.name}' is composed of parts and has no description")
+        return self.description
+
+    @property
+    def root_link(self) -> str:
+        """The root link of a flat spec (always set once validated and flattened)."""
+        if self.root is None:
+            raise SpecError(f"spec '{self.name}' names no root link")
+        return self.root
 
 
 @dataclass(frozen=True)
@@ -277,20 +397,30 @@ def _merge(base: Any, child: Any) -> Any:
     return child
 
 
-def _absolutize(data: dict[str, Any], folder: Path) -> None:
-    """Rewrite a base spec's relative file paths so they stay right inside the child spec."""
-    desc = data.get("description")
-    if not isinstance(desc, dict):
-        return
-    for key in ("urdf", "srdf"):
+def _absolute_paths(desc: dict[str, Any], folder: Path, keys: tuple[str, ...]) -> None:
+    for key in keys:
         value = desc.get(key)
         if isinstance(value, str) and "://" not in value and not Path(value).is_absolute():
+            if key == "spec" and not (folder / value).is_file():
+                continue  # a shipped robot's name, not a path
             desc[key] = str((folder / value).resolve())
     paths = desc.get("package_paths")
     if isinstance(paths, list):
         desc["package_paths"] = [
             str((folder / v).resolve()) if not Path(v).is_absolute() else v for v in paths
         ]
+
+
+def _absolutize(data: dict[str, Any], folder: Path) -> None:
+    """Rewrite a base spec's relative file paths so they stay right inside the child spec."""
+    desc = data.get("description")
+    if isinstance(desc, dict):
+        _absolute_paths(desc, folder, ("urdf", "srdf"))
+    parts = data.get("parts")
+    if isinstance(parts, dict):
+        for part in parts.values():
+            if isinstance(part, dict):
+                _absolute_paths(part, folder, ("urdf", "srdf", "spec"))
 
 
 def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:

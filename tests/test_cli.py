@@ -176,7 +176,7 @@ def test_list_and_schema(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> 
     code, out, _ = run(capsys, "list")
     assert code == 0
     names = [line.split()[0] for line in out.splitlines()[1:]]
-    assert names == ["hsrb", "panda", "pr2", "tiago", "ur5"]
+    assert names == ["b1_ur5_allegro", "dual_panda", "hsrb", "panda", "pr2", "tiago", "ur5"]
     code, out, _ = run(capsys, "schema")
     assert code == 0
     assert out == json_schema_text() == shipped_schema_path().read_text()

@@ -145,7 +145,10 @@ def pr2_urdf() -> Path:
 
 # --------------------------------------------------------------------------- shipped
 def test_shipped_specs_are_the_five_robots() -> None:
-    assert set(shipped_specs()) == {"pr2", "hsrb", "tiago", "panda", "ur5"}
+    assert set(shipped_specs()) == {
+        *("pr2", "hsrb", "tiago", "panda", "ur5"),
+        *("b1_ur5_allegro", "dual_panda"),  # composed of parts
+    }
 
 
 @pytest.mark.parametrize(

@@ -21,7 +21,13 @@ def list_robots() -> None:
     rows = []
     for name, path in shipped_specs().items():
         spec = load_spec(path).spec
-        rows.append([name, spec.name, spec.description.urdf])
+        if spec.description is not None:
+            source = spec.description.urdf
+        else:
+            source = "parts: " + ", ".join(
+                f"{k} ({p.spec or Path(p.urdf or '').name})" for k, p in spec.parts.items()
+            )
+        rows.append([name, spec.name, source])
     sys.stdout.write(render_table(["name", "robot", "description"], rows) + "\n")
 
 

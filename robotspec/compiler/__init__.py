@@ -17,7 +17,6 @@ from typing import Any
 from robotspec.compiler.build import Build, build_robot
 from robotspec.compiler.diagnostics import Diagnostics
 from robotspec.errors import RobotSpecError, SpecError, missing_file
-from robotspec.geometry import pose_from_xyz_quaternion, pose_from_xyz_rpy
 from robotspec.semantic import AbstractRobot
 from robotspec.spec import LoadedSpec, load_spec, shipped_spec_files
 from robotspec.world import ConnectionType, World
@@ -85,20 +84,13 @@ def load_camera_presets() -> dict[str, dict[str, Any]]:
     return copy.deepcopy(_PRESETS[key])
 
 
-def _frame_pose(frame: Any) -> Any:
-    xyz = tuple(frame.xyz)
-    if frame.quaternion is not None:
-        return pose_from_xyz_quaternion(xyz, tuple(frame.quaternion))
-    return pose_from_xyz_rpy(xyz, tuple(frame.rpy or (0.0, 0.0, 0.0)))
-
-
 def _prepare_world(
     loaded: LoadedSpec, world: World, srdf: Any, diag: Diagnostics, *, add_drive: bool
 ) -> World:
     """Add the spec's frames and the base connection (drive or SRDF virtual joint)."""
     spec = loaded.spec
     frames = []
-    for name, f in spec.description.frames.items():
+    for name, f in spec.files.frames.items():
         loc = ("description", "frames", name)
         if f.rpy is not None and f.quaternion is not None:
             diag.error(loc, "give rpy or quaternion, not both")
@@ -121,7 +113,7 @@ def _prepare_world(
                 (world.source or world.name).rsplit("/", 1)[-1],
             )
             continue
-        frames.append((name, f.parent, _frame_pose(f)))
+        frames.append((name, f.parent, f.pose()))
     if frames:
         world = world.add_frames(frames)
     if not add_drive or world.parent_connection(world.root) is not None:
@@ -133,7 +125,7 @@ def _prepare_world(
     if drive is not None:
         if drive.type == "fixed":
             return world
-        if spec.root != world.root.name:
+        if spec.root_link != world.root.name:
             diag.error(
                 ("drive",),
                 f"a drive moves the URDF's root link '{world.root.name}', "
@@ -163,22 +155,41 @@ def _compile(
     from robotspec.description import load_description, resolve_file
     from robotspec.srdf import check_srdf_against, check_srdf_references
 
+    composition = None
+    if loaded.spec.parts:
+        from robotspec.compose import compose
+
+        composition = compose(loaded, package_paths=package_paths)
+        loaded = composition.loaded
     spec = loaded.spec
+    desc_spec = spec.files
     diag = Diagnostics(loaded)
-    paths = [*spec.description.package_paths, *map(str, package_paths)]
-    if world is None:
+    paths = [*desc_spec.package_paths, *map(str, package_paths)]
+    if world is None and composition is not None:
+        from robotspec.urdf import world_from_urdf_xml
+
+        issues: list[RobotSpecError] = []
+        base_world = world_from_urdf_xml(
+            copy.deepcopy(composition.urdf),
+            composition.source,
+            resolver=composition.resolver,
+            meshes="report",
+            issues=issues,
+        )
+        for w in issues:
+            diag.add(w)
+        resolver, urdf_name = composition.resolver, composition.source
+    elif world is None:
         try:
             desc = load_description(
-                spec.description.urdf,
+                desc_spec.urdf,
                 srdf=None,
                 package_paths=paths,
-                xacro_args=spec.description.xacro_args,
+                xacro_args=desc_spec.xacro_args,
                 base_folder=loaded.folder,
             )
         except RobotSpecError as exc:
-            diag.add(
-                _at_spec_if_missing(exc, diag, ("description", "urdf")), ("description", "urdf")
-            )
+            diag.add_all(exc, ("description", "urdf"))
             diag.raise_if_failed()
             raise
         for w in desc.warnings:
@@ -197,18 +208,14 @@ def _compile(
             source if source is not None and source.is_file() else None, extra_paths=extra
         )
         base_world, urdf_name = world, (world.source or world.name).rsplit("/", 1)[-1]
-    srdf = None
-    if spec.description.srdf is not None:
+    srdf = None if composition is None else composition.srdf
+    if composition is None and desc_spec.srdf is not None:
         from robotspec.srdf import load_srdf
 
         try:
-            srdf = load_srdf(
-                resolve_file(spec.description.srdf, loaded.folder, resolver), strict=False
-            )
+            srdf = load_srdf(resolve_file(desc_spec.srdf, loaded.folder, resolver), strict=False)
         except RobotSpecError as exc:
-            diag.add(
-                _at_spec_if_missing(exc, diag, ("description", "srdf")), ("description", "srdf")
-            )
+            diag.add_all(exc, ("description", "srdf"))
     if srdf is not None:
         for err in [
             *check_srdf_references(srdf),
@@ -230,25 +237,6 @@ def _compile(
     diag.raise_if_failed(strict=strict)
     return CompileResult(
         loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))
-    )
-
-
-def _at_spec_if_missing(
-    err: RobotSpecError, diag: Diagnostics, loc: tuple[str, ...]
-) -> RobotSpecError:
-    """A missing description file is the spec's mistake: point at the line that names it."""
-    if err.detail.kind != "file" or err.file is None:
-        return err
-    file, line, col = diag.loaded.position(loc)
-    return RobotSpecError(
-        f"{err.file}: {err.message}",
-        file=file,
-        line=line,
-        column=col,
-        kind="file",
-        name=err.detail.name,
-        suggestions=err.detail.suggestions,
-        location=loc,
     )
 
 

@@ -96,6 +96,27 @@ class Diagnostics:
             err = err.located(file=file, line=line, column=col, location=loc)
         (self.warnings if err.severity == "warning" else self.errors).append(err)
 
+    def add_all(self, err: RobotSpecError, loc: Loc | None = None) -> None:
+        """Record every problem of an error raised elsewhere (one or a collection).
+
+        A missing file is the spec's mistake: it is moved to the spec line at ``loc`` that names
+        the file, keeping the file's path in the message.
+        """
+        for one in getattr(err, "errors", (err,)):
+            if loc is not None and one.detail.kind == "file" and one.file is not None:
+                file, line, col = self._at(loc)
+                one = RobotSpecError(
+                    f"{one.file}: {one.message}",
+                    file=file,
+                    line=line,
+                    column=col,
+                    kind="file",
+                    name=one.detail.name,
+                    suggestions=one.detail.suggestions,
+                    location=loc,
+                )
+            self.add(one, loc)
+
     def suggest(self, name: str, candidates: Iterable[str]) -> tuple[str, ...]:
         """Closest names, for messages built by hand."""
         return closest_names(name, candidates)

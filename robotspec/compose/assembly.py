@@ -1,0 +1,641 @@
+"""A composed spec (``parts:``) to one URDF tree, one SRDF and one flat spec.
+
+Pipeline: load every part (a URDF/xacro, or a spec, itself possibly composed), order the parts by
+their welds (the base first), rename each part's names (:class:`PartNames`), weld the trees, merge
+the SRDFs and the part specs' semantics, then let the composed spec's own entries override. The
+compiler then treats the result like any flat spec; ``robotspec export urdf`` writes the tree.
+
+Every problem of every part is collected and raised together, each at its spec line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from lxml import etree
+from pydantic import ValidationError
+
+from robotspec.compiler.diagnostics import Diagnostics, Loc
+from robotspec.compose.naming import PartNames
+from robotspec.compose.semantics import NAMED_SECTIONS, remap_marks, rename_semantics
+from robotspec.compose.srdf_merge import merge_srdfs, rename_srdf
+from robotspec.compose.urdf_merge import (
+    TreeFacts,
+    absolute_mesh_paths,
+    add_fixed_frames,
+    is_unit,
+    rename_tree,
+    tree_facts,
+    weld,
+)
+from robotspec.errors import RobotSpecError, SpecError, missing_file
+from robotspec.packages import PackageResolver
+from robotspec.spec import LoadedSpec, PartSpec, RobotSpec, load_spec, shipped_spec_files
+from robotspec.srdf import Srdf
+from robotspec.yamlio import LocatedYaml, validation_errors
+
+__all__ = ["ComposedPart", "Composition", "compose", "description_tree"]
+
+
+@dataclass(frozen=True)
+class ComposedPart:
+    """One part as it ended up in the composed robot."""
+
+    name: str
+    names: PartNames
+    file: Path
+    root_link: str
+    weld_joint: str | None
+    links: tuple[str, ...]
+    joints: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Composition:
+    """The joined description of a robot and its flat spec.
+
+    ``urdf`` is shared: callers that change a tree (the world builder strips comments) work on
+    ``copy.deepcopy(composition.urdf)``.
+    """
+
+    loaded: LoadedSpec
+    urdf: etree._Element = field(repr=False)
+    srdf: Srdf | None
+    resolver: PackageResolver = field(repr=False)
+    parts: tuple[ComposedPart, ...] = ()
+
+    @property
+    def source(self) -> str:
+        """How messages name the joined description."""
+        return f"{self.loaded.file.name} (composed)"
+
+
+@dataclass
+class _Part:
+    name: str
+    spec: PartSpec
+    file: Path
+    tree: etree._Element
+    srdf: Srdf | None
+    resolver: PackageResolver
+    facts: TreeFacts
+    data: dict[str, Any] = field(default_factory=dict)
+    documents: tuple[LocatedYaml, ...] = ()
+    use_srdf: bool = True
+    spec_root: str | None = None
+    drive: dict[str, Any] | None = None
+    collision: dict[str, Any] = field(default_factory=dict)
+
+
+# ------------------------------------------------------------------------------------- loading
+def description_tree(
+    loaded: LoadedSpec, package_paths: Sequence[str | Path] = ()
+) -> tuple[etree._Element, Path, PackageResolver, Srdf | None]:
+    """A flat spec's URDF tree (xacro run, frames added, mesh paths absolute) and its SRDF."""
+    from robotspec.description import resolve_file
+    from robotspec.urdf import read_description_xml
+    from robotspec.urdf_check import check_urdf_tree
+
+    desc = loaded.spec.files
+    folder = loaded.folder
+    extra = [
+        p if Path(p).is_absolute() else folder / p
+        for p in [*desc.package_paths, *map(str, package_paths)]
+    ]
+    if "://" in desc.urdf:
+        urdf = PackageResolver.create(None, extra_paths=extra).resolve(
+            desc.urdf, relative_to=folder
+        )
+    else:
+        urdf = Path(desc.urdf) if Path(desc.urdf).is_absolute() else folder / desc.urdf
+    if not urdf.is_file():
+        raise missing_file(urdf)
+    resolver = PackageResolver.create(urdf, extra_paths=extra)
+    tree = read_description_xml(urdf, resolver, desc.xacro_args)
+    check_urdf_tree(tree, str(urdf))
+    absolute_mesh_paths(tree, urdf.parent)
+    links = {el.get("name") for el in tree.iterfind("link")}
+    add_fixed_frames(
+        tree,
+        [(n, f.parent, f.pose()) for n, f in desc.frames.items() if n not in links],
+    )
+    srdf = None
+    if desc.srdf is not None:
+        from robotspec.srdf import load_srdf
+
+        srdf = load_srdf(resolve_file(desc.srdf, folder, resolver), strict=False)
+    return tree, urdf, resolver, srdf
+
+
+def _spec_path(ref: str, folder: Path) -> Path | None:
+    p = Path(ref) if Path(ref).is_absolute() else folder / ref
+    if p.is_file():
+        return p
+    return shipped_spec_files().get(ref.lower())
+
+
+def _load_part(
+    name: str,
+    ps: PartSpec,
+    loaded: LoadedSpec,
+    diag: Diagnostics,
+    package_paths: Sequence[str | Path],
+    seen: tuple[Path, ...],
+) -> _Part | None:
+    loc: Loc = ("parts", name)
+    try:
+        if ps.spec is not None:
+            path = _spec_path(ps.spec, loaded.folder)
+            if path is None:
+                candidates = [
+                    *shipped_spec_files(),
+                    *(f.name for f in loaded.folder.glob("*.yaml")),
+                ]
+                diag.not_found(
+                    (*loc, "spec"), "spec", ps.spec, candidates, "this folder or the shipped robots"
+                )
+                return None
+            if path.resolve() in seen:
+                chain = " -> ".join(p.name for p in (*seen, path.resolve()))
+                diag.error((*loc, "spec"), f"parts include each other: {chain}")
+                return None
+            part_loaded = load_spec(path)
+            if part_loaded.spec.parts:
+                inner = compose(part_loaded, package_paths=package_paths, _seen=seen)
+                flat = inner.loaded
+                tree, file, resolver, srdf = inner.urdf, path, inner.resolver, inner.srdf
+            else:
+                flat = part_loaded
+                tree, file, resolver, srdf = description_tree(part_loaded, package_paths)
+            spec = flat.spec
+            data = spec.model_dump(mode="json", exclude_unset=True)
+            return _Part(
+                name=name,
+                spec=ps,
+                file=file,
+                tree=tree,
+                srdf=srdf,
+                resolver=resolver,
+                facts=tree_facts(tree),
+                data=data,
+                documents=flat.documents,
+                use_srdf=spec.collision.use_srdf,
+                spec_root=spec.root,
+                drive=data.get("drive"),
+                collision={
+                    k: v
+                    for k, v in data.get("collision", {}).items()
+                    if k in ("buffer_distance", "violated_distance")
+                },
+            )
+        assert ps.urdf is not None  # PartSpec checks one of spec/urdf is given
+        part_desc = RobotSpec.model_validate(
+            {
+                "name": name,
+                "root": "-",
+                "description": {
+                    "urdf": ps.urdf,
+                    "srdf": ps.srdf,
+                    "xacro_args": ps.xacro_args,
+                    "package_paths": ps.package_paths,
+                },
+            }
+        )
+        tree, file, resolver, srdf = description_tree(
+            LoadedSpec(part_desc, loaded.file, loaded.documents), package_paths
+        )
+        return _Part(name, ps, file, tree, srdf, resolver, tree_facts(tree))
+    except RobotSpecError as exc:
+        key = "spec" if ps.spec is not None else "urdf"
+        diag.add_all(exc, (*loc, key))
+        return None
+
+
+# ------------------------------------------------------------------------------------ ordering
+def _order(parts: Mapping[str, PartSpec], diag: Diagnostics) -> list[str]:
+    """Parts in weld order, base first; missing parents, several bases and cycles reported."""
+    bases = [n for n, p in parts.items() if p.attach is None]
+    for extra in bases[1:]:
+        diag.error(
+            ("parts", extra),
+            f"part '{extra}' has no 'attach', and neither has part '{bases[0]}'; "
+            "only the base part is not attached to another",
+        )
+    for n, p in parts.items():
+        if p.attach is not None and p.attach.part not in parts:
+            diag.not_found(
+                ("parts", n, "attach", "part"),
+                "part",
+                p.attach.part,
+                [m for m in parts if m != n],
+                "the spec's parts",
+            )
+    order: list[str] = []
+    done: set[str] = set()
+    frontier = bases[:1]
+    while frontier:
+        current = frontier.pop(0)
+        order.append(current)
+        done.add(current)
+        frontier += [
+            n
+            for n, p in parts.items()
+            if p.attach is not None and p.attach.part == current and n not in done
+        ]
+    for n, p in parts.items():
+        if n in done or p.attach is None or p.attach.part not in parts:
+            continue
+        # Not reachable from the base and its parent exists: it hangs in a cycle.
+        path, cur = [n], p.attach.part
+        while cur not in path and cur in parts and parts[cur].attach is not None:
+            path.append(cur)
+            att = parts[cur].attach
+            assert att is not None
+            cur = att.part
+        if cur in path:
+            cycle = [*path[path.index(cur) :], cur]
+            diag.error(
+                ("parts", n, "attach", "part"),
+                f"the parts' attachments form a cycle: {' -> '.join(cycle)}",
+            )
+    if not bases and parts:
+        diag.error(("parts",), "every part is attached to another: one part must be the base")
+    return order
+
+
+# ------------------------------------------------------------------------------------ joining
+def _merged_resolver(parts: Sequence[_Part]) -> PackageResolver:
+    def union(attr: str) -> tuple[Path, ...]:
+        out: dict[Path, None] = {}
+        for p in parts:
+            out.update(dict.fromkeys(getattr(p.resolver, attr)))
+        return tuple(out)
+
+    return PackageResolver(
+        search_folders=union("search_folders"),
+        roots=union("allowed_roots"),
+        description=None,
+        bare_name_folders=union("bare_name_folders"),
+        flat_folders=union("flat_folders"),
+    )
+
+
+def _pin_packages(part: _Part, meshes: Sequence[etree._Element], joined: PackageResolver) -> None:
+    """Write a mesh's absolute path when the joined search path finds its package elsewhere."""
+    for mesh in meshes:
+        uri = mesh.get("filename", "")
+        if not uri.startswith("package://"):
+            continue
+        package = uri[len("package://") :].split("/", 1)[0]
+        try:
+            mine = part.resolver.find_package(package)
+            path = part.resolver.resolve(uri, relative_to=part.file.parent)
+        except RobotSpecError:
+            continue  # unresolvable for the part too: the world builder reports it
+        try:
+            theirs: Path | None = joined.find_package(package)
+        except RobotSpecError:
+            theirs = None
+        if theirs != mine:
+            mesh.set("filename", str(path))
+
+
+def _materials(
+    part: _Part, n: PartNames, used: dict[str, bytes]
+) -> tuple[dict[str, str], set[str]]:
+    """Composed material names, and the part's materials an earlier part defined identically.
+
+    Material names are global in a URDF: a clash with a different colour gets the part's name
+    as well as its prefix.
+    """
+    out: dict[str, str] = {}
+    duplicate: set[str] = set()
+    for el in part.tree.iterfind("material"):
+        own = el.get("name")
+        if not own:
+            continue
+        body = b"".join(etree.tostring(c, with_tail=False) for c in el)
+        composed = n.name(own)
+        if composed in used:
+            if used[composed] == body:
+                duplicate.add(own)
+            else:
+                composed = f"{part.name}_{composed}"
+        out[own] = composed
+        used.setdefault(composed, body)
+    for el in part.tree.iter("material"):
+        own = el.get("name")
+        if own and own not in out:
+            out[own] = n.name(own)
+    return out, duplicate
+
+
+def _clashes(
+    kind: str,
+    names: Sequence[str],
+    owner: dict[str, str],
+    part: str,
+    diag: Diagnostics,
+    loc: Loc,
+) -> None:
+    for name in names:
+        other = owner.get(name)
+        if other is not None and other != part:
+            diag.error(
+                loc,
+                f"{kind} '{name}' is in both part '{other}' and part '{part}'; "
+                f"give part '{part}' a (different) prefix",
+                name=name,
+                kind="clash",
+            )
+        else:
+            owner[name] = part
+
+
+def compose(
+    loaded: LoadedSpec,
+    *,
+    package_paths: Sequence[str | Path] = (),
+    _seen: tuple[Path, ...] = (),
+) -> Composition:
+    """Join the parts of a composed spec; every problem is raised together."""
+    spec = loaded.spec
+    diag = Diagnostics(loaded)
+    seen = (*_seen, loaded.file.resolve())
+    order = _order(spec.parts, diag)
+    loaded_parts: dict[str, _Part] = {}
+    for name in order:
+        part = _load_part(name, spec.parts[name], loaded, diag, package_paths, seen)
+        if part is not None:
+            loaded_parts[name] = part
+            if len(part.facts.roots) != 1:
+                diag.error(
+                    ("parts", name),
+                    f"part '{name}' ({part.file.name}) must have one root link, "
+                    f"it has {len(part.facts.roots)}: {', '.join(part.facts.roots)}",
+                )
+    diag.raise_if_failed()
+    robot = etree.Element("robot")
+    robot.set("name", spec.name)
+    composed: list[ComposedPart] = []
+    names_of: dict[str, PartNames] = {}
+    link_owner: dict[str, str] = {}
+    joint_owner: dict[str, str] = {}
+    group_owner: dict[str, str] = {}
+    used_materials: dict[str, bytes] = {}
+    srdfs: list[Srdf] = []
+    mesh_lists: list[tuple[_Part, list[etree._Element]]] = []
+    for name in order:
+        part = loaded_parts[name]
+        ps = part.spec
+        loc: Loc = ("parts", name)
+        root = part.facts.roots[0]
+        merged: dict[str, str] = {}
+        parent_link = None
+        weld_joint = None
+        attach = ps.attach
+        if attach is not None:
+            parent = loaded_parts[attach.part]
+            if attach.link not in parent.facts.links:
+                diag.not_found(
+                    (*loc, "attach", "link"),
+                    "link",
+                    attach.link,
+                    parent.facts.links,
+                    f"part '{attach.part}' ({parent.file.name})",
+                )
+                continue
+            if attach.rpy is not None and attach.quaternion is not None:
+                diag.error((*loc, "attach"), "give rpy or quaternion, not both")
+                continue
+            if attach.quaternion is not None and not is_unit(attach.quaternion):
+                diag.error((*loc, "attach", "quaternion"), "must be a unit quaternion")
+                continue
+            parent_link = names_of[attach.part].link(attach.link)
+            if attach.replace_root:
+                merged[root] = parent_link
+            else:
+                weld_joint = attach.joint or f"{name}_weld"
+        n = PartNames(name, ps.prefix, merged)
+        names_of[name] = n
+        links = [n.link(x) for x in part.facts.links if x not in merged]
+        joints = [n.joint(x) for x in part.facts.joints]
+        where = (*loc, "prefix") if "prefix" in ps.model_fields_set else loc
+        _clashes("link", links, link_owner, name, diag, where)
+        _clashes(
+            "joint",
+            [*joints, *([weld_joint] if weld_joint else [])],
+            joint_owner,
+            name,
+            diag,
+            where,
+        )
+        if part.srdf is not None:
+            renamed = rename_srdf(
+                part.srdf, n, keep_virtual=attach is None, keep_collisions=part.use_srdf
+            )
+            _clashes("SRDF group", [g.name for g in renamed.groups], group_owner, name, diag, where)
+            srdfs.append(renamed)
+        tree = part.tree
+        mesh_lists.append((part, list(tree.iter("mesh"))))
+        materials, duplicate = _materials(part, n, used_materials)
+        dropped = [el for el in tree.iterfind("material") if el.get("name") in duplicate]
+        rename_tree(tree, n, materials)
+        for el in dropped:
+            tree.remove(el)
+        if attach is None or parent_link is None:
+            for el in list(tree):
+                if isinstance(el.tag, str):
+                    robot.append(el)
+        else:
+            pose = attach.pose()
+            weld(
+                robot,
+                tree,
+                parent_link=parent_link,
+                part_root=n.link(root),
+                pose=pose,
+                joint_name=weld_joint or "",
+                replace_root=attach.replace_root,
+            )
+        composed.append(
+            ComposedPart(
+                name=name,
+                names=n,
+                file=part.file,
+                root_link=n.link(root),
+                weld_joint=weld_joint,
+                links=tuple(links),
+                joints=tuple(joints),
+            )
+        )
+    diag.raise_if_failed()
+    resolver = _merged_resolver(list(loaded_parts.values()))
+    for part, meshes in mesh_lists:
+        _pin_packages(part, meshes, resolver)
+    flat = _flat_spec(loaded, loaded_parts, order, names_of, composed, robot, diag)
+    diag.raise_if_failed()
+    assert flat is not None
+    return Composition(
+        loaded=flat,
+        urdf=robot,
+        srdf=merge_srdfs(spec.name, srdfs) if srdfs else None,
+        resolver=resolver,
+        parts=tuple(composed),
+    )
+
+
+# ---------------------------------------------------------------------------------- semantics
+def _ancestors(robot: etree._Element, link: str) -> list[str]:
+    parent_of = tree_facts(robot).parent_of
+    out = [link]
+    while out[-1] in parent_of:
+        out.append(parent_of[out[-1]])
+    return out
+
+
+def _flat_spec(
+    loaded: LoadedSpec,
+    parts: Mapping[str, _Part],
+    order: Sequence[str],
+    names_of: Mapping[str, PartNames],
+    composed: Sequence[ComposedPart],
+    robot: etree._Element,
+    diag: Diagnostics,
+) -> LoadedSpec | None:
+    """The composed robot's spec: every part's semantics renamed, then the spec's own entries."""
+    spec = loaded.spec
+    merged: dict[str, Any] = {s: {} for s in NAMED_SECTIONS}
+    owner: dict[tuple[str, str], str] = {}
+    velocity: dict[str, float] = {}
+    controlled: list[str] = []
+    any_controlled = False
+    disabled: list[str] = []
+    documents: list[LocatedYaml] = []
+    import_states = False
+    for name in order:
+        part, n = parts[name], names_of[name]
+        sem = rename_semantics(part.data, n, part.facts)
+        loc: Loc = ("parts", name)
+        for section in NAMED_SECTIONS:
+            for key, value in sem.get(section, {}).items():
+                other = owner.get((section, key))
+                if other is not None:
+                    diag.error(
+                        loc,
+                        f"{section[:-1]} '{key}' comes from both part '{other}' and part "
+                        f"'{name}'; give part '{name}' a (different) prefix",
+                        name=key,
+                        kind="clash",
+                    )
+                    continue
+                owner[(section, key)] = name
+                merged[section][key] = value
+        for key in ("torso", "neck"):
+            if key in sem:
+                if key in merged:
+                    diag.error(
+                        loc, f"both part '{owner[(key, '')]}' and part '{name}' have a {key}"
+                    )
+                    continue
+                owner[(key, "")] = name
+                merged[key] = sem[key]
+        velocity.update(sem.get("velocity_limits", {}).get("joints", {}))
+        if "controlled_joints" in sem:
+            any_controlled = True
+            controlled += sem["controlled_joints"]
+        else:
+            controlled += [n.joint(j) for j in part.facts.driven_joints]
+        disabled += sem.get("collision", {}).get("disabled_bodies", [])
+        import_states |= bool(sem.get("import_srdf_group_states"))
+        documents += [remap_marks(d, n) for d in part.documents]
+    _hand_over_manipulators(spec, parts, order, merged, owner, robot, names_of)
+    base = parts[order[0]]
+    base_names = names_of[order[0]]
+    root = spec.root or base_names.link(base.spec_root or base.facts.roots[0])
+    data: dict[str, Any] = {
+        "name": spec.name,
+        "description": {"urdf": str(loaded.file)},
+        "root": root,
+        **{k: v for k, v in merged.items() if v},
+    }
+    if base.drive is not None:
+        drive = dict(base.drive)
+        if drive.get("joint"):
+            drive["joint"] = base_names.joint(drive["joint"])
+        data["drive"] = drive
+    if velocity:
+        data["velocity_limits"] = {"joints": velocity}
+    if any_controlled:
+        data["controlled_joints"] = controlled
+    collision: dict[str, Any] = dict(base.collision)
+    if disabled:
+        collision["disabled_bodies"] = disabled
+    if collision:
+        data["collision"] = collision
+    if import_states:
+        data["import_srdf_group_states"] = True
+    own = spec.model_dump(mode="json", exclude_unset=True)
+    for key, value in own.items():
+        if key in ("parts", "description", "robotspec", "extends"):
+            continue
+        if key in NAMED_SECTIONS and isinstance(value, dict):
+            data[key] = {**data.get(key, {}), **value}
+        elif key in ("velocity_limits", "collision") and isinstance(value, dict):
+            data[key] = {**data.get(key, {}), **value}
+        else:
+            data[key] = value
+    try:
+        flat = RobotSpec.model_validate(data)
+    except ValidationError as exc:
+        diag.add_all(validation_errors(exc, loaded.documents[0], RobotSpec, SpecError))
+        return None
+    return LoadedSpec(flat, loaded.file, (*loaded.documents, *documents))
+
+
+def _hand_over_manipulators(
+    spec: RobotSpec,
+    parts: Mapping[str, _Part],
+    order: Sequence[str],
+    merged: dict[str, Any],
+    owner: Mapping[tuple[str, str], str],
+    robot: etree._Element,
+    names_of: Mapping[str, PartNames],
+) -> None:
+    """A welded hand's manipulator becomes the manipulator of the arm chain it is welded to.
+
+    The chain chosen is the parent part's chain whose tip is nearest above the weld link. Its
+    previous manipulator (an arm's bare flange) is dropped unless another chain carries it or the
+    composed spec names it; the hand's tool frame is now the chain's end.
+    """
+    chains: dict[str, Any] = merged["chains"]
+    manips: dict[str, Any] = merged["manipulators"]
+    own_manips = set(spec.manipulators)
+    for name in order:
+        attach = parts[name].spec.attach
+        if attach is None:
+            continue
+        carried = {c.get("manipulator") for c in chains.values()}
+        free = [m for m in manips if owner.get(("manipulators", m)) == name and m not in carried]
+        if len(free) != 1:
+            continue
+        weld_link = names_of[attach.part].link(attach.link)
+        above = _ancestors(robot, weld_link)
+        best: tuple[int, str] | None = None
+        for cname, chain in chains.items():
+            if owner.get(("chains", cname)) != attach.part or chain.get("tip") not in above:
+                continue
+            depth = above.index(chain["tip"])
+            if best is None or depth < best[0]:
+                best = (depth, cname)
+        if best is None:
+            continue
+        chain = chains[best[1]]
+        old = chain.get("manipulator")
+        chain["manipulator"] = free[0]
+        still_used = any(c.get("manipulator") == old for c in chains.values())
+        if old is not None and not still_used and old not in own_manips:
+            manips.pop(old, None)

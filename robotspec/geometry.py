@@ -61,9 +61,9 @@ def matrix_to_rpy(r: Matrix) -> tuple[float, float, float]:
     At pitch +-90 degrees roll and yaw are not separable; roll is set to 0 there and yaw takes
     the whole rotation about z, which gives the same matrix back.
     """
-    sp = -float(r[2, 0])
-    pitch = math.asin(max(-1.0, min(1.0, sp)))
-    if abs(sp) < 1.0 - 1e-9:
+    cp = math.hypot(float(r[0, 0]), float(r[1, 0]))
+    pitch = math.atan2(-float(r[2, 0]), cp)  # atan2, not asin: exact near +-90 degrees too
+    if cp > 1e-12:
         roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
         yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
     else:

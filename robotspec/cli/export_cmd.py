@@ -111,3 +111,60 @@ def srdf(
         f"effectors, {len(exported.group_states)} group states, "
         f"{len(exported.disabled_collisions)} disabled pairs\n"
     )
+
+
+@export_app.command("urdf")
+def urdf(
+    spec: SpecArg,
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write to FILE instead of stdout.")
+    ] = None,
+    package_path: PackagePath = None,
+) -> None:
+    """One URDF of the robot: a composed robot's parts joined, welds as fixed joints.
+
+    For any spec, xacro is run and the spec's extra frames become links. Relative mesh paths
+    become absolute; package:// URIs are kept.
+    """
+    from robotspec.compiler import resolve_spec
+    from robotspec.description_export import joined_urdf, urdf_text
+    from robotspec.spec import load_spec
+
+    loaded = load_spec(resolve_spec(spec))
+    tree = joined_urdf(loaded, package_paths=package_path or ())
+    text = urdf_text(tree, comment=f"{loaded.spec.name}: exported by robotspec from {spec}")
+    if output is None:
+        sys.stdout.write(text)
+        return
+    output.write_text(text, encoding="utf-8")
+    links = sum(1 for _ in tree.iterfind("link"))
+    joints = sum(1 for _ in tree.iterfind("joint"))
+    sys.stderr.write(f"wrote {output}: {links} links, {joints} joints\n")
+
+
+@export_app.command("bundle")
+def bundle_cmd(
+    spec: SpecArg,
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="Folder to write NAME.urdf/.srdf/.yaml into.")
+    ],
+    name: Annotated[
+        str | None, typer.Option("--name", help="File stem (default: the spec's file stem).")
+    ] = None,
+    package_path: PackagePath = None,
+) -> None:
+    """URDF + SRDF + a flat spec naming them: the same robot without the source files.
+
+    `robotspec validate FOLDER/NAME.yaml` then compiles to the same robot (a composed one too).
+    """
+    from robotspec.compiler import check_spec, resolve_spec
+    from robotspec.description_export import bundle
+
+    path = resolve_spec(spec)
+    result = check_spec(path, package_paths=package_path or ())
+    stem = name or path.stem
+    out = bundle(result, name=stem, package_paths=package_path or ())
+    output.mkdir(parents=True, exist_ok=True)
+    for suffix, text in ((".urdf", out.urdf), (".srdf", out.srdf), (".yaml", out.spec)):
+        (output / f"{stem}{suffix}").write_text(text, encoding="utf-8")
+    sys.stderr.write(f"wrote {output}/{stem}.urdf, .srdf and .yaml\n")

@@ -77,7 +77,7 @@ def origin_pose(el: etree._Element | None) -> Matrix:
 
 
 def _fmt(values: Iterable[float]) -> str:
-    return " ".join(f"{0.0 if abs(v) < 1e-15 else v:.12g}" for v in values)
+    return " ".join(repr(0.0 if abs(v) < 1e-15 else float(v)) for v in values)
 
 
 def set_origin(el: etree._Element, pose: Matrix) -> None:

@@ -98,7 +98,9 @@ def test_semantics_survive_composition() -> None:
     assert arm.manipulator is not None and arm.manipulator.name == "allegro_hand"
     assert arm.manipulator.tool_frame.name == "allegro_grasp_frame"
     assert mobile.world.is_ancestor(arm.tip, arm.manipulator.tool_frame)
-    hand_alone = compile_robot(_spec_file("b1_ur5_allegro").parent / "parts" / "allegro_right_hand.yaml")
+    hand_alone = compile_robot(
+        _spec_file("b1_ur5_allegro").parent / "parts" / "allegro_right_hand.yaml"
+    )
     (alone,) = hand_alone.manipulators
     assert alone.tool_frame.name == "grasp_frame"
     np.testing.assert_allclose(
@@ -192,3 +194,240 @@ def _summary(robot: AbstractRobot) -> list[tuple[str, ...]]:
     ]
     manips = [(m.name, m.root.name, m.tool_frame.name) for m in robot.manipulators]
     return [*chains, *manips, (robot.root.name, str(robot.drive and robot.drive.type))]
+
+
+# ------------------------------------------------------------------------ small fixtures
+ARM_URDF = """<?xml version="1.0"?>
+<robot name="arm">
+  <material name="paint"><color rgba="1 0 0 1"/></material>
+  <link name="mount"/>
+  <link name="base_link">
+    <visual><geometry><mesh filename="meshes/base.stl"/></geometry><material name="paint"/></visual>
+    <inertial><origin xyz="0 0 0.05"/><mass value="2"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.02"/></inertial>
+  </link>
+  <link name="upper"><collision><geometry><box size="0.1 0.1 0.4"/></geometry></collision></link>
+  <link name="flange"/>
+  <joint name="mount_joint" type="fixed"><parent link="mount"/><child link="base_link"/></joint>
+  <joint name="shoulder" type="revolute">
+    <origin xyz="0 0 0.1"/><axis xyz="0 0 1"/><parent link="base_link"/><child link="upper"/>
+    <limit lower="-2" upper="2" velocity="1.5" effort="10"/>
+  </joint>
+  <joint name="wrist" type="revolute">
+    <origin xyz="0 0 0.4" rpy="0 1.5707963267948966 0"/><axis xyz="0 1 0"/>
+    <parent link="upper"/><child link="flange"/>
+    <limit lower="-2" upper="2" velocity="1.5" effort="10"/>
+  </joint>
+</robot>
+"""
+
+HAND_URDF = """<?xml version="1.0"?>
+<robot name="hand">
+  <material name="paint"><color rgba="0 0 1 1"/></material>
+  <link name="palm">
+    <visual><geometry><box size="0.08 0.08 0.02"/></geometry><material name="paint"/></visual>
+    <collision><origin xyz="0 0 0.01"/><geometry><box size="0.08 0.08 0.02"/></geometry></collision>
+    <inertial><origin xyz="0.01 0 0.02" rpy="0 0 0.3"/><mass value="0.5"/>
+      <inertia ixx="0.001" ixy="0.0001" ixz="0" iyy="0.002" iyz="0" izz="0.003"/></inertial>
+  </link>
+  <link name="finger"><collision><geometry><box size="0.01 0.01 0.05"/></geometry></collision>
+    <inertial><mass value="0.05"/>
+      <inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial>
+  </link>
+  <link name="tcp"/>
+  <joint name="finger_joint" type="prismatic">
+    <origin xyz="0 0.02 0.03"/><axis xyz="0 1 0"/><parent link="palm"/><child link="finger"/>
+    <limit lower="0" upper="0.04" velocity="0.2" effort="10"/>
+  </joint>
+  <joint name="tcp_joint" type="fixed">
+    <origin xyz="0 0 0.1"/><parent link="palm"/><child link="tcp"/>
+  </joint>
+</robot>
+"""
+
+ARM_SPEC = """robotspec: 1
+name: Arm
+description: {urdf: arm.urdf}
+root: mount
+drive: {type: fixed}
+chains:
+  arm: {root: base_link, tip: flange, manipulator: flange, states: {up: {shoulder: 0.5}}}
+manipulators:
+  flange: {type: generic, root: flange, tool_frame: flange}
+"""
+
+HAND_SPEC = """robotspec: 1
+name: Hand
+description: {urdf: hand.urdf}
+root: palm
+drive: {type: fixed}
+manipulators:
+  gripper: {type: generic, root: palm, tool_frame: tcp, states: {open: {finger_joint: 0.04}}}
+"""
+
+
+def _fixture(tmp_path: Path, composed: str, name: str = "robot.yaml") -> Path:
+    (tmp_path / "arm.urdf").write_text(ARM_URDF)
+    (tmp_path / "hand.urdf").write_text(HAND_URDF)
+    (tmp_path / "arm.yaml").write_text(ARM_SPEC)
+    (tmp_path / "hand.yaml").write_text(HAND_SPEC)
+    (tmp_path / "meshes").mkdir(exist_ok=True)
+    (tmp_path / "meshes" / "base.stl").write_text("solid base\nendsolid base\n")
+    spec = tmp_path / name
+    spec.write_text(composed)
+    return spec
+
+
+ARM_AND_HAND = """robotspec: 1
+name: ArmWithHand
+parts:
+  arm: {spec: arm.yaml}
+  hand:
+    spec: hand.yaml
+    prefix: hand_
+    attach: {part: arm, link: flange, xyz: [0, 0, 0.02], replace_root: REPLACE}
+"""
+
+
+def _errors(exc: RobotSpecError) -> list[RobotSpecError]:
+    return list(getattr(exc, "errors", (exc,)))
+
+
+@pytest.mark.parametrize("replace", [False, True])
+def test_small_composition_hands_over_and_matches_pinocchio(tmp_path: Path, replace: bool) -> None:
+    spec = _fixture(tmp_path, ARM_AND_HAND.replace("REPLACE", str(replace).lower()))
+    robot = compile_robot(spec)
+    chain = robot.get_chain("arm")
+    assert chain.manipulator is not None and chain.manipulator.name == "hand_gripper"
+    assert chain.manipulator.tool_frame.name == "hand_tcp"
+    assert [m.name for m in robot.manipulators] == ["hand_gripper"]
+    assert robot.world.has_body("hand_palm") is not replace
+    assert robot.world.has_connection("hand_weld") is not replace
+    assert "hand_gripper.open" in robot.joint_states and "arm.up" in robot.joint_states
+    # Relative mesh paths of a part are made absolute in the joined file.
+    tree = joined_urdf(load_spec(spec))
+    (mesh,) = tree.iter("mesh")
+    assert mesh.get("filename") == str(tmp_path / "meshes" / "base.stl")
+    # Materials of one name but two colours are kept apart.
+    names = [m.get("name") for m in tree.iterfind("material")]
+    assert names == ["paint", "hand_paint"]
+    urdf = tmp_path / "joined.urdf"
+    urdf.write_text(urdf_text(tree, comment="test"))
+    q = np.array([0.4, -0.7, 0.02])
+    theirs = _pin_poses(urdf, robot.world, q, "mount")
+    kin = Kinematics(robot.world)
+    for body, pose in theirs.items():
+        np.testing.assert_allclose(kin.pose(q, body, relative_to="mount"), pose, atol=1e-12)
+
+
+def test_replaced_root_keeps_the_mass_where_it_was(tmp_path: Path) -> None:
+    """pinocchio merges a fixed link's inertia into its parent: replacing must give the same."""
+    import pinocchio as pin
+
+    inertias = []
+    for replace in (False, True):
+        spec = _fixture(tmp_path, ARM_AND_HAND.replace("REPLACE", str(replace).lower()))
+        urdf = tmp_path / f"joined_{replace}.urdf"
+        urdf.write_text(urdf_text(joined_urdf(load_spec(spec)), comment="test"))
+        model = pin.buildModelFromUrdf(str(urdf))
+        inertias.append(model.inertias[model.getJointId("wrist")])
+    welded, replaced = inertias
+    assert replaced.mass == pytest.approx(welded.mass) == pytest.approx(0.5)
+    np.testing.assert_allclose(replaced.lever, welded.lever, atol=1e-12)
+    np.testing.assert_allclose(replaced.inertia, welded.inertia, atol=1e-12)
+
+
+def test_a_composed_spec_is_a_part_of_another(tmp_path: Path) -> None:
+    _fixture(tmp_path, ARM_AND_HAND.replace("REPLACE", "false"), "arm_with_hand.yaml")
+    spec = tmp_path / "two.yaml"
+    spec.write_text(
+        """robotspec: 1
+name: TwoArms
+parts:
+  left: {spec: arm_with_hand.yaml, prefix: l_}
+  right:
+    spec: arm_with_hand.yaml
+    prefix: r_
+    attach: {part: left, link: mount, xyz: [0, -0.5, 0]}
+"""
+    )
+    robot = compile_robot(spec)
+    assert sorted(c.name for c in robot.kinematic_chains) == ["l_arm", "r_arm"]
+    assert robot.get_chain("r_arm").manipulator.tool_frame.name == "r_hand_tcp"  # type: ignore[union-attr]
+    assert "r_hand_gripper.open" in robot.joint_states
+
+
+BAD = [
+    # (what changes in the composed spec, expected messages)
+    (
+        "attach: {part: arm, link: flang}",
+        ["link 'flang' not found in part 'arm' (arm.urdf); did you mean 'flange'?"],
+    ),
+    (
+        "attach: {part: amr, link: flange}",
+        ["part 'amr' not found in the spec's parts; did you mean 'arm'?"],
+    ),
+    ("prefix: ''\n    attach: {part: arm, link: flange}", ["link 'finger' is in both"]),
+]
+
+
+@pytest.mark.parametrize(("hand", "messages"), BAD)
+def test_bad_compositions_are_located_errors(
+    tmp_path: Path, hand: str, messages: list[str]
+) -> None:
+    text = f"""robotspec: 1
+name: Bad
+parts:
+  arm: {{spec: arm.yaml}}
+  hand:
+    spec: hand.yaml
+    {hand}
+"""
+    if "both" in messages[0]:
+        # Make the clash real: the arm gets a link the hand also has.
+        text = text.replace("arm.yaml", "arm2.yaml")
+        (tmp_path / "arm.urdf").write_text(ARM_URDF)
+    spec = _fixture(tmp_path, text)
+    if "both" in messages[0]:
+        (tmp_path / "arm2.urdf").write_text(
+            ARM_URDF.replace(
+                '<link name="flange"/>', '<link name="flange"/><link name="finger"/>'
+            ).replace(
+                "</robot>",
+                '<joint name="f" type="fixed"><parent link="flange"/>'
+                '<child link="finger"/></joint></robot>',
+            )
+        )
+        (tmp_path / "arm2.yaml").write_text(ARM_SPEC.replace("arm.urdf", "arm2.urdf"))
+    with pytest.raises(RobotSpecError) as info:
+        check_spec(spec)
+    errors = _errors(info.value)
+    assert len(errors) == len(messages)
+    for err, msg in zip(errors, messages, strict=True):
+        assert msg in err.message
+        assert err.file == str(spec) and err.line is not None and err.line >= 5
+
+
+def test_every_composition_error_of_a_spec_at_once(tmp_path: Path) -> None:
+    spec = _fixture(
+        tmp_path,
+        """robotspec: 1
+name: Bad
+parts:
+  arm: {spec: arm.yaml}
+  hand: {spec: hand.yaml, attach: {part: grip, link: palm}}
+  grip: {spec: hand.yaml, prefix: g_, attach: {part: hand, link: palm}}
+  ghost: {urdf: ghost.urdf, attach: {part: arm, link: flange}}
+  other: {spec: arm.yaml, prefix: o_}
+""",
+    )
+    with pytest.raises(RobotSpecError) as info:
+        check_spec(spec)
+    text = [f"{e.line}: {e.message}" for e in _errors(info.value)]
+    assert any(
+        "8: parts.other: part 'other' has no 'attach', and neither has part 'arm'" in t
+        for t in text
+    )
+    assert any(t.startswith("5: ") and "cycle: hand -> grip -> hand" in t for t in text), text
+    assert any(t.startswith("7: ") and "ghost.urdf" in t and "file not found" in t for t in text)
+    assert len(text) == 3, text  # the cycle once, not once per member

@@ -245,8 +245,9 @@ def _order(parts: Mapping[str, PartSpec], diag: Diagnostics) -> list[str]:
             for n, p in parts.items()
             if p.attach is not None and p.attach.part == current and n not in done
         ]
+    in_cycle: set[str] = set()
     for n, p in parts.items():
-        if n in done or p.attach is None or p.attach.part not in parts:
+        if n in done or n in in_cycle or p.attach is None or p.attach.part not in parts:
             continue
         # Not reachable from the base and its parent exists: it hangs in a cycle.
         path, cur = [n], p.attach.part
@@ -257,6 +258,7 @@ def _order(parts: Mapping[str, PartSpec], diag: Diagnostics) -> list[str]:
             cur = att.part
         if cur in path:
             cycle = [*path[path.index(cur) :], cur]
+            in_cycle.update(cycle)
             diag.error(
                 ("parts", n, "attach", "part"),
                 f"the parts' attachments form a cycle: {' -> '.join(cycle)}",

@@ -40,14 +40,22 @@ def test_abb_flange_orientation() -> None:
     np.testing.assert_allclose(rot_to_quat(r), [0.7071, 0, 0.7071, 0], atol=1e-4)
 
 
-def _random_chain(seed: int) -> HPChain:
+def _random_chain(seed: int, coordinate_axes: bool = False) -> HPChain:
     rng = np.random.default_rng(seed)
     n = int(rng.integers(1, 8))
     h = rng.normal(size=(n, 3))
     h /= np.linalg.norm(h, axis=1)[:, None]
+    offsets = rng.normal(size=(n + 1, 3)) * 0.3
+    if coordinate_axes:
+        # Mostly +-x/y/z axes (the fast path of tcp_state), some general ones; some zero offsets.
+        for i in range(n):
+            if rng.random() < 0.8:
+                h[i] = 0.0
+                h[i, rng.integers(3)] = rng.choice([-1.0, 1.0])
+        offsets[rng.random(n + 1) < 0.3] = 0.0
     return HPChain(
         h,
-        rng.normal(size=(n + 1, 3)) * 0.3,
+        offsets,
         prismatic=list(rng.random(n) < 0.3),
         flange_rotation=quat_to_rot(rng.normal(size=4)),
         flange_position=rng.normal(size=3) * 0.1,
@@ -73,10 +81,10 @@ def test_jacobian_matches_finite_differences(seed: int) -> None:
         np.testing.assert_allclose(omega, jac[:3, i], atol=1e-5)
 
 
-@settings(max_examples=40, deadline=None)
-@given(st.integers(0, 10_000))
-def test_fast_path_equals_numpy_path(seed: int) -> None:
-    hp = _random_chain(seed)
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 10_000), st.booleans())
+def test_fast_path_equals_numpy_path(seed: int, coordinate_axes: bool) -> None:
+    hp = _random_chain(seed, coordinate_axes)
     rng = np.random.default_rng(seed + 2)
     q = rng.uniform(-3, 3, hp.n)
     qd = rng.uniform(-1, 1, hp.n)

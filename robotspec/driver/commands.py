@@ -127,6 +127,8 @@ class CommandGuard:
         self.limits = limits
         self.period = period
         self._max_step = limits.velocity * period
+        self._neg_max_step = -self._max_step
+        self._neg_velocity = -limits.velocity
         self._pos = np.zeros(limits.count)
         self._vel = np.zeros(limits.count)
         self.clamped = 0
@@ -134,29 +136,37 @@ class CommandGuard:
 
     def position(self, cmd: FloatArray, reference: FloatArray) -> FloatArray | None:
         """The safe position command for ``cmd``, given the previous command or measured q."""
-        if not np.all(np.isfinite(cmd)):
+        if not _finite(cmd):
             self.refused += 1
             return None
-        out = self._pos
-        np.subtract(cmd, reference, out=out)
-        np.clip(out, -self._max_step, self._max_step, out=out)
+        out = np.subtract(cmd, reference, out=self._pos)
+        np.maximum(out, self._neg_max_step, out=out)
+        np.minimum(out, self._max_step, out=out)
         np.add(out, reference, out=out)
-        np.clip(out, self.limits.lower, self.limits.upper, out=out)
-        if not np.array_equal(out, cmd):
+        np.maximum(out, self.limits.lower, out=out)
+        np.minimum(out, self.limits.upper, out=out)
+        if out.tolist() != cmd.tolist():
             self.clamped += 1
         return out.copy()
 
     def velocity(self, cmd: FloatArray, measured: FloatArray) -> FloatArray | None:
         """The safe velocity command for ``cmd`` at measured position ``measured``."""
-        if not np.all(np.isfinite(cmd)):
+        if not _finite(cmd):
             self.refused += 1
             return None
         out = self._vel
-        np.clip(cmd, -self.limits.velocity, self.limits.velocity, out=out)
+        np.maximum(cmd, self._neg_velocity, out=out)
+        np.minimum(out, self.limits.velocity, out=out)
         dt = self.period
         hi = np.maximum((self.limits.upper - measured) / dt, 0.0)
         lo = np.minimum((self.limits.lower - measured) / dt, 0.0)
-        np.clip(out, lo, hi, out=out)
-        if not np.array_equal(out, cmd):
+        np.maximum(out, lo, out=out)
+        np.minimum(out, hi, out=out)
+        if out.tolist() != cmd.tolist():
             self.clamped += 1
         return out.copy()
+
+
+def _finite(a: FloatArray) -> bool:
+    """``np.all(np.isfinite(a))`` for the loop's short arrays, at a quarter of the cost."""
+    return all(map(math.isfinite, a.tolist()))

@@ -91,6 +91,14 @@ def rot_to_quat_tuple(r: Sequence[float]) -> tuple[float, float, float, float]:
     return (w / n, x / n, y / n, z / n)
 
 
+def _axis_kind(h: tuple[float, ...]) -> tuple[int, float]:
+    """``(k, sign)`` when ``h`` is ``sign`` times coordinate axis ``k``, else ``(-1, 1)``."""
+    for k in range(3):
+        if abs(h[k]) == 1.0 and not any(h[j] for j in range(3) if j != k):
+            return k, float(h[k])
+    return -1, 1.0
+
+
 def _skew(v: FloatArray) -> FloatArray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
@@ -131,6 +139,10 @@ class HPChain:
         self._pris_list = [bool(x) for x in self.prismatic]
         self._flange_r_list = tuple(float(x) for x in self.flange_r.reshape(9))
         self._flange_p_list = tuple(float(x) for x in self.flange_p)
+        # Per joint for tcp_state: the coordinate axis (0, 1, 2) and sign when ``H[i]`` is +-x,
+        # +-y or +-z (most industrial arms), else -1; and whether ``P[i + 1]`` is zero.
+        self._axis_kind: list[tuple[int, float]] = [_axis_kind(a) for a in self._h_list]
+        self._p_zero = [not any(a) for a in self._p_list]
         # Preallocated work arrays: the loop calls fk_jacobian every step.
         self._axes = np.zeros((self.n, 3))
         self._origins = np.zeros((self.n, 3))
@@ -161,10 +173,18 @@ class HPChain:
         origins: list[tuple[float, float, float]] = []
         cos, sin = math.cos, math.sin
         for i in range(self.n):
-            hx, hy, hz = self._h_list[i]
-            ax = r00 * hx + r01 * hy + r02 * hz
-            ay = r10 * hx + r11 * hy + r12 * hz
-            az = r20 * hx + r21 * hy + r22 * hz
+            kind, sign = self._axis_kind[i]
+            if kind == 2:
+                ax, ay, az = sign * r02, sign * r12, sign * r22
+            elif kind == 1:
+                ax, ay, az = sign * r01, sign * r11, sign * r21
+            elif kind == 0:
+                ax, ay, az = sign * r00, sign * r10, sign * r20
+            else:
+                hx, hy, hz = self._h_list[i]
+                ax = r00 * hx + r01 * hy + r02 * hz
+                ay = r10 * hx + r11 * hy + r12 * hz
+                az = r20 * hx + r21 * hy + r22 * hz
             axes.append((ax, ay, az))
             origins.append((px, py, pz))
             qi = q[i]
@@ -172,7 +192,25 @@ class HPChain:
                 px += qi * ax
                 py += qi * ay
                 pz += qi * az
+            elif kind >= 0:
+                # Rotation about a coordinate axis: only two columns of R change (a third of
+                # the work of the general Rodrigues product below).
+                c = cos(qi)
+                s_ = sign * sin(qi)
+                if kind == 2:  # R Rz: col0' = c col0 + s col1, col1' = c col1 - s col0
+                    r00, r01 = c * r00 + s_ * r01, c * r01 - s_ * r00
+                    r10, r11 = c * r10 + s_ * r11, c * r11 - s_ * r10
+                    r20, r21 = c * r20 + s_ * r21, c * r21 - s_ * r20
+                elif kind == 1:  # R Ry: col0' = c col0 - s col2, col2' = c col2 + s col0
+                    r00, r02 = c * r00 - s_ * r02, c * r02 + s_ * r00
+                    r10, r12 = c * r10 - s_ * r12, c * r12 + s_ * r10
+                    r20, r22 = c * r20 - s_ * r22, c * r22 + s_ * r20
+                else:  # R Rx: col1' = c col1 + s col2, col2' = c col2 - s col1
+                    r01, r02 = c * r01 + s_ * r02, c * r02 - s_ * r01
+                    r11, r12 = c * r11 + s_ * r12, c * r12 - s_ * r11
+                    r21, r22 = c * r21 + s_ * r22, c * r22 - s_ * r21
             else:
+                hx, hy, hz = self._h_list[i]
                 c = cos(qi)
                 s_ = sin(qi)
                 v = 1.0 - c
@@ -197,10 +235,11 @@ class HPChain:
                     r20 * a01 + r21 * a11 + r22 * a21,
                     r20 * a02 + r21 * a12 + r22 * a22,
                 )
-            bx, by, bz = self._p_list[i + 1]
-            px += r00 * bx + r01 * by + r02 * bz
-            py += r10 * bx + r11 * by + r12 * bz
-            pz += r20 * bx + r21 * by + r22 * bz
+            if not self._p_zero[i + 1]:
+                bx, by, bz = self._p_list[i + 1]
+                px += r00 * bx + r01 * by + r02 * bz
+                py += r10 * bx + r11 * by + r12 * bz
+                pz += r20 * bx + r21 * by + r22 * bz
         frames = [(self._flange_r_list, self._flange_p_list)]
         if tool_rotation is not None and tool_position is not None:
             frames.append((tuple(tool_rotation), tuple(tool_position)))

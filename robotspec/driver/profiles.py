@@ -36,11 +36,17 @@ def rest_to_rest_time(distance: FloatArray, vmax: FloatArray, amax: FloatArray) 
 
 def _braking_velocity(distance: FloatArray, amax: FloatArray, dt: float) -> FloatArray:
     # The largest speed from which a discrete-time deceleration at amax stops within ``distance``.
+    # Plain ufuncs (no np.clip / np.where wrappers): the loop calls this three times a step.
     half = 0.5 * amax * dt
-    v: FloatArray = np.sign(distance) * (
-        np.sqrt(half * half + 2.0 * amax * np.abs(distance)) - half
-    )
-    return v
+    root = np.sqrt(half * half + 2.0 * amax * np.abs(distance))
+    root -= half
+    root *= np.sign(distance)
+    return root
+
+
+def _any(a: FloatArray | npt.NDArray[np.bool_]) -> bool:
+    """``np.any`` for the loop's short arrays, without its wrapper overhead (~2 us a call)."""
+    return any(a.tolist())
 
 
 class JogMotion:
@@ -78,6 +84,17 @@ class JogMotion:
         self.velocity_until = 0.0
         self.t = 0.0
         self.done = False
+        # The three braking curves of a step (target, upper limit, lower limit) are evaluated in
+        # one (3, n) pass; the stacked goals and accelerations are rebuilt only when the target
+        # or ``amax`` object changes (both are replaced, never modified in place).
+        n = self.q.shape[0]
+        self._goals: FloatArray = np.empty((3, n))
+        self._goals[1] = upper
+        self._goals[2] = lower
+        self._goals_for: FloatArray | None = None
+        self._acc3: FloatArray = np.empty((3, n))
+        self._acc3_for: FloatArray | None = None
+        self._dist3: FloatArray = np.empty((3, n))
 
     def to_position(self, target: FloatArray, synchronize: bool = True) -> None:
         """Move to ``target``; joints are time-synchronised when starting from rest.
@@ -108,45 +125,65 @@ class JogMotion:
         self.done = False
 
     def step(self) -> FloatArray:
-        """Advance one period; return the new position command."""
+        """Advance one period; return the new position command.
+
+        Written with plain ufuncs (``np.minimum``/``np.maximum`` for clips, masks only when a
+        joint is landing): at 1 kHz the ``np.clip``/``np.where``/``np.any`` wrappers cost more
+        than the arithmetic. Same maths, same results, bit for bit.
+        """
         dt = self.dt
-        if self.target_position is not None:
-            dist = self.target_position - self.q
-            v_des = np.clip(
-                _braking_velocity(dist, self.amax * BRAKING_MARGIN, dt), -self.vmax, self.vmax
-            )
+        q, v, amax, vmax = self.q, self.v, self.amax, self.vmax
+        adt = amax * dt
+        tgt = self.target_position
+        if tgt is not None and tgt is not self._goals_for:
+            self._goals[0] = tgt
+            self._goals_for = tgt
+        if amax is not self._acc3_for:
+            np.multiply(amax, BRAKING_MARGIN, out=self._acc3[0])
+            self._acc3[1] = amax
+            self._acc3[2] = amax
+            self._acc3_for = amax
+        # Row 0: toward the target (unused without one); rows 1 and 2: toward the limits.
+        dist3 = np.subtract(self._goals, q, out=self._dist3)
+        brake3 = _braking_velocity(dist3, self._acc3, dt)
+        if tgt is not None:
+            dist = dist3[0]
+            v_des = np.minimum(np.maximum(brake3[0], -vmax), vmax)
         elif self.target_velocity is not None and self.t < self.velocity_until:
             v_des = self.target_velocity
         else:
-            v_des = np.zeros_like(self.q)
+            v_des = np.zeros_like(q)
         # Never plan past a joint limit: brake so as to stop on it.
         # (At the full deceleration: a target on the limit is then governed by its own braking.)
-        v_hi = np.maximum(_braking_velocity(self.upper - self.q, self.amax, dt), 0.0)
-        v_lo = np.minimum(_braking_velocity(self.lower - self.q, self.amax, dt), 0.0)
-        v_des = np.clip(v_des, v_lo, v_hi)
-        dv = np.clip(v_des - self.v, -self.amax * dt, self.amax * dt)
-        v_new = self.v + dv
-        q_new = self.q + v_new * dt
-        if self.target_position is not None:
+        v_hi = np.maximum(brake3[1], 0.0)
+        v_lo = np.minimum(brake3[2], 0.0)
+        v_des = np.minimum(np.maximum(v_des, v_lo), v_hi)
+        dv = np.minimum(np.maximum(v_des - v, -adt), adt)
+        v_new = v + dv
+        q_new = q + v_new * dt
+        if tgt is not None:
             # Land exactly on the target instead of oscillating around it.
-            tgt = self.target_position
-            crossed = (tgt - self.q) * (tgt - q_new) <= 0.0
-            slow = np.abs(v_new) <= self.amax * dt * 1.0001
-            # Landing implies the velocity (tgt - q) / dt; only land when that is reachable.
-            feasible = np.abs((tgt - self.q) / dt - self.v) <= self.amax * dt * (1 + 1e-9)
-            land = (crossed & slow & feasible) | (np.abs(tgt - q_new) < 1e-12) & slow
-            # Crossing but unable to land this step: brake as hard as allowed; the overshoot is
-            # below a_max * dt^2 and is taken back on the next step.
-            brake = crossed & slow & ~feasible
-            v_new = np.where(brake, self.v - np.sign(self.v) * self.amax * dt, v_new)
-            q_new = np.where(brake, self.q + v_new * dt, q_new)
-            q_new = np.where(land, tgt, q_new)
-            v_new = np.where(land, 0.0, v_new)
-            self.done = bool(np.all(q_new == tgt) and not np.any(v_new))
+            crossed = dist * (tgt - q_new) <= 0.0
+            slow = np.abs(v_new) <= adt * 1.0001
+            near = np.abs(tgt - q_new) < 1e-12
+            if _any((crossed | near) & slow):
+                # Landing implies the velocity (tgt - q) / dt; only land when that is reachable.
+                feasible = np.abs(dist / dt - v) <= adt * (1 + 1e-9)
+                land = (crossed & slow & feasible) | near & slow
+                # Crossing but unable to land this step: brake as hard as allowed; the overshoot
+                # is below a_max * dt^2 and is taken back on the next step.
+                brake = crossed & slow & ~feasible
+                v_new = np.where(brake, v - np.sign(v) * adt, v_new)
+                q_new = np.where(brake, q + v_new * dt, q_new)
+                q_new = np.where(land, tgt, q_new)
+                v_new = np.where(land, 0.0, v_new)
+                self.done = bool((q_new == tgt).all()) and not _any(v_new)
+            else:
+                self.done = False
         else:
-            self.done = self.t >= self.velocity_until and not np.any(v_new)
-        q_new = np.clip(q_new, self.lower, self.upper)
-        self.q = q_new
+            self.done = self.t >= self.velocity_until and not _any(v_new)
+        q_out: FloatArray = np.minimum(np.maximum(q_new, self.lower), self.upper)
+        self.q = q_out
         self.v = v_new
         self.t += dt
-        return q_new
+        return q_out

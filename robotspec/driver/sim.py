@@ -67,7 +67,7 @@ class SimRobot(RobotDriver):
         self._zeros = np.zeros(n)
         self._neg_vmax = -lim.velocity
         self._pending_pos: FloatArray | None = None
-        self._settle_on: FloatArray | None = None
+        self._settle_on: list[float] | None = None
         self._pending_vel: FloatArray | None = None
         self._sim_enabled = True
         self._sim_error = False
@@ -119,25 +119,29 @@ class SimRobot(RobotDriver):
         elif self._pending_pos is not None:
             err = self._pending_pos - self._q
             v_des = err / dt
-            if self._settle_on is not None and np.array_equal(self._pending_pos, self._settle_on):
+            pending = self._pending_pos.tolist()
+            if pending == self._settle_on:
                 # A command held still: brake so as to land on it (discrete-time braking
                 # curve). Without this, short steps make the servo ring around the target.
                 a_dt = lim.acceleration * dt
                 v_cap = a_dt * (np.sqrt(0.25 + 2.0 * np.abs(err) / (a_dt * dt)) - 0.5)
-                v_des = np.clip(v_des, -v_cap, v_cap)
-            self._settle_on = self._pending_pos.copy()
+                v_des = np.minimum(np.maximum(v_des, -v_cap), v_cap)
+            self._settle_on = pending
         elif self._pending_vel is not None:
             v_des = self._pending_vel
         else:
             v_des = self._zeros
+        # Plain ufuncs and list checks, no np.clip / .any(): this runs every step at 1 kHz.
         v_des = np.minimum(np.maximum(v_des, self._neg_vmax), lim.velocity)
         amax_dt = lim.acceleration * dt
         dv = np.minimum(np.maximum(v_des - self._v, -amax_dt), amax_dt)
         self._v += dv
         self._q += self._v * dt
-        if (self._q < lim.lower).any() or (self._q > lim.upper).any():
-            hit = (self._q < lim.lower) | (self._q > lim.upper)
-            np.clip(self._q, lim.lower, lim.upper, out=self._q)
+        hit = np.less(self._q, lim.lower)
+        hit |= np.greater(self._q, lim.upper)
+        if any(hit.tolist()):
+            np.maximum(self._q, lim.lower, out=self._q)
+            np.minimum(self._q, lim.upper, out=self._q)
             self._v[hit] = 0.0
         if self._homing_target is not None and np.allclose(self._q, self._homing_target, atol=1e-9):
             self._q[:] = self._homing_target

@@ -120,6 +120,10 @@ class TcpPose:
 
 
 def _frozen(a: FloatArray) -> FloatArray:
+    if a.dtype == np.float64 and a.ndim == 1:
+        # A read-only view of a bytes copy: a third of the cost of copy-then-lock (the loop
+        # freezes five arrays a step), and its WRITEABLE flag cannot be turned back on.
+        return np.frombuffer(a.tobytes(), dtype=np.float64)
     out = np.array(a, dtype=np.float64, copy=True)
     out.flags.writeable = False
     return out

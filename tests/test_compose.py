@@ -431,3 +431,51 @@ parts:
     assert any(t.startswith("5: ") and "cycle: hand -> grip -> hand" in t for t in text), text
     assert any(t.startswith("7: ") and "ghost.urdf" in t and "file not found" in t for t in text)
     assert len(text) == 3, text  # the cycle once, not once per member
+
+
+def test_xacro_arm_without_a_spec_composed_with_a_hand(tmp_path: Path) -> None:
+    """The ROS-Industrial UR5e xacro (no robotspec spec exists for it) with its MoveIt SRDF."""
+    from .conftest import shared_path
+
+    erd_robots()
+    ur = shared_path("robots", "ur5e")
+    shipped = _spec_file("dual_panda").parent / "parts"
+    spec = tmp_path / "ur5e_on_stand.yaml"
+    spec.write_text(
+        f"""robotspec: 1
+name: UR5eOnStand
+parts:
+  stand: {{urdf: {shipped / "stand.urdf"}}}
+  arm:
+    urdf: {ur / "ur_description" / "urdf" / "ur5e.xacro"}
+    srdf: {ur / "ur5e_moveit_config" / "config" / "ur5e.srdf"}
+    package_paths: [{ur}]
+    prefix: arm_
+    attach: {{part: stand, link: torso_plate, xyz: [0, 0, 0.05], replace_root: true}}
+  hand:
+    spec: {shipped / "allegro_right_hand.yaml"}
+    prefix: hand_
+    attach: {{part: arm, link: tool0, xyz: [0, 0, 0.095]}}
+chains:
+  arm: {{group: arm_manipulator}}
+"""
+    )
+    result = check_spec(spec)
+    assert result.warnings == ()
+    robot = result.robot
+    assert robot is not None
+    chain = robot.get_chain("arm")
+    assert (chain.root.name, chain.tip.name) == ("torso_plate", "arm_tool0")
+    assert chain.manipulator is not None and chain.manipulator.tool_frame.name == "hand_grasp_frame"
+    assert robot.srdf is not None and "arm_manipulator" in robot.srdf.group_names
+    # The UR5e's base link merged into the stand's plate, so its first body is adjacent to it.
+    rules = CollisionRules.from_robot(robot)
+    assert rules.why_disabled("torso_plate", "arm_base_link_inertia") == "Adjacent"
+    assert rules.is_checked("stand_base", "hand_palm_link")
+    urdf = tmp_path / "joined.urdf"
+    urdf.write_text(urdf_text(joined_urdf(load_spec(spec)), comment="test"))
+    q = np.random.default_rng(11).uniform(-1.5, 1.5, len(robot.world.degrees_of_freedom))
+    theirs = _pin_poses(urdf, robot.world, q, "stand_base")
+    kin = Kinematics(robot.world)
+    for body, pose in theirs.items():
+        np.testing.assert_allclose(kin.pose(q, body, relative_to="stand_base"), pose, atol=1e-9)

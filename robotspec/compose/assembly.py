@@ -478,13 +478,14 @@ def compose(
     resolver = _merged_resolver(list(loaded_parts.values()))
     for part, meshes in mesh_lists:
         _pin_packages(part, meshes, resolver)
-    flat = _flat_spec(loaded, loaded_parts, order, names_of, composed, robot, diag)
+    srdf = merge_srdfs(spec.name, srdfs) if srdfs else None
+    flat = _flat_spec(loaded, loaded_parts, order, names_of, srdf, robot, diag)
     diag.raise_if_failed()
     assert flat is not None
     return Composition(
         loaded=flat,
         urdf=robot,
-        srdf=merge_srdfs(spec.name, srdfs) if srdfs else None,
+        srdf=srdf,
         resolver=resolver,
         parts=tuple(composed),
     )
@@ -504,7 +505,7 @@ def _flat_spec(
     parts: Mapping[str, _Part],
     order: Sequence[str],
     names_of: Mapping[str, PartNames],
-    composed: Sequence[ComposedPart],
+    srdf: Srdf | None,
     robot: etree._Element,
     diag: Diagnostics,
 ) -> LoadedSpec | None:
@@ -554,7 +555,6 @@ def _flat_spec(
         disabled += sem.get("collision", {}).get("disabled_bodies", [])
         import_states |= bool(sem.get("import_srdf_group_states"))
         documents += [remap_marks(d, n) for d in part.documents]
-    _hand_over_manipulators(spec, parts, order, merged, owner, robot, names_of)
     base = parts[order[0]]
     base_names = names_of[order[0]]
     root = spec.root or base_names.link(base.spec_root or base.facts.roots[0])
@@ -590,6 +590,11 @@ def _flat_spec(
             data[key] = {**data.get(key, {}), **value}
         else:
             data[key] = value
+    explicit = {c for c, chain in own.get("chains", {}).items() if "manipulator" in chain}
+    tips = {
+        g.name: g.chains[0].tip_link for g in (srdf.groups if srdf else ()) if len(g.chains) == 1
+    }
+    _hand_over_manipulators(data, explicit, tips, parts, order, owner, robot, names_of)
     try:
         flat = RobotSpec.model_validate(data)
     except ValidationError as exc:
@@ -599,23 +604,26 @@ def _flat_spec(
 
 
 def _hand_over_manipulators(
-    spec: RobotSpec,
+    data: dict[str, Any],
+    explicit: set[str],
+    group_tips: Mapping[str, str],
     parts: Mapping[str, _Part],
     order: Sequence[str],
-    merged: dict[str, Any],
     owner: Mapping[tuple[str, str], str],
     robot: etree._Element,
     names_of: Mapping[str, PartNames],
 ) -> None:
     """A welded hand's manipulator becomes the manipulator of the arm chain it is welded to.
 
-    The chain chosen is the parent part's chain whose tip is nearest above the weld link. Its
-    previous manipulator (an arm's bare flange) is dropped unless another chain carries it or the
-    composed spec names it; the hand's tool frame is now the chain's end.
+    The chain chosen is the one whose tip is nearest above the weld link, among the parent
+    part's chains and the composed spec's own (a chain given by SRDF group counts with the
+    group's tip); a chain whose manipulator the composed spec names is left alone. Its previous
+    manipulator (an arm's bare flange) is dropped unless another chain carries it or the composed
+    spec names it: the hand's tool frame is now the chain's end.
     """
-    chains: dict[str, Any] = merged["chains"]
-    manips: dict[str, Any] = merged["manipulators"]
-    own_manips = set(spec.manipulators)
+    chains: dict[str, Any] = data.get("chains", {})
+    manips: dict[str, Any] = data.get("manipulators", {})
+    own_manips = {m for m in manips if ("manipulators", m) not in owner}
     for name in order:
         attach = parts[name].spec.attach
         if attach is None:
@@ -624,13 +632,16 @@ def _hand_over_manipulators(
         free = [m for m in manips if owner.get(("manipulators", m)) == name and m not in carried]
         if len(free) != 1:
             continue
-        weld_link = names_of[attach.part].link(attach.link)
-        above = _ancestors(robot, weld_link)
+        above = _ancestors(robot, names_of[attach.part].link(attach.link))
         best: tuple[int, str] | None = None
         for cname, chain in chains.items():
-            if owner.get(("chains", cname)) != attach.part or chain.get("tip") not in above:
+            chain_owner = owner.get(("chains", cname))
+            if cname in explicit or chain_owner not in (attach.part, None):
                 continue
-            depth = above.index(chain["tip"])
+            tip = chain.get("tip") or group_tips.get(chain.get("group") or "")
+            if tip not in above:
+                continue
+            depth = above.index(tip)
             if best is None or depth < best[0]:
                 best = (depth, cname)
         if best is None:

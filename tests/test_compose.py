@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robotspec.collision import CollisionRules
 from robotspec.compiler import check_spec, compile_robot
@@ -479,3 +481,110 @@ chains:
     kin = Kinematics(robot.world)
     for body, pose in theirs.items():
         np.testing.assert_allclose(kin.pose(q, body, relative_to="stand_base"), pose, atol=1e-9)
+
+
+# ------------------------------------------------------------------------------------ CLI
+def test_cli_inspect_export_and_errors(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    import json
+
+    from .test_cli import run
+
+    erd_robots()
+    code, out, _ = run(capsys, "inspect", "parts", "dual_panda", "--json")
+    assert code == 0
+    rows = json.loads(out)
+    assert [(r["part"], r["prefix"], r["attached_to"], r["weld"]) for r in rows] == [
+        ("stand", "", None, None),
+        ("left", "left_", "stand/torso_plate", "left_weld"),
+        ("right", "right_", "stand/torso_plate", "right_weld"),
+    ]
+    code, _, err = run(capsys, "inspect", "parts", "pr2")
+    assert code == 1 and "not composed of parts" in err
+    code, _, err = run(capsys, "export", "urdf", "dual_panda", "-o", str(tmp_path / "d.urdf"))
+    assert code == 0 and "28 links, 27 joints" in err
+    code, _, err = run(capsys, "export", "bundle", "dual_panda", "-o", str(tmp_path / "b"))
+    assert code == 0
+    code, out, _ = run(capsys, "validate", str(tmp_path / "b" / "dual_panda.yaml"))
+    assert code == 0 and "1 of 1 spec valid; 0 errors, 0 warnings" in out
+    bad = _fixture(
+        tmp_path,
+        "robotspec: 1\nname: Bad\nparts:\n  arm: {spec: arm.yaml}\n"
+        "  hand: {spec: hand.yaml, attach: {part: arm, link: flang}}\n",
+    )
+    code, out, err = run(capsys, "validate", str(bad))
+    assert code == 1
+    assert f"{bad}:5:" in out + err and "did you mean 'flange'?" in out + err
+    assert "Traceback" not in out + err
+
+
+def test_extending_a_composed_spec_and_from_world(tmp_path: Path) -> None:
+    from robotspec.robots import DualPanda
+
+    erd_robots()
+    child = tmp_path / "child.yaml"
+    child.write_text(
+        "robotspec: 1\nextends: dual_panda\nname: DualPandaLow\n"
+        "parts:\n  left:\n    attach: {part: stand, link: torso_plate, xyz: [0, 0.4, 0.05]}\n"
+    )
+    robot = compile_robot(child)
+    kin = Kinematics(robot.world)
+    q = np.zeros(len(robot.world.degrees_of_freedom))
+    assert kin.pose(q, "left_panda_link0", relative_to="torso_plate")[1, 3] == pytest.approx(0.4)
+    assert robot.get_chain("left_arm").manipulator is not None
+    loaded = DualPanda.load()
+    again = DualPanda.from_world(loaded.world)
+    assert again.world is loaded.world
+    assert _summary(again) == _summary(loaded)
+
+
+PART_FILES = ("arm.yaml", "hand.yaml", "arm.urdf", "hand.urdf")
+LINKS = ("mount", "base_link", "flange", "palm", "tcp", "flang")
+
+
+@st.composite
+def compositions(draw: st.DrawFn) -> str:
+    n = draw(st.integers(1, 4))
+    names = [f"p{i}" for i in range(n)]
+    lines = ["robotspec: 1", "name: Random", "parts:"]
+    for i, name in enumerate(names):
+        source = draw(st.sampled_from(PART_FILES))
+        key = "spec" if source.endswith(".yaml") else "urdf"
+        lines.append(f"  {name}:")
+        lines.append(f"    {key}: {source}")
+        lines.append(f"    prefix: '{draw(st.sampled_from(['', 'a_', 'b_', name + '_']))}'")
+        if i > 0 or draw(st.booleans()):
+            parent = draw(st.sampled_from([*names, "nowhere"]))
+            link = draw(st.sampled_from(LINKS))
+            replace = draw(st.booleans())
+            lines.append(
+                f"    attach: {{part: {parent}, link: {link}, xyz: [0, 0, 0.1], "
+                f"replace_root: {str(replace).lower()}}}"
+            )
+    return "\n".join(lines) + "\n"
+
+
+@settings(max_examples=40, deadline=None)
+@given(text=compositions())
+def test_random_compositions_compile_or_fail_cleanly(text: str) -> None:
+    import shutil
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="compose-"))
+    spec = _fixture(folder, text)
+    try:
+        result = check_spec(spec)
+        loaded = load_spec(spec)
+    except RobotSpecError as exc:
+        for err in _errors(exc):
+            assert err.file is not None and err.message
+        return
+    finally:
+        shutil.rmtree(folder)
+    robot = result.robot
+    assert robot is not None
+    replaced = sum(
+        1 for p in loaded.spec.parts.values() if p.attach is not None and p.attach.replace_root
+    )
+    part_links = {"arm.yaml": 4, "arm.urdf": 4, "hand.yaml": 3, "hand.urdf": 3}
+    expected = sum(part_links[p.spec or p.urdf or ""] for p in loaded.spec.parts.values())
+    assert len(robot.world.bodies) == expected - replaced

@@ -359,3 +359,48 @@ def _vec(v: list[float]) -> str:
 
 def _num(x: float) -> float | None:
     return x if math.isfinite(x) else None
+
+
+@inspect_app.command("parts")
+def parts(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
+    """The parts of a composed robot: source, prefix, where each is welded, what it brings."""
+    from robotspec.compiler import resolve_spec
+    from robotspec.compose import compose
+    from robotspec.spec import load_spec
+
+    loaded = load_spec(resolve_spec(spec))
+    if not loaded.spec.parts:
+        sys.stderr.write(f"{loaded.file.name} is not composed of parts (it has no 'parts:')\n")
+        raise typer.Exit(1)
+    composition = compose(loaded, package_paths=package_path or ())
+    data = []
+    for p in composition.parts:
+        ps = loaded.spec.parts[p.name]
+        at = ps.attach
+        data.append(
+            {
+                "part": p.name,
+                "source": ps.spec or ps.urdf,
+                "prefix": p.names.prefix,
+                "attached_to": None if at is None else f"{at.part}/{at.link}",
+                "weld": p.weld_joint or ("root replaced" if at is not None else None),
+                "root_link": p.root_link,
+                "links": len(p.links),
+                "joints": len(p.joints),
+            }
+        )
+    rows = [
+        [
+            d["part"],
+            d["source"],
+            d["prefix"] or "-",
+            d["attached_to"] or "(base)",
+            d["weld"] or "-",
+            d["root_link"],
+            d["links"],
+            d["joints"],
+        ]
+        for d in data
+    ]
+    headers = ["part", "source", "prefix", "attached to", "weld", "root link", "links", "joints"]
+    _emit(data, headers, rows, as_json)

@@ -486,6 +486,12 @@ def shipped_spec_files() -> dict[str, Path]:
     return {f.stem: f for f in sorted(folder.glob("*.yaml"))}
 
 
+def shipped_part_files() -> dict[str, Path]:
+    """Parts shipped with robotspec for composed robots (``spec: allegro_right_hand``)."""
+    folder = Path(__file__).resolve().parent / "specs" / "parts"
+    return {f.stem: f for f in sorted(folder.glob("*.yaml"))}
+
+
 def shipped_schema_path() -> Path:
     """Where the installed package keeps the schema (specs written by robotspec point here)."""
     return Path(__file__).resolve().parent / "data" / "robotspec.schema.json"

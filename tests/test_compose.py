@@ -563,7 +563,7 @@ def compositions(draw: st.DrawFn) -> str:
     return "\n".join(lines) + "\n"
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(text=compositions())
 def test_random_compositions_compile_or_fail_cleanly(text: str) -> None:
     import shutil

@@ -33,7 +33,14 @@ from robotspec.compose.urdf_merge import (
 )
 from robotspec.errors import RobotSpecError, SpecError, missing_file
 from robotspec.packages import PackageResolver
-from robotspec.spec import LoadedSpec, PartSpec, RobotSpec, load_spec, shipped_spec_files
+from robotspec.spec import (
+    LoadedSpec,
+    PartSpec,
+    RobotSpec,
+    load_spec,
+    shipped_part_files,
+    shipped_spec_files,
+)
 from robotspec.srdf import Srdf
 from robotspec.yamlio import LocatedYaml, validation_errors
 
@@ -131,10 +138,12 @@ def description_tree(
 
 
 def _spec_path(ref: str, folder: Path) -> Path | None:
+    """A part's spec: a path, a shipped robot's name, or a shipped part's name."""
     p = Path(ref) if Path(ref).is_absolute() else folder / ref
     if p.is_file():
         return p
-    return shipped_spec_files().get(ref.lower())
+    key = ref.lower()
+    return shipped_spec_files().get(key) or shipped_part_files().get(key)
 
 
 def _load_part(
@@ -155,7 +164,11 @@ def _load_part(
                     *(f.name for f in loaded.folder.glob("*.yaml")),
                 ]
                 diag.not_found(
-                    (*loc, "spec"), "spec", ps.spec, candidates, "this folder or the shipped robots"
+                    (*loc, "spec"),
+                    "spec",
+                    ps.spec,
+                    candidates,
+                    "this folder or the shipped robots and parts",
                 )
                 return None
             if path.resolve() in seen:
@@ -400,6 +413,8 @@ def compose(
         weld_joint = None
         attach = ps.attach
         if attach is not None:
+            if attach.part not in names_of:
+                continue  # its parent failed to weld; that error is reported already
             parent = loaded_parts[attach.part]
             if attach.link not in parent.facts.links:
                 diag.not_found(

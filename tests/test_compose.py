@@ -369,7 +369,12 @@ BAD = [
         "attach: {part: amr, link: flange}",
         ["part 'amr' not found in the spec's parts; did you mean 'arm'?"],
     ),
-    ("prefix: ''\n    attach: {part: arm, link: flange}", ["link 'finger' is in both"]),
+    (
+        "prefix: ''\n    attach: {part: arm, link: flange}",
+        [
+            "part 'hand' and part 'arm' both have link 'finger'; give part 'hand' a (different) prefix"
+        ],
+    ),
 ]
 
 
@@ -385,12 +390,12 @@ parts:
     spec: hand.yaml
     {hand}
 """
-    if "both" in messages[0]:
+    if "both have" in messages[0]:
         # Make the clash real: the arm gets a link the hand also has.
         text = text.replace("arm.yaml", "arm2.yaml")
         (tmp_path / "arm.urdf").write_text(ARM_URDF)
     spec = _fixture(tmp_path, text)
-    if "both" in messages[0]:
+    if "both have" in messages[0]:
         (tmp_path / "arm2.urdf").write_text(
             ARM_URDF.replace(
                 '<link name="flange"/>', '<link name="flange"/><link name="finger"/>'

@@ -348,26 +348,43 @@ def _materials(
     return out, duplicate
 
 
-def _clashes(
-    kind: str,
-    names: Sequence[str],
-    owner: dict[str, str],
-    part: str,
-    diag: Diagnostics,
-    loc: Loc,
-) -> None:
+def _claim(
+    kind: str, names: Sequence[str], owner: dict[str, str], part: str
+) -> dict[str, dict[str, list[str]]]:
+    """Record ``part`` as owner of ``names``; return the clashes (other part -> kind -> names)."""
+    clashes: dict[str, dict[str, list[str]]] = {}
     for name in names:
         other = owner.get(name)
         if other is not None and other != part:
-            diag.error(
-                loc,
-                f"{kind} '{name}' is in both part '{other}' and part '{part}'; "
-                f"give part '{part}' a (different) prefix",
-                name=name,
-                kind="clash",
-            )
+            clashes.setdefault(other, {}).setdefault(kind, []).append(name)
         else:
             owner[name] = part
+    return clashes
+
+
+def _report_clashes(
+    clashes: Sequence[dict[str, dict[str, list[str]]]], part: str, diag: Diagnostics, loc: Loc
+) -> None:
+    """One error per pair of parts, listing the clashing names by kind (a few of each)."""
+    merged: dict[str, dict[str, list[str]]] = {}
+    for c in clashes:
+        for other, kinds in c.items():
+            for kind, names in kinds.items():
+                merged.setdefault(other, {}).setdefault(kind, []).extend(names)
+    for other, kinds in merged.items():
+        parts = []
+        for kind, names in kinds.items():
+            shown = ", ".join(f"'{n}'" for n in names[:3])
+            more = f" and {len(names) - 3} more" if len(names) > 3 else ""
+            parts.append(f"{kind}{'s' if len(names) > 1 else ''} {shown}{more}")
+        first = next(iter(kinds.values()))[0]
+        diag.error(
+            loc,
+            f"part '{part}' and part '{other}' both have {'; '.join(parts)}; "
+            f"give part '{part}' a (different) prefix",
+            name=first,
+            kind="clash",
+        )
 
 
 def compose(
@@ -441,21 +458,20 @@ def compose(
         links = [n.link(x) for x in part.facts.links if x not in merged]
         joints = [n.joint(x) for x in part.facts.joints]
         where = (*loc, "prefix") if "prefix" in ps.model_fields_set else loc
-        _clashes("link", links, link_owner, name, diag, where)
-        _clashes(
-            "joint",
-            [*joints, *([weld_joint] if weld_joint else [])],
-            joint_owner,
-            name,
-            diag,
-            where,
-        )
+        welds = [weld_joint] if weld_joint else []
+        clashes = [
+            _claim("link", links, link_owner, name),
+            _claim("joint", [*joints, *welds], joint_owner, name),
+        ]
         if part.srdf is not None:
             renamed = rename_srdf(
                 part.srdf, n, keep_virtual=attach is None, keep_collisions=part.use_srdf
             )
-            _clashes("SRDF group", [g.name for g in renamed.groups], group_owner, name, diag, where)
+            clashes.append(
+                _claim("SRDF group", [g.name for g in renamed.groups], group_owner, name)
+            )
             srdfs.append(renamed)
+        _report_clashes(clashes, name, diag, where)
         tree = part.tree
         mesh_lists.append((part, list(tree.iter("mesh"))))
         materials, duplicate = _materials(part, n, used_materials)

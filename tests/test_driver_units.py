@@ -186,3 +186,40 @@ def test_loop_thread_mode() -> None:
     # last command; a thread hiccup may have let it overshoot by a few millimetres.
     robot.run_for(0.5)
     assert np.max(np.abs(robot.sim_position - target)) < 1e-6
+
+
+def test_published_snapshot_is_a_complete_read_only_robot_state() -> None:
+    # The loop builds RobotState without its dataclass __init__: every field must be there and
+    # equal to what the constructor makes, and every array must stay read-only.
+    import dataclasses
+
+    from robotspec.driver.state import RobotState
+
+    robot = make_sim(RRP)
+    robot.command_mode = CommandMode.jog
+    robot.jog_joint(robot.limits.velocity * 0.1, 0.5)
+    state = robot.run_for(0.1)
+    names = {f.name for f in dataclasses.fields(RobotState)}
+    assert set(vars(state)) == names
+    rebuilt = RobotState(**{n: getattr(state, n) for n in names})
+    for n in names:
+        a, b = getattr(state, n), getattr(rebuilt, n)
+        if isinstance(a, np.ndarray):
+            np.testing.assert_array_equal(a, b)
+        elif n not in ("kin_chain_tcp", "kin_chain_tcp_vel"):
+            assert a == b, n
+    assert state.trajectory_running is False and state.joint_velocity.any()
+    arrays = [
+        state.joint_position,
+        state.joint_velocity,
+        state.joint_effort,
+        state.position_command,
+    ]
+    arrays += [state.kin_chain_tcp[0].position, state.kin_chain_tcp[0].orientation]
+    arrays += list(state.kin_chain_tcp_vel)
+    for a in arrays:
+        assert not a.flags.writeable
+        with pytest.raises(ValueError):
+            a[0] = 1.0
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        state.seqno = 3  # type: ignore[misc]

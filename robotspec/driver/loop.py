@@ -74,7 +74,6 @@ from robotspec.driver.conversions import (
     as_lists,
     convert_command,
     parse_mode,
-    read_only,
     tool_transform,
     twist_vector,
 )
@@ -111,6 +110,7 @@ from robotspec.driver.state import (
     StateFlags,
     TcpPose,
     frozen_array,
+    robot_state_snapshot,
 )
 from robotspec.driver.trajectory import JointTrajectory, load_trajectory
 from robotspec.errors import DriverError
@@ -189,6 +189,7 @@ class RobotDriver(ABC):
         ]
         self._tool_tf_lists = [as_lists(t) for t in self._tool_tf]
         self._chain_idx_list = [list(c.joint_numbers) for c in chains]
+        self._chain_is_all = [idx == list(range(n)) for idx in self._chain_idx_list]
         self._endpoint_key: tuple[bytes, bytes, int] | None = None
         self._endpoint_cache: tuple[list[TcpPose], list[FloatArray]] | None = None
         self._keep_going = False
@@ -249,7 +250,8 @@ class RobotDriver(ABC):
         self._epoch = self._clock.now()
         self._next_deadline = self._epoch
         self._thread: threading.Thread | None = None
-        self._step_done = threading.Condition(self._lock)
+        #: Callers blocked in :meth:`_wait_for` on the loop thread: (predicate, event).
+        self._waiters: list[tuple[Callable[[], bool], threading.Event]] = []
         self._scheduled: list[tuple[float, int, Callable[[], None]]] = []
         self._scheduled_count = 0
         self._listeners: list[Callable[[RobotState], None]] = []
@@ -359,6 +361,10 @@ class RobotDriver(ABC):
         thread, self._thread = self._thread, None
         if thread is not None and thread is not threading.current_thread():
             thread.join()
+        with self._lock:
+            waiters, self._waiters = self._waiters, []
+        for _, event in waiters:
+            event.set()  # the waiter sees no loop thread and returns
 
     def _close(self) -> None:
         """Close the driver: stop the loop."""
@@ -369,16 +375,30 @@ class RobotDriver(ABC):
 
         With a loop thread the caller waits on it; without one the caller steps the loop itself,
         which is what makes simulated-time tests deterministic.
+
+        Why the loop evaluates the predicate (under ``_lock``, after each step) and wakes the
+        caller only once it holds: waking every waiter on every step cost the loop thread a
+        futex wake and lock hand-over per step, and the waiter a wake-up per step, for nothing.
+        Predicates must be cheap and must not block (they read a flag or two).
         """
         thread = self._thread
         if thread is not None and thread is not threading.current_thread():
+            entry = (predicate, threading.Event())
             deadline = self._clock.now() + timeout
-            with self._step_done:
-                while not predicate():
+            with self._lock:
+                if predicate():
+                    return
+                self._waiters.append(entry)
+            try:
+                while not entry[1].is_set():
                     remaining = deadline - self._clock.now()
                     if remaining <= 0 or self._thread is None:
                         return
-                    self._step_done.wait(min(remaining, 0.1))
+                    entry[1].wait(min(remaining, 0.1))
+            finally:
+                with self._lock:
+                    if entry in self._waiters:
+                        self._waiters.remove(entry)
             return
         end = self._stopwatch_ellapsed_s() + timeout
         while not predicate() and self._stopwatch_ellapsed_s() < end:
@@ -465,13 +485,25 @@ class RobotDriver(ABC):
                 )
 
     def _publish(self) -> None:
-        with self._step_done:
-            self._step_done.notify_all()
+        if self._waiters:
+            self._wake_waiters()
         for listener in list(self._listeners):
             try:
                 listener(self._state)
             except Exception:  # noqa: BLE001 - a bad listener must not stop the loop
                 self._listeners.remove(listener)
+
+    def _wake_waiters(self) -> None:
+        """Wake the blocked callers whose predicate now holds (see :meth:`_wait_for`)."""
+        with self._lock:
+            for entry in list(self._waiters):
+                try:
+                    ready = entry[0]()
+                except Exception:  # noqa: BLE001 - let the caller re-check and see the error
+                    ready = True
+                if ready:
+                    self._waiters.remove(entry)
+                    entry[1].set()
 
     def add_state_listener(self, listener: Callable[[RobotState], None]) -> None:
         """Call ``listener(state)`` after every step (loggers, status views)."""
@@ -817,21 +849,22 @@ class RobotDriver(ABC):
         q_list = q.tolist()
         qd_list = qd.tolist() if qd.shape[0] == self._joint_count else None
         for c, hp in enumerate(self._hp):
-            idx = self._chain_idx_list[c]
             tf = self._tool_tf_lists[c]
+            if self._chain_is_all[c]:  # one chain of every joint, in order: no gather
+                q_c, qd_c = q_list, qd_list
+            else:
+                idx = self._chain_idx_list[c]
+                q_c = [q_list[i] for i in idx]
+                qd_c = None if qd_list is None else [qd_list[i] for i in idx]
             rot, pos, twist = hp.tcp_state(
-                [q_list[i] for i in idx],
-                None if qd_list is None else [qd_list[i] for i in idx],
-                None if tf is None else tf[0],
-                None if tf is None else tf[1],
+                q_c, qd_c, None if tf is None else tf[0], None if tf is None else tf[1]
             )
-            poses.append(
-                TcpPose(
-                    position=read_only(np.array(pos)),
-                    orientation=read_only(np.array(rot_to_quat_tuple(rot))),
-                )
-            )
-            vels.append(read_only(np.array(twist)))
+            # One read-only array per chain, sliced into position, orientation and twist
+            # (views of a read-only buffer stay read-only): one allocation instead of three.
+            tcp = np.array((*pos, *rot_to_quat_tuple(rot), *twist))
+            tcp.flags.writeable = False
+            poses.append(TcpPose(position=tcp[0:3], orientation=tcp[3:7]))
+            vels.append(tcp[7:13])
         self._endpoint_key = key
         self._endpoint_cache = (poses, vels)
         self._endpoint_vel = vels
@@ -863,7 +896,7 @@ class RobotDriver(ABC):
             self._endpoint_pose = None
             self._endpoint_vel = None
         task = self._traj_active
-        self._state = RobotState(
+        self._state = robot_state_snapshot(
             ts=now,
             seqno=self._state_seqno,
             command_mode=self._command_mode,
@@ -877,7 +910,7 @@ class RobotDriver(ABC):
             velocity_command=frozen_array(self._velocity_command),
             kin_chain_tcp=tuple(self._endpoint_pose or ()),
             kin_chain_tcp_vel=tuple(self._endpoint_vel or ()),
-            trajectory_running=bool(self._flags & StateFlags.trajectory_running),
+            trajectory_running=bool(self._flags_int & _F_TRAJ),
             trajectory_time=0.0 if task is None else task.time,
             trajectory_max_time=0.0 if task is None else task.interp.max_time,
             trajectory_current_waypoint=0 if task is None else task.waypoint,

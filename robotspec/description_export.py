@@ -22,9 +22,7 @@ from robotspec.spec import LoadedSpec, load_spec
 __all__ = ["Bundle", "bundle", "joined_urdf", "urdf_text"]
 
 
-def joined_urdf(
-    loaded: LoadedSpec, *, package_paths: Sequence[str | Path] = ()
-) -> etree._Element:
+def joined_urdf(loaded: LoadedSpec, *, package_paths: Sequence[str | Path] = ()) -> etree._Element:
     """The robot's URDF tree: the parts joined, or the flat spec's file with its frames added.
 
     Relative mesh paths are made absolute (the file is written elsewhere); ``package://`` URIs

@@ -371,9 +371,7 @@ BAD = [
     ),
     (
         "prefix: ''\n    attach: {part: arm, link: flange}",
-        [
-            "part 'hand' and part 'arm' both have link 'finger'; give part 'hand' a (different) prefix"
-        ],
+        ["part 'hand' and part 'arm' both have link 'finger'; give part 'hand' a (different)"],
     ),
 ]
 
@@ -593,3 +591,49 @@ def test_random_compositions_compile_or_fail_cleanly(text: str) -> None:
     part_links = {"arm.yaml": 4, "arm.urdf": 4, "hand.yaml": 3, "hand.urdf": 3}
     expected = sum(part_links[p.spec or p.urdf or ""] for p in loaded.spec.parts.values())
     assert len(robot.world.bodies) == expected - replaced
+
+
+def test_part_files_that_include_each_other(tmp_path: Path) -> None:
+    _fixture(tmp_path, "")
+    (tmp_path / "a.yaml").write_text(
+        "robotspec: 1\nname: A\nparts:\n  arm: {spec: arm.yaml}\n"
+        "  more: {spec: b.yaml, prefix: m_, attach: {part: arm, link: flange}}\n"
+    )
+    (tmp_path / "b.yaml").write_text("robotspec: 1\nname: B\nparts:\n  again: {spec: a.yaml}\n")
+    with pytest.raises(RobotSpecError) as info:
+        check_spec(tmp_path / "a.yaml")
+    (err,) = _errors(info.value)
+    assert "parts include each other: a.yaml -> b.yaml -> a.yaml" in err.message
+    assert err.file == str(tmp_path / "b.yaml") and err.line == 4
+
+
+XACRO_PART = """<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="tool">
+  <xacro:arg name="length" default="0.1"/>
+  <link name="tool_base"/>
+  <link name="tool_tip"/>
+  <joint name="tool_joint" type="fixed">
+    <origin xyz="0 0 $(arg length)"/>
+    <parent link="tool_base"/><child link="tool_tip"/>
+  </joint>
+</robot>
+"""
+
+
+def test_a_xacro_part_with_arguments(tmp_path: Path) -> None:
+    _fixture(tmp_path, "")
+    (tmp_path / "tool.urdf.xacro").write_text(XACRO_PART)
+    spec = tmp_path / "tooled.yaml"
+    spec.write_text(
+        "robotspec: 1\nname: Tooled\nparts:\n  arm: {spec: arm.yaml}\n"
+        "  tool:\n    urdf: tool.urdf.xacro\n    xacro_args: {length: '0.25'}\n"
+        "    prefix: t_\n    attach: {part: arm, link: flange, replace_root: true}\n"
+        "manipulators:\n  tool: {type: generic, root: flange, tool_frame: t_tool_tip}\n"
+        "chains:\n  arm: {root: base_link, tip: flange, manipulator: tool}\n"
+    )
+    robot = compile_robot(spec)
+    assert robot.get_chain("arm").manipulator.tool_frame.name == "t_tool_tip"  # type: ignore[union-attr]
+    assert [m.name for m in robot.manipulators] == ["tool"]  # the flange was replaced
+    q = np.zeros(len(robot.world.degrees_of_freedom))
+    offset = Kinematics(robot.world).pose(q, "t_tool_tip", relative_to="flange")
+    np.testing.assert_allclose(offset[:3, 3], [0, 0, 0.25], atol=1e-12)

@@ -550,10 +550,14 @@ def _flat_spec(
     disabled: list[str] = []
     documents: list[LocatedYaml] = []
     import_states = False
+    carried_before: set[str] = set()
     for name in order:
         part, n = parts[name], names_of[name]
         sem = rename_semantics(part.data, n, part.facts)
         loc: Loc = ("parts", name)
+        carried_before.update(
+            c["manipulator"] for c in sem.get("chains", {}).values() if c.get("manipulator")
+        )
         for section in NAMED_SECTIONS:
             for key, value in sem.get(section, {}).items():
                 other = owner.get((section, key))
@@ -626,6 +630,12 @@ def _flat_spec(
         g.name: g.chains[0].tip_link for g in (srdf.groups if srdf else ()) if len(g.chains) == 1
     }
     _hand_over_manipulators(data, explicit, tips, parts, order, owner, robot, names_of)
+    # A part's manipulator that its own chain carried and no chain carries any more was
+    # replaced (by a hand, or by the composed spec's own choice): it is not the robot's.
+    carried = {c.get("manipulator") for c in data.get("chains", {}).values()}
+    for m in [m for m in data.get("manipulators", {}) if m in carried_before - carried]:
+        if m not in own.get("manipulators", {}):
+            del data["manipulators"][m]
     try:
         flat = RobotSpec.model_validate(data)
     except ValidationError as exc:
@@ -654,7 +664,6 @@ def _hand_over_manipulators(
     """
     chains: dict[str, Any] = data.get("chains", {})
     manips: dict[str, Any] = data.get("manipulators", {})
-    own_manips = {m for m in manips if ("manipulators", m) not in owner}
     for name in order:
         attach = parts[name].spec.attach
         if attach is None:
@@ -677,9 +686,4 @@ def _hand_over_manipulators(
                 best = (depth, cname)
         if best is None:
             continue
-        chain = chains[best[1]]
-        old = chain.get("manipulator")
-        chain["manipulator"] = free[0]
-        still_used = any(c.get("manipulator") == old for c in chains.values())
-        if old is not None and not still_used and old not in own_manips:
-            manips.pop(old, None)
+        chains[best[1]]["manipulator"] = free[0]  # the one it replaces is dropped later

@@ -30,7 +30,7 @@ from robotspec.driver.state import (
     StateFlags,
 )
 from robotspec.driver.trajectory import JointTrajectory
-from tests.driver_support import make_sim, q_of, robotinfo
+from tests.driver_support import RRP, make_sim, q_of, robotinfo
 
 HEALTHY = 0x60000
 
@@ -690,6 +690,65 @@ def test_45_lost_feedback(abb: SimRobot) -> None:
     st = abb.step()
     assert st.command_mode is CommandMode.halt
     assert int(st.flags) == HEALTHY
+
+
+def _stream_velocity(robot: SimRobot, v: np.ndarray, seconds: float) -> list[np.ndarray]:
+    """A client streaming ``v`` each step for ``seconds``; the arm's true velocity per step."""
+    out = []
+    for k in range(round(seconds / robot.update_period)):
+        robot.set_velocity_command(RobotJointCommand(k, robot.robot_state.seqno, v.tolist()))
+        robot.step()
+        out.append(robot.sim_velocity)
+    return out
+
+
+@pytest.mark.parametrize("timeout", [None, 0.5])
+def test_command_watchdog_stops_the_arm_when_the_driver_goes_silent(timeout: float | None) -> None:
+    # [deviate 11] with feedback lost the driver stops sending (communication timeout 0.25 s);
+    # the reference's simulated robot then follows its last velocity command into a joint
+    # limit. Like a real controller, the sim brakes to rest at its acceleration limits once no
+    # command has arrived for ``command_timeout`` (0.1 s by default).
+    kw = {} if timeout is None else {"command_timeout": timeout}
+    robot = make_sim(RRP, **kw)
+    wd = SimRobot.DEFAULT_COMMAND_TIMEOUT if timeout is None else timeout
+    assert robot.command_timeout == wd
+    lim, dt = robot.limits, robot.update_period
+    to_mode(robot, CommandMode.velocity_command)
+    v = np.array([0.5, 0.4, 0.05])
+    _stream_velocity(robot, v, 0.5)
+    np.testing.assert_allclose(robot.sim_velocity, v)
+    q_fault = robot.sim_position
+    robot.inject_fault(Fault.lost_feedback)
+    vels = _stream_velocity(robot, v, 3.0)  # the client keeps streaming, unaware
+    assert int(robot.robot_state.flags) == int(StateFlags.communication_failure)
+    assert robot.watchdog_trips == 1  # once: never while commands flowed
+    np.testing.assert_array_equal(robot.sim_velocity, np.zeros(3))
+    # Braked within the acceleration limits ...
+    accel = np.abs(np.diff(np.array(vels), axis=0)) / dt
+    assert np.all(accel <= lim.acceleration * (1 + 1e-9))
+    # ... starting once the driver had been silent for the timeout, and not before.
+    moving = [bool(np.any(x)) for x in vels]
+    stop_step = moving.index(False)
+    braking = float(np.max(v / lim.acceleration))
+    assert stop_step * dt <= 0.25 + wd + braking + 3 * dt
+    assert all(moving[: round((0.25 + wd) / dt) - 1])
+    # So the arm went no further than those seconds at speed (well short of every limit).
+    travel = robot.sim_position - q_fault
+    assert np.all(travel <= v * (0.25 + wd + braking + 3 * dt))
+    # The operator restores feedback: commands flow again and the arm follows them.
+    robot.clear_fault(Fault.lost_feedback)
+    robot.step()
+    to_mode(robot, CommandMode.velocity_command)
+    _stream_velocity(robot, -v, 0.5)
+    np.testing.assert_allclose(robot.sim_velocity, -v)
+
+
+def test_command_timeout_must_be_positive() -> None:
+    from robotspec.driver.robot_info import load_robot_info
+
+    for bad in (0.0, -1.0, math.nan, math.inf):
+        with pytest.raises(InvalidArgumentError):
+            SimRobot(load_robot_info(RRP), command_timeout=bad)
 
 
 def test_exception_in_step_never_kills_the_loop(abb: SimRobot) -> None:

@@ -45,6 +45,11 @@ Deliberate deviations from the reference (its defects, §1.11 of the note), each
 9. ``velocity_command`` mode works (the reference's loop thread dies on the first command); it
    scales by the speed ratio and sets ``valid_velocity_command``.
 10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares).
+11. The simulated robot (:class:`~robotspec.driver.sim.SimRobot`) has a command watchdog, like a
+    real controller: when the driver sends no command for ``command_timeout`` (default 0.1 s; the
+    driver stops sending once feedback is lost), the arm drops its last command and brakes to
+    rest at its acceleration limits. The reference's simulated robot keeps following its last
+    velocity command until a joint limit.
 """
 
 from __future__ import annotations

@@ -7,10 +7,16 @@ error, disabled drives) without a robot.
 
 The command sent in one step is applied over the following period, and feedback read at the next
 step reports the result (``_read_feedback`` integrates, then reports).
+
+Like a real controller's command interface, the simulated arm has a command watchdog: when no
+command arrives from the driver for ``command_timeout`` seconds (the driver stopped sending, e.g.
+because feedback was lost), it drops the last command and brakes to a stop at its acceleration
+limits, instead of following a stale velocity command into a joint limit.
 """
 
 from __future__ import annotations
 
+import math
 from enum import StrEnum
 from typing import Any
 
@@ -18,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robotspec.driver.clock import Clock
+from robotspec.driver.errors import InvalidArgumentError
 from robotspec.driver.loop import Completion, RobotDriver
 from robotspec.driver.robot_info import RobotInfo
 from robotspec.driver.state import EstopSource
@@ -47,7 +54,12 @@ class SimRobot(RobotDriver):
         update_period: loop period in seconds.
         initial_position: starting joint positions (default: ``home`` clipped to the limits).
         homing_speed: fraction of the velocity limit used while homing.
+        command_timeout: the command watchdog, in seconds: with no command from the driver for
+            this long, the arm brakes to a stop at its acceleration limits (default 0.1 s).
     """
+
+    #: Default command watchdog timeout in seconds (10 periods at the default 100 Hz).
+    DEFAULT_COMMAND_TIMEOUT = 0.1
 
     def __init__(
         self,
@@ -57,7 +69,10 @@ class SimRobot(RobotDriver):
         update_period: float = 0.01,
         initial_position: Any = None,
         homing_speed: float = 0.25,
+        command_timeout: float = DEFAULT_COMMAND_TIMEOUT,
     ) -> None:
+        if not (math.isfinite(command_timeout) and command_timeout > 0):
+            raise InvalidArgumentError("command timeout must be a positive number of seconds")
         super().__init__(robot_info, clock=clock, update_period=update_period)
         lim = self._limits
         n = self._joint_count
@@ -80,6 +95,10 @@ class SimRobot(RobotDriver):
         self._homing_completion: Completion | None = None
         self._homing_speed = homing_speed
         self._sim_last_t: float | None = None
+        self._command_timeout = command_timeout
+        self._last_command_t: float | None = None
+        #: How many times the command watchdog has stopped the arm (tests and logs read it).
+        self.watchdog_trips = 0
         #: Every command actually sent, as (now, position or None, velocity or None); only kept
         #: when ``record_commands`` is True (tests check invariants on it).
         self.record_commands = False
@@ -91,6 +110,16 @@ class SimRobot(RobotDriver):
     def sim_position(self) -> FloatArray:
         """The simulated arm's true joint positions (a copy)."""
         return self._q.copy()
+
+    @property
+    def sim_velocity(self) -> FloatArray:
+        """The simulated arm's true joint velocities (a copy)."""
+        return self._v.copy()
+
+    @property
+    def command_timeout(self) -> float:
+        """The command watchdog timeout in seconds."""
+        return self._command_timeout
 
     def _integrate(self, now: float) -> None:
         last = self._sim_last_t
@@ -106,6 +135,15 @@ class SimRobot(RobotDriver):
             self._v[:] = 0.0
             self._pending_pos = self._pending_vel = None
             return
+        if (
+            self._last_command_t is not None
+            and now - self._last_command_t > self._command_timeout
+            and (self._pending_pos is not None or self._pending_vel is not None)
+        ):
+            # Command watchdog: the driver went silent. Drop the stale command; with none,
+            # the arm brakes to rest at its acceleration limits (below).
+            self._pending_pos = self._pending_vel = None
+            self.watchdog_trips += 1
         if self._homing_target is not None and (
             self._homing_completion is None or self._homing_completion.done
         ):
@@ -180,6 +218,7 @@ class SimRobot(RobotDriver):
     ) -> None:
         self._pending_pos = joint_pos_cmd
         self._pending_vel = joint_vel_cmd
+        self._last_command_t = now
         if joint_pos_cmd is not None:
             self._position_command = joint_pos_cmd
             self._velocity_command = None

@@ -5,6 +5,10 @@ robotspec: spec YAML -> URDF world + SRDF + every semantic part, checks and coll
 (COLLISION, with package dirs) + ``addAllCollisionPairs`` + ``removeCollisionPairs`` (the SRDF).
 Neither side caches anything between runs. Target: robotspec no slower than pinocchio.
 
+Second line: the composed ``b1_ur5_allegro`` (three parts welded, semantics merged) against
+pinocchio loading the same robot already joined (``robotspec export bundle``'s URDF and SRDF):
+the cost of composing on every load.
+
 Run: ``python benchmarks/bench_compile.py [--repeat N] [--profile]`` (needs the dev extra:
 example-robot-data, pin). Prints medians and the ratio pinocchio / robotspec (above 1 means
 robotspec is faster); ``--profile`` adds robotspec's top costs (cProfile, cumulative).
@@ -82,6 +86,37 @@ def main() -> None:
     print(f"{'robotspec compile_robot(pr2)':<40}{t_ours * 1e3:9.1f} ms")
     print(f"{'pinocchio model+geom+SRDF pairs':<40}{t_pin * 1e3:9.1f} ms")
     ratio = t_pin / t_ours
+    verdict = "robotspec faster" if ratio >= 1 else "robotspec SLOWER"
+    print(f"ratio pinocchio/robotspec: {ratio:.2f} ({verdict}; median of {args.repeat})")
+
+    import tempfile
+
+    from robotspec.compiler import check_spec
+    from robotspec.description_export import bundle
+
+    folder = Path(tempfile.mkdtemp(prefix="bench-compose-"))
+    out = bundle(check_spec("b1_ur5_allegro"), name="b1")
+    (folder / "b1.urdf").write_text(out.urdf)
+    (folder / "b1.srdf").write_text(out.srdf)
+
+    def composed() -> object:
+        return compile_robot("b1_ur5_allegro")
+
+    def pin_joined() -> object:
+        path = str(folder / "b1.urdf")
+        model = pin.buildModelFromUrdf(path)
+        geom = pin.buildGeomFromUrdf(
+            model, path, pin.GeometryType.COLLISION, package_dirs=package_dirs
+        )
+        geom.addAllCollisionPairs()
+        pin.removeCollisionPairs(model, geom, str(folder / "b1.srdf"))
+        return model, geom
+
+    t_comp = median_time(composed, args.repeat)
+    t_pin_joined = median_time(pin_joined, args.repeat)
+    print(f"{'robotspec compile_robot(b1_ur5_allegro)':<40}{t_comp * 1e3:9.1f} ms")
+    print(f"{'pinocchio, the exported joined files':<40}{t_pin_joined * 1e3:9.1f} ms")
+    ratio = t_pin_joined / t_comp
     verdict = "robotspec faster" if ratio >= 1 else "robotspec SLOWER"
     print(f"ratio pinocchio/robotspec: {ratio:.2f} ({verdict}; median of {args.repeat})")
 

@@ -71,6 +71,7 @@ def load_description(
     base = base_folder or Path.cwd()
     extra = [p if Path(p).is_absolute() else base / p for p in map(str, package_paths)]
     urdf_ref = str(urdf)
+    bootstrap = None
     if "://" in urdf_ref:
         bootstrap = PackageResolver.create(None, extra_paths=extra)
         urdf_path = bootstrap.resolve(urdf_ref, relative_to=base)
@@ -78,7 +79,7 @@ def load_description(
         urdf_path = Path(urdf_ref) if Path(urdf_ref).is_absolute() else base / urdf_ref
     if not urdf_path.is_file():
         raise missing_file(urdf_path, DescriptionError)
-    resolver = PackageResolver.create(urdf_path, extra_paths=extra)
+    resolver = PackageResolver.create(urdf_path, extra_paths=extra, share_crawls_with=bootstrap)
     root = read_description_xml(urdf_path, resolver, xacro_args)
     issues: list[RobotSpecError] = []
     world = world_from_urdf_xml(

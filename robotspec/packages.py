@@ -199,6 +199,10 @@ class PackageResolver:
     #: Folders whose children are packages and are not crawled into (example-robot-data's).
     flat_folders: tuple[Path, ...] = ()
     _index: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
+    #: Crawled folders (folder, bare, flat) -> packages; shared by resolvers of one compilation.
+    _crawls: dict[tuple[Path, bool, bool], dict[str, Path]] = field(
+        default_factory=dict, compare=False, repr=False
+    )
     _real_roots: list[Path] = field(default_factory=list, compare=False, repr=False)
     _real_dirs: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
     _resolved: dict[tuple[str, str], Path] = field(default_factory=dict, compare=False, repr=False)
@@ -213,6 +217,7 @@ class PackageResolver:
         use_example_robot_data: bool = True,
         extra_allowed_roots: Sequence[str | Path] = (),
         environ: Mapping[str, str] | None = None,
+        share_crawls_with: PackageResolver | None = None,
     ) -> PackageResolver:
         """A resolver for ``description`` (a URDF/xacro/SRDF path, or ``None``).
 
@@ -230,6 +235,10 @@ class PackageResolver:
             extra_allowed_roots: More folders reads may reach (e.g. a symlink-install's
                 source tree) without being searched for packages.
             environ: The environment to read instead of ``os.environ`` (tests, servers).
+            share_crawls_with: A resolver of the same compilation whose folder crawls this
+                one reuses (and adds to): parts of a composed robot search the same folders.
+            share_crawls_with: A resolver of the same compilation whose folder crawls this
+                one reuses (and adds to): parts of a composed robot search the same folders.
         """
         env = os.environ if environ is None else environ
         folders: list[Path] = [Path(p).absolute() for p in extra_paths]
@@ -261,6 +270,7 @@ class PackageResolver:
             description=desc,
             bare_name_folders=_unique(Path(os.path.normpath(f)) for f in bare if f.is_dir()),
             flat_folders=_unique(Path(os.path.normpath(f)) for f in flat if f.is_dir()),
+            _crawls={} if share_crawls_with is None else share_crawls_with._crawls,
         )
 
     @property
@@ -280,19 +290,55 @@ class PackageResolver:
         folder's own name, or a child folder without a manifest); across folders, the search
         order decides.
         """
+        return dict(self._packages())
+
+    def _packages(self) -> dict[str, Path]:
+        """The index itself (not a copy): lookups run once per mesh."""
         if not self._index:
             index: dict[str, Path] = {}
             for folder in self.search_folders:
-                bare = folder in self.bare_name_folders
-                flat = folder in self.flat_folders
-                for name, path in _folder_packages(folder, bare=bare, flat=flat).items():
+                key = (folder, folder in self.bare_name_folders, folder in self.flat_folders)
+                found = self._crawls.get(key)
+                if found is None:
+                    found = _folder_packages(folder, bare=key[1], flat=key[2])
+                    self._crawls[key] = found
+                for name, path in found.items():
                     index.setdefault(name, path)
             self._index.update(index)
-        return dict(self._index)
+        return self._index
+
+    @classmethod
+    def joined(cls, resolvers: Sequence[PackageResolver]) -> PackageResolver:
+        """One resolver for files that came from several descriptions (a composed robot).
+
+        Search folders and allowed roots are the union, in order. Its package index is the
+        union of the resolvers' indexes (first wins), so it is not crawled again; a caller that
+        needs a reference resolved as its own description's resolver does compares the two.
+        """
+
+        def union(attr: str) -> tuple[Path, ...]:
+            out: dict[Path, None] = {}
+            for r in resolvers:
+                out.update(dict.fromkeys(getattr(r, attr)))
+            return tuple(out)
+
+        out = cls(
+            search_folders=union("search_folders"),
+            roots=union("allowed_roots"),
+            description=None,
+            bare_name_folders=union("bare_name_folders"),
+            flat_folders=union("flat_folders"),
+        )
+        index: dict[str, Path] = {}
+        for r in resolvers:
+            for name, path in r._packages().items():
+                index.setdefault(name, path)
+        out._index.update(index)
+        return out
 
     def find_package(self, name: str, *, file: str | None = None, line: int | None = None) -> Path:
         """The folder of package ``name``; unknown names suggest the closest known ones."""
-        index = self.packages()
+        index = self._packages()
         found = index.get(name) if _PACKAGE_NAME.match(name) else None
         if found is not None:
             return found

@@ -100,14 +100,18 @@ def world_from_urdf_xml(
     resolver: PackageResolver | None = None,
     meshes: MeshPolicy = "keep",
     issues: list[RobotSpecError] | None = None,
+    checked: bool = False,
 ) -> World:
     """Interpret a checked URDF element tree as a world; all problems are raised together.
 
     With ``meshes="report"``, unresolvable meshes are appended to ``issues`` as warnings.
+    ``checked=True`` skips :func:`check_urdf_tree` for a tree whose pieces were checked in their
+    own files already (a composed robot's parts), where its line numbers would mislead.
     """
     import yourdfpy
 
-    check_urdf_tree(root, file)
+    if not checked:
+        check_urdf_tree(root, file)
     # yourdfpy's own loader strips comments before parsing; its element parser needs the same.
     etree.strip_tags(root, etree.Comment)
     try:

@@ -175,6 +175,7 @@ def _compile(
             resolver=composition.resolver,
             meshes="report",
             issues=issues,
+            checked=True,  # each part's file was checked; composition checked the joins
         )
         for w in issues:
             diag.add(w)

@@ -99,9 +99,16 @@ class _Part:
 
 # ------------------------------------------------------------------------------------- loading
 def description_tree(
-    loaded: LoadedSpec, package_paths: Sequence[str | Path] = ()
+    loaded: LoadedSpec,
+    package_paths: Sequence[str | Path] = (),
+    *,
+    share_crawls_with: PackageResolver | None = None,
 ) -> tuple[etree._Element, Path, PackageResolver, Srdf | None]:
-    """A flat spec's URDF tree (xacro run, frames added, mesh paths absolute) and its SRDF."""
+    """A flat spec's URDF tree (xacro run, frames added, mesh paths absolute) and its SRDF.
+
+    ``share_crawls_with``: a resolver of the same compilation whose package-folder crawls are
+    reused (parts of a composed robot search the same folders).
+    """
     from robotspec.description import resolve_file
     from robotspec.urdf import read_description_xml
     from robotspec.urdf_check import check_urdf_tree
@@ -112,15 +119,15 @@ def description_tree(
         p if Path(p).is_absolute() else folder / p
         for p in [*desc.package_paths, *map(str, package_paths)]
     ]
+    share = share_crawls_with
     if "://" in desc.urdf:
-        urdf = PackageResolver.create(None, extra_paths=extra).resolve(
-            desc.urdf, relative_to=folder
-        )
+        share = PackageResolver.create(None, extra_paths=extra, share_crawls_with=share)
+        urdf = share.resolve(desc.urdf, relative_to=folder)
     else:
         urdf = Path(desc.urdf) if Path(desc.urdf).is_absolute() else folder / desc.urdf
     if not urdf.is_file():
         raise missing_file(urdf)
-    resolver = PackageResolver.create(urdf, extra_paths=extra)
+    resolver = PackageResolver.create(urdf, extra_paths=extra, share_crawls_with=share)
     tree = read_description_xml(urdf, resolver, desc.xacro_args)
     check_urdf_tree(tree, str(urdf))
     absolute_mesh_paths(tree, urdf.parent)
@@ -153,6 +160,7 @@ def _load_part(
     diag: Diagnostics,
     package_paths: Sequence[str | Path],
     seen: tuple[Path, ...],
+    share: PackageResolver | None,
 ) -> _Part | None:
     loc: Loc = ("parts", name)
     try:
@@ -182,7 +190,9 @@ def _load_part(
                 tree, file, resolver, srdf = inner.urdf, path, inner.resolver, inner.srdf
             else:
                 flat = part_loaded
-                tree, file, resolver, srdf = description_tree(part_loaded, package_paths)
+                tree, file, resolver, srdf = description_tree(
+                    part_loaded, package_paths, share_crawls_with=share
+                )
             spec = flat.spec
             data = spec.model_dump(mode="json", exclude_unset=True)
             return _Part(
@@ -218,7 +228,9 @@ def _load_part(
             }
         )
         tree, file, resolver, srdf = description_tree(
-            LoadedSpec(part_desc, loaded.file, loaded.documents), package_paths
+            LoadedSpec(part_desc, loaded.file, loaded.documents),
+            package_paths,
+            share_crawls_with=share,
         )
         return _Part(name, ps, file, tree, srdf, resolver, tree_facts(tree))
     except RobotSpecError as exc:
@@ -399,10 +411,12 @@ def compose(
     seen = (*_seen, loaded.file.resolve())
     order = _order(spec.parts, diag)
     loaded_parts: dict[str, _Part] = {}
+    share: PackageResolver | None = None
     for name in order:
-        part = _load_part(name, spec.parts[name], loaded, diag, package_paths, seen)
+        part = _load_part(name, spec.parts[name], loaded, diag, package_paths, seen, share)
         if part is not None:
             loaded_parts[name] = part
+            share = share or part.resolver
             if len(part.facts.roots) != 1:
                 diag.error(
                     ("parts", name),

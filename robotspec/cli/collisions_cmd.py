@@ -11,7 +11,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from robotspec.cli.app import app
-from robotspec.cli.options import JsonFlag, PackagePath, SkipMeshes, SpecArg, load_robot
+from robotspec.cli.options import (
+    JsonFlag,
+    PackagePath,
+    SkipMeshes,
+    SpecArg,
+    load_robot,
+    write_output,
+)
 from robotspec.cli.table import render_table
 from robotspec.errors import CollisionError
 
@@ -189,10 +196,7 @@ def generate(
         )
     _warn_skipped(matrix.skipped)
     text = write_srdf(matrix.to_srdf(robot.srdf if merge else None, merge=True))
-    if output is None:
-        sys.stdout.write(text)
-    else:
-        output.write_text(text, encoding="utf-8")
+    write_output(text, output)
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
     lines = [
         f"{len(matrix.disabled)} pairs disabled ({counts}); {len(matrix.checked)} stay checked; "

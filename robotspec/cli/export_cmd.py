@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from robotspec.cli.app import app
-from robotspec.cli.options import PackagePath, SpecArg
+from robotspec.cli.options import OutputFile, PackagePath, SpecArg, write_file, write_output
 
 if TYPE_CHECKING:
     from robotspec.driver.export import ExportedRobotInfo
@@ -52,9 +52,7 @@ def robotinfo(
     chain: Annotated[
         str, typer.Option("--chain", "-c", help="The chain to export (see `inspect chains`).")
     ],
-    output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="Write to FILE instead of stdout.")
-    ] = None,
+    output: OutputFile = None,
     package_path: PackagePath = None,
 ) -> None:
     """A Robot Raconteur RobotInfo YAML of one chain: H/P kinematics, limits, flange pose.
@@ -72,10 +70,8 @@ def robotinfo(
     text = dump_robot_info_yaml(ex.info, header=header)
     for note in ex.notes:
         sys.stderr.write(f"note: {note}\n")
-    if output is None:
-        sys.stdout.write(text)
+    if not write_output(text, output):
         return
-    output.write_text(text, encoding="utf-8")
     sys.stderr.write(
         f"wrote {output} ({len(ex.info.joint_info)} joints, chain "
         f"{ex.info.chains[0].kin_chain_identifier.name})\n"
@@ -85,9 +81,7 @@ def robotinfo(
 @export_app.command("srdf")
 def srdf(
     spec: SpecArg,
-    output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="Write to FILE instead of stdout.")
-    ] = None,
+    output: OutputFile = None,
     package_path: PackagePath = None,
 ) -> None:
     """A MoveIt SRDF of the compiled robot: a group per chain, end effectors, group states.
@@ -101,11 +95,8 @@ def srdf(
 
     robot = compile_robot(spec, package_paths=package_path or ())
     exported = srdf_from_robot(robot)
-    text = write_srdf(exported)
-    if output is None:
-        sys.stdout.write(text)
+    if not write_output(write_srdf(exported), output):
         return
-    output.write_text(text, encoding="utf-8")
     sys.stderr.write(
         f"wrote {output}: {len(exported.groups)} groups, {len(exported.end_effectors)} end "
         f"effectors, {len(exported.group_states)} group states, "
@@ -116,9 +107,7 @@ def srdf(
 @export_app.command("urdf")
 def urdf(
     spec: SpecArg,
-    output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="Write to FILE instead of stdout.")
-    ] = None,
+    output: OutputFile = None,
     package_path: PackagePath = None,
 ) -> None:
     """One URDF of the robot: a composed robot's parts joined, welds as fixed joints.
@@ -133,10 +122,8 @@ def urdf(
     loaded = load_spec(resolve_spec(spec))
     tree = joined_urdf(loaded, package_paths=package_path or ())
     text = urdf_text(tree, comment=f"{loaded.spec.name}: exported by robotspec from {spec}")
-    if output is None:
-        sys.stdout.write(text)
+    if not write_output(text, output):
         return
-    output.write_text(text, encoding="utf-8")
     links = sum(1 for _ in tree.iterfind("link"))
     joints = sum(1 for _ in tree.iterfind("joint"))
     sys.stderr.write(f"wrote {output}: {links} links, {joints} joints\n")
@@ -164,7 +151,6 @@ def bundle_cmd(
     result = check_spec(path, package_paths=package_path or ())
     stem = name or path.stem
     out = bundle(result, name=stem, package_paths=package_path or ())
-    output.mkdir(parents=True, exist_ok=True)
     for suffix, text in ((".urdf", out.urdf), (".srdf", out.srdf), (".yaml", out.spec)):
-        (output / f"{stem}{suffix}").write_text(text, encoding="utf-8")
+        write_file(output / f"{stem}{suffix}", text)
     sys.stderr.write(f"wrote {output}/{stem}.urdf, .srdf and .yaml\n")

@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from robotspec.cli.app import app
-from robotspec.cli.options import PackagePath
+from robotspec.cli.options import PackagePath, write_output
 
 
 @app.command()
@@ -72,10 +72,7 @@ def init(
     )
     draft.package_paths = extra_paths
     text = render_draft(draft, schema_hint=shipped_schema_path().as_uri())
-    if output is None:
-        sys.stdout.write(text)
-    else:
-        output.write_text(text)
+    if write_output(text, output):
         sys.stderr.write(
             f"wrote {output}: {len(draft.chains)} chains, {len(draft.manipulators)} manipulators, "
             f"{len(draft.cameras)} cameras; check the lines marked DECIDE, then run "

@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from robotspec.cli.app import app
+from robotspec.cli.options import write_output
 from robotspec.cli.table import render_table
 
 
@@ -41,7 +42,4 @@ def schema(
     from robotspec.spec import json_schema_text
 
     text = json_schema_text()
-    if output is None:
-        sys.stdout.write(text)
-    else:
-        output.write_text(text)
+    write_output(text, output)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -20,6 +21,34 @@ PackagePath = Annotated[
         show_default=False,
     ),
 ]
+OutputFile = Annotated[
+    Path | None, typer.Option("--output", "-o", help="Write to FILE instead of stdout.")
+]
+
+
+def write_output(text: str, output: Path | None) -> bool:
+    """Write ``text`` to ``output``, or to stdout when it is None; True if a file was written."""
+    if output is None:
+        sys.stdout.write(text)
+        return False
+    write_file(output, text)
+    return True
+
+
+def write_file(path: Path, text: str) -> None:
+    """Write a file the user named; a folder that is missing or read-only is their error."""
+    from robotspec.errors import RobotSpecError
+
+    try:
+        if path.parent != Path(""):
+            path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise RobotSpecError(
+            f"cannot write file: {exc.strerror or exc}", file=str(path), kind="file"
+        ) from None
+
+
 JsonFlag = Annotated[bool, typer.Option("--json", help="Print JSON instead of a table.")]
 
 

@@ -388,11 +388,12 @@ class LoadedSpec:
         return self.file.parent
 
 
-def _merge(base: Any, child: Any) -> Any:
+def merge_data(base: Any, child: Any) -> Any:
+    """``child`` over ``base``, mapping by mapping (``extends`` and composed specs' overrides)."""
     if isinstance(base, Mapping) and isinstance(child, Mapping):
         out = dict(base)
         for k, v in child.items():
-            out[k] = _merge(base[k], v) if k in base else v
+            out[k] = merge_data(base[k], v) if k in base else v
         return out
     return child
 
@@ -457,7 +458,7 @@ def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
         base_data = base.spec.model_dump(mode="json", exclude_unset=True, by_alias=True)
         base_data.pop("extends", None)
         _absolutize(base_data, base.folder)
-        data = _merge(base_data, {k: v for k, v in data.items() if k != "extends"})
+        data = merge_data(base_data, {k: v for k, v in data.items() if k != "extends"})
         data["extends"] = base_file
         documents = (doc, *base.documents)
     try:

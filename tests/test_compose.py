@@ -637,3 +637,27 @@ def test_a_xacro_part_with_arguments(tmp_path: Path) -> None:
     q = np.zeros(len(robot.world.degrees_of_freedom))
     offset = Kinematics(robot.world).pose(q, "t_tool_tip", relative_to="flange")
     np.testing.assert_allclose(offset[:3, 3], [0, 0, 0.25], atol=1e-12)
+
+
+def test_the_composed_spec_changes_a_parts_entry_key_by_key(tmp_path: Path) -> None:
+    erd_robots()
+    spec = tmp_path / "typo.yaml"
+    spec.write_text(
+        "robotspec: 1\nextends: b1_ur5_allegro\nname: Typo\nchains:\n"
+        "  ur5_arm: {tip: ur5_wrist_3_lnk}\n"
+        "  leg: {kind: chain, root: trunk, tip: FR_foott}\n"
+    )
+    with pytest.raises(RobotSpecError) as info:
+        check_spec(spec)
+    text = [f"{e.line}:{e.column}: {e.message}" for e in _errors(info.value)]
+    assert text == [
+        "5:18: link 'ur5_wrist_3_lnk' not found in typo.yaml (composed); did you mean "
+        "'ur5_wrist_3_link', 'ur5_wrist_2_link' or 'ur5_wrist_1_link'?",
+        "6:41: link 'FR_foott' not found in typo.yaml (composed); did you mean 'FR_foot', "
+        "'RR_foot' or 'RL_foot'?",
+    ]
+    spec.write_text(spec.read_text().replace("lnk", "link").replace("foott", "foot"))
+    robot = compile_robot(spec)
+    arm = robot.get_chain("ur5_arm")
+    assert arm.root.name == "ur5_base_link"  # kept from the UR5 part's chain
+    assert "ur5_arm.home" in robot.joint_states

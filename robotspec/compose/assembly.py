@@ -38,6 +38,7 @@ from robotspec.spec import (
     PartSpec,
     RobotSpec,
     load_spec,
+    merge_data,
     shipped_part_files,
     shipped_spec_files,
 )
@@ -633,10 +634,10 @@ def _flat_spec(
     for key, value in own.items():
         if key in ("parts", "description", "robotspec", "extends"):
             continue
-        if key in NAMED_SECTIONS and isinstance(value, dict):
-            data[key] = {**data.get(key, {}), **value}
-        elif key in ("velocity_limits", "collision") and isinstance(value, dict):
-            data[key] = {**data.get(key, {}), **value}
+        if isinstance(value, dict) and isinstance(data.get(key), dict):
+            # Like ``extends``: an entry the spec names changes the part's entry key by key
+            # (``chains: {ur5_arm: {tip: ...}}`` keeps the part's root and states).
+            data[key] = merge_data(data[key], value)
         else:
             data[key] = value
     explicit = {c for c, chain in own.get("chains", {}).items() if "manipulator" in chain}

@@ -653,7 +653,7 @@ def test_the_composed_spec_changes_a_parts_entry_key_by_key(tmp_path: Path) -> N
     assert text == [
         "5:18: link 'ur5_wrist_3_lnk' not found in typo.yaml (composed); did you mean "
         "'ur5_wrist_3_link', 'ur5_wrist_2_link' or 'ur5_wrist_1_link'?",
-        "6:41: link 'FR_foott' not found in typo.yaml (composed); did you mean 'FR_foot', "
+        "6:40: link 'FR_foott' not found in typo.yaml (composed); did you mean 'FR_foot', "
         "'RR_foot' or 'RL_foot'?",
     ]
     spec.write_text(spec.read_text().replace("lnk", "link").replace("foott", "foot"))

@@ -661,3 +661,36 @@ def test_the_composed_spec_changes_a_parts_entry_key_by_key(tmp_path: Path) -> N
     arm = robot.get_chain("ur5_arm")
     assert arm.root.name == "ur5_base_link"  # kept from the UR5 part's chain
     assert "ur5_arm.home" in robot.joint_states
+
+
+def test_one_package_name_in_two_parts_resolves_per_part(tmp_path: Path) -> None:
+    """Two vendors' packages called 'tools': each part's meshes stay its own."""
+    from robotspec.geometry import Mesh
+
+    for vendor, mesh in (("a", "one.stl"), ("b", "two.stl")):
+        pkg = tmp_path / vendor / "tools"
+        (pkg / "meshes").mkdir(parents=True)
+        (pkg / "package.xml").write_text("<package><name>tools</name></package>")
+        (pkg / "meshes" / mesh).write_text("solid m\nendsolid m\n")
+        (pkg / "robot.urdf").write_text(
+            f'<robot name="{vendor}"><link name="{vendor}_link"><visual><geometry>'
+            f'<mesh filename="package://tools/meshes/{mesh}"/></geometry></visual></link></robot>'
+        )
+    spec = tmp_path / "two.yaml"
+    spec.write_text(
+        "robotspec: 1\nname: Two\nparts:\n  a: {urdf: a/tools/robot.urdf}\n"
+        "  b: {urdf: b/tools/robot.urdf, attach: {part: a, link: a_link}}\n"
+    )
+    result = check_spec(spec)
+    assert result.warnings == ()
+    assert result.robot is not None
+    w = result.robot.world
+    paths = {}
+    for name in ("a_link", "b_link"):
+        (shape,) = w.get_body_by_name(name).visuals
+        assert isinstance(shape.geometry, Mesh)
+        paths[name] = shape.geometry.path
+    assert paths == {
+        "a_link": str((tmp_path / "a" / "tools" / "meshes" / "one.stl").resolve()),
+        "b_link": str((tmp_path / "b" / "tools" / "meshes" / "two.stl").resolve()),
+    }

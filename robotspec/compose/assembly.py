@@ -295,40 +295,30 @@ def _order(parts: Mapping[str, PartSpec], diag: Diagnostics) -> list[str]:
 
 
 # ------------------------------------------------------------------------------------ joining
-def _merged_resolver(parts: Sequence[_Part]) -> PackageResolver:
-    def union(attr: str) -> tuple[Path, ...]:
-        out: dict[Path, None] = {}
-        for p in parts:
-            out.update(dict.fromkeys(getattr(p.resolver, attr)))
-        return tuple(out)
-
-    return PackageResolver(
-        search_folders=union("search_folders"),
-        roots=union("allowed_roots"),
-        description=None,
-        bare_name_folders=union("bare_name_folders"),
-        flat_folders=union("flat_folders"),
-    )
-
-
 def _pin_packages(part: _Part, meshes: Sequence[etree._Element], joined: PackageResolver) -> None:
     """Write a mesh's absolute path when the joined search path finds its package elsewhere."""
+    same: dict[str, bool] = {}
     for mesh in meshes:
         uri = mesh.get("filename", "")
         if not uri.startswith("package://"):
             continue
         package = uri[len("package://") :].split("/", 1)[0]
+        if package not in same:
+            try:
+                mine: Path | None = part.resolver.find_package(package)
+            except RobotSpecError:
+                mine = None  # unresolvable for the part too: the world builder reports it
+            try:
+                theirs: Path | None = joined.find_package(package)
+            except RobotSpecError:
+                theirs = None
+            same[package] = mine is None or mine == theirs
+        if same[package]:
+            continue
         try:
-            mine = part.resolver.find_package(package)
-            path = part.resolver.resolve(uri, relative_to=part.file.parent)
+            mesh.set("filename", str(part.resolver.resolve(uri, relative_to=part.file.parent)))
         except RobotSpecError:
-            continue  # unresolvable for the part too: the world builder reports it
-        try:
-            theirs: Path | None = joined.find_package(package)
-        except RobotSpecError:
-            theirs = None
-        if theirs != mine:
-            mesh.set("filename", str(path))
+            continue
 
 
 def _materials(
@@ -521,7 +511,7 @@ def compose(
             )
         )
     diag.raise_if_failed()
-    resolver = _merged_resolver(list(loaded_parts.values()))
+    resolver = PackageResolver.joined([p.resolver for p in loaded_parts.values()])
     for part, meshes in mesh_lists:
         _pin_packages(part, meshes, resolver)
     srdf = merge_srdfs(spec.name, srdfs) if srdfs else None

@@ -34,6 +34,7 @@ from robotspec.compose.urdf_merge import (
 from robotspec.errors import RobotSpecError, SpecError, missing_file
 from robotspec.packages import PackageResolver
 from robotspec.spec import (
+    AttachSpec,
     LoadedSpec,
     PartSpec,
     RobotSpec,
@@ -390,6 +391,115 @@ def _report_clashes(
         )
 
 
+@dataclass
+class _Joiner:
+    """The robot tree being joined, and who owns each name so far."""
+
+    name: str
+    diag: Diagnostics
+    parts: Mapping[str, _Part]
+    robot: etree._Element = field(init=False)
+    names_of: dict[str, PartNames] = field(default_factory=dict)
+    owners: dict[str, dict[str, str]] = field(default_factory=dict)  # kind -> name -> part
+    materials: dict[str, bytes] = field(default_factory=dict)
+    srdfs: list[Srdf] = field(default_factory=list)
+    meshes: list[tuple[_Part, list[etree._Element]]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.robot = etree.Element("robot")
+        self.robot.set("name", self.name)
+
+    def _parent_link(self, name: str, attach: AttachSpec) -> str | None:
+        """The composed name of the link ``attach`` names, or None after reporting why not."""
+        loc: Loc = ("parts", name, "attach")
+        if attach.part not in self.names_of:
+            return None  # its parent failed to weld; that error is reported already
+        parent = self.parts[attach.part]
+        if attach.link not in parent.facts.links:
+            self.diag.not_found(
+                (*loc, "link"),
+                "link",
+                attach.link,
+                parent.facts.links,
+                f"part '{attach.part}' ({parent.file.name})",
+            )
+            return None
+        if attach.rpy is not None and attach.quaternion is not None:
+            self.diag.error(loc, "give rpy or quaternion, not both")
+            return None
+        if attach.quaternion is not None and not is_unit(attach.quaternion):
+            self.diag.error((*loc, "quaternion"), "must be a unit quaternion")
+            return None
+        return self.names_of[attach.part].link(attach.link)
+
+    def _claim_names(self, name: str, n: PartNames, part: _Part, weld_joint: str | None) -> None:
+        """Own the part's names; one error per other part that already has some of them."""
+        links = [n.link(x) for x in part.facts.links if x not in n.merged_links]
+        joints = [n.joint(x) for x in part.facts.joints]
+        kinds = {"link": links, "joint": [*joints, *([weld_joint] if weld_joint else [])]}
+        if part.srdf is not None:
+            renamed = rename_srdf(
+                part.srdf,
+                n,
+                keep_virtual=part.spec.attach is None,
+                keep_collisions=part.use_srdf,
+            )
+            kinds["SRDF group"] = [g.name for g in renamed.groups]
+            self.srdfs.append(renamed)
+        clashes = [_claim(k, v, self.owners.setdefault(k, {}), name) for k, v in kinds.items()]
+        loc: Loc = ("parts", name)
+        where = (*loc, "prefix") if "prefix" in part.spec.model_fields_set else loc
+        _report_clashes(clashes, name, self.diag, where)
+
+    def add(self, name: str) -> ComposedPart | None:
+        """Rename one part and weld it into the robot (the base part: just add it)."""
+        part = self.parts[name]
+        attach = part.spec.attach
+        root = part.facts.roots[0]
+        merged: dict[str, str] = {}
+        parent_link = None
+        weld_joint = None
+        if attach is not None:
+            parent_link = self._parent_link(name, attach)
+            if parent_link is None:
+                return None
+            if attach.replace_root:
+                merged[root] = parent_link
+            else:
+                weld_joint = attach.joint or f"{name}_weld"
+        n = PartNames(name, part.spec.prefix, merged)
+        self.names_of[name] = n
+        self._claim_names(name, n, part, weld_joint)
+        tree = part.tree
+        self.meshes.append((part, list(tree.iter("mesh"))))
+        materials, duplicate = _materials(part, n, self.materials)
+        dropped = [el for el in tree.iterfind("material") if el.get("name") in duplicate]
+        rename_tree(tree, n, materials)
+        for el in dropped:
+            tree.remove(el)
+        if attach is None or parent_link is None:
+            self.robot.extend(el for el in list(tree) if isinstance(el.tag, str))
+        else:
+            weld(
+                self.robot,
+                tree,
+                parent_link=parent_link,
+                part_root=n.link(root),
+                pose=attach.pose(),
+                joint_name=weld_joint or "",
+                replace_root=attach.replace_root,
+            )
+        return ComposedPart(
+            name=name,
+            names=n,
+            file=part.file,
+            root_link=n.link(root),
+            weld_joint=weld_joint,
+            links=tuple(n.link(x) for x in part.facts.links if x not in merged),
+            joints=tuple(n.joint(x) for x in part.facts.joints),
+        )
+
+
 def compose(
     loaded: LoadedSpec,
     *,
@@ -415,112 +525,19 @@ def compose(
                     f"it has {len(part.facts.roots)}: {', '.join(part.facts.roots)}",
                 )
     diag.raise_if_failed()
-    robot = etree.Element("robot")
-    robot.set("name", spec.name)
-    composed: list[ComposedPart] = []
-    names_of: dict[str, PartNames] = {}
-    link_owner: dict[str, str] = {}
-    joint_owner: dict[str, str] = {}
-    group_owner: dict[str, str] = {}
-    used_materials: dict[str, bytes] = {}
-    srdfs: list[Srdf] = []
-    mesh_lists: list[tuple[_Part, list[etree._Element]]] = []
-    for name in order:
-        part = loaded_parts[name]
-        ps = part.spec
-        loc: Loc = ("parts", name)
-        root = part.facts.roots[0]
-        merged: dict[str, str] = {}
-        parent_link = None
-        weld_joint = None
-        attach = ps.attach
-        if attach is not None:
-            if attach.part not in names_of:
-                continue  # its parent failed to weld; that error is reported already
-            parent = loaded_parts[attach.part]
-            if attach.link not in parent.facts.links:
-                diag.not_found(
-                    (*loc, "attach", "link"),
-                    "link",
-                    attach.link,
-                    parent.facts.links,
-                    f"part '{attach.part}' ({parent.file.name})",
-                )
-                continue
-            if attach.rpy is not None and attach.quaternion is not None:
-                diag.error((*loc, "attach"), "give rpy or quaternion, not both")
-                continue
-            if attach.quaternion is not None and not is_unit(attach.quaternion):
-                diag.error((*loc, "attach", "quaternion"), "must be a unit quaternion")
-                continue
-            parent_link = names_of[attach.part].link(attach.link)
-            if attach.replace_root:
-                merged[root] = parent_link
-            else:
-                weld_joint = attach.joint or f"{name}_weld"
-        n = PartNames(name, ps.prefix, merged)
-        names_of[name] = n
-        links = [n.link(x) for x in part.facts.links if x not in merged]
-        joints = [n.joint(x) for x in part.facts.joints]
-        where = (*loc, "prefix") if "prefix" in ps.model_fields_set else loc
-        welds = [weld_joint] if weld_joint else []
-        clashes = [
-            _claim("link", links, link_owner, name),
-            _claim("joint", [*joints, *welds], joint_owner, name),
-        ]
-        if part.srdf is not None:
-            renamed = rename_srdf(
-                part.srdf, n, keep_virtual=attach is None, keep_collisions=part.use_srdf
-            )
-            clashes.append(
-                _claim("SRDF group", [g.name for g in renamed.groups], group_owner, name)
-            )
-            srdfs.append(renamed)
-        _report_clashes(clashes, name, diag, where)
-        tree = part.tree
-        mesh_lists.append((part, list(tree.iter("mesh"))))
-        materials, duplicate = _materials(part, n, used_materials)
-        dropped = [el for el in tree.iterfind("material") if el.get("name") in duplicate]
-        rename_tree(tree, n, materials)
-        for el in dropped:
-            tree.remove(el)
-        if attach is None or parent_link is None:
-            for el in list(tree):
-                if isinstance(el.tag, str):
-                    robot.append(el)
-        else:
-            pose = attach.pose()
-            weld(
-                robot,
-                tree,
-                parent_link=parent_link,
-                part_root=n.link(root),
-                pose=pose,
-                joint_name=weld_joint or "",
-                replace_root=attach.replace_root,
-            )
-        composed.append(
-            ComposedPart(
-                name=name,
-                names=n,
-                file=part.file,
-                root_link=n.link(root),
-                weld_joint=weld_joint,
-                links=tuple(links),
-                joints=tuple(joints),
-            )
-        )
+    joiner = _Joiner(spec.name, diag, loaded_parts)
+    composed = [c for c in map(joiner.add, order) if c is not None]
     diag.raise_if_failed()
     resolver = PackageResolver.joined([p.resolver for p in loaded_parts.values()])
-    for part, meshes in mesh_lists:
+    for part, meshes in joiner.meshes:
         _pin_packages(part, meshes, resolver)
-    srdf = merge_srdfs(spec.name, srdfs) if srdfs else None
-    flat = _flat_spec(loaded, loaded_parts, order, names_of, srdf, robot, diag)
+    srdf = merge_srdfs(spec.name, joiner.srdfs) if joiner.srdfs else None
+    flat = _flat_spec(loaded, loaded_parts, order, joiner.names_of, srdf, joiner.robot, diag)
     diag.raise_if_failed()
     assert flat is not None
     return Composition(
         loaded=flat,
-        urdf=robot,
+        urdf=joiner.robot,
         srdf=srdf,
         resolver=resolver,
         parts=tuple(composed),

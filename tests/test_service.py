@@ -534,3 +534,214 @@ def test_isoch_downsample_per_client(served: Served) -> None:
         wire.Close()
     steps = set(np.diff(seqnos[1:]).tolist())
     assert steps == {3}, seqnos
+
+
+# ---------------------------------------------------------------------------- homing, Cartesian
+# jogging, the velocity stream, the publisher thread, --public
+
+
+def test_home_through_the_homing_generator(served: Served) -> None:
+    r = served.robot
+    home = served.driver.limits.home
+    # Away from home first (the simulated arm starts there).
+    r.command_mode = int(CommandMode.jog)
+    r.jog_freespace(home + np.array([0.3, -0.2, 0.05]), np.array([1.0, 1.0, 0.2]), True)
+    r.command_mode = int(CommandMode.halt)
+    served.wait_mode(CommandMode.halt)
+    with pytest.raises(rr_exception("InvalidOperationException"), match="homing command mode"):
+        r.home().Next()  # only in homing mode, as the driver says
+    r.command_mode = int(CommandMode.homing)
+    gen = r.home()
+    statuses = []
+    with pytest.raises(rr_exception("StopIterationException")):
+        for _ in range(10):  # "running" every 5 s at most, then "complete", then the end
+            statuses.append(gen.Next())
+    assert statuses[-1] == 3  # ActionStatusCode complete
+    wait_until(lambda: bool(served.state().robot_state_flags & int(StateFlags.homed)))
+    np.testing.assert_allclose(served.q(), home, atol=1e-6)
+
+
+def _spatial_velocity(served: Served, linear_x: float) -> Any:
+    dtype = served.node.GetNamedArrayDType(
+        "com.robotraconteur.geometry.SpatialVelocity", served.robot
+    )
+    v = np.zeros(1, dtype=dtype)
+    v[0]["linear"]["x"] = linear_x
+    return v
+
+
+def test_jog_cartesian(served: Served) -> None:
+    r = served.robot
+    r.command_mode = int(CommandMode.jog)
+    x0 = float(served.state().kin_chain_tcp[0]["position"]["x"])
+    y0 = float(served.state().kin_chain_tcp[0]["position"]["y"])
+    r.jog_cartesian({0: _spatial_velocity(served, 0.05)}, 0.5, True)  # +x, along the slide
+    wait_until(lambda: not np.any(served.state().joint_velocity))
+    tcp = served.state().kin_chain_tcp[0]["position"]
+    dx, dy = float(tcp["x"]) - x0, float(tcp["y"]) - y0
+    assert dx > 0.01
+    assert abs(dy) < 0.1 * dx  # mostly along x (damped least squares, from a yawed pose)
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="Invalid kinematic chain"):
+        r.jog_cartesian({3: _spatial_velocity(served, 0.05)}, 0.5, True)
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="exactly one"):
+        r.jog_cartesian(
+            {0: _spatial_velocity(served, 0.05), 1: _spatial_velocity(served, 0.05)}, 0.5, True
+        )
+
+
+def test_velocity_command_wire(served: Served) -> None:
+    r = served.robot
+    r.command_mode = int(CommandMode.velocity_command)
+    wire = r.velocity_command.Connect()
+    v = np.array([0.2, 0.0, 0.0])
+    try:
+        cmd = served.struct("com.robotraconteur.robotics.robot.RobotJointCommand")
+        cmd.command = v
+        cmd.units = np.array([], dtype=np.uint8)
+        flagged = at_speed = False
+        seqno = 0
+        q0 = served.q()
+        end = time.monotonic() + WAIT
+        while time.monotonic() < end and not (flagged and at_speed):
+            st = served.state()
+            flagged = flagged or bool(st.robot_state_flags & int(StateFlags.valid_velocity_command))
+            at_speed = np.allclose(st.joint_velocity, v, atol=1e-9) and st.joint_position[0] > q0[0]
+            seqno += 1
+            cmd.seqno = seqno
+            cmd.state_seqno = st.seqno  # a command is only used while it is this fresh
+            wire.OutValue = cmd
+            time.sleep(PERIOD)
+        assert flagged and at_speed
+        np.testing.assert_allclose(served.state().joint_velocity_command, v)
+    finally:
+        wire.Close()
+    # The stream stopped: the command goes stale and the arm brakes to rest.
+    wait_until(lambda: not np.any(served.state().joint_velocity))
+    assert not served.state().robot_state_flags & int(StateFlags.valid_velocity_command)
+
+
+def test_publisher_thread_sends_every_step_in_order(short_tmp: Path, client_node: Any) -> None:
+    # The loop only queues its snapshot; the adapter's publisher thread packs and sends it.
+    info = load_robot_info(RRP)
+    driver = SimRobot(info, update_period=PERIOD)
+    server = RobotServer(
+        driver, info, ServeOptions(port=0, state_dir=short_tmp / "rr"), start_loop=False
+    )
+    with server:
+        service = server.service
+        assert service is not None and service.publisher_thread.is_alive()
+        robot = client_node.ConnectService(server.url)
+        try:
+            wire = robot.robot_state.Connect()
+            seqnos: list[int] = []
+            wire.WireValueChanged += lambda _w, value, _ts: seqnos.append(int(value.seqno))
+            try:
+                for _ in range(20):
+                    driver.step()  # stepped here: no loop thread
+                wait_until(lambda: service.published == 20)
+                wait_until(lambda: bool(seqnos) and seqnos[-1] == driver.robot_state.seqno)
+            finally:
+                wire.Close()
+            assert seqnos == sorted(seqnos)
+            assert service.publish_dropped == 0 and service.publish_errors == 0
+        finally:
+            client_node.DisconnectService(robot)
+    assert not service.publisher_thread.is_alive()  # stopped with the server
+
+
+def _own_sockets(kind: str) -> list[tuple[str, int]]:
+    """(local address in /proc hex, port) of this process's ``tcp`` or ``udp`` sockets."""
+    inodes = set()
+    for fd in os.listdir("/proc/self/fd"):
+        try:
+            target = os.readlink(f"/proc/self/fd/{fd}")
+        except OSError:
+            continue
+        if target.startswith("socket:["):
+            inodes.add(target[8:-1])
+    out = []
+    for table in (Path(f"/proc/net/{kind}"), Path(f"/proc/net/{kind}6")):
+        if not table.exists():
+            continue
+        for line in table.read_text().splitlines()[1:]:
+            fields = line.split()
+            if fields[9] in inodes:
+                addr, port = fields[1].split(":")
+                out.append((addr, int(port, 16)))
+    return out
+
+
+def _listen_addresses(port: int) -> set[str]:
+    return {a for a, p in _own_sockets("tcp") if p == port}
+
+
+def test_loopback_only_without_public_and_discoverable_with_it(
+    short_tmp: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import RobotRaconteur as RR  # noqa: N814
+
+    calls: list[str] = []
+    for name in ("EnableNodeAnnounce", "EnableNodeDiscoveryListening"):
+        original = getattr(RR.TcpTransport, name)
+
+        def spy(self: Any, *args: Any, _name: str = name, _original: Any = original) -> Any:
+            calls.append(_name)
+            return _original(self, *args)
+
+        monkeypatch.setattr(RR.TcpTransport, name, spy)
+    loopback = {"0100007F", "00000000000000000000000001000000"}  # 127.0.0.1, ::1
+    wildcard = {"00000000", "00000000000000000000000000000000"}  # 0.0.0.0, ::
+    proc_net = Path("/proc/net/tcp").exists()
+    info = load_robot_info(RRP)
+    for public in (False, True):
+        calls.clear()
+        options = ServeOptions(
+            port=0, public=public, node_name=f"arm_{public}", state_dir=short_tmp / str(public)
+        )
+        with RobotServer(SimRobot(info), info, options, start_loop=False) as server:
+            assert server._server is not None and server._server.public is public
+            addresses = _listen_addresses(server.port) if proc_net else set()
+            if public:  # every interface, announced and discovering
+                assert calls == ["EnableNodeAnnounce", "EnableNodeDiscoveryListening"]
+                assert addresses & wildcard or not proc_net, addresses
+            else:  # the default: loopback only, discovery off
+                assert calls == []
+                assert (addresses and addresses <= loopback) or not proc_net, addresses
+
+
+def test_cli_passes_public_through(
+    short_tmp: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from robotspec.service import cli as service_cli
+
+    seen: list[ServeOptions] = []
+
+    class Recording(RobotServer):
+        def __init__(self, *args: Any, **kw: Any) -> None:
+            super().__init__(*args, **kw)
+            seen.append(self.options)
+
+    monkeypatch.setattr(service_cli, "RobotServer", Recording)
+    _register()
+    for extra in ([], ["--public"]):
+        code = render.run_app(
+            app,
+            [
+                "drive",
+                "--sim",
+                str(RRP),
+                "--serve",
+                *extra,
+                "--port",
+                "0",
+                "--duration",
+                "0.2",
+                "--state-dir",
+                str(short_tmp / "cli"),
+            ],
+        )
+        assert code == 0
+    assert [o.public for o in seen] == [False, True]
+    err = capsys.readouterr().err
+    assert "on loopback only (--public to expose)" in err
+    assert "on every interface, discoverable" in err

@@ -15,11 +15,13 @@ Where the adapter deliberately differs from the reference service (the reference
 beyond what the driver already fixes: ``halt()``, ``home()``, ``operational_mode``,
 ``controller_state`` and ``current_errors`` work; ``robot_info.config_seqno`` follows tool and
 payload changes; joint units on AdvancedRobotState are meter / newton for prismatic joints; the
-state structures are built without allocation and only for wires and pipes somebody reads.
+state structures are built without allocation and only for wires and pipes somebody reads, and
+they are packed and sent by a publisher thread of the adapter's own, not by the control loop.
 """
 
 from __future__ import annotations
 
+import queue
 import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -56,6 +58,9 @@ Handler = Callable[..., None]
 CONNECTION_CHECK_STEPS = 8
 #: Streams nobody is connected to are still refreshed this often (s), for ``PeekInValue()``.
 IDLE_REFRESH_S = 0.1
+#: Steps the publisher thread may fall behind before the oldest are dropped (wires only ever
+#: carry the latest value; the sensor-data pipe loses those samples, counted).
+PUBLISH_BACKLOG = 8
 
 
 def to_rr_error(exc: BaseException) -> BaseException:
@@ -266,6 +271,15 @@ class RobotService:
         self._stream_ep = {"position": -1, "velocity": -1}
         self.publish_errors = 0
         self.last_publish_error = ""
+        #: States handed to the publisher thread, and those it dropped because it fell behind.
+        self.published = 0
+        self.publish_dropped = 0
+        self._queue: queue.SimpleQueue[RobotState | None] = queue.SimpleQueue()
+        #: The thread that packs and sends the states (its CPU time is the publishing cost).
+        self.publisher_thread = threading.Thread(
+            target=self._publisher_loop, name="robotspec-rr-publisher", daemon=True
+        )
+        self.publisher_thread.start()
         self.tool_changed = rrmod.EventHook()
         self.payload_changed = rrmod.EventHook()
         self.param_changed = rrmod.EventHook()
@@ -299,19 +313,54 @@ class RobotService:
     def close(self) -> None:
         """Stop publishing and accepting blocking calls (pending ones end with the driver)."""
         self._wires_ready = False
+        self._queue.put(None)
+        if self.publisher_thread is not threading.current_thread():
+            self.publisher_thread.join(timeout=2.0)
         self._executor.shutdown(wait=False, cancel_futures=True)
 
     # ------------------------------------------------------------------ publishing
 
     def publish(self, st: RobotState) -> None:
-        """Send one step's state to the clients (a driver state listener; never raises).
+        """Hand one step's state to the publisher thread (a driver state listener).
+
+        Why a thread of its own: Robot Raconteur packs a structure the moment it is assigned to
+        a wire, about 0.15 ms or more per structure on a small VM, most of a step's cost. The
+        control loop only queues the (immutable) snapshot; it never waits for serialisation or
+        for the network, and its timing does not depend on how many clients read.
+        """
+        if self._wires_ready:
+            self._queue.put(st)
+
+    def _publisher_loop(self) -> None:
+        """Publisher thread: send every queued state in order; wires get only the latest."""
+        q = self._queue
+        while True:
+            batch = [q.get()]
+            while True:
+                try:
+                    batch.append(q.get_nowait())
+                except queue.Empty:
+                    break
+            states = [st for st in batch if st is not None]
+            if len(states) > PUBLISH_BACKLOG:
+                self.publish_dropped += len(states) - PUBLISH_BACKLOG
+                states = states[-PUBLISH_BACKLOG:]
+            for i, st in enumerate(states):
+                self._publish_step(st, latest=i == len(states) - 1)
+            self.published += len(states)
+            if len(states) != len(batch):  # the close() sentinel
+                return
+
+    def _publish_step(self, st: RobotState, latest: bool) -> None:
+        """Send one step's state to the clients (never raises).
 
         ``robot_state`` is set every step. ``advanced_robot_state`` and ``device_clock_now`` are
         set every step while a client is connected to them, and otherwise refreshed at
         :data:`IDLE_REFRESH_S` intervals so that ``PeekInValue()`` still answers; the sensor
         data pipe is fed only while connected. Who is connected is asked every
-        :data:`CONNECTION_CHECK_STEPS` steps. Why: packing a structure is most of a step's cost
-        (about 0.15 ms each on a small VM), so only what somebody reads is packed.
+        :data:`CONNECTION_CHECK_STEPS` steps. Why: packing a structure is most of the cost, so
+        only what somebody reads is packed. When the publisher has fallen behind, wires are set
+        for the ``latest`` state only (a wire carries the latest value anyway).
         """
         if not self._wires_ready:
             return
@@ -320,29 +369,31 @@ class RobotService:
             if ds is not None:
                 ds.BeginStep()
             try:
-                self._publish(st)
+                self._publish(st, latest)
             finally:
                 if ds is not None:
                     ds.EndStep()
-        except Exception as exc:  # noqa: BLE001 - a listener must not stop the loop
+        except Exception as exc:  # noqa: BLE001 - the publisher must keep going
             # Counted and kept for diagnosis; the next step tries again.
             self.publish_errors += 1
             self.last_publish_error = f"{type(exc).__name__}: {exc}"
 
-    def _publish(self, st: RobotState) -> None:
-        self.robot_state.OutValue = self._structs.robot_state(st)
+    def _publish(self, st: RobotState, latest: bool = True) -> None:
+        if latest:
+            self.robot_state.OutValue = self._structs.robot_state(st)
         self._steps_since_check += 1
         if self._steps_since_check >= CONNECTION_CHECK_STEPS:
             self._steps_since_check = 0
             self._ars_connected = self.advanced_robot_state.ActiveWireConnectionCount > 0
             self._pipe_connected = self.robot_state_sensor_data.ActivePipeEndpointCount > 0
             self._clock_connected = self.device_clock_now.ActiveWireConnectionCount > 0
-        idle_refresh = st.ts - self._last_idle_refresh >= IDLE_REFRESH_S
+        idle_refresh = latest and st.ts - self._last_idle_refresh >= IDLE_REFRESH_S
         if idle_refresh:
             self._last_idle_refresh = st.ts
-        if self._ars_connected or self._pipe_connected or idle_refresh:
+        ars_wire = (self._ars_connected or idle_refresh) and latest
+        if ars_wire or self._pipe_connected:
             ars = self._structs.advanced_robot_state(st)
-            if self._ars_connected or idle_refresh:
+            if ars_wire:
                 self.advanced_robot_state.OutValue = ars
             if self._pipe_connected:
                 data = self._sensor_data_type()
@@ -351,7 +402,7 @@ class RobotService:
                 )
                 data.robot_state = ars
                 self.robot_state_sensor_data.AsyncSendPacket(data, _ignore)
-        if self._clock_connected or idle_refresh:
+        if (self._clock_connected or idle_refresh) and latest:
             self.device_clock_now.OutValue = self._datetime_util.FillDeviceTime(
                 self._device_info, st.seqno
             )

@@ -733,8 +733,11 @@ class RobotDriver(ABC):
         t = now - task.start_time
         measured = self._joint_position
         if task.last_setpoint is not None and measured.shape == task.last_setpoint.shape:
-            err = np.abs(measured - task.last_setpoint)
-            if any((err > self._trajectory_error_tol).tolist()):  # np.any costs ~2 us a call
+            tol = self._trajectory_error_tol
+            if any(  # plain floats: a few joints, every step
+                abs(m - s) > tol
+                for m, s in zip(measured.tolist(), task.last_setpoint.tolist(), strict=True)
+            ):
                 task.fail(OperationFailedError("Trajectory tolerance failure"))
                 self._traj_active = None
                 self._traj_failed_this_step = True
@@ -745,10 +748,9 @@ class RobotDriver(ABC):
                 self._command_mode = CommandMode.halt
                 self._prev_mode = CommandMode.halt
                 return None
-        setpoint, wp = task.interp.evaluate(t)
+        q, wp = task.interp.evaluate(t)  # a new array
         task.time = min(t, task.interp.max_time)
         task.waypoint = wp
-        q = setpoint.copy()
         task.last_setpoint = q
         self._traj_hold = q
         if t >= task.interp.max_time:

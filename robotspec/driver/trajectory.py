@@ -16,6 +16,7 @@ ends at rest.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -116,30 +117,37 @@ class TrajectoryInterpolator:
             d[1:-1] = np.where(same & np.isfinite(hm), hm, 0.0)
         self._h = h
         self._slopes = d
-        self._out = np.zeros(positions.shape[1])
+        # Plain-float copies for evaluate(), which the loop calls every step.
+        self._times_l: list[float] = times.tolist()
+        self._h_l: list[float] = h.tolist()
+        self._pos_l: list[list[float]] = positions.tolist()
+        self._slopes_l: list[list[float]] = d.tolist()
 
     def evaluate(self, t: float) -> tuple[FloatArray, int]:
-        """Position at time ``t`` (clamped to the ends) and the index of the segment's start."""
+        """Position at time ``t`` (clamped to the ends; a new array) and the segment's start.
+
+        Per joint in plain floats: on an arm's few joints that is several times faster than
+        numpy's per-call overhead; the same operations in the same order as the vector form.
+        """
         if t >= self.max_time:
-            self._out[:] = self.positions[-1]
-            return self._out, self.n_waypoints - 1
+            return self.positions[-1].copy(), self.n_waypoints - 1
         if t <= 0.0:
-            self._out[:] = self.positions[0]
-            return self._out, 0
-        k = int(np.searchsorted(self.times, t, side="right")) - 1
-        h = float(self._h[k])
-        s = (t - float(self.times[k])) / h
+            return self.positions[0].copy(), 0
+        k = bisect.bisect_right(self._times_l, t) - 1
+        h = self._h_l[k]
+        s = (t - self._times_l[k]) / h
         s2 = s * s
         s3 = s2 * s
         h00 = 2 * s3 - 3 * s2 + 1
         h10 = s3 - 2 * s2 + s
         h01 = -2 * s3 + 3 * s2
         h11 = s3 - s2
-        p0, p1 = self.positions[k], self.positions[k + 1]
-        m0, m1 = self._slopes[k], self._slopes[k + 1]
-        np.multiply(p0, h00, out=self._out)
-        self._out += h10 * h * m0 + h01 * p1 + h11 * h * m1
-        return self._out, k
+        hh10 = h10 * h
+        hh11 = h11 * h
+        p0, p1 = self._pos_l[k], self._pos_l[k + 1]
+        m0, m1 = self._slopes_l[k], self._slopes_l[k + 1]
+        out = [p0[i] * h00 + (hh10 * m0[i] + h01 * p1[i] + hh11 * m1[i]) for i in range(len(p0))]
+        return np.array(out), k
 
 
 def load_trajectory(

@@ -56,6 +56,7 @@ from __future__ import annotations
 
 import heapq
 import math
+import struct
 import threading
 from abc import ABC, abstractmethod
 from collections import deque
@@ -116,6 +117,7 @@ from robotspec.driver.state import (
     TcpPose,
     frozen_array,
     robot_state_snapshot,
+    tcp_pose_snapshot,
 )
 from robotspec.driver.trajectory import JointTrajectory, load_trajectory
 from robotspec.errors import DriverError
@@ -250,7 +252,10 @@ class RobotDriver(ABC):
         self._stream_last_seqno = -1
         self._stream_valid = StateFlags.none
         self._last_sent: FloatArray | None = None
-        self._last_sent_velocity = np.zeros(n)
+        # What _last_sent_velocity derives from, lazily (it is read only when a motion starts):
+        # the position sent the step before _last_sent, or the velocity command sent.
+        self._prev_sent: FloatArray | None = None
+        self._sent_velocity: FloatArray | None = None
         self._sent_last_step = False
         self._epoch = self._clock.now()
         self._next_deadline = self._epoch
@@ -448,19 +453,35 @@ class RobotDriver(ABC):
 
     def _record_sent(self, pos: FloatArray | None, vel: FloatArray | None) -> None:
         if pos is not None:
-            if self._last_sent is not None and self._sent_last_step:
-                self._last_sent_velocity = (pos - self._last_sent) / self._update_period
-            else:
-                self._last_sent_velocity = np.zeros(self._joint_count)
+            consecutive = self._last_sent is not None and self._sent_last_step
+            self._prev_sent = self._last_sent if consecutive else None
+            self._sent_velocity = None
             self._last_sent = pos
             self._sent_last_step = True
         elif vel is not None:
-            self._last_sent_velocity = vel
+            self._sent_velocity = vel
+            self._prev_sent = None
             self._last_sent = None
             self._sent_last_step = False
         else:
             self._sent_last_step = False
-            self._last_sent_velocity = np.zeros(self._joint_count)
+            self._sent_velocity = None
+            self._prev_sent = None
+
+    @property
+    def _last_sent_velocity(self) -> FloatArray:
+        """The velocity of the last command sent (zero when none went out last step).
+
+        The velocity command, or the difference of the last two consecutive position commands
+        over the period. Why computed on demand: only a starting jog or halt ramp reads it,
+        not every step.
+        """
+        if self._sent_velocity is not None:
+            return self._sent_velocity
+        if self._prev_sent is not None and self._last_sent is not None:
+            velocity: FloatArray = (self._last_sent - self._prev_sent) / self._update_period
+            return velocity
+        return np.zeros(self._joint_count)
 
     def _step_failed(self, now: float, exc: BaseException) -> None:
         with self._lock:
@@ -690,8 +711,8 @@ class RobotDriver(ABC):
             return self._jog_hold
         if self._jog_cartesian is not None:
             self._update_cartesian_jog(motion)
-        q = motion.step()
-        self._jog_hold = q.copy()
+        q = motion.step()  # a new array, never modified afterwards
+        self._jog_hold = q
         if motion.done:
             self._jog = None
             self._jog_cartesian = None
@@ -868,9 +889,8 @@ class RobotDriver(ABC):
             )
             # One read-only array per chain, sliced into position, orientation and twist
             # (views of a read-only buffer stay read-only): one allocation instead of three.
-            tcp = np.array((*pos, *rot_to_quat_tuple(rot), *twist))
-            tcp.flags.writeable = False
-            poses.append(TcpPose(position=tcp[0:3], orientation=tcp[3:7]))
+            tcp = np.frombuffer(_PACK_TCP(*pos, *rot_to_quat_tuple(rot), *twist))  # read-only
+            poses.append(tcp_pose_snapshot(tcp[0:3], tcp[3:7]))
             vels.append(tcp[7:13])
         self._endpoint_key = key
         self._endpoint_cache = (poses, vels)
@@ -1389,6 +1409,9 @@ class RobotDriver(ABC):
         """Signals are not implemented by the base driver."""
         raise NotImplementedDriverError("Not implemented")
 
+
+#: Position, orientation and twist of one TCP as packed bytes (a read-only array's buffer).
+_PACK_TCP = struct.Struct("13d").pack
 
 _F_ERROR = int(StateFlags.error)
 _F_ESTOP = int(StateFlags.estop)

@@ -186,3 +186,10 @@ def robot_state_snapshot(**fields: object) -> RobotState:
     state: RobotState = _new_object(RobotState)
     state.__dict__.update(fields)
     return state
+
+
+def tcp_pose_snapshot(position: FloatArray, orientation: FloatArray) -> TcpPose:
+    """A :class:`TcpPose` without the frozen-dataclass ``__init__`` (see above)."""
+    pose: TcpPose = _new_object(TcpPose)
+    pose.__dict__.update(position=position, orientation=orientation)
+    return pose

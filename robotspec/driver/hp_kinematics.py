@@ -169,8 +169,10 @@ class HPChain:
         """
         r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
         px, py, pz = self._p_list[0]
-        axes: list[tuple[float, float, float]] = []
-        origins: list[tuple[float, float, float]] = []
+        # The twist accumulates during the walk: with w = sum qd_i a_i, the TCP's linear
+        # velocity sum qd_i a_i x (p - o_i) is w x p - sum qd_i a_i x o_i (+ prismatic terms),
+        # so no second pass over stored axes and origins is needed.
+        wx = wy = wz = cx = cy = cz = lx = ly = lz = 0.0
         cos, sin = math.cos, math.sin
         for i in range(self.n):
             kind, sign = self._axis_kind[i]
@@ -185,8 +187,20 @@ class HPChain:
                 ax = r00 * hx + r01 * hy + r02 * hz
                 ay = r10 * hx + r11 * hy + r12 * hz
                 az = r20 * hx + r21 * hy + r22 * hz
-            axes.append((ax, ay, az))
-            origins.append((px, py, pz))
+            if qd is not None:
+                qdi = qd[i]
+                if qdi != 0.0:
+                    if self._pris_list[i]:
+                        lx += qdi * ax
+                        ly += qdi * ay
+                        lz += qdi * az
+                    else:
+                        wx += qdi * ax
+                        wy += qdi * ay
+                        wz += qdi * az
+                        cx += qdi * (ay * pz - az * py)
+                        cy += qdi * (az * px - ax * pz)
+                        cz += qdi * (ax * py - ay * px)
             qi = q[i]
             if self._pris_list[i]:
                 px += qi * ax
@@ -240,9 +254,11 @@ class HPChain:
                 px += r00 * bx + r01 * by + r02 * bz
                 py += r10 * bx + r11 * by + r12 * bz
                 pz += r20 * bx + r21 * by + r22 * bz
-        frames = [(self._flange_r_list, self._flange_p_list)]
+        frames: tuple[tuple[Sequence[float], Sequence[float]], ...] = (
+            (self._flange_r_list, self._flange_p_list),
+        )
         if tool_rotation is not None and tool_position is not None:
-            frames.append((tuple(tool_rotation), tuple(tool_position)))
+            frames += ((tool_rotation, tool_position),)
         for fr, fp in frames:
             bx, by, bz = fp
             px += r00 * bx + r01 * by + r02 * bz
@@ -260,26 +276,9 @@ class HPChain:
                 r20 * a01 + r21 * a11 + r22 * a21,
                 r20 * a02 + r21 * a12 + r22 * a22,
             )
-        wx = wy = wz = vx = vy = vz = 0.0
-        if qd is not None:
-            for i in range(self.n):
-                qdi = qd[i]
-                if qdi == 0.0:
-                    continue
-                ax, ay, az = axes[i]
-                if self._pris_list[i]:
-                    vx += qdi * ax
-                    vy += qdi * ay
-                    vz += qdi * az
-                    continue
-                ox, oy, oz = origins[i]
-                dx, dy, dz = px - ox, py - oy, pz - oz
-                wx += qdi * ax
-                wy += qdi * ay
-                wz += qdi * az
-                vx += qdi * (ay * dz - az * dy)
-                vy += qdi * (az * dx - ax * dz)
-                vz += qdi * (ax * dy - ay * dx)
+        vx = wy * pz - wz * py - cx + lx
+        vy = wz * px - wx * pz - cy + ly
+        vz = wx * py - wy * px - cz + lz
         rot = (r00, r01, r02, r10, r11, r12, r20, r21, r22)
         return rot, (px, py, pz), (wx, wy, wz, vx, vy, vz)
 

@@ -360,7 +360,8 @@ class RobotService:
         data pipe is fed only while connected. Who is connected is asked every
         :data:`CONNECTION_CHECK_STEPS` steps. Why: packing a structure is most of the cost, so
         only what somebody reads is packed. When the publisher has fallen behind, wires are set
-        for the ``latest`` state only (a wire carries the latest value anyway).
+        for the ``latest`` state only (a wire carries the latest value anyway), unless a client
+        asked for downsampling.
         """
         if not self._wires_ready:
             return
@@ -369,7 +370,9 @@ class RobotService:
             if ds is not None:
                 ds.BeginStep()
             try:
-                self._publish(st, latest)
+                # With a downsampler every step counts (each client gets every n-th): none of
+                # the wires may be skipped then.
+                self._publish(st, latest or ds is not None)
             finally:
                 if ds is not None:
                     ds.EndStep()

@@ -237,8 +237,6 @@ class PackageResolver:
             environ: The environment to read instead of ``os.environ`` (tests, servers).
             share_crawls_with: A resolver of the same compilation whose folder crawls this
                 one reuses (and adds to): parts of a composed robot search the same folders.
-            share_crawls_with: A resolver of the same compilation whose folder crawls this
-                one reuses (and adds to): parts of a composed robot search the same folders.
         """
         env = os.environ if environ is None else environ
         folders: list[Path] = [Path(p).absolute() for p in extra_paths]

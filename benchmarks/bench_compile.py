@@ -23,19 +23,25 @@ import io
 import pstats
 import statistics
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 
-def median_time(fn: Callable[[], object], repeat: int) -> float:
-    """Median wall time of ``repeat`` calls (seconds), after one warm-up call."""
-    fn()
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
+def median_times(fns: Sequence[Callable[[], object]], repeat: int) -> list[float]:
+    """Median wall time (seconds) of each function over ``repeat`` rounds, after a warm-up.
+
+    Why rounds: the functions take turns (one call each per round), so a slow spell of this
+    shared machine hits both sides of a ratio alike instead of one side's whole series.
+    """
+    for fn in fns:
         fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for fn, out in zip(fns, times, strict=True):
+            t = time.perf_counter()
+            fn()
+            out.append(time.perf_counter() - t)
+    return [statistics.median(t) for t in times]
 
 
 def main() -> None:
@@ -81,8 +87,7 @@ def main() -> None:
         f"pinocchio: {model.njoints} joints, {geom.ngeoms} collision geometries, "
         f"{len(geom.collisionPairs)} collision pairs after the SRDF"
     )
-    t_ours = median_time(ours, args.repeat)
-    t_pin = median_time(pinocchio, args.repeat)
+    t_ours, t_pin = median_times([ours, pinocchio], args.repeat)
     print(f"{'robotspec compile_robot(pr2)':<40}{t_ours * 1e3:9.1f} ms")
     print(f"{'pinocchio model+geom+SRDF pairs':<40}{t_pin * 1e3:9.1f} ms")
     ratio = t_pin / t_ours
@@ -112,8 +117,7 @@ def main() -> None:
         pin.removeCollisionPairs(model, geom, str(folder / "b1.srdf"))
         return model, geom
 
-    t_comp = median_time(composed, args.repeat)
-    t_pin_joined = median_time(pin_joined, args.repeat)
+    t_comp, t_pin_joined = median_times([composed, pin_joined], args.repeat)
     print(f"{'robotspec compile_robot(b1_ur5_allegro)':<40}{t_comp * 1e3:9.1f} ms")
     print(f"{'pinocchio, the exported joined files':<40}{t_pin_joined * 1e3:9.1f} ms")
     ratio = t_pin_joined / t_comp

@@ -172,6 +172,11 @@ def _walk_up(description_folder: Path) -> tuple[list[Path], list[Path]]:
     return search, roots
 
 
+def _has_dotdot(path: str) -> bool:
+    """Whether a path has a '..' component (as ``".." in Path(path).parts``, without pathlib)."""
+    return ".." in path.split(os.sep)
+
+
 def _unique(paths: Iterable[Path]) -> tuple[Path, ...]:
     return tuple(dict.fromkeys(paths))
 
@@ -205,6 +210,8 @@ class PackageResolver:
     )
     _real_roots: list[Path] = field(default_factory=list, compare=False, repr=False)
     _real_dirs: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
+    #: (root, root + separator) of each resolved root, for prefix tests on path strings.
+    _root_prefixes: list[tuple[str, str]] = field(default_factory=list, compare=False, repr=False)
     _resolved: dict[tuple[str, str], Path] = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
@@ -362,9 +369,10 @@ class PackageResolver:
         path again costs more than parsing the URDF. Only the last component is checked per file
         (a symlinked mesh is still followed).
         """
-        text = os.path.abspath(path)  # abspath normalizes '..' lexically: check the raw path
-        if ".." in Path(path).parts or ".." in Path(text).parts:
-            return Path(os.path.realpath(path))  # the OS follows a symlink before '..'
+        raw = os.fspath(path)
+        text = os.path.abspath(raw)  # abspath normalizes '..' lexically: check the raw path
+        if _has_dotdot(raw):
+            return Path(os.path.realpath(raw))  # the OS follows a symlink before '..'
         parent, name = os.path.split(text)
         if not name or os.path.islink(text):
             return Path(os.path.realpath(text))
@@ -375,7 +383,12 @@ class PackageResolver:
         return Path(real_parent, name)
 
     def _inside(self, real: Path) -> bool:
-        return any(real == r or real.is_relative_to(r) for r in self._resolved_roots())
+        text = str(real)
+        if not self._root_prefixes:
+            for r in self._resolved_roots():
+                root = str(r)
+                self._root_prefixes.append((root, root.rstrip(os.sep) + os.sep))
+        return any(text == root or text.startswith(prefix) for root, prefix in self._root_prefixes)
 
     def is_allowed(self, path: str | Path) -> bool:
         """Whether ``path``, symlinks followed, lies inside one of the allowed roots."""

@@ -131,7 +131,15 @@ def test_planar_and_floating_base(pr2) -> None:
             c, s = np.cos(0.9), np.sin(0.9)
             np.testing.assert_allclose(base[:3, 3], [0.3, 0.6, 0.0], atol=1e-12)
             np.testing.assert_allclose(base[:2, :2], [[c, -s], [s, c]], atol=1e-12)
+        else:
+            from robotspec.geometry import pose_from_xyz_rpy
+
+            x, y, z, roll, pitch, yaw = q[:6]
+            expected = pose_from_xyz_rpy((x, y, z), (roll, pitch, yaw))
+            np.testing.assert_allclose(base, expected, atol=1e-12)
         chain = k.chain("odom", "r_gripper_tool_frame")
+        # The chain class composes the base motion elementary motion by elementary motion.
+        np.testing.assert_allclose(chain.fk(q), k.pose(q, "r_gripper_tool_frame"), atol=1e-12)
         np.testing.assert_allclose(chain.jacobian(q), _numeric_jacobian(chain, q), atol=2e-5)
         np.testing.assert_allclose(k.forward_batch(np.stack([q] * 20))[5], k.forward(q), atol=1e-12)
 

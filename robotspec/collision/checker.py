@@ -12,7 +12,7 @@ Everything is built on the first query (meshes read once), so constructing a che
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -42,6 +42,8 @@ Bools = NDArray[np.bool_]
 
 #: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).
 _BLOCK = 512
+#: Below this many box-overlapping pairs, the oriented-box test is skipped (see _candidates).
+_SAT_MIN = 48
 
 
 @dataclass(frozen=True)
@@ -73,6 +75,18 @@ class _Compiled:
     pair_of: I64  # (Q,) index of the body pair each geometry pair belongs to
     collide: tuple[Any, ...]  # coal.ComputeCollision per geometry pair
     transforms: tuple[Any, ...]  # one reusable coal.Transform3s per geometry
+
+    # Python lists for the per-pair loop (indexing a list is several times cheaper).
+    pair_geom1_list: list[int] = field(init=False)
+    pair_geom2_list: list[int] = field(init=False)
+    pair_of_list: list[int] = field(init=False)
+    pair_index_list: list[int] = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "pair_geom1_list", self.pair_geom1.tolist())
+        object.__setattr__(self, "pair_geom2_list", self.pair_geom2.tolist())
+        object.__setattr__(self, "pair_of_list", self.pair_of.tolist())
+        object.__setattr__(self, "pair_index_list", list(range(len(self.pair_of))))
 
 
 class SelfCollisionChecker:
@@ -242,7 +256,9 @@ class SelfCollisionChecker:
             ok &= lo[:, g1] <= hi[:, g2]
             ok &= lo[:, g2] <= hi[:, g1]
         rows, ks = np.nonzero(ok)
-        if not len(rows):
+        if len(rows) < _SAT_MIN:
+            # A hundred array operations cost more than coal's own bounding-volume test on a
+            # few pairs (one configuration): leave those to the narrow phase.
             return rows, ks, centers
         i, j = g1[ks], g2[ks]
         # Oriented boxes A (geometry i) and B (geometry j), B expressed in A's frame.
@@ -300,8 +316,10 @@ class SelfCollisionChecker:
         cols: I64 | None = None
         if pair_mask is not None:
             cols = np.flatnonzero(pair_mask[c.pair_of])
-        owner = (c.pair_of if cols is None else c.pair_of[cols]).tolist()
-        q_index = (np.arange(len(c.pair_of)) if cols is None else cols).tolist()
+        if cols is None:
+            owner, q_index = c.pair_of_list, c.pair_index_list
+        else:
+            owner, q_index = c.pair_of[cols].tolist(), cols.tolist()
         req = coal.CollisionRequest()
         req.security_margin = margin
         res = coal.CollisionResult()
@@ -309,7 +327,7 @@ class SelfCollisionChecker:
         found = [False] * len(self._pairs)
         tf = c.transforms
         fns = c.collide
-        g1s, g2s = c.pair_geom1.tolist(), c.pair_geom2.tolist()
+        g1s, g2s = c.pair_geom1_list, c.pair_geom2_list
         hit_rows: list[int] = []
         hit_pairs: list[int] = []
         for start in range(0, n, _BLOCK):

@@ -2,7 +2,7 @@
 
 The subpackage follows the contract of ``robotraconteur_abstract_robot.AbstractRobot`` (the seed
 document) and the behaviour recorded in the reference note, with the reference's defects fixed (see
-:mod:`robotspec.driver.loop` and ``docs/driver.md``). Modules, one job each:
+:mod:`robotspec.driver.robot_driver` and ``docs/driver.md``). Modules, one job each:
 
 * :mod:`~robotspec.driver.robot_info` -- the RobotInfo YAML as validated, located models;
 * :mod:`~robotspec.driver.state` -- command modes, state flags and frozen state snapshots;
@@ -11,7 +11,8 @@ document) and the behaviour recorded in the reference note, with the reference's
 * :mod:`~robotspec.driver.trajectory` -- joint trajectory checks and interpolation;
 * :mod:`~robotspec.driver.hp_kinematics` -- forward kinematics and Jacobians of H/P chains;
 * :mod:`~robotspec.driver.clock` -- real and simulated clocks;
-* :mod:`~robotspec.driver.loop` -- the driver base class and its timestep pipeline;
+* :mod:`~robotspec.driver.loop` -- the timestep pipeline and state machine;
+* :mod:`~robotspec.driver.robot_driver` -- the driver base class: the seed's client API;
 * :mod:`~robotspec.driver.sim` -- the simulated robot with injectable faults;
 * :mod:`~robotspec.driver.script` -- YAML scenarios of client calls with expected outcomes.
 

@@ -22,7 +22,7 @@ from robotspec.driver.trajectory import TrajectoryInterpolator
 from robotspec.errors import DriverError
 
 if TYPE_CHECKING:
-    from robotspec.driver.loop import RobotDriver
+    from robotspec.driver.robot_driver import RobotDriver
 
 __all__ = ["Completion", "RobotJointCommand", "TrajectoryGenerator", "TrajectoryStatus"]
 

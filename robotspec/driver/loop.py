@@ -1,55 +1,19 @@
-"""The driver base class: the seed's members, its timestep pipeline and its state machine.
+"""The driver's real-time machinery: its timestep pipeline and its state machine.
 
-:class:`RobotDriver` follows ``robotraconteur_abstract_robot.AbstractRobot`` 0.2.2 (the seed
-document is the contract; the reference note records its behaviour). Each timestep runs, in order:
-feedback (``_read_feedback``, the subclass), communication check, robot state check, command fill,
-the command guard, state fill, and ``_send_robot_command`` (the subclass). The state machine is the
-reference's (§1.2 of the note), rule for rule.
+:class:`DriverLoop`, the base of :class:`~robotspec.driver.robot_driver.RobotDriver`, follows
+``robotraconteur_abstract_robot.AbstractRobot`` 0.2.2 (the seed document is the contract; the
+reference note records its behaviour). Each timestep runs, in order: feedback
+(``_read_feedback``, the subclass), communication check, robot state check, command fill, the
+command guard, state fill, and ``_send_robot_command`` (the subclass). The state machine is the
+reference's (§1.2 of the note), rule for rule; its deliberate deviations are listed in
+:mod:`robotspec.driver.robot_driver`.
 
 Time comes from a :class:`~robotspec.driver.clock.Clock`. With a simulated clock and no loop
 thread, blocking calls (a ``wait=True`` jog, a trajectory ``Next()``) step the loop themselves
 until they finish, so tests run deterministically in simulated time with no sleeping.
 
-Deliberate deviations from the reference (its defects, §1.11 of the note), each tested:
-
-1. An exception inside a step never kills the loop: the driver enters ``invalid_state`` with the
-   message in ``current_errors`` and the ``error`` flag, keeps publishing, and recovers after
-   ``reset_errors()`` or ``command_mode = halt``.
-2. ``halt()``, ``home()``, and the ``operational_mode``, ``controller_state`` and
-   ``current_errors`` properties work.
-3. Limits: ``jog_joint`` checks ``|velocity|`` (both signs) against the limit of the operational
-   mode; ``jog_freespace`` refuses targets outside the joint limits; jogs brake before a joint
-   limit; the position stream is clamped to the limits; every command passes
-   :class:`~robotspec.driver.commands.CommandGuard`. NaN and infinity are refused everywhere.
-   A speed ratio above 1 never raises jog speed or acceleration beyond the joint limits.
-4. Trajectories: the final waypoint is commanded exactly; a tracking failure fails the task with
-   OperationFailed, clears ``trajectory_running``, cancels the queue and drops to ``halt``;
-   ``running`` status reports the real trajectory time and waypoint; each outcome is delivered
-   once; a queued task cancelled before it starts raises OperationAborted "Trajectory cancelled
-   by controller before start" from ``Next()``; ``Close()`` on a finished task is a no-op; the
-   100 ms gap rule uses the unscaled times; messages carry the waypoint index; the tracking check
-   compares the measured position with the setpoint sent the step before (not the new one, which
-   tripped at high speed).
-5. Messages: "Robot must be in trajectory mode to execute trajectory"; "Position command must be
-   within 1000 degrees from current position".
-6. Tools: ``tool_detached`` accepts the attached tool's name (or ""); tools and payloads work on
-   every chain; ``robot_info.config_seqno`` follows the attachments.
-7. A waiting jog interrupted by halt, an error, an e-stop or lost communication raises
-   OperationAborted instead of returning success; ``Abort()`` takes the lock; leaving a motion
-   mode for ``halt`` brakes at the acceleration limits instead of stopping dead.
-8. Capabilities are checked: ``trajectory_command`` for trajectory mode (also on the homing route
-   out of ``invalid_state``), ``software_enable`` for ``enable()``/``disable()``,
-   ``software_reset_errors`` for ``reset_errors()`` (a driver-internal fault can always be reset).
-   ``speed_ratio`` and ``trajectory_queueing`` are *not* enforced: none of the real RobotInfo
-   files declares them, yet every reference driver honours both.
-9. ``velocity_command`` mode works (the reference's loop thread dies on the first command); it
-   scales by the speed ratio and sets ``valid_velocity_command``.
-10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares).
-11. The simulated robot (:class:`~robotspec.driver.sim.SimRobot`) has a command watchdog, like a
-    real controller: when the driver sends no command for ``command_timeout`` (default 0.1 s; the
-    driver stops sending once feedback is lost), the arm drops its last command and brakes to
-    rest at its acceleration limits. The reference's simulated robot keeps following its last
-    velocity command until a joint limit.
+The client API (the seed's public members) is :class:`~robotspec.driver.robot_driver.RobotDriver`,
+a subclass; this module is the machinery it drives.
 """
 
 from __future__ import annotations
@@ -61,7 +25,6 @@ import threading
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -70,18 +33,13 @@ from robotspec.driver.clock import Clock, RealClock
 from robotspec.driver.commands import (
     CommandGuard,
     JointLimitArrays,
-    check_speed_ratio,
-    finite_scalar,
-    joint_array,
 )
 from robotspec.driver.conversions import (
     POSITION_UNITS,
     VELOCITY_UNITS,
     as_lists,
     convert_command,
-    parse_mode,
     tool_transform,
-    twist_vector,
 )
 from robotspec.driver.errors import (
     InvalidArgumentError,
@@ -100,7 +58,6 @@ from robotspec.driver.handles import (
 from robotspec.driver.hp_kinematics import HPChain, quat_to_rot, rot_to_quat_tuple
 from robotspec.driver.profiles import JogMotion
 from robotspec.driver.robot_info import (
-    DeviceInfo,
     PayloadInfo,
     Pose,
     RobotCapability,
@@ -119,12 +76,11 @@ from robotspec.driver.state import (
     robot_state_snapshot,
     tcp_pose_snapshot,
 )
-from robotspec.driver.trajectory import JointTrajectory, load_trajectory
 from robotspec.errors import DriverError
 
 __all__ = [
     "Completion",
-    "RobotDriver",
+    "DriverLoop",
     "RobotJointCommand",
     "TrajectoryGenerator",
     "TrajectoryStatus",
@@ -138,8 +94,8 @@ STREAM_STALE_SEQNOS = 10
 MAX_WAIT_S = 3600.0
 
 
-class RobotDriver(ABC):
-    """Base class of robot drivers (the seed's ``AbstractRobot``), with its real-time loop.
+class DriverLoop(ABC):
+    """The real-time loop of a robot driver: state, timestep pipeline, state machine.
 
     A subclass fills feedback in :meth:`_read_feedback` and implements
     :meth:`_send_robot_command`, :meth:`_send_enable`, :meth:`_send_disable` and
@@ -946,204 +902,6 @@ class RobotDriver(ABC):
             error_message=self._fault_message,
         )
 
-    # ------------------------------------------------------------------ client API: modes
-
-    @property
-    def robot_state(self) -> RobotState:
-        """The state published by the last step."""
-        return self._state
-
-    @property
-    def command_mode(self) -> CommandMode:
-        """The current command mode."""
-        return self._command_mode
-
-    @command_mode.setter
-    def command_mode(self, value: CommandMode | int | str) -> None:
-        self.set_command_mode(value)
-
-    def set_command_mode(self, value: CommandMode | int | str) -> None:
-        """Request a command mode; the reference's checks, in its order (note §1.2)."""
-        mode = parse_mode(value)
-        with self._lock:
-            current = self._command_mode
-            comm_ok = not self._communication_failure
-            error = self._error or bool(self._fault_message)
-            if mode is CommandMode.halt and self._fault_message and not self._error:
-                # A driver-internal fault is cleared by switching to halt (escalation level 1).
-                self._fault_message = ""
-                self._command_mode = CommandMode.halt
-                return
-            if current is CommandMode.invalid_state:
-                if mode is CommandMode.homing:
-                    if self._enabled and comm_ok and self._uses_homing:
-                        self._command_mode = mode
-                        return
-                    raise InvalidOperationError("Cannot set homing command mode in current state")
-                if mode is CommandMode.halt and self._enabled and not error and comm_ok:
-                    self._command_mode = mode
-                    return
-            if not comm_ok:
-                raise InvalidOperationError("Cannot set robot command mode in current state")
-            if not self._ready and mode is not CommandMode.halt:
-                if not (mode is CommandMode.homing and self._enabled and not error):
-                    raise InvalidOperationError("Cannot set robot command mode in current state")
-            if current is not CommandMode.halt and mode is not CommandMode.halt:
-                raise InvalidOperationError('Must switch to "halt" before selecting new mode')
-            if mode is CommandMode.jog:
-                if not self._has_jog_command:
-                    raise InvalidOperationError("Robot does not support jog command mode")
-                self._jog = None
-            elif mode is CommandMode.trajectory:
-                if not self._has_trajectory_command:
-                    raise InvalidOperationError("Robot does not support trajectory command mode")
-            elif mode is CommandMode.position_command:
-                if not self._has_position_command:
-                    raise InvalidOperationError("Robot does not support position command mode")
-            elif mode is CommandMode.velocity_command:
-                if not self._has_velocity_command:
-                    raise InvalidOperationError("Robot does not support velocity command mode")
-            elif mode is CommandMode.homing:
-                if not self._uses_homing:
-                    raise InvalidOperationError("Robot does not support homing command mode")
-            elif mode is not CommandMode.halt:
-                raise InvalidOperationError("Invalid command mode specified")
-            self._command_mode = mode
-
-    def halt(self) -> None:
-        """Stop motion: command mode ``halt`` (the reference lacks this robdef function)."""
-        self.set_command_mode(CommandMode.halt)
-
-    @property
-    def operational_mode(self) -> OperationalMode:
-        """The controller's operational mode."""
-        return self._operational_mode
-
-    @property
-    def controller_state(self) -> ControllerState:
-        """The controller's state."""
-        return self._controller_state
-
-    @property
-    def current_errors(self) -> tuple[str, ...]:
-        """Human-readable current errors (empty when healthy)."""
-        out: list[str] = []
-        if self._communication_failure:
-            out.append("communication failure")
-        if self._fault_message:
-            out.append(self._fault_message)
-        if self._error:
-            out.append("robot error")
-        if self._stopped:
-            out.append("emergency stop")
-        return tuple(out)
-
-    @property
-    def speed_ratio(self) -> float:
-        """The speed ratio in [0.1, 10]."""
-        return self._speed_ratio
-
-    @speed_ratio.setter
-    def speed_ratio(self, value: float) -> None:
-        self._speed_ratio = check_speed_ratio(value)
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """Joint names in global order."""
-        return self._joint_names
-
-    @property
-    def limits(self) -> JointLimitArrays:
-        """Joint limits as arrays."""
-        return self._limits
-
-    @property
-    def update_period(self) -> float:
-        """The loop period in seconds."""
-        return self._update_period
-
-    @property
-    def isoch_info(self) -> dict[str, float]:
-        """``IsochInfo``: update rate, max downsample and epoch."""
-        return {
-            "update_rate": 1.0 / self._update_period,
-            "max_downsample": 1000.0,
-            "isoch_epoch": self._epoch,
-        }
-
-    @property
-    def robot_info(self) -> RobotInfo:
-        """The RobotInfo with current tools and payloads and the live ``config_seqno``."""
-        with self._lock:
-            chains = tuple(
-                c.model_copy(
-                    update={
-                        "current_tool": self._current_tool[i],
-                        "current_payload": self._current_payload[i],
-                    }
-                )
-                for i, c in enumerate(self._robot_info.chains)
-            )
-            return self._robot_info.model_copy(
-                update={"chains": chains, "config_seqno": self._config_seqno}
-            )
-
-    @property
-    def device_info(self) -> DeviceInfo:
-        """The RobotInfo's DeviceInfo."""
-        return self._robot_info.device_info
-
-    # ------------------------------------------------------------------ enable, errors, homing
-
-    def enable(self) -> None:
-        """Enable the drives (needs ``software_enable``)."""
-        if not self._robot_info.has(RobotCapability.software_enable):
-            raise InvalidOperationError("Robot does not support software enable")
-        self._send_enable()
-
-    def disable(self) -> None:
-        """Disable the drives (needs ``software_enable``)."""
-        if not self._robot_info.has(RobotCapability.software_enable):
-            raise InvalidOperationError("Robot does not support software enable")
-        self._send_disable()
-
-    def reset_errors(self) -> None:
-        """Clear a driver fault, and the robot's errors (needs ``software_reset_errors``)."""
-        with self._lock:
-            had_fault = bool(self._fault_message)
-            self._fault_message = ""
-        if self._robot_info.has(RobotCapability.software_reset_errors):
-            self._send_reset_errors()
-        elif not had_fault:
-            raise InvalidOperationError("Robot does not support software reset errors")
-
-    def home(self, wait: bool = True) -> Completion:
-        """Home the robot (mode ``homing``); with ``wait`` return when homed."""
-        with self._lock:
-            if self._command_mode is not CommandMode.homing:
-                raise InvalidOperationError("Robot must be in homing command mode to home")
-            if self._homing is not None:
-                raise InvalidOperationError("Homing already in progress")
-            completion = Completion()
-            self._homing = completion
-            self._start_homing(completion)
-        if wait:
-            self._wait_completion(completion)
-        return completion
-
-    def _homing_finished(self, success: bool, message: str = "") -> None:
-        """Called by the subclass when homing ends."""
-        with self._lock:
-            if self._homing is None:
-                return
-            if success:
-                self._homing.succeed()
-            else:
-                self._homing.fail(OperationFailedError(message or "Homing failed"))
-            self._homing = None
-
-    # ------------------------------------------------------------------ jogging
-
     def _jog_limits(self) -> tuple[FloatArray, FloatArray]:
         op = self._operational_mode
         if op is OperationalMode.manual_reduced_speed:
@@ -1151,263 +909,6 @@ class RobotDriver(ABC):
         if op in (OperationalMode.manual_full_speed, OperationalMode.cobot):
             return self._limits.velocity, self._limits.acceleration
         raise InvalidOperationError("Invalid operation mode for jog")
-
-    def _jog_preamble(self, not_ready: type[DriverError]) -> None:
-        if self._command_mode is not CommandMode.jog:
-            raise InvalidOperationError("Robot not in jog mode")
-        if not self._ready or self._communication_failure:
-            raise not_ready("Robot not ready")
-
-    def _install_jog(self, motion: JogMotion, wait: bool) -> Completion | None:
-        if self._jog_waiter is not None:
-            self._jog_waiter.fail(OperationAbortedError("Operation interrupted by new jog command"))
-        self._jog = motion
-        waiter = Completion() if wait else None
-        self._jog_waiter = waiter
-        return waiter
-
-    def jog_freespace(self, joint_position: Any, max_velocity: Any, wait: bool = False) -> None:
-        """Jog to ``joint_position`` (rad/m) at up to ``max_velocity``; ``wait`` for arrival."""
-        n = self._joint_count
-        with self._lock:
-            self._jog_preamble(InvalidOperationError)
-            target = joint_array("joint_position", joint_position, n)
-            vmax = joint_array("max_velocity", max_velocity, n)
-            if np.any(vmax <= 0.0):
-                raise InvalidArgumentError("max_velocity must be greater than zero")
-            vlim, alim = self._jog_limits()
-            for i in range(n):
-                if vmax[i] > vlim[i]:
-                    raise InvalidArgumentError(
-                        f"max_velocity[{i}] is greater than joint limits ({vlim[i]:.4g})"
-                    )
-            measured = self._joint_position
-            if np.any(np.abs(target - measured) > self._jog_joint_limit):
-                raise InvalidArgumentError(
-                    "Position command must be within "
-                    f"{math.degrees(self._jog_joint_limit):.0f} degrees from current position"
-                )
-            lo, hi = self._limits.lower, self._limits.upper
-            for i in range(n):
-                if not lo[i] <= target[i] <= hi[i]:
-                    raise InvalidArgumentError(
-                        f"joint_position[{i}] = {target[i]:.4g} is outside the joint limits "
-                        f"[{lo[i]:.4g}, {hi[i]:.4g}]"
-                    )
-            ratio = self._speed_ratio
-            existing = self._jog
-            if existing is None:
-                q0, v0 = self._start_point()
-                motion = self._new_motion(q0, v0)
-            else:
-                motion = existing
-            motion.vmax = np.minimum(vmax * ratio, vlim)
-            motion.amax = np.minimum(alim * ratio, alim)
-            motion.to_position(target, synchronize=existing is None)
-            self._jog_cartesian = None
-            waiter = self._install_jog(motion, wait)
-        if waiter is not None:
-            self._wait_completion(waiter)
-
-    def jog_joint(self, joint_velocity: Any, timeout: float, wait: bool = False) -> None:
-        """Jog at ``joint_velocity`` for ``timeout`` seconds, then stop; ``wait`` for the stop."""
-        n = self._joint_count
-        with self._lock:
-            self._jog_preamble(OperationAbortedError)
-            qd = joint_array("joint_velocity", joint_velocity, n)
-            t = finite_scalar("timeout", timeout)
-            if t <= 0.0:
-                raise InvalidArgumentError("Invalid jog timeout specified")
-            vlim, alim = self._jog_limits()
-            if np.any(np.abs(qd) > vlim):
-                raise InvalidArgumentError("Joint velocity exceeds joint limits")
-            waiter = self._velocity_jog(qd, t, wait, vlim, alim)
-        if waiter is not None:
-            self._wait_completion(waiter)
-
-    def _velocity_jog(
-        self, qd: FloatArray, timeout: float, wait: bool, vlim: FloatArray, alim: FloatArray
-    ) -> Completion | None:
-        existing = self._jog
-        if existing is None:
-            q0, v0 = self._start_point()
-            motion = self._new_motion(q0, v0)
-        else:
-            motion = existing
-        motion.vmax = vlim.copy()
-        motion.amax = np.minimum(alim * self._speed_ratio, alim)
-        motion.t = 0.0
-        motion.at_velocity(qd, timeout)
-        return self._install_jog(motion, wait)
-
-    def jog_cartesian(
-        self, velocity: Any, timeout: float, wait: bool = False, chain: int = 0
-    ) -> None:
-        """Jog a chain's TCP at spatial ``velocity`` ``[wx, wy, wz, vx, vy, vz]`` (base frame).
-
-        The joint velocities come from the chain's Jacobian (damped least squares), scaled down
-        together when one would exceed its limit, recomputed every step.
-        """
-        with self._lock:
-            self._jog_preamble(OperationAbortedError)
-            twist = joint_array("velocity", twist_vector(velocity), 6)
-            t = finite_scalar("timeout", timeout)
-            if t <= 0.0:
-                raise InvalidArgumentError("Invalid jog timeout specified")
-            self._check_chain(chain, "jog")
-            vlim, alim = self._jog_limits()
-            waiter = self._velocity_jog(np.zeros(self._joint_count), t, wait, vlim, alim)
-            self._jog_cartesian = (chain, twist)
-        if waiter is not None:
-            self._wait_completion(waiter)
-
-    # ------------------------------------------------------------------ trajectories
-
-    def execute_trajectory(self, trajectory: JointTrajectory) -> TrajectoryGenerator:
-        """Check and queue a trajectory; drive it by calling ``Next()`` on the generator."""
-        with self._lock:
-            interp = load_trajectory(trajectory, self._joint_names, self._limits, self._speed_ratio)
-            measured = self._joint_position
-            if measured.shape[0] != self._joint_count or np.any(
-                np.abs(measured - interp.positions[0]) > self._trajectory_error_tol
-            ):
-                raise InvalidArgumentError("Starting waypoint too far from current joint positions")
-            if self._command_mode is not CommandMode.trajectory:
-                raise InvalidOperationError(
-                    "Robot must be in trajectory mode to execute trajectory"
-                )
-            task = TrajectoryTask(interp)
-            if self._traj_active is None:
-                self._traj_active = task
-            else:
-                self._traj_queue.append(task)
-            return TrajectoryGenerator(self, task)
-
-    def _abort_trajectory(self, task: TrajectoryTask) -> None:
-        """Abort: drop to ``halt`` (which ends every trajectory on the next step)."""
-        with self._lock:
-            if self._command_mode is CommandMode.trajectory:
-                self._command_mode = CommandMode.halt
-            if self._traj_active is task:
-                self._traj_active = None
-            if task in self._traj_queue:
-                self._traj_queue.remove(task)
-
-    def _cancel_trajectory(self, task: TrajectoryTask) -> None:
-        """Close: remove one task; closing the active one cancels the queue too."""
-        with self._lock:
-            if self._traj_active is task:
-                self._traj_active = None
-                while self._traj_queue:
-                    self._traj_queue.popleft().fail(
-                        OperationAbortedError("Trajectory cancelled by controller before start")
-                    )
-            elif task in self._traj_queue:
-                self._traj_queue.remove(task)
-
-    # ------------------------------------------------------------------ streaming
-
-    def set_position_command(self, command: RobotJointCommand) -> None:
-        """Write the position-command wire (used in ``position_command`` mode only)."""
-        with self._lock:
-            if self._command_mode is CommandMode.position_command:
-                self._stream_position = command
-
-    def set_velocity_command(self, command: RobotJointCommand) -> None:
-        """Write the velocity-command wire (used in ``velocity_command`` mode only)."""
-        with self._lock:
-            if self._command_mode is CommandMode.velocity_command:
-                self._stream_velocity = command
-
-    # ------------------------------------------------------------------ tools and payloads
-
-    def _check_chain(self, chain: int, what: str) -> None:
-        if not (isinstance(chain, int) and 0 <= chain < len(self._hp)):
-            raise InvalidArgumentError(f"Invalid kinematic chain {chain} for {what}")
-
-    def tool_attached(self, chain: int, tool: ToolInfo | None) -> None:
-        """A tool was attached to ``chain``: its TCP now defines the endpoint."""
-        if tool is None:
-            raise InvalidArgumentError("Tool cannot be null")
-        with self._lock:
-            self._check_chain(chain, "tool")
-            if self._current_tool[chain] is not None:
-                raise InvalidArgumentError(f"Tool already attached to kinematic chain {chain}")
-            self._current_tool[chain] = tool
-            self._tool_tf[chain] = tool_transform(tool)
-            self._tool_tf_lists[chain] = as_lists(self._tool_tf[chain])
-            self._config_seqno += 1
-            self.events.append(("tool_changed", chain, tool.name))
-
-    def tool_detached(self, chain: int, tool_name: str) -> None:
-        """The tool named ``tool_name`` (or "" for any) was detached from ``chain``."""
-        with self._lock:
-            self._check_chain(chain, "tool")
-            tool = self._current_tool[chain]
-            if tool is None:
-                raise InvalidArgumentError(f"Tool not attached to kinematic chain {chain}")
-            if self._current_payload[chain] is not None:
-                raise InvalidArgumentError("Cannot remove tool while payload attached")
-            if tool_name not in ("", tool.name):
-                raise InvalidArgumentError(
-                    f"Invalid tool name to detach: '{tool_name}' (attached: '{tool.name}')"
-                )
-            self._current_tool[chain] = None
-            self._tool_tf[chain] = None
-            self._tool_tf_lists[chain] = None
-            self._config_seqno += 1
-            self.events.append(("tool_changed", chain, ""))
-
-    def payload_attached(self, chain: int, payload: PayloadInfo | None, pose: Pose | None) -> None:
-        """A payload was attached to the tool of ``chain`` at ``pose`` relative to the TCP."""
-        if payload is None:
-            raise InvalidArgumentError("Payload cannot be null")
-        with self._lock:
-            self._check_chain(chain, "payload")
-            if self._current_tool[chain] is None:
-                raise InvalidArgumentError(
-                    f"No tool attached to kinematic chain {chain}, cannot attach payload"
-                )
-            if self._current_payload[chain] is not None:
-                raise InvalidArgumentError(f"Payload already attached to kinematic chain {chain}")
-            self._current_payload[chain] = payload
-            self._current_payload_pose[chain] = pose or Pose()
-            self._config_seqno += 1
-            self.events.append(("payload_changed", chain, payload.name))
-
-    def payload_detached(self, chain: int, payload_name: str) -> None:
-        """The payload named ``payload_name`` (or "") was detached from ``chain``."""
-        with self._lock:
-            self._check_chain(chain, "payload")
-            payload = self._current_payload[chain]
-            if payload is None:
-                raise InvalidArgumentError(f"Payload not attached to kinematic chain {chain}")
-            if payload_name not in ("", payload.name):
-                raise InvalidArgumentError(
-                    f"Invalid payload name to detach: '{payload_name}' (attached: '{payload.name}')"
-                )
-            self._current_payload[chain] = None
-            self._current_payload_pose[chain] = None
-            self._config_seqno += 1
-            self.events.append(("payload_changed", chain, ""))
-
-    # ------------------------------------------------------------------ parameters and signals
-
-    def getf_param(self, param_name: str) -> Any:
-        """No parameters in the base driver."""
-        raise InvalidArgumentError("Invalid parameter")
-
-    def setf_param(self, param_name: str, value: Any) -> None:
-        """No parameters in the base driver."""
-        raise InvalidArgumentError("Invalid parameter")
-
-    def getf_signal(self, signal_name: str) -> Any:
-        """Signals are not implemented by the base driver."""
-        raise NotImplementedDriverError("Not implemented")
-
-    def setf_signal(self, signal_name: str, value: Any) -> None:
-        """Signals are not implemented by the base driver."""
-        raise NotImplementedDriverError("Not implemented")
 
 
 #: Position, orientation and twist of one TCP as packed bytes (a read-only array's buffer).

@@ -30,7 +30,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from robotspec.driver.errors import error_kind
-from robotspec.driver.loop import RobotDriver
+from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import PayloadInfo, Pose, ToolInfo
 from robotspec.driver.sim import Fault, SimRobot
 from robotspec.driver.state import CommandMode, StateFlags

@@ -25,7 +25,8 @@ import numpy.typing as npt
 
 from robotspec.driver.clock import Clock
 from robotspec.driver.errors import InvalidArgumentError
-from robotspec.driver.loop import Completion, RobotDriver
+from robotspec.driver.handles import Completion
+from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
 from robotspec.driver.state import EstopSource
 

@@ -1,7 +1,7 @@
 """Joint trajectories: the acceptance checks and the interpolation the loop samples.
 
 The checks follow the reference's ``JointTrajectoryInterpolator`` in order, with its messages,
-except where the reference is defective (documented in :mod:`robotspec.driver.loop`):
+except where the reference is defective (documented in :mod:`robotspec.driver.robot_driver`):
 
 * messages carry the real waypoint index (the reference prints a literal ``{i}``);
 * the 100 ms gap rule applies to the trajectory as written, not to the times stretched by a speed

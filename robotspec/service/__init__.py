@@ -6,7 +6,7 @@ Needs the optional extra: ``pip install 'robotspec[robotraconteur]'``. Modules:
   (loopback, no discovery, state in a user folder);
 * :mod:`~robotspec.service.convert` -- driver values to and from the standard robdef structures;
 * :mod:`~robotspec.service.robot_service` -- the ``com.robotraconteur.robotics.robot.Robot``
-  service object, an adapter over :class:`~robotspec.driver.loop.RobotDriver`;
+  service object, an adapter over :class:`~robotspec.driver.robot_driver.RobotDriver`;
 * :mod:`~robotspec.service.server` -- :class:`~robotspec.service.server.RobotServer`, which owns
   the node, the service and the driver loop;
 * :mod:`~robotspec.service.cli` -- ``robotspec drive --sim ROBOTINFO --serve``.

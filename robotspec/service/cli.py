@@ -12,7 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-from robotspec.driver.loop import RobotDriver
+from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
 from robotspec.service.server import RobotServer, ServeOptions
 

@@ -1,9 +1,9 @@
 """The ``com.robotraconteur.robotics.robot.Robot`` service object: an adapter over a driver.
 
-Every member delegates to the :class:`~robotspec.driver.loop.RobotDriver` that ``drive --sim``
-runs; nothing about the robot's behaviour is implemented here. The adapter only converts values
-(:mod:`robotspec.service.convert`), maps the driver's errors to the Robot Raconteur exceptions of
-the same name, and publishes each step's state on the wires and the pipe.
+Every member delegates to the :class:`~robotspec.driver.robot_driver.RobotDriver` that
+``drive --sim`` runs; nothing about the robot's behaviour is implemented here. The adapter only
+converts values (:mod:`robotspec.service.convert`), maps the driver's errors to the Robot
+Raconteur exceptions of the same name, and publishes each step's state on the wires and the pipe.
 
 Threading: RR calls members from its thread pool; the driver's own lock serialises them against
 the loop thread. Calls that block until the robot has done something (``jog_*`` with
@@ -32,7 +32,7 @@ from pydantic import ValidationError
 
 from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError, error_kind
 from robotspec.driver.handles import NEXT_TIMEOUT_S, Completion, TrajectoryGenerator
-from robotspec.driver.loop import RobotDriver
+from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotCapability, RobotInfo
 from robotspec.driver.state import ActionStatus, RobotState
 from robotspec.errors import RobotSpecError

@@ -16,7 +16,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from robotspec.driver.loop import RobotDriver
+from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
 from robotspec.errors import ServiceError
 from robotspec.service import convert

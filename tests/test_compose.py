@@ -694,3 +694,23 @@ def test_one_package_name_in_two_parts_resolves_per_part(tmp_path: Path) -> None
         "a_link": str((tmp_path / "a" / "tools" / "meshes" / "one.stl").resolve()),
         "b_link": str((tmp_path / "b" / "tools" / "meshes" / "two.stl").resolve()),
     }
+
+
+def test_the_error_output_shown_in_the_docs_is_what_validate_prints(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from .test_cli import run
+    from .test_docs import DOCS, blocks
+
+    erd_robots()
+    page = DOCS / "composition.md"
+    found = list(blocks(page))
+    spec = next(b for b in found if b.marks.get("file") == "broken.yaml")
+    shown = next(b for b in found if b.lang == "text" and "broken.yaml:" in b.text)
+    (tmp_path / "broken.yaml").write_text(spec.text)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("NO_COLOR", "1")
+    code, out, err = run(capsys, "validate", "broken.yaml")
+    assert code == 1
+    printed = (out + err).splitlines()
+    assert sorted(printed) == sorted(shown.text.splitlines())

@@ -714,3 +714,17 @@ def test_the_error_output_shown_in_the_docs_is_what_validate_prints(
     assert code == 1
     printed = (out + err).splitlines()
     assert sorted(printed) == sorted(shown.text.splitlines())
+
+
+def test_a_composed_robot_renders_with_every_parts_meshes() -> None:
+    from robotspec.render import RenderOptions, build_scene, render_scene
+
+    erd_robots()
+    robot = compile_robot("b1_ur5_allegro")
+    scene = build_scene(robot)
+    q = np.zeros(len(robot.world.degrees_of_freedom))
+    from .test_render import _mask
+
+    picture = render_scene(scene, q, RenderOptions(view="front", width=320, height=240))
+    shown = {e.name: int(_mask(picture.image, e.colour).sum()) for e in scene.legend}
+    assert shown["ur5_arm"] > 200 and shown["allegro_hand"] > 50, shown

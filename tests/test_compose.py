@@ -728,3 +728,44 @@ def test_a_composed_robot_renders_with_every_parts_meshes() -> None:
     picture = render_scene(scene, q, RenderOptions(view="front", width=320, height=240))
     shown = {e.name: int(_mask(picture.image, e.colour).sum()) for e in scene.legend}
     assert shown["ur5_arm"] > 200 and shown["allegro_hand"] > 50, shown
+
+
+@pytest.mark.parametrize("name", COMPOSED)
+def test_pinocchio_reads_the_exported_urdf_and_srdf_to_the_same_checked_pairs(
+    name: str, tmp_path: Path
+) -> None:
+    """What MoveIt-style tools load: pinocchio's geometry + SRDF pairs are robotspec's pairs.
+
+    pinocchio never pairs geometries on one rigid body (bodies joined by fixed joints only);
+    those pairs can never change, and are the only difference allowed.
+    """
+    import pinocchio as pin
+
+    from robotspec.packages import PackageResolver
+
+    erd_robots()
+    result = check_spec(name)
+    robot = result.robot
+    assert robot is not None
+    out = bundle(result, name=name)
+    urdf, srdf = tmp_path / f"{name}.urdf", tmp_path / f"{name}.srdf"
+    urdf.write_text(out.urdf)
+    srdf.write_text(out.srdf)
+    dirs = [str(p) for p in PackageResolver.create(None).search_folders]
+    model = pin.buildModelFromUrdf(str(urdf))
+    geom = pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION, package_dirs=dirs)
+    geom.addAllCollisionPairs()
+    pin.removeCollisionPairs(model, geom, str(srdf))
+
+    def body(g: int) -> str:
+        return str(model.frames[geom.geometryObjects[g].parentFrame].name)
+
+    theirs = {frozenset((body(p.first), body(p.second))) for p in geom.collisionPairs}
+    ours = {frozenset(p) for p in CollisionRules.from_robot(robot).active_pairs()}
+    assert theirs <= ours
+    w = robot.world
+    for pair in ours - theirs:
+        a, b = sorted(pair)
+        top = w.common_ancestor(a, b)
+        joints = [*w.compute_chain_of_connections(top, a), *w.compute_chain_of_connections(top, b)]
+        assert all(c.is_fixed for c in joints), f"{a}-{b} moves yet pinocchio does not check it"

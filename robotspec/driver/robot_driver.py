@@ -235,6 +235,12 @@ class RobotDriver(DriverLoop):
         }
 
     @property
+    def config_seqno(self) -> int:
+        """The live ``config_seqno`` (the state snapshot's lags until the next step)."""
+        with self._lock:
+            return self._config_seqno
+
+    @property
     def robot_info(self) -> RobotInfo:
         """The RobotInfo with current tools and payloads and the live ``config_seqno``."""
         with self._lock:

@@ -421,7 +421,8 @@ class RobotService:
     def robot_info(self) -> Any:
         """RobotInfo with the attached tools and payloads and the current ``config_seqno``."""
         with self._info_lock:
-            seqno = self.driver.robot_state.config_seqno
+            # The live seqno: the published state's lags a step behind an attach or detach.
+            seqno = self.driver.config_seqno
             if seqno != self._info_seqno:
                 for i, chain in enumerate(self._rr_info.chains):
                     chain.current_tool = self._rr_tools[i]
@@ -605,6 +606,7 @@ class RobotService:
             assert model is not None
             with self._info_lock:
                 self._rr_tools[int(chain)] = tool
+                self._info_seqno = -1  # rebuilt on the next read, whatever the seqno
         self.tool_changed.fire(int(chain), model.name)
 
     def tool_detached(self, chain: int, tool_name: str) -> None:
@@ -613,6 +615,7 @@ class RobotService:
             self.driver.tool_detached(int(chain), str(tool_name))
             with self._info_lock:
                 self._rr_tools[int(chain)] = None
+                self._info_seqno = -1  # rebuilt on the next read, whatever the seqno
         self.tool_changed.fire(int(chain), "")
 
     def payload_attached(self, chain: int, payload: Any, pose: Any) -> None:
@@ -623,6 +626,7 @@ class RobotService:
             assert model is not None
             with self._info_lock:
                 self._rr_payloads[int(chain)] = payload
+                self._info_seqno = -1  # rebuilt on the next read, whatever the seqno
         self.payload_changed.fire(int(chain), model.name)
 
     def payload_detached(self, chain: int, payload_name: str) -> None:
@@ -631,6 +635,7 @@ class RobotService:
             self.driver.payload_detached(int(chain), str(payload_name))
             with self._info_lock:
                 self._rr_payloads[int(chain)] = None
+                self._info_seqno = -1  # rebuilt on the next read, whatever the seqno
         self.payload_changed.fire(int(chain), "")
 
     # ------------------------------------------------------------------ parameters and signals

@@ -338,6 +338,11 @@ class RobotSpec(_Model):
         if self.description is None and not self.parts:
             raise ValueError("a spec needs 'description' (its files) or 'parts' (a composed robot)")
         if self.description is not None and self.parts:
+            if self.extends is not None:
+                raise ValueError(
+                    f"'{self.extends}' has a description, so parts cannot be added to it; make "
+                    f"it a part instead: parts: {{base: {{spec: {self.extends}}}, ...}}"
+                )
             raise ValueError(
                 "give 'description' or 'parts', not both; put extra frames in a part's spec"
             )

@@ -769,3 +769,28 @@ def test_pinocchio_reads_the_exported_urdf_and_srdf_to_the_same_checked_pairs(
         top = w.common_ancestor(a, b)
         joints = [*w.compute_chain_of_connections(top, a), *w.compute_chain_of_connections(top, b)]
         assert all(c.is_fixed for c in joints), f"{a}-{b} moves yet pinocchio does not check it"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            "extends: pr2\nparts:\n  arm: {spec: ur5}\n",
+            "'pr2' has a description, so parts cannot be added to it; make it a part instead",
+        ),
+        ("parts:\n  arm: {spec: ur5, urdf: x.urdf}\n", "a part needs either 'spec' or 'urdf'"),
+        (
+            "parts:\n  arm: {spec: ur5}\n  hand: {spec: ur5, attach: {part: arm, lnk: tool0}}\n",
+            "unknown key 'lnk' at parts.hand.attach.lnk; did you mean 'link'?",
+        ),
+        ("parts: {}\n", "a spec needs 'description' (its files) or 'parts'"),
+    ],
+)
+def test_malformed_composed_specs(tmp_path: Path, text: str, message: str) -> None:
+    spec = tmp_path / "bad.yaml"
+    spec.write_text("robotspec: 1\nname: Bad\n" + text)
+    with pytest.raises(RobotSpecError) as info:
+        check_spec(spec)
+    errors = _errors(info.value)
+    assert any(message in e.message for e in errors), [e.message for e in errors]
+    assert all(e.file == str(spec) and e.line is not None for e in errors)

@@ -107,11 +107,15 @@ class Kinematics:
         nb = len(world.bodies)
         self._nb = nb
         self._nd = len(world.degrees_of_freedom)
-        self._origin = np.stack([c.origin for c in conns]) if conns else np.zeros((0, 4, 4))
-        one = [c for c in conns if c.type.dof_count == 1]
+        # Small batches work on the moving joints only, fixed joints above each folded into its
+        # origin (see _plan_fixed_collapse); index arrays below are positions among them.
+        moving = self._plan_fixed_collapse(world)
+        self._origin = np.stack([o for _, o in moving]) if moving else np.zeros((0, 4, 4))
+        position = {c.index: i for i, (c, _) in enumerate(moving)}
+        one = [c for c, _ in moving if c.type.dof_count == 1]
         rev = [c for c in one if c.type is not ConnectionType.PRISMATIC]
         pri = [c for c in one if c.type is ConnectionType.PRISMATIC]
-        self._rev_idx = np.array([c.index for c in rev], dtype=np.int64)
+        self._rev_idx = np.array([position[c.index] for c in rev], dtype=np.int64)
         self._rev_dof = np.array([c.dofs[0] for c in rev], dtype=np.int64)
         self._rev_mul = np.array([c.mimic.multiplier if c.mimic else 1.0 for c in rev])
         self._rev_off = np.array([c.mimic.offset if c.mimic else 0.0 for c in rev])
@@ -122,18 +126,19 @@ class Kinematics:
         self._rev_o = o_r
         self._rev_ok = o_r @ k
         self._rev_okk = o_r @ k @ k
-        self._pri_idx = np.array([c.index for c in pri], dtype=np.int64)
+        self._pri_idx = np.array([position[c.index] for c in pri], dtype=np.int64)
         self._pri_dof = np.array([c.dofs[0] for c in pri], dtype=np.int64)
         self._pri_mul = np.array([c.mimic.multiplier if c.mimic else 1.0 for c in pri])
         self._pri_off = np.array([c.mimic.offset if c.mimic else 0.0 for c in pri])
         pri_axes = np.array([c.axis for c in pri], dtype=np.float64).reshape(-1, 3)
         self._pri_dir = np.einsum("cij,cj->ci", self._origin[self._pri_idx, :3, :3], pri_axes)
-        self._multi = [(c.index, _MultiMotion.of(c)) for c in conns if c.type.dof_count > 1]
-        self._plan_fixed_collapse(world)
+        self._multi = [
+            (position[c.index], _MultiMotion.of(c)) for c, _ in moving if c.type.dof_count > 1
+        ]
         self._plan = [_plan_entry(c) for c in conns]
         self._chains: dict[tuple[int, int], ChainKinematics] = {}
 
-    def _plan_fixed_collapse(self, world: World) -> None:
+    def _plan_fixed_collapse(self, world: World) -> list[tuple[Connection, F64]]:
         """Plan the small-batch path: fixed joints folded away, moving ones level by level.
 
         Why: most bodies of a real robot hang on fixed joints (PR2: 82 bodies, 20 moving
@@ -141,6 +146,7 @@ class Kinematics:
         a moving joint or the root starts) times a constant. So only moving joints are composed
         level by level, each with the constant of the fixed joints above it folded into its
         local transform, and every other body follows in one batched product at the end.
+        Returns the moving joints with their folded origins (anchor frame to joint frame).
         """
         nb = len(world.bodies)
         anchor = np.zeros(nb, dtype=np.int64)
@@ -159,11 +165,6 @@ class Kinematics:
                 anchor[b.index] = b.index
                 moving_depth[b.index] = moving_depth[conn.parent] + 1
         moving = [c for c in world.connections if not c.is_fixed]
-        self._moving_idx = np.array([c.index for c in moving], dtype=np.int64)
-        # The fixed joints between a moving joint's anchor and its parent body, folded in.
-        self._moving_pre = (
-            np.stack([const[c.parent] for c in moving]) if moving else np.zeros((0, 4, 4))
-        )
         position = {c.index: i for i, c in enumerate(moving)}
         by_depth: dict[int, list[Connection]] = {}
         for c in moving:
@@ -180,10 +181,11 @@ class Kinematics:
         self._followers = np.array(followers, dtype=np.int64)
         self._follower_anchor = anchor[self._followers]
         self._follower_const = const[self._followers]
+        return [(c, const[c.parent] @ c.origin) for c in moving]
 
     # ------------------------------------------------------------------ local transforms
     def _local(self, q: F64) -> F64:
-        """Parent-to-child transforms of every connection for configurations ``q`` (N, D)."""
+        """Anchor-to-child transforms of every moving joint for configurations ``q`` (N, D)."""
         n = q.shape[0]
         local = np.broadcast_to(self._origin, (n, *self._origin.shape)).copy()
         if self._rev_idx.size:
@@ -280,7 +282,7 @@ class Kinematics:
 
     def _compose(self, q: F64) -> F64:
         """Small batches: moving joints level by level, then every fixed-joint body at once."""
-        local = self._moving_pre @ self._local(q)[:, self._moving_idx]
+        local = self._local(q)
         poses = np.empty((q.shape[0], self._nb, 4, 4))
         poses[:, 0] = np.eye(4)
         for anchors, children, moving in self._levels:

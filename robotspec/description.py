@@ -17,10 +17,12 @@ from robotspec.urdf import MeshPolicy, read_description_xml, world_from_urdf_xml
 from robotspec.world import ConnectionType, World
 
 if TYPE_CHECKING:
+    from lxml import etree
+
     from robotspec.packages import PackageResolver
     from robotspec.srdf import Srdf
 
-__all__ = ["Description", "load_description"]
+__all__ = ["Description", "load_description", "read_urdf_tree"]
 
 #: SRDF virtual joint types and the world connection each becomes.
 VIRTUAL_JOINT_TYPES = {
@@ -56,6 +58,35 @@ def resolve_file(
     return p if p.is_absolute() else (base / p)
 
 
+def read_urdf_tree(
+    urdf: str | Path,
+    *,
+    package_paths: Sequence[str | Path] = (),
+    xacro_args: Mapping[str, str] | None = None,
+    base_folder: Path,
+    share_crawls_with: PackageResolver | None = None,
+) -> tuple[etree._Element, Path, PackageResolver]:
+    """The element tree of a URDF reference (xacro run), its file and its resolver.
+
+    Relative paths and ``package_paths`` start at ``base_folder``. ``share_crawls_with``: a
+    resolver of the same compilation whose package-folder crawls are reused.
+    """
+    from robotspec.packages import PackageResolver
+
+    extra = [p if Path(p).is_absolute() else base_folder / p for p in map(str, package_paths)]
+    urdf_ref = str(urdf)
+    share = share_crawls_with
+    if "://" in urdf_ref:
+        share = PackageResolver.create(None, extra_paths=extra, share_crawls_with=share)
+        urdf_path = share.resolve(urdf_ref, relative_to=base_folder)
+    else:
+        urdf_path = Path(urdf_ref) if Path(urdf_ref).is_absolute() else base_folder / urdf_ref
+    if not urdf_path.is_file():
+        raise missing_file(urdf_path, DescriptionError)
+    resolver = PackageResolver.create(urdf_path, extra_paths=extra, share_crawls_with=share)
+    return read_description_xml(urdf_path, resolver, xacro_args), urdf_path, resolver
+
+
 def load_description(
     urdf: str | Path,
     *,
@@ -66,21 +97,10 @@ def load_description(
     base_folder: Path | None = None,
 ) -> Description:
     """Load a URDF (or xacro) and optionally its SRDF; URIs resolve through one resolver."""
-    from robotspec.packages import PackageResolver
-
     base = base_folder or Path.cwd()
-    extra = [p if Path(p).is_absolute() else base / p for p in map(str, package_paths)]
-    urdf_ref = str(urdf)
-    bootstrap = None
-    if "://" in urdf_ref:
-        bootstrap = PackageResolver.create(None, extra_paths=extra)
-        urdf_path = bootstrap.resolve(urdf_ref, relative_to=base)
-    else:
-        urdf_path = Path(urdf_ref) if Path(urdf_ref).is_absolute() else base / urdf_ref
-    if not urdf_path.is_file():
-        raise missing_file(urdf_path, DescriptionError)
-    resolver = PackageResolver.create(urdf_path, extra_paths=extra, share_crawls_with=bootstrap)
-    root = read_description_xml(urdf_path, resolver, xacro_args)
+    root, urdf_path, resolver = read_urdf_tree(
+        urdf, package_paths=package_paths, xacro_args=xacro_args, base_folder=base
+    )
     issues: list[RobotSpecError] = []
     world = world_from_urdf_xml(
         root, str(urdf_path), resolver=resolver, meshes=meshes, issues=issues

@@ -32,7 +32,7 @@ def joined_urdf(loaded: LoadedSpec, *, package_paths: Sequence[str | Path] = ())
 
     if loaded.spec.parts:
         return compose(loaded, package_paths=package_paths).urdf
-    return description_tree(loaded, package_paths)[0]
+    return description_tree(loaded.spec.files, loaded.folder, package_paths)[0]
 
 
 def urdf_text(tree: etree._Element, *, comment: str) -> str:

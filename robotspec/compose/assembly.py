@@ -31,10 +31,11 @@ from robotspec.compose.urdf_merge import (
     tree_facts,
     weld,
 )
-from robotspec.errors import RobotSpecError, SpecError, missing_file
+from robotspec.errors import RobotSpecError, SpecError
 from robotspec.packages import PackageResolver
 from robotspec.spec import (
     AttachSpec,
+    DescriptionSpec,
     LoadedSpec,
     PartSpec,
     RobotSpec,
@@ -101,36 +102,27 @@ class _Part:
 
 # ------------------------------------------------------------------------------------- loading
 def description_tree(
-    loaded: LoadedSpec,
+    desc: DescriptionSpec,
+    folder: Path,
     package_paths: Sequence[str | Path] = (),
     *,
     share_crawls_with: PackageResolver | None = None,
 ) -> tuple[etree._Element, Path, PackageResolver, Srdf | None]:
-    """A flat spec's URDF tree (xacro run, frames added, mesh paths absolute) and its SRDF.
+    """A description's URDF tree (xacro run, frames added, mesh paths absolute) and its SRDF.
 
-    ``share_crawls_with``: a resolver of the same compilation whose package-folder crawls are
-    reused (parts of a composed robot search the same folders).
+    Paths start at ``folder`` (the spec's). ``share_crawls_with``: a resolver of the same
+    compilation whose package-folder crawls are reused (parts search the same folders).
     """
-    from robotspec.description import resolve_file
-    from robotspec.urdf import read_description_xml
+    from robotspec.description import read_urdf_tree, resolve_file
     from robotspec.urdf_check import check_urdf_tree
 
-    desc = loaded.spec.files
-    folder = loaded.folder
-    extra = [
-        p if Path(p).is_absolute() else folder / p
-        for p in [*desc.package_paths, *map(str, package_paths)]
-    ]
-    share = share_crawls_with
-    if "://" in desc.urdf:
-        share = PackageResolver.create(None, extra_paths=extra, share_crawls_with=share)
-        urdf = share.resolve(desc.urdf, relative_to=folder)
-    else:
-        urdf = Path(desc.urdf) if Path(desc.urdf).is_absolute() else folder / desc.urdf
-    if not urdf.is_file():
-        raise missing_file(urdf)
-    resolver = PackageResolver.create(urdf, extra_paths=extra, share_crawls_with=share)
-    tree = read_description_xml(urdf, resolver, desc.xacro_args)
+    tree, urdf, resolver = read_urdf_tree(
+        desc.urdf,
+        package_paths=[*desc.package_paths, *map(str, package_paths)],
+        xacro_args=desc.xacro_args,
+        base_folder=folder,
+        share_crawls_with=share_crawls_with,
+    )
     check_urdf_tree(tree, str(urdf))
     absolute_mesh_paths(tree, urdf.parent)
     links = {el.get("name") for el in tree.iterfind("link")}
@@ -193,7 +185,10 @@ def _load_part(
             else:
                 flat = part_loaded
                 tree, file, resolver, srdf = description_tree(
-                    part_loaded, package_paths, share_crawls_with=share
+                    part_loaded.spec.files,
+                    part_loaded.folder,
+                    package_paths,
+                    share_crawls_with=share,
                 )
             spec = flat.spec
             data = spec.model_dump(mode="json", exclude_unset=True)
@@ -217,22 +212,11 @@ def _load_part(
                 },
             )
         assert ps.urdf is not None  # PartSpec checks one of spec/urdf is given
-        part_desc = RobotSpec.model_validate(
-            {
-                "name": name,
-                "root": "-",
-                "description": {
-                    "urdf": ps.urdf,
-                    "srdf": ps.srdf,
-                    "xacro_args": ps.xacro_args,
-                    "package_paths": ps.package_paths,
-                },
-            }
+        part_desc = DescriptionSpec(
+            urdf=ps.urdf, srdf=ps.srdf, xacro_args=ps.xacro_args, package_paths=ps.package_paths
         )
         tree, file, resolver, srdf = description_tree(
-            LoadedSpec(part_desc, loaded.file, loaded.documents),
-            package_paths,
-            share_crawls_with=share,
+            part_desc, loaded.folder, package_paths, share_crawls_with=share
         )
         return _Part(name, ps, file, tree, srdf, resolver, tree_facts(tree))
     except RobotSpecError as exc:

@@ -13,7 +13,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from pydantic import (
     BaseModel,
@@ -25,8 +25,10 @@ from pydantic import (
 )
 
 from robotspec.errors import NotFoundError, SpecError
-from robotspec.geometry import Matrix
 from robotspec.yamlio import LocatedYaml, load_yaml, validation_errors
+
+if TYPE_CHECKING:
+    from robotspec.geometry import Matrix
 
 __all__ = [
     "AttachSpec",
@@ -93,6 +95,7 @@ def _pose(
     rpy: tuple[float, float, float] | None,
     quaternion: tuple[float, float, float, float] | None,
 ) -> Matrix:
+    # Imported here: reading and validating a spec needs no numpy (the CLI starts faster).
     from robotspec.geometry import pose_from_xyz_quaternion, pose_from_xyz_rpy
 
     if quaternion is not None:

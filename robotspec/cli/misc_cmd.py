@@ -16,11 +16,10 @@ from robotspec.cli.table import render_table
 @app.command("list")
 def list_robots() -> None:
     """The robots shipped with robotspec and the description each is built from."""
-    from robotspec.compiler import shipped_specs
-    from robotspec.spec import load_spec
+    from robotspec.spec import load_spec, shipped_spec_files
 
     rows = []
-    for name, path in shipped_specs().items():
+    for name, path in shipped_spec_files().items():
         spec = load_spec(path).spec
         if spec.description is not None:
             source = spec.description.urdf

@@ -18,6 +18,7 @@ from typing import Any
 from lxml import etree
 from pydantic import ValidationError
 
+from robotspec.compiler.context import UNIT_TOL, unit_norm
 from robotspec.compiler.diagnostics import Diagnostics, Loc
 from robotspec.compose.naming import PartNames
 from robotspec.compose.semantics import NAMED_SECTIONS, remap_marks, rename_semantics
@@ -26,7 +27,6 @@ from robotspec.compose.urdf_merge import (
     TreeFacts,
     absolute_mesh_paths,
     add_fixed_frames,
-    is_unit,
     rename_tree,
     tree_facts,
     weld,
@@ -411,7 +411,7 @@ class _Joiner:
         if attach.rpy is not None and attach.quaternion is not None:
             self.diag.error(loc, "give rpy or quaternion, not both")
             return None
-        if attach.quaternion is not None and not is_unit(attach.quaternion):
+        if attach.quaternion is not None and abs(unit_norm(attach.quaternion) - 1) > UNIT_TOL:
             self.diag.error((*loc, "quaternion"), "must be a unit quaternion")
             return None
         return self.names_of[attach.part].link(attach.link)
@@ -529,8 +529,7 @@ def compose(
 
 
 # ---------------------------------------------------------------------------------- semantics
-def _ancestors(robot: etree._Element, link: str) -> list[str]:
-    parent_of = tree_facts(robot).parent_of
+def _ancestors(parent_of: Mapping[str, str], link: str) -> list[str]:
     out = [link]
     while out[-1] in parent_of:
         out.append(parent_of[out[-1]])
@@ -670,6 +669,7 @@ def _hand_over_manipulators(
     """
     chains: dict[str, Any] = data.get("chains", {})
     manips: dict[str, Any] = data.get("manipulators", {})
+    parent_of = tree_facts(robot).parent_of
     for name in order:
         attach = parts[name].spec.attach
         if attach is None:
@@ -678,7 +678,7 @@ def _hand_over_manipulators(
         free = [m for m in manips if owner.get(("manipulators", m)) == name and m not in carried]
         if len(free) != 1:
             continue
-        above = _ancestors(robot, names_of[attach.part].link(attach.link))
+        above = _ancestors(parent_of, names_of[attach.part].link(attach.link))
         best: tuple[int, str] | None = None
         for cname, chain in chains.items():
             chain_owner = owner.get(("chains", cname))

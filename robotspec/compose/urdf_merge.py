@@ -9,7 +9,6 @@ world model keeps. The world is then built from the joined tree like from any UR
 from __future__ import annotations
 
 import copy
-import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -267,8 +266,3 @@ def weld(
     for el in list(part):
         if isinstance(el.tag, str):  # comments and processing instructions stay behind
             robot.append(el)
-
-
-def is_unit(q: tuple[float, ...]) -> bool:
-    """A quaternion's norm is 1 within the tolerance the spec uses elsewhere."""
-    return abs(math.sqrt(sum(x * x for x in q)) - 1.0) <= 1e-3

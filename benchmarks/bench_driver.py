@@ -417,8 +417,8 @@ def main() -> None:
     else:
         import importlib.metadata as md
 
+        from robotspec.description.urdf import load_urdf
         from robotspec.driver.export import robot_info_from_chain
-        from robotspec.urdf import load_urdf
 
         share = Path(
             str(

@@ -13,7 +13,8 @@ import yaml
 from robotspec.cli.app import _register, app
 from robotspec.cli.render import run_app
 from robotspec.compiler import check_spec
-from robotspec.spec import json_schema_text, shipped_schema_path
+from robotspec.shipped import shipped_schema_path
+from robotspec.spec.load import json_schema_text
 
 from .conftest import erd_robots, shared_path
 

@@ -14,8 +14,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from robotspec.errors import NotFoundError, RobotSpecError, RobotSpecErrors, SrdfError
-from robotspec.srdf import (
+from robotspec.description.srdf import (
     DisabledCollision,
     DisableDefaultCollisions,
     EnabledCollision,
@@ -33,7 +32,8 @@ from robotspec.srdf import (
     parse_srdf_bytes,
     write_srdf,
 )
-from robotspec.xmlsafe import parse_xml_file
+from robotspec.errors import NotFoundError, RobotSpecError, RobotSpecErrors, SrdfError
+from robotspec.files.xmlsafe import parse_xml_file
 
 from .conftest import shared_path
 

@@ -14,15 +14,15 @@ import pytest
 from robotspec.cli.app import _register, app
 from robotspec.cli.render import run_app
 from robotspec.compiler import check_spec
-from robotspec.semantic import AbstractRobot
-from robotspec.srdf import (
+from robotspec.description.srdf import (
     Srdf,
     check_srdf_against,
     check_srdf_references,
     parse_srdf_bytes,
     write_srdf,
 )
-from robotspec.srdf_export import srdf_from_robot
+from robotspec.export.srdf import srdf_from_robot
+from robotspec.semantic import AbstractRobot
 
 from .conftest import erd_robots, shared_path
 

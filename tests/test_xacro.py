@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from robotspec.errors import DescriptionError, PackageNotFoundError, PathOutsideRootsError
-from robotspec.packages import PackageResolver
-from robotspec.xacro_io import process_xacro
-from robotspec.xmlsafe import parse_xml_bytes
+from robotspec.files.packages import PackageResolver
+from robotspec.files.xacro import process_xacro
+from robotspec.files.xmlsafe import parse_xml_bytes
 
 from .conftest import DATA, shared_path
 

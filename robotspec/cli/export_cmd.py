@@ -90,8 +90,8 @@ def srdf(
     virtual joint.
     """
     from robotspec.compiler import compile_robot
-    from robotspec.srdf import write_srdf
-    from robotspec.srdf_export import srdf_from_robot
+    from robotspec.description.srdf import write_srdf
+    from robotspec.export.srdf import srdf_from_robot
 
     robot = compile_robot(spec, package_paths=package_path or ())
     exported = srdf_from_robot(robot)
@@ -116,8 +116,8 @@ def urdf(
     become absolute; package:// URIs are kept.
     """
     from robotspec.compiler import resolve_spec
-    from robotspec.description_export import joined_urdf, urdf_text
-    from robotspec.spec import load_spec
+    from robotspec.export.urdf import joined_urdf, urdf_text
+    from robotspec.spec.load import load_spec
 
     loaded = load_spec(resolve_spec(spec))
     tree = joined_urdf(loaded, package_paths=package_path or ())
@@ -145,7 +145,7 @@ def bundle_cmd(
     `robotspec validate FOLDER/NAME.yaml` then compiles to the same robot (a composed one too).
     """
     from robotspec.compiler import check_spec, resolve_spec
-    from robotspec.description_export import bundle
+    from robotspec.export.urdf import bundle
 
     path = resolve_spec(spec)
     result = check_spec(path, package_paths=package_path or ())

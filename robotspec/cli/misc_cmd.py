@@ -16,7 +16,8 @@ from robotspec.cli.table import render_table
 @app.command("list")
 def list_robots() -> None:
     """The robots shipped with robotspec and the description each is built from."""
-    from robotspec.spec import load_spec, shipped_spec_files
+    from robotspec.shipped import shipped_spec_files
+    from robotspec.spec.load import load_spec
 
     rows = []
     for name, path in shipped_spec_files().items():
@@ -38,7 +39,7 @@ def schema(
     ] = None,
 ) -> None:
     """The JSON Schema of the spec format, for editors (YAML language server)."""
-    from robotspec.spec import json_schema_text
+    from robotspec.spec.load import json_schema_text
 
     text = json_schema_text()
     write_output(text, output)

@@ -54,8 +54,9 @@ JsonFlag = Annotated[bool, typer.Option("--json", help="Print JSON instead of a 
 
 def complete_spec(incomplete: str) -> list[str]:
     """Shell completion of a spec argument: shipped robot names, then YAML files here."""
-    shipped = Path(__file__).resolve().parents[1] / "specs"
-    names = sorted(p.stem for p in shipped.glob("*.yaml"))
+    from robotspec.shipped import shipped_spec_files
+
+    names = sorted(shipped_spec_files())
     head = os.path.dirname(incomplete)
     try:
         files = sorted(

@@ -28,8 +28,8 @@ from robotspec.collision.shapes import (
     import_coal,
 )
 from robotspec.errors import CollisionError, RobotSpecError
-from robotspec.kinematics import Kinematics
-from robotspec.world import World
+from robotspec.model.kinematics import Kinematics
+from robotspec.model.world import World
 
 if TYPE_CHECKING:
     from robotspec.semantic.robot import AbstractRobot

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.errors import CollisionError, NotFoundError
-from robotspec.world import ConnectionType, World
+from robotspec.model.world import ConnectionType, World
 
 if TYPE_CHECKING:
     from robotspec.semantic.robot import AbstractRobot

@@ -21,9 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.errors import CollisionError, RobotSpecError
-from robotspec.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
-from robotspec.mesh_files import read_triangles
-from robotspec.world import Body, World
+from robotspec.files.meshes import read_triangles
+from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
+from robotspec.model.world import Body, World
 
 if TYPE_CHECKING:
     import coal

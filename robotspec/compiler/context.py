@@ -6,11 +6,12 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from robotspec.compiler.diagnostics import Diagnostics, Loc
+from robotspec.description.srdf import Srdf
+from robotspec.diagnostics import Diagnostics, Loc
+from robotspec.model.world import Body, Connection, World
 from robotspec.semantic import JointState
-from robotspec.spec import LoadedSpec, RobotSpec
-from robotspec.srdf import Srdf
-from robotspec.world import Body, Connection, World
+from robotspec.spec.load import LoadedSpec
+from robotspec.spec.models import RobotSpec
 
 __all__ = ["AXIS_TOL", "UNIT_TOL", "Build", "moved_by", "subtree_joints", "unit_norm"]
 

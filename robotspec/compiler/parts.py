@@ -16,17 +16,17 @@ from robotspec.compiler.context import (
     subtree_joints,
     unit_norm,
 )
-from robotspec.compiler.diagnostics import Loc
 from robotspec.compiler.joints import check_states
+from robotspec.diagnostics import Loc
+from robotspec.model.world import Body
 from robotspec.semantic import front_facing_axis_of
-from robotspec.spec import (
+from robotspec.spec.models import (
     CameraSpec,
     ChainSpec,
     FingerSpec,
     GenericManipulatorSpec,
     ParallelGripperSpec,
 )
-from robotspec.world import Body
 
 __all__ = ["CameraValues", "camera_values", "chain_ends", "check_manipulator", "use_sensor"]
 

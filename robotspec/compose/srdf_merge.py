@@ -1,7 +1,8 @@
 """Joining the parts' SRDFs: every record renamed with its part's names, then concatenated.
 
-Why records and not XML: the compiler reads :class:`~robotspec.srdf.Srdf` records, and the
-renaming rules (:mod:`robotspec.compose.naming`) apply per field, which records make explicit.
+Why records and not XML: the compiler reads :class:`~robotspec.description.srdf.Srdf` records,
+and the renaming rules (:mod:`robotspec.compose.naming`) apply per field, which records make
+explicit.
 Virtual joints of welded parts are dropped: a weld fixes the part, so only the base part's
 virtual joint (its drive) survives.
 """
@@ -12,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from robotspec.compose.naming import PartNames
-from robotspec.srdf import (
+from robotspec.description.srdf import (
     DisabledCollision,
     DisableDefaultCollisions,
     EnabledCollision,

@@ -15,14 +15,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar
 
 from robotspec.errors import KinematicsError, NotFoundError
+from robotspec.model.world import Body, Connection, World
 from robotspec.semantic.base import AssignmentError, JointState, SemanticRobotAnnotation
 from robotspec.semantic.chains import KinematicChain, Neck, Torso
 from robotspec.semantic.manipulators import Manipulator
 from robotspec.semantic.sensors import Camera, Sensor
-from robotspec.world import Body, Connection, World
 
 if TYPE_CHECKING:
-    from robotspec.srdf import Srdf
+    from robotspec.description.srdf import Srdf
 
 __all__ = ["AbstractRobot", "CollisionCheckingConfig", "EmptyChainWarning"]
 
@@ -235,7 +235,7 @@ class AbstractRobot:
         The reference's rule: a disabled pair counts only when both bodies have collision
         geometry; ``disable_default_collisions`` disables a body entirely.
         """
-        from robotspec.srdf import load_srdf
+        from robotspec.description.srdf import load_srdf
 
         srdf = self.srdf if path is None else load_srdf(path)
         if srdf is None:

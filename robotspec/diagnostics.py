@@ -17,7 +17,7 @@ from robotspec.errors import (
     SpecError,
     closest_names,
 )
-from robotspec.spec import LoadedSpec
+from robotspec.spec.load import LoadedSpec
 
 __all__ = ["Diagnostics", "Loc"]
 

@@ -37,7 +37,7 @@ from robotspec.errors import (
     SrdfError,
     raise_collected,
 )
-from robotspec.xmlsafe import parse_xml_bytes
+from robotspec.files.xmlsafe import parse_xml_bytes
 
 __all__ = [
     "VIRTUAL_JOINT_TYPES",

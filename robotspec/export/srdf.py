@@ -9,8 +9,7 @@ disabled collision pairs and bodies with their reasons.
 
 from __future__ import annotations
 
-from robotspec.semantic import AbstractRobot, Finger
-from robotspec.srdf import (
+from robotspec.description.srdf import (
     DisabledCollision,
     DisableDefaultCollisions,
     EndEffector,
@@ -21,6 +20,7 @@ from robotspec.srdf import (
     Srdf,
     VirtualJoint,
 )
+from robotspec.semantic import AbstractRobot, Finger
 
 __all__ = ["WHOLE_ROBOT_GROUP", "srdf_from_robot"]
 

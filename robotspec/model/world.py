@@ -18,7 +18,6 @@ from typing import TypeVar
 
 import numpy as np
 
-from robotspec.entities import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic
 from robotspec.errors import (
     DescriptionError,
     DuplicateNameError,
@@ -26,7 +25,8 @@ from robotspec.errors import (
     NotFoundError,
     raise_collected,
 )
-from robotspec.geometry import Matrix, frozen_array
+from robotspec.model.entities import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic
+from robotspec.model.geometry import Matrix, frozen_array
 
 _T = TypeVar("_T")
 

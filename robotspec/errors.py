@@ -35,6 +35,7 @@ __all__ = [
     "SpecError",
     "SrdfError",
     "closest_names",
+    "printable",
 ]
 
 
@@ -52,6 +53,23 @@ def closest_names(name: str, candidates: Iterable[str], n: int = 3) -> tuple[str
         lowered = name.lower()
         found = [c for c in pool if lowered and (lowered in c.lower() or c.lower() in lowered)][:n]
     return tuple(found)
+
+
+_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x00, 0x20), *range(0x7F, 0xA0))}
+_BIDI = (0x2028, 0x2029, *range(0x202A, 0x202F), *range(0x2066, 0x206A))
+_CONTROL.update({c: f"\\u{c:04x}" for c in _BIDI})
+
+
+def printable(text: str) -> str:
+    """``text`` with terminal control characters escaped (as ``x1b`` after a backslash).
+
+    Why: names come from downloaded files; an escape sequence echoed raw can rewrite the
+    terminal (move the cursor, hide text, set the title), and bidi overrides reorder what a
+    reader sees.
+    """
+    if text.isprintable():
+        return text
+    return text.translate(_CONTROL)
 
 
 def did_you_mean(suggestions: Sequence[str]) -> str:

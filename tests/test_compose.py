@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from robotspec.collision import CollisionRules
 from robotspec.compiler import check_spec, compile_robot
 from robotspec.description.srdf import write_srdf
-from robotspec.errors import RobotSpecError
+from robotspec.errors import RobotSpecError, SpecError
 from robotspec.export.srdf import srdf_from_robot
 from robotspec.export.urdf import bundle, joined_urdf, urdf_text
 from robotspec.model.kinematics import Kinematics
@@ -465,7 +465,11 @@ chains:
   arm: {{group: arm_manipulator}}
 """
     )
-    result = check_spec(spec)
+    # The part's package folder lies outside the spec's folder: refused until the user allows it.
+    with pytest.raises(SpecError) as info:
+        check_spec(spec)
+    assert info.value.line == 8 and "-P/--package-path" in info.value.message
+    result = check_spec(spec, package_paths=[ur])
     assert result.warnings == ()
     robot = result.robot
     assert robot is not None

@@ -78,3 +78,11 @@ def init(
             f"{len(draft.cameras)} cameras; check the lines marked DECIDE, then run "
             f"`robotspec validate {output}`\n"
         )
+    outside = [p for p in extra_paths if p.startswith("..") or Path(p).is_absolute()]
+    if outside:
+        # A spec may name package folders outside its own tree only with the user's leave.
+        allow = " ".join(f"-P {(folder / p).resolve()}" for p in outside)
+        sys.stderr.write(
+            f"note: package_paths outside the spec's folder are read only when allowed: "
+            f"pass {allow} (or set ROS_PACKAGE_PATH)\n"
+        )

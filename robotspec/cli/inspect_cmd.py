@@ -336,20 +336,17 @@ def tree_text(w: Any, labels: dict[str, list[str]]) -> str:
                 text += f" [{d.lower:.4g}, {d.upper:.4g}]"
         return f"  ({c.name}: {text})"
 
-    def walk(b: Any, prefix: str, last: bool, top: bool) -> None:
+    # An explicit stack, not recursion: a valid 2,000-joint chain is as deep as it is long.
+    stack: list[tuple[Any, str, bool, bool]] = [(w.root, "", True, True)]
+    while stack:
+        b, prefix, last, top = stack.pop()
         tag = "" if b.name not in labels else "  <" + "; ".join(labels[b.name]) + ">"
         branch = "" if top else ("└── " if last else "├── ")
         lines.append(f"{prefix}{branch}{b.name}{joint_text(b)}{tag}")
         kids = w.child_bodies(b)
-        for i, k in enumerate(kids):
-            walk(
-                k,
-                prefix if top else prefix + ("    " if last else "│   "),
-                i == len(kids) - 1,
-                False,
-            )
-
-    walk(w.root, "", True, True)
+        inner = prefix if top else prefix + ("    " if last else "│   ")
+        for i in reversed(range(len(kids))):
+            stack.append((kids[i], inner, i == len(kids) - 1, False))
     return "\n".join(lines)
 
 

@@ -12,13 +12,41 @@ import typer
 if TYPE_CHECKING:
     from robotspec.semantic import AbstractRobot
 
+
+def _package_folders(values: list[Path] | None) -> list[Path] | None:
+    """``-P`` folders made absolute against the current folder; a missing one is a usage error.
+
+    Why here: relative ``-P`` paths mean what the shell means (the current folder, not the
+    spec's), and a typo must not be searched silently as nothing.
+    """
+    if not values:
+        return values
+    out: list[Path] = []
+    missing: list[str] = []
+    for value in values:
+        folder = Path(os.path.normpath(Path(value).absolute()))
+        if not folder.is_dir():
+            missing.append(str(folder))
+        out.append(folder)
+    if missing:
+        raise typer.BadParameter(
+            "folder does not exist: "
+            + ", ".join(missing)
+            + f" (searched: {', '.join(map(str, out))})",
+            param_hint="'--package-path' / '-P'",
+        )
+    return out
+
+
 PackagePath = Annotated[
     list[Path] | None,
     typer.Option(
         "--package-path",
         "-P",
-        help="Extra folder to search for ROS packages (repeatable).",
+        help="Extra folder to search for ROS packages (repeatable); it may also be read. "
+        "Relative to the current folder; it must exist.",
         show_default=False,
+        callback=_package_folders,
     ),
 ]
 OutputFile = Annotated[

@@ -10,7 +10,7 @@ from typing import TextIO
 
 import typer
 
-from robotspec.errors import ErrorDetail, RobotSpecError
+from robotspec.errors import ErrorDetail, RobotSpecError, printable
 
 EXIT_OK = 0
 EXIT_INVALID = 1
@@ -33,8 +33,11 @@ def use_colour(stream: TextIO) -> bool:
 
 
 def styled(detail: ErrorDetail, stream: TextIO) -> str:
-    """``file:line:col: error: message``, with the position bold and the severity coloured."""
-    text = detail.render()
+    """``file:line:col: error: message``, with the position bold and the severity coloured.
+
+    Control characters from names in the input are escaped, never sent to the terminal.
+    """
+    text = printable(detail.render())
     if not use_colour(stream):
         return text
     marker = f": {detail.severity}: "
@@ -78,7 +81,7 @@ def run_app(app: typer.Typer, argv: Sequence[str] | None) -> int:
         if _verbose(args):
             traceback.print_exc()
         sys.stderr.write(
-            f"internal error: {type(exc).__name__}: {exc}\n"
+            f"internal error: {type(exc).__name__}: {printable(str(exc))}\n"
             "This is a bug in robotspec; rerun with --verbose and report the traceback.\n"
         )
         return EXIT_INTERNAL

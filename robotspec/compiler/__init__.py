@@ -151,7 +151,9 @@ def _compile(
 ) -> CompileResult:
     from robotspec.description.load import load_description, resolve_file
     from robotspec.description.srdf import check_srdf_against, check_srdf_references
+    from robotspec.spec.load import check_package_paths
 
+    check_package_paths(loaded, package_paths)
     composition = None
     if loaded.spec.parts:
         from robotspec.compose import compose

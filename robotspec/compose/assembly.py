@@ -36,7 +36,7 @@ from robotspec.errors import RobotSpecError, SpecError
 from robotspec.files.packages import PackageResolver
 from robotspec.files.yamlio import LocatedYaml, validation_errors
 from robotspec.shipped import shipped_part_files, shipped_spec_files
-from robotspec.spec.load import LoadedSpec, load_spec, merge_data
+from robotspec.spec.load import LoadedSpec, check_package_paths, load_spec, merge_data
 from robotspec.spec.models import AttachSpec, DescriptionSpec, PartSpec, RobotSpec
 
 __all__ = ["ComposedPart", "Composition", "compose", "description_tree"]
@@ -106,7 +106,7 @@ def description_tree(
     compilation whose package-folder crawls are reused (parts search the same folders).
     """
     from robotspec.description.load import read_urdf_tree, resolve_file
-    from robotspec.description.urdf_check import check_urdf_tree
+    from robotspec.description.urdf_walk import check_urdf_tree
 
     tree, urdf, resolver = read_urdf_tree(
         desc.urdf,
@@ -170,6 +170,7 @@ def _load_part(
                 diag.error((*loc, "spec"), f"parts include each other: {chain}")
                 return None
             part_loaded = load_spec(path)
+            check_package_paths(part_loaded, package_paths)
             if part_loaded.spec.parts:
                 inner = compose(part_loaded, package_paths=package_paths, _seen=seen)
                 flat = inner.loaded
@@ -483,6 +484,7 @@ def compose(
     _seen: tuple[Path, ...] = (),
 ) -> Composition:
     """Join the parts of a composed spec; every problem is raised together."""
+    check_package_paths(loaded, package_paths)
     spec = loaded.spec
     diag = Diagnostics(loaded)
     seen = (*_seen, loaded.file.resolve())

@@ -219,16 +219,22 @@ class Srdf:
         out: dict[str, None] = {}
         seen: set[str] = set()
 
-        def visit(group: Group) -> None:
-            if group.name in seen:
-                return
+        # An explicit stack, not recursion: a 1,500-deep chain of subgroups is valid input.
+        first = self.group(name)
+        seen.add(first.name)
+        out.update(dict.fromkeys(first.joints))
+        stack: list[Iterator[str]] = [iter(first.subgroups)]
+        while stack:
+            sub = next(stack[-1], None)
+            if sub is None:
+                stack.pop()
+                continue
+            group = by_name.get(sub)
+            if group is None or group.name in seen:
+                continue
             seen.add(group.name)
             out.update(dict.fromkeys(group.joints))
-            for sub in group.subgroups:
-                if sub in by_name:
-                    visit(by_name[sub])
-
-        visit(self.group(name))
+            stack.append(iter(group.subgroups))
         return list(out)
 
     def disabled_pairs(self) -> frozenset[frozenset[str]]:
@@ -252,15 +258,17 @@ def load_srdf(path: str | Path, *, strict: bool = True) -> Srdf:
 
     A missing or unreadable file is an SrdfError naming it.
     """
+    from robotspec.files.limits import limits
+    from robotspec.files.reading import read_bounded
+
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except FileNotFoundError:
-        raise SrdfError("file not found", file=str(p)) from None
-    except IsADirectoryError:
-        raise SrdfError("is a directory, not an SRDF file", file=str(p)) from None
-    except OSError as exc:
-        raise SrdfError(f"cannot read file: {exc.strerror}", file=str(p)) from None
+    data = read_bounded(
+        p,
+        cap=limits().max_srdf_bytes,
+        cap_name="max_srdf_bytes",
+        what="an SRDF file",
+        error_type=SrdfError,
+    )
     return parse_srdf_bytes(data, str(p), strict=strict)
 
 
@@ -270,7 +278,7 @@ def parse_srdf_bytes(data: bytes, file: str | None = None, *, strict: bool = Tru
     Raises one SrdfError, or a RobotSpecErrors holding every problem found, in file order.
     """
     try:
-        root = parse_xml_bytes(data, file or "<string>", SrdfError)
+        root = parse_xml_bytes(data, file or "<string>", SrdfError, cap_name="max_srdf_bytes")
     except RobotSpecError as exc:
         if file is None:
             raise exc.located(file=None, line=exc.line, column=exc.column) from None
@@ -561,25 +569,30 @@ def _cycle_errors(srdf: Srdf) -> list[RobotSpecError]:
     state: dict[str, int] = {}  # 1: on the current path, 2: done
     found: dict[tuple[str, ...], Group] = {}
 
-    def visit(name: str, path: list[str]) -> None:
-        state[name] = 1
-        path.append(name)
-        for sub in by_name[name].subgroups:
+    # Depth-first with an explicit stack (a deep but valid subgroup chain must not recurse).
+    for start_name in by_name:
+        if start_name in state:
+            continue
+        path = [start_name]
+        state[start_name] = 1
+        stack: list[Iterator[str]] = [iter(by_name[start_name].subgroups)]
+        while stack:
+            sub = next(stack[-1], None)
+            if sub is None:
+                stack.pop()
+                state[path.pop()] = 2
+                continue
             if sub not in by_name:
                 continue
             if state.get(sub) == 1:
                 cycle = path[path.index(sub) :]
-                start = min(range(len(cycle)), key=lambda i: order[cycle[i]])
-                key = tuple(cycle[start:] + cycle[:start])
+                first = min(range(len(cycle)), key=lambda i: order[cycle[i]])
+                key = tuple(cycle[first:] + cycle[:first])
                 found.setdefault(key, by_name[key[0]])
             elif sub not in state:
-                visit(sub, path)
-        path.pop()
-        state[name] = 2
-
-    for name in by_name:
-        if name not in state:
-            visit(name, [])
+                state[sub] = 1
+                path.append(sub)
+                stack.append(iter(by_name[sub].subgroups))
     return [
         SrdfError(
             f"groups contain each other: {' -> '.join((*cycle, cycle[0]))}",

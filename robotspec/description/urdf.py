@@ -1,8 +1,8 @@
 """Build a :class:`~robotspec.model.world.World` from a URDF or xacro file.
 
-The pipeline is: read the file safely (``xmlsafe``; xacro first if it is one), check the element
-tree with line numbers (``urdf_check``), let yourdfpy interpret the elements into its records, and
-turn those into frozen world records. Mesh URIs are resolved through one
+The pipeline is: read the file safely (bounded, ``xmlsafe``; xacro first if it is one), walk the
+element tree once (``urdf_walk``: every element checked with its line and made a record), and turn
+those records into frozen world records. Mesh URIs are resolved through one
 :class:`~robotspec.files.packages.PackageResolver`, so ``package://``, ``file://`` and relative
 paths all stay inside the allowed roots.
 """
@@ -12,12 +12,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from lxml import etree
 
-from robotspec.errors import DescriptionError, RobotSpecError, missing_file, raise_collected
+from robotspec.errors import DescriptionError, RobotSpecError, raise_collected
 from robotspec.model.geometry import (
     Box,
     Capsule,
@@ -26,12 +26,13 @@ from robotspec.model.geometry import (
     Mesh,
     Shape,
     Sphere,
-    frozen_array,
 )
 
 if TYPE_CHECKING:
     from robotspec.files.packages import PackageResolver
-from robotspec.description.urdf_check import check_urdf_tree, geometry_element, parse_floats
+from robotspec.description.urdf_walk import JointRecord, ShapeRecord, walk_urdf
+from robotspec.files.limits import limits
+from robotspec.files.reading import read_bounded
 from robotspec.files.xmlsafe import line_of, parse_xml_bytes
 from robotspec.model.world import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic, World
 
@@ -56,14 +57,14 @@ def read_description_xml(
     path: Path, resolver: PackageResolver, xacro_args: Mapping[str, str] | None = None
 ) -> etree._Element:
     """The URDF element tree of ``path``, running xacro first when the file is xacro."""
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise missing_file(path, DescriptionError) from None
-    except IsADirectoryError:
-        raise DescriptionError("is a directory, not a URDF file", file=str(path)) from None
-    except OSError as exc:
-        raise DescriptionError(f"cannot read file: {exc.strerror}", file=str(path)) from None
+    cap = limits()
+    data = read_bounded(
+        path,
+        cap=max(cap.max_urdf_bytes, cap.max_xacro_include_bytes),
+        cap_name="max_urdf_bytes",
+        what="a URDF file",
+        error_type=DescriptionError,
+    )
     if is_xacro(path, data):
         from robotspec.files.xacro import process_xacro
 
@@ -102,40 +103,26 @@ def world_from_urdf_xml(
     issues: list[RobotSpecError] | None = None,
     checked: bool = False,
 ) -> World:
-    """Interpret a checked URDF element tree as a world; all problems are raised together.
+    """Interpret a URDF element tree as a world; all problems are raised together.
 
     With ``meshes="report"``, unresolvable meshes are appended to ``issues`` as warnings.
-    ``checked=True`` skips :func:`check_urdf_tree` for a tree whose pieces were checked in their
-    own files already (a composed robot's parts), where its line numbers would mislead.
+    ``checked=True`` marks a tree whose pieces were checked in their own files already (a
+    composed robot's parts): its problems are still found, but reported without lines, which
+    would point into the joined tree rather than a file.
     """
-    import yourdfpy
-
-    if not checked:
-        check_urdf_tree(root, file)
-    # yourdfpy's own loader strips comments before parsing; its element parser needs the same.
-    etree.strip_tags(root, etree.Comment)
     try:
-        robot = yourdfpy.URDF._parse_robot(xml_element=root)
-    except (ValueError, TypeError, AttributeError, KeyError) as exc:
-        # The tree passed our checks, so this is a construct we do not check for yet.
-        raise DescriptionError(f"cannot interpret URDF: {exc}", file=file) from None
-    link_el = {el.get("name"): el for el in root.iterfind("link")}
-    joint_el = {el.get("name", ""): el for el in root.iterfind("joint")}
+        records = walk_urdf(root, file)
+    except RobotSpecError as exc:
+        if checked:
+            raise exc.located(file=file, line=None) from None
+        raise
     problems: list[RobotSpecError] = []
     bodies: list[Body] = []
     body_index: dict[str, int] = {}
     base = Path(file).parent
-    for link in robot.links:
-        el = link_el[link.name]
-        visuals = _shapes(
-            link.visuals, el.iterfind("visual"), file, base, resolver, meshes, problems
-        )
-        collisions = _shapes(
-            link.collisions, el.iterfind("collision"), file, base, resolver, meshes, problems
-        )
-        mass = None
-        if link.inertial is not None and link.inertial.mass is not None:
-            mass = float(link.inertial.mass)
+    for link in records.links:
+        visuals = _shapes(link.visuals, file, base, resolver, meshes, problems)
+        collisions = _shapes(link.collisions, file, base, resolver, meshes, problems)
         body_index[link.name] = len(bodies)
         bodies.append(
             Body(
@@ -143,16 +130,16 @@ def world_from_urdf_xml(
                 index=len(bodies),
                 visuals=visuals,
                 collisions=collisions,
-                mass=mass,
-                line=line_of(el),
+                mass=link.mass,
+                line=line_of(link.element),
             )
         )
     raise_collected(problems)
-    joints = {j.name: j for j in robot.joints}
-    leaders = _resolve_mimics(joints, joint_el, file)
+    joints = {j.name: j for j in records.joints}
+    leaders = _resolve_mimics(joints, file)
     dofs: list[DegreeOfFreedom] = []
     own_dofs: dict[str, tuple[int, ...]] = {}
-    for j in robot.joints:
+    for j in records.joints:
         jtype = ConnectionType(j.type)
         if j.name in leaders or jtype.dof_count == 0:
             continue
@@ -172,7 +159,7 @@ def world_from_urdf_xml(
             )
         own_dofs[j.name] = tuple(range(start, len(dofs)))
     connections: list[Connection] = []
-    for j in robot.joints:
+    for j in records.joints:
         jtype = ConnectionType(j.type)
         mimic = None
         dof_idx = own_dofs.get(j.name, ())
@@ -186,15 +173,14 @@ def world_from_urdf_xml(
                         f"joint '{j.name}' mimics '{leader}', a {joints[leader].type} joint; "
                         "only revolute, continuous and prismatic joints can be mimicked",
                         file=file,
-                        line=line_of(joint_el[j.name]),
+                        line=line_of(j.element),
                         kind="joint",
                         name=j.name,
                     )
                 )
                 continue
-        axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, float)
+        axis = np.asarray(j.axis, dtype=np.float64)
         axis = axis / np.linalg.norm(axis) if jtype is not ConnectionType.FIXED else axis
-        origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=np.float64)
         connections.append(
             Connection(
                 name=j.name,
@@ -202,35 +188,34 @@ def world_from_urdf_xml(
                 type=jtype,
                 parent=body_index[j.parent],
                 child=body_index[j.child],
-                origin=frozen_array(origin),
+                origin=j.origin,
                 axis=(float(axis[0]), float(axis[1]), float(axis[2])),
                 dofs=dof_idx,
                 mimic=mimic,
-                line=line_of(joint_el[j.name]),
+                line=line_of(j.element),
             )
         )
     raise_collected(problems)
-    return World(robot.name, bodies, connections, dofs, source=file)
+    return World(records.name, bodies, connections, dofs, source=file)
 
 
-def _limits(j: Any, jtype: ConnectionType) -> tuple[float, float, float, float]:
-    lim = j.limit
+def _limits(j: JointRecord, jtype: ConnectionType) -> tuple[float, float, float, float]:
     lower, upper = -math.inf, math.inf
     vel, eff = math.inf, math.inf
-    if lim is not None:
+    if j.element.find("limit") is not None:
         if jtype in (ConnectionType.REVOLUTE, ConnectionType.PRISMATIC):
-            lower = 0.0 if lim.lower is None else float(lim.lower)
-            upper = 0.0 if lim.upper is None else float(lim.upper)
+            lower = 0.0 if j.lower is None else j.lower
+            upper = 0.0 if j.upper is None else j.upper
         # A velocity or effort limit of 0 means "not given" in many vendor files.
-        if lim.velocity:
-            vel = float(lim.velocity)
-        if lim.effort:
-            eff = float(lim.effort)
+        if j.velocity:
+            vel = j.velocity
+        if j.effort:
+            eff = j.effort
     return lower, upper, vel, eff
 
 
 def _resolve_mimics(
-    joints: Mapping[str, Any], joint_el: Mapping[str, etree._Element], file: str
+    joints: Mapping[str, JointRecord], file: str
 ) -> dict[str, tuple[str, float, float]]:
     """Map each mimic joint to its ultimate leader with composed multiplier and offset."""
     out: dict[str, tuple[str, float, float]] = {}
@@ -242,22 +227,22 @@ def _resolve_mimics(
         mult, off = 1.0, 0.0
         current = name
         seen = {name}
-        while (
-            joints[current].mimic is not None
-            and ConnectionType(joints[current].type).dof_count == 1
-        ):
-            m = joints[current].mimic
-            m_mult = 1.0 if m.multiplier is None else float(m.multiplier)
-            m_off = 0.0 if m.offset is None else float(m.offset)
+        while True:
+            record = joints.get(current)
+            if record is None or record.mimic is None:
+                break
+            if ConnectionType(record.type).dof_count != 1:
+                break
+            leader, m_mult, m_off = record.mimic
             # q_current = m_mult * q_next + m_off, so compose outward-in.
             off = mult * m_off + off
             mult = mult * m_mult
-            current = m.joint
+            current = leader
             if current in seen:
                 raise DescriptionError(
                     f"mimic joints form a cycle through joint '{name}'",
                     file=file,
-                    line=line_of(joint_el[name]),
+                    line=line_of(j.element),
                     kind="joint",
                     name=name,
                 )
@@ -267,8 +252,7 @@ def _resolve_mimics(
 
 
 def _shapes(
-    records: list[Any],
-    elements: Any,
+    records: tuple[ShapeRecord, ...],
     file: str,
     base: Path,
     resolver: PackageResolver | None,
@@ -276,56 +260,41 @@ def _shapes(
     problems: list[RobotSpecError],
 ) -> tuple[Shape, ...]:
     out: list[Shape] = []
-    for rec, el in zip(records, elements, strict=True):
-        geom_el = geometry_element(el.find("geometry"))
-        assert geom_el is not None  # checked by check_urdf_tree
-        geometry = _geometry(rec.geometry, geom_el, file, base, resolver, meshes, problems)
+    for rec in records:
+        geometry = _geometry(rec, file, base, resolver, meshes, problems)
         if geometry is None:
             continue
-        origin = np.eye(4) if rec.origin is None else np.asarray(rec.origin, dtype=np.float64)
-        rgba = None
-        material = getattr(rec, "material", None)
-        if material is not None and material.color is not None:
-            c = material.color.rgba
-            rgba = (float(c[0]), float(c[1]), float(c[2]), float(c[3]))
         out.append(
             Shape(
                 geometry=geometry,
-                origin=frozen_array(origin),
+                origin=rec.origin,
                 name=rec.name,
-                line=line_of(el),
-                rgba=rgba,
+                line=line_of(rec.element),
+                rgba=rec.rgba,
             )
         )
     return tuple(out)
 
 
 def _geometry(
-    g: Any,
-    el: etree._Element,
+    rec: ShapeRecord,
     file: str,
     base: Path,
     resolver: PackageResolver | None,
     meshes: MeshPolicy,
     problems: list[RobotSpecError],
 ) -> GeometryShape | None:
+    el, v = rec.shape, rec.values
     if el.tag == "capsule":
-        return Capsule(radius=float(el.get("radius", "nan")), length=float(el.get("length", "nan")))
-    if g.box is not None:
-        s = g.box.size
-        return Box(size=(float(s[0]), float(s[1]), float(s[2])))
-    if g.cylinder is not None:
-        return Cylinder(radius=float(g.cylinder.radius), length=float(g.cylinder.length))
-    if g.sphere is not None:
-        return Sphere(radius=float(g.sphere.radius))
-    uri = str(g.mesh.filename)
-    scale_attr = el.get("scale")
-    scale = (1.0, 1.0, 1.0)
-    if scale_attr is not None:
-        vals = parse_floats(
-            scale_attr, len(scale_attr.replace(",", " ").split()), "mesh scale", el, file
-        )
-        scale = (vals[0], vals[0], vals[0]) if len(vals) == 1 else (vals[0], vals[1], vals[2])
+        return Capsule(radius=v[0], length=v[1])
+    if el.tag == "box":
+        return Box(size=(v[0], v[1], v[2]))
+    if el.tag == "cylinder":
+        return Cylinder(radius=v[0], length=v[1])
+    if el.tag == "sphere":
+        return Sphere(radius=v[0])
+    uri = el.get("filename") or ""
+    scale = (v[0], v[1], v[2])
     path: str | None = None
     if meshes != "keep":
         if resolver is None:

@@ -17,7 +17,7 @@ from typing import Any
 from lxml import etree
 
 from robotspec.compiler import CompileResult
-from robotspec.spec.load import LoadedSpec, load_spec
+from robotspec.spec.load import LoadedSpec, check_package_paths, load_spec
 
 __all__ = ["Bundle", "bundle", "joined_urdf", "urdf_text"]
 
@@ -30,6 +30,7 @@ def joined_urdf(loaded: LoadedSpec, *, package_paths: Sequence[str | Path] = ())
     """
     from robotspec.compose import compose, description_tree
 
+    check_package_paths(loaded, package_paths)
     if loaded.spec.parts:
         return compose(loaded, package_paths=package_paths).urdf
     return description_tree(loaded.spec.files, loaded.folder, package_paths)[0]

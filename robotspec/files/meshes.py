@@ -6,10 +6,14 @@ broken file with the same message; each caller names the error type its users ex
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 import numpy.typing as npt
 
 from robotspec.errors import RobotSpecError
+from robotspec.files.limits import limits
+from robotspec.files.reading import read_bounded
 
 __all__ = ["read_triangles"]
 
@@ -22,12 +26,19 @@ def read_triangles(
 
     suffix = path.rsplit(".", 1)[-1].lower() if "." in path else ""
     try:
-        with open(path, "rb") as f:
-            mesh = trimesh.load(f, file_type=suffix, force="mesh", process=False)
-    except FileNotFoundError:
-        raise error_type("mesh file not found", file=path, kind="mesh") from None
-    except OSError as exc:
-        raise error_type(f"cannot read mesh: {exc.strerror}", file=path, kind="mesh") from None
+        data = read_bounded(
+            path,
+            cap=limits().max_mesh_bytes,
+            cap_name="max_mesh_bytes",
+            what="a mesh file",
+            error_type=error_type,
+        )
+    except RobotSpecError as exc:
+        if exc.detail.kind == "file" and exc.message.startswith("file not found"):
+            raise error_type("mesh file not found", file=path, kind="mesh") from None
+        raise
+    try:
+        mesh = trimesh.load(io.BytesIO(data), file_type=suffix, force="mesh", process=False)
     except Exception as exc:  # trimesh and its readers raise anything on a corrupt file
         raise error_type(
             f"cannot read mesh: {type(exc).__name__}: {exc}", file=path, kind="mesh"

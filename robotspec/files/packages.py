@@ -27,7 +27,7 @@ from robotspec.errors import (
     did_you_mean,
 )
 
-__all__ = ["PackageResolver"]
+__all__ = ["PackageResolver", "user_roots"]
 
 #: How deep below a search folder the crawl looks for ``package.xml`` (rospack crawls without a
 #: bound; a bound keeps a stray ``/`` or home folder on the path from scanning the disk).
@@ -155,7 +155,9 @@ def _walk_up(description_folder: Path) -> tuple[list[Path], list[Path]]:
 
     Why walk up: a description usually sits inside its own package (``pkg/urdf/robot.urdf``)
     whose siblings (``pkg_meshes``) are what ``package://`` names, exactly as in a catkin
-    ``src`` folder.
+    ``src`` folder. The enclosing package becomes readable, its parent folder only searched:
+    a ``package.xml`` never widens the roots beyond its own package (the packages found beside
+    it are readable each on its own, see :meth:`PackageResolver.is_allowed`).
     """
     home = Path(os.path.normpath(Path.home().absolute()))
     search = [description_folder]
@@ -170,6 +172,29 @@ def _walk_up(description_folder: Path) -> tuple[list[Path], list[Path]]:
                 search.append(folder.parent)
         folder = folder.parent
     return search, roots
+
+
+def user_roots(
+    extra_paths: Sequence[str | Path] = (),
+    *,
+    use_environment: bool = True,
+    use_example_robot_data: bool = True,
+    environ: Mapping[str, str] | None = None,
+) -> list[Path]:
+    """The folders the *user* allows: ``-P`` folders, the ROS environment, installed data.
+
+    Why a function of its own: allowed roots come from the user, never from the input, so a
+    spec's ``package_paths`` are checked against exactly these (see
+    :func:`robotspec.spec.load.check_package_paths`).
+    """
+    env = os.environ if environ is None else environ
+    folders: list[Path] = [Path(p).absolute() for p in extra_paths]
+    if use_environment:
+        folders += [p.absolute() for p in _split_path_list(env.get("ROS_PACKAGE_PATH"))]
+        folders += [p.absolute() / "share" for p in _split_path_list(env.get("AMENT_PREFIX_PATH"))]
+    if use_example_robot_data:
+        folders += _example_robot_data_folders()
+    return [Path(os.path.normpath(f)) for f in folders]
 
 
 def _has_dotdot(path: str) -> bool:
@@ -203,6 +228,8 @@ class PackageResolver:
     bare_name_folders: tuple[Path, ...] = ()
     #: Folders whose children are packages and are not crawled into (example-robot-data's).
     flat_folders: tuple[Path, ...] = ()
+    #: Folders the caller asked to search that do not exist (listed in "searched:").
+    missing_folders: tuple[Path, ...] = ()
     _index: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
     #: Crawled folders (folder, bare, flat) -> packages; shared by resolvers of one compilation.
     _crawls: dict[tuple[Path, bool, bool], dict[str, Path]] = field(
@@ -246,15 +273,14 @@ class PackageResolver:
                 one reuses (and adds to): parts of a composed robot search the same folders.
         """
         env = os.environ if environ is None else environ
-        folders: list[Path] = [Path(p).absolute() for p in extra_paths]
+        given = [Path(os.path.normpath(Path(p).absolute())) for p in extra_paths]
+        missing = tuple(p for p in given if not p.is_dir())
+        folders: list[Path] = list(given)
         if use_environment:
-            folders += [p.absolute() for p in _split_path_list(env.get("ROS_PACKAGE_PATH"))]
-            folders += [
-                p.absolute() / "share" for p in _split_path_list(env.get("AMENT_PREFIX_PATH"))
-            ]
+            folders += user_roots(environ=env, use_example_robot_data=False)
         bare = list(folders)
         desc: Path | None = None
-        roots: list[Path] = []
+        roots: list[Path] = list(folders)
         if description is not None:
             desc = Path(description).absolute()
             near, package_roots = _walk_up(Path(os.path.normpath(desc.parent)))
@@ -266,22 +292,28 @@ class PackageResolver:
             flat += erd
             folders += erd
             bare += erd
+            roots += erd
         search = _unique(Path(os.path.normpath(f)) for f in folders if f.is_dir())
         roots += [Path(p).absolute() for p in extra_allowed_roots]
-        all_roots = _unique(Path(os.path.normpath(r)) for r in [*search, *roots])
+        all_roots = _unique(Path(os.path.normpath(r)) for r in roots)
         return cls(
             search_folders=search,
             roots=all_roots,
             description=desc,
             bare_name_folders=_unique(Path(os.path.normpath(f)) for f in bare if f.is_dir()),
             flat_folders=_unique(Path(os.path.normpath(f)) for f in flat if f.is_dir()),
+            missing_folders=missing,
             _crawls={} if share_crawls_with is None else share_crawls_with._crawls,
         )
 
     @property
     def allowed_roots(self) -> tuple[Path, ...]:
-        """The folders (as given, and symlink-resolved) every resolved path must lie in."""
-        return _unique([*self.roots, *self._resolved_roots()])
+        """The folders (as given, and symlink-resolved) every resolved path must lie in.
+
+        These are :attr:`roots` and the packages found on the search path, each on its own.
+        """
+        packages = (Path(os.path.realpath(f)) for f in self._packages().values())
+        return _unique([*self.roots, *self._resolved_roots(), *packages])
 
     def _resolved_roots(self) -> list[Path]:
         if not self._real_roots:
@@ -352,7 +384,15 @@ class PackageResolver:
         for known, folder in index.items():
             by_folder.setdefault(folder, known)
         suggestions = closest_names(name, by_folder.values())
-        searched = ", ".join(str(f) for f in self.search_folders) or "(no folders)"
+        searched = (
+            ", ".join(
+                [
+                    *(str(f) for f in self.search_folders),
+                    *(f"{f} (does not exist)" for f in self.missing_folders),
+                ]
+            )
+            or "(no folders)"
+        )
         raise PackageNotFoundError(
             f"package '{name}' not found; searched: {searched}{did_you_mean(suggestions)}",
             file=file,
@@ -383,9 +423,17 @@ class PackageResolver:
         return Path(real_parent, name)
 
     def _inside(self, real: Path) -> bool:
+        """Inside an allowed root, or inside a package found on the search path.
+
+        Why packages too: a search folder that is not a root (the parent of the package around
+        the description) provides its packages, each readable on its own, but not the files
+        beside them.
+        """
         text = str(real)
         if not self._root_prefixes:
-            for r in self._resolved_roots():
+            folders = [*self._resolved_roots()]
+            folders += _unique(Path(os.path.realpath(f)) for f in self._packages().values())
+            for r in _unique(folders):
                 root = str(r)
                 self._root_prefixes.append((root, root.rstrip(os.sep) + os.sep))
         return any(text == root or text.startswith(prefix) for root, prefix in self._root_prefixes)

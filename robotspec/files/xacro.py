@@ -13,13 +13,18 @@ restores them afterwards:
 * ``open`` inside ``xacro`` (used for the top file, every ``<xacro:include>`` and
   ``xacro.load_yaml``) is shadowed by a guard that refuses paths outside the resolver's allowed
   roots and XML that declares entities, before minidom sees a byte.
-* ``${...}`` expressions are evaluated by xacro's own restricted evaluator: no builtins except
-  a few conversions and ``math``, and names starting with ``__`` refused. xacro 2.1.1 checks
-  that only for the outer expression, so ``${[x.__class__ for x in [0]]}`` reaches any Python
-  object; the guard here checks nested code (comprehensions, lambdas) too, and disables
-  ``python.vars``/``python.type``, which give the same reach through string keys.
-* ``$(eval ...)`` in xacro 2.1.1 runs with Python's full builtins (``open``, ``exec``); here it
-  gets only the conversions xacro meant to allow.
+* xacro's symbol table is made fresh for every document (``create_global_symbols``), so
+  nothing a document does to ``math`` or ``xacro`` is seen by the next one.
+* ``${...}`` and ``$(eval ...)`` are evaluated by :class:`~robotspec.files.xacro_sandbox.Budget`:
+  a checked and rewritten expression with no route to module globals, and budgets of value
+  size, integer size, loop steps and wall time; macro calls are counted and their nesting
+  bounded. ``python.vars``/``python.type`` are disabled (they reach object internals).
+* ``xacro.load_yaml`` reads through robotspec's bounded YAML reader (depth and alias caps)
+  and the same allowed roots.
+
+Every budget is a field of :class:`~robotspec.files.limits.Limits`, raised with an environment
+variable. The hooks are module globals of xacro 2.x, which is why ``pyproject.toml`` pins
+``xacro>=2.0,<2.2``; ``tests/test_xacro.py`` checks the hooks still exist.
 """
 
 from __future__ import annotations
@@ -29,15 +34,16 @@ import io
 import os
 import re
 import threading
-import types
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 from xml.parsers import expat
 
 from robotspec.errors import DescriptionError, PathOutsideRootsError, RobotSpecError
+from robotspec.files.limits import limits
 from robotspec.files.packages import PackageResolver
-from robotspec.files.xmlsafe import MAX_XML_BYTES
+from robotspec.files.reading import read_bounded, refuse_entities
+from robotspec.files.xacro_sandbox import Budget, math_limits, unbounded_math
 
 __all__ = ["process_xacro"]
 
@@ -54,90 +60,88 @@ def _current_file(xacro: Any) -> str | None:
     return str(stack[-1]) if stack else None
 
 
-def _check_entities(data: bytes, file: str) -> None:
-    """Refuse XML declaring entities, with :mod:`robotspec.files.xmlsafe`'s wording.
-
-    Why here: xacro parses with minidom (expat), which expands internal entities.
-    """
-    doctype = data.find(b"<!DOCTYPE")
-    if doctype < 0:
+def _refuse_outside(resolver: PackageResolver, xacro: Any, filename: Any, path: str) -> None:
+    if resolver.is_allowed(path):
         return
-    entity = data.find(b"<!ENTITY", doctype)
-    if entity < 0:
-        return
-    name = data[entity + 8 : entity + 80].split()[:1]
-    shown = name[0].decode("utf-8", "replace") if name else "?"
-    raise DescriptionError(
-        f"XML entity declarations are not allowed (found '{shown}')",
-        file=file,
-        line=data.count(b"\n", 0, entity) + 1,
-        kind="entity",
-        name=shown,
+    stack = [str(f) for f in (getattr(xacro, "filestack", None) or []) if f]
+    # xacro pushes an include on its file stack before opening it; report the includer.
+    if stack and os.path.abspath(stack[-1]) == path:
+        stack.pop()
+    shown = ", ".join(str(r) for r in resolver.roots) or "none"
+    raise PathOutsideRootsError(
+        f"xacro file '{filename}' resolves to {os.path.realpath(path)}, "
+        f"outside the allowed folders ({shown})",
+        file=stack[-1] if stack else None,
+        kind="path",
+        name=str(filename),
     )
 
 
-def _guarded_open(resolver: PackageResolver, xacro: Any) -> Callable[..., Any]:
-    """An ``open`` for xacro's module: reads only allowed files, refuses entity declarations."""
+def _guarded_open(resolver: PackageResolver, xacro: Any, budget: Budget) -> Callable[..., Any]:
+    """An ``open`` for xacro's module: allowed files only, bounded, no entity declarations."""
 
     def guarded(filename: Any, mode: str = "r", *args: Any, **kwargs: Any) -> Any:
         if any(c in mode for c in "wax+"):
             raise DescriptionError(f"xacro tried to write '{filename}'", file=_current_file(xacro))
         path = os.path.abspath(os.fspath(filename))
-        stack = [str(f) for f in (getattr(xacro, "filestack", None) or []) if f]
-        # xacro pushes an include on its file stack before opening it; report the includer.
-        if stack and os.path.abspath(stack[-1]) == path:
-            stack.pop()
-        includer = stack[-1] if stack else None
-        if not resolver.is_allowed(path):
-            shown = ", ".join(str(r) for r in resolver.roots) or "none"
-            raise PathOutsideRootsError(
-                f"xacro file '{filename}' resolves to {os.path.realpath(path)}, "
-                f"outside the allowed folders ({shown})",
-                file=includer,
-                kind="path",
-                name=str(filename),
+        _refuse_outside(resolver, xacro, filename, path)
+        budget.check_time()
+        budget.files_opened += 1
+        if budget.files_opened > budget.limits.max_xacro_includes:
+            raise budget.over(
+                "opened too many files", "max_xacro_includes", budget.limits.max_xacro_includes
             )
-        with open(path, "rb") as handle:  # OSError stays OSError: xacro handles optional includes
-            data = handle.read(MAX_XML_BYTES + 1)
-        if len(data) > MAX_XML_BYTES:
-            raise DescriptionError(f"file larger than {MAX_XML_BYTES} bytes", file=path)
-        if data.lstrip()[:1] == b"<":
-            _check_entities(data, path)
+        if not os.path.lexists(path):  # an OSError: xacro skips optional includes on it
+            raise FileNotFoundError(2, "No such file or directory", str(filename))
+        data = read_bounded(
+            path,
+            cap=budget.limits.max_xacro_include_bytes,
+            cap_name="max_xacro_include_bytes",
+            what="a xacro file",
+            error_type=DescriptionError,
+        )
+        refuse_entities(data, path, DescriptionError)
         return io.BytesIO(data)
 
     return guarded
 
 
-def _nested_names(code: types.CodeType) -> Iterator[str]:
-    yield from code.co_names
-    for const in code.co_consts:
-        if isinstance(const, types.CodeType):
-            yield from _nested_names(const)
+def _load_yaml(resolver: PackageResolver, xacro: Any, budget: Budget) -> Callable[[str], Any]:
+    """``xacro.load_yaml`` through the allowed roots and robotspec's bounded YAML reader."""
+    import yaml
 
+    from robotspec.files.yamlio import check_yaml_shape
 
-def _strict_safe_eval(original: Callable[..., Any]) -> Callable[..., Any]:
-    """A ``safe_eval`` for xacro whose dunder check also covers nested code objects."""
+    class Loader(yaml.SafeLoader):
+        """xacro's unit tags (``!degrees``) on a private loader, not on PyYAML's global one."""
 
-    def safe_eval(expr: str, globals: Any, locals: Any = None) -> Any:
-        code = compile(expr.strip(), "<expression>", "eval")
-        bad = sorted({n for n in _nested_names(code) if n.startswith("__")})
-        if bad:
-            raise DescriptionError(
-                f"xacro expression uses {', '.join(bad)}, which robotspec does not allow "
-                f"(dunder names reach outside xacro's sandbox): '{expr.strip()}'"
-            )
-        return original(expr, globals, locals)
+    for unit in xacro.ConstructUnits:
+        Loader.add_constructor(unit.value.tag, unit.constructor)
 
-    return safe_eval
+    def load_yaml(filename: Any) -> Any:
+        name = xacro.abs_filename_spec(str(filename))
+        path = os.path.abspath(name)
+        _refuse_outside(resolver, xacro, filename, path)
+        budget.check_time()
+        data = read_bounded(
+            path,
+            cap=budget.limits.max_yaml_bytes,
+            cap_name="max_yaml_bytes",
+            what="a YAML file",
+            error_type=DescriptionError,
+        )
+        text = data.decode("utf-8", errors="replace")
+        check_yaml_shape(text, path)
+        xacro.filestack.append(name)
+        try:
+            return xacro.YamlListWrapper.wrap(yaml.load(text, Loader=Loader))  # noqa: S506
+        except yaml.YAMLError as exc:
+            raise DescriptionError(f"invalid YAML: {exc}", file=path) from None
+        finally:
+            xacro.filestack.pop()
+            xacro.all_includes.append(name)
 
-
-def _restricted_eval(builtins: Mapping[str, Any]) -> Callable[..., Any]:
-    """The ``eval`` of ``$(eval ...)``, with only the builtins xacro meant to expose."""
-
-    def restricted(source: str, _globals: Any, locals: Any = None) -> Any:
-        return eval(source, {"__builtins__": dict(builtins)}, locals)
-
-    return restricted
+    return load_yaml
 
 
 def _disabled(name: str) -> Callable[..., Any]:
@@ -149,8 +153,68 @@ def _disabled(name: str) -> Callable[..., Any]:
     return refuse
 
 
+def _fresh_symbols(xacro: Any, resolver: PackageResolver, budget: Budget) -> Any:
+    """Xacro's global symbol table, new for this document, with robotspec's replacements."""
+    symbols = xacro.create_global_symbols()
+    load = _load_yaml(resolver, xacro, budget)
+    bounded_range = budget.range
+    for table in (symbols, symbols.get("python"), symbols.get("xacro"), symbols.get("math")):
+        if table is None:
+            continue
+        for key in [k for k in dict.keys(table) if k in ("load_yaml", "range")]:
+            dict.__setitem__(table, key, load if key == "load_yaml" else bounded_range)
+    python_ns = symbols.get("python")
+    if python_ns is not None:
+        for key in _DISABLED_PYTHON_HELPERS:
+            dict.__setitem__(python_ns, key, _disabled(key))
+    _bound_math(symbols, budget)
+    math_ns = symbols.get("math")
+    if math_ns is not None:
+        _bound_math(math_ns, budget)
+    return symbols
+
+
+def _bound_math(table: dict[str, Any], budget: Budget) -> None:
+    for name, cap in math_limits().items():
+        if name in table:
+            dict.__setitem__(table, name, budget.bounded(dict.__getitem__(table, name), name, cap))
+    for name in unbounded_math():
+        if name in table:
+            dict.__delitem__(table, name)
+
+
+def _counted_macro_call(original: Callable[..., Any], budget: Budget) -> Callable[..., Any]:
+    """Xacro's ``handle_macro_call`` counting calls and nesting against the budget."""
+
+    def handle_macro_call(node: Any, macros: Any, symbols: Any) -> Any:
+        tag = getattr(node, "tagName", "")
+        if not (isinstance(tag, str) and tag.startswith("xacro:")):
+            return original(node, macros, symbols)
+        budget.check_time()
+        budget.macro_calls += 1
+        if budget.macro_calls > budget.limits.xacro_macro_calls:
+            raise budget.over(
+                f"expanded too many macro calls (in <{tag}>)",
+                "xacro_macro_calls",
+                budget.limits.xacro_macro_calls,
+            )
+        budget.macro_depth += 1
+        try:
+            if budget.macro_depth > budget.limits.xacro_macro_depth:
+                raise budget.over(
+                    f"macro calls nested too deeply (in <{tag}>)",
+                    "xacro_macro_depth",
+                    budget.limits.xacro_macro_depth,
+                )
+            return original(node, macros, symbols)
+        finally:
+            budget.macro_depth -= 1
+
+    return handle_macro_call
+
+
 @contextlib.contextmanager
-def _patched(resolver: PackageResolver) -> Iterator[Any]:
+def _patched(resolver: PackageResolver, budget: Budget) -> Iterator[Any]:
     """Install the hooks described in the module docstring; restore them on exit."""
     import xacro
     import xacro.substitution_args as subst
@@ -158,37 +222,38 @@ def _patched(resolver: PackageResolver) -> Iterator[Any]:
     def find(pkg: str) -> str:
         return str(resolver.find_package(pkg, file=_current_file(xacro)))
 
-    python_ns = xacro._global_symbols.get("python")
-    saved_python = {
-        k: dict.__getitem__(python_ns, k)
-        for k in _DISABLED_PYTHON_HELPERS
-        if python_ns is not None and k in python_ns
-    }
+    budget.namespace_types = (xacro.NameSpace,)
+    budget.mapping_types = (xacro.YamlDictWrapper,)
+    saved_symbols = xacro._global_symbols
     saved_find = subst._eval_find
-    saved_dict_find = subst._eval_dict.get("find")
+    saved_eval_dict = dict(subst._eval_dict)
     saved_safe_eval = xacro.safe_eval
+    saved_macro_call = xacro.handle_macro_call
     saved_includes = list(xacro.all_includes)
-    builtins = dict(subst._eval_dict.get("__builtins__", {}))
+    eval_builtins = dict(subst._eval_dict.get("__builtins__", {}))
     try:
+        xacro._global_symbols = _fresh_symbols(xacro, resolver, budget)
         subst._eval_find = find
         subst._eval_dict["find"] = find
-        subst.eval = _restricted_eval(builtins)
-        xacro.open = _guarded_open(resolver, xacro)
-        xacro.safe_eval = _strict_safe_eval(saved_safe_eval)
-        for k in saved_python:
-            dict.__setitem__(python_ns, k, _disabled(k))
+        _bound_math(subst._eval_dict, budget)
+        subst.eval = lambda source, _g, locals=None: budget.eval(
+            source, {}, locals, extra=eval_builtins
+        )
+        xacro.open = _guarded_open(resolver, xacro, budget)
+        xacro.safe_eval = budget.eval
+        xacro.handle_macro_call = _counted_macro_call(saved_macro_call, budget)
         yield xacro
     finally:
+        xacro._global_symbols = saved_symbols
         subst._eval_find = saved_find
-        if saved_dict_find is not None:
-            subst._eval_dict["find"] = saved_dict_find
+        subst._eval_dict.clear()
+        subst._eval_dict.update(saved_eval_dict)
         with contextlib.suppress(AttributeError):
             del subst.eval
         with contextlib.suppress(AttributeError):
             del xacro.open
         xacro.safe_eval = saved_safe_eval
-        for k, v in saved_python.items():
-            dict.__setitem__(python_ns, k, v)
+        xacro.handle_macro_call = saved_macro_call
         xacro.all_includes[:] = saved_includes
         xacro.substitution_args_context["arg"] = {}
 
@@ -229,7 +294,7 @@ def _convert(exc: BaseException, xacro: Any, top: Path) -> RobotSpecError:
     for inner in _chain(exc):
         if isinstance(inner, RobotSpecError):
             if inner.file is None:
-                return inner.located(file=file, line=inner.line, column=inner.column)
+                return inner.located(file=file, line=_expression_line(exc, file))
             return inner
     for inner in _chain(exc):
         if isinstance(inner, ArgException):
@@ -258,11 +323,23 @@ def _convert(exc: BaseException, xacro: Any, top: Path) -> RobotSpecError:
                 name=str(inner.filename),
             )
     message = _message(exc) or type(exc).__name__
-    expr = re.search(r"when evaluating expression '(.*)'", str(exc))
-    line = None
+    if len(message) > 400:
+        message = message[:400] + "..."
+    return DescriptionError(
+        f"xacro failed: {message}", file=file, line=_expression_line(exc, file), kind="xacro"
+    )
+
+
+def _expression_line(exc: BaseException, file: str) -> int | None:
+    """The line of the ``${...}`` xacro names in its message, or of the macro call."""
+    text = str(exc)
+    expr = re.search(r"when evaluating expression '(.*)'", text)
     if expr is not None:
-        line = _line_of(file, re.compile(r"\$\{" + re.escape(expr.group(1)) + r"\}"))
-    return DescriptionError(f"xacro failed: {message}", file=file, line=line, kind="xacro")
+        return _line_of(file, re.compile(r"\$\{" + re.escape(expr.group(1)) + r"\}"))
+    tag = re.search(r"\(in <(xacro:[\w.:-]+)>\)", text)
+    if tag is not None:
+        return _line_of(file, re.compile("<" + re.escape(tag.group(1)) + r"[\s/>]"))
+    return None
 
 
 def process_xacro(
@@ -286,22 +363,27 @@ def process_xacro(
     mappings = {str(k): str(v) for k, v in (args or {}).items()}
     top = Path(path)
     sink = io.StringIO()
-    with (
-        _LOCK,
-        contextlib.redirect_stdout(sink),
-        contextlib.redirect_stderr(sink),
-        _patched(resolver) as xacro,
-    ):
-        try:
-            doc = xacro.process_file(str(top), mappings=mappings)
-            text = doc.toprettyxml(indent="  ")
-        except RecursionError:
-            raise DescriptionError(
-                "xacro recursion too deep (a macro or include calls itself)", file=str(top)
-            ) from None
-        except Exception as exc:  # xacro raises anything; all become ours
-            raise _convert(exc, xacro, top) from None
-        finally:
-            xacro.filestack = None
-    data: bytes = text.encode("utf-8")
-    return data
+    with _LOCK:
+        budget = Budget(limits())  # the clock starts once the lock is held
+        with (
+            contextlib.redirect_stdout(sink),
+            contextlib.redirect_stderr(sink),
+            _patched(resolver, budget) as xacro,
+        ):
+            return _expand(xacro, top, mappings)
+
+
+def _expand(xacro: Any, top: Path, mappings: dict[str, str]) -> bytes:
+    """Run xacro on ``top`` with the hooks installed; every failure becomes ours."""
+    try:
+        doc = xacro.process_file(str(top), mappings=mappings)
+        text: str = doc.toprettyxml(indent="  ")
+    except RecursionError:
+        raise DescriptionError(
+            "xacro recursion too deep (a macro or include calls itself)", file=str(top)
+        ) from None
+    except Exception as exc:  # xacro raises anything; all become ours
+        raise _convert(exc, xacro, top) from None
+    finally:
+        xacro.filestack = None
+    return text.encode("utf-8")

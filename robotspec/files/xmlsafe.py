@@ -11,12 +11,11 @@ from pathlib import Path
 
 from lxml import etree
 
-from robotspec.errors import DescriptionError, RobotSpecError, missing_file
+from robotspec.errors import DescriptionError, RobotSpecError
+from robotspec.files.limits import env_name, limits
+from robotspec.files.reading import read_bounded, refuse_entities
 
 __all__ = ["parse_xml_bytes", "parse_xml_file", "safe_parser"]
-
-#: Robot descriptions are at most a few MB; refuse anything far larger before parsing.
-MAX_XML_BYTES = 64 * 1024 * 1024
 
 
 def safe_parser() -> etree.XMLParser:
@@ -64,26 +63,26 @@ def _check_no_entities(root: etree._Element, file: str) -> None:
 
 
 def parse_xml_bytes(
-    data: bytes, file: str, error_type: type[RobotSpecError] = DescriptionError
+    data: bytes,
+    file: str,
+    error_type: type[RobotSpecError] = DescriptionError,
+    *,
+    cap: int | None = None,
+    cap_name: str = "max_urdf_bytes",
 ) -> etree._Element:
-    """Parse ``data`` (the contents of ``file``) into an lxml element, safely."""
-    if len(data) > MAX_XML_BYTES:
-        raise error_type(f"XML file larger than {MAX_XML_BYTES} bytes", file=file)
-    # Entities are refused before libxml2 sees them: internal entities are expanded inside
-    # attribute values whatever the parser options say (billion laughs).
-    doctype = data.find(b"<!DOCTYPE")
-    if doctype >= 0:
-        entity = data.find(b"<!ENTITY", doctype)
-        if entity >= 0:
-            name = data[entity + 8 : entity + 80].split()[:1]
-            shown = name[0].decode("utf-8", "replace") if name else "?"
-            raise error_type(
-                f"XML entity declarations are not allowed (found '{shown}')",
-                file=file,
-                line=data.count(b"\n", 0, entity) + 1,
-                kind="entity",
-                name=shown,
-            )
+    """Parse ``data`` (the contents of ``file``) into an lxml element, safely.
+
+    ``cap`` (default: the URDF cap) bounds documents that did not come through
+    :func:`~robotspec.files.reading.read_bounded`, such as a xacro expansion's output.
+    """
+    limit = getattr(limits(), cap_name) if cap is None else cap
+    if len(data) > limit:
+        raise error_type(
+            f"XML document larger than {limit} bytes (set {env_name(cap_name)} to raise it)",
+            file=file,
+            kind="size",
+        )
+    refuse_entities(data, file, error_type)
     try:
         root: etree._Element | None = etree.fromstring(data, parser=safe_parser())
     except etree.XMLSyntaxError as exc:
@@ -100,16 +99,13 @@ def parse_xml_bytes(
 
 
 def parse_xml_file(
-    path: str | Path, error_type: type[RobotSpecError] = DescriptionError
+    path: str | Path,
+    error_type: type[RobotSpecError] = DescriptionError,
+    *,
+    cap_name: str = "max_urdf_bytes",
+    what: str = "an XML file",
 ) -> etree._Element:
-    """Read and parse an XML file safely; a missing or unreadable file is an error of our type."""
-    p = Path(path)
-    try:
-        data = p.read_bytes()
-    except FileNotFoundError:
-        raise missing_file(path, error_type) from None
-    except IsADirectoryError:
-        raise error_type("is a directory, not an XML file", file=str(path)) from None
-    except OSError as exc:
-        raise error_type(f"cannot read file: {exc.strerror}", file=str(path)) from None
-    return parse_xml_bytes(data, str(path), error_type)
+    """Read (bounded, regular files only) and parse an XML file safely."""
+    cap = getattr(limits(), cap_name)
+    data = read_bounded(path, cap=cap, cap_name=cap_name, what=what, error_type=error_type)
+    return parse_xml_bytes(data, str(path), error_type, cap=cap, cap_name=cap_name)

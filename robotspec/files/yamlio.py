@@ -19,14 +19,23 @@ from typing import Annotated, Any, Union, get_args, get_origin
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names, missing_file
+from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names
+from robotspec.files.limits import env_name, limits
+from robotspec.files.reading import read_bounded
 
-__all__ = ["LocatedYaml", "load_yaml", "load_yaml_text", "validation_errors"]
+__all__ = [
+    "LocatedYaml",
+    "check_yaml_shape",
+    "load_yaml",
+    "load_yaml_text",
+    "validation_errors",
+]
 
 Loc = tuple[str | int, ...]
 
-#: Refuse documents larger than this; a spec or RobotInfo is a few kB.
-MAX_YAML_BYTES = 8 * 1024 * 1024
+#: Integers wider than this many bits are refused (a spec or RobotInfo never needs more; a
+#: 5,000-digit integer would otherwise stop Python's int() with an internal error).
+MAX_INT_BITS = 64
 
 
 @dataclass(frozen=True)
@@ -74,8 +83,96 @@ class _PySafeComposer(yaml.SafeLoader):
     """The pure-Python loader, for its clearer syntax-error messages."""
 
 
-def _scalar(node: yaml.ScalarNode, loader: yaml.SafeLoader) -> Any:
-    return loader.construct_object(node, deep=True)
+def _scalar(node: yaml.ScalarNode, loader: yaml.SafeLoader, file: str) -> Any:
+    """The value of a plain scalar; a value its tag cannot hold is a located error."""
+    if node.tag.endswith(":int") and len(node.value) > 40:  # before int() works on it
+        raise RobotSpecError(
+            f"integer '{_clip(node.value)}' is too large (more than {MAX_INT_BITS} bits)",
+            file=file,
+            line=node.start_mark.line + 1,
+            column=node.start_mark.column + 1,
+        )
+    try:
+        value = loader.construct_object(node, deep=True)
+    except (ValueError, OverflowError, TypeError, yaml.YAMLError) as exc:
+        kind = node.tag.rsplit(":", 1)[-1]
+        reason = str(exc).split("\n")[0]
+        raise RobotSpecError(
+            f"invalid {kind} '{_clip(node.value)}': {reason}",
+            file=file,
+            line=node.start_mark.line + 1,
+            column=node.start_mark.column + 1,
+        ) from None
+    if isinstance(value, int) and not isinstance(value, bool):
+        if value.bit_length() > MAX_INT_BITS:
+            raise RobotSpecError(
+                f"integer '{_clip(node.value)}' is too large (more than {MAX_INT_BITS} bits)",
+                file=file,
+                line=node.start_mark.line + 1,
+                column=node.start_mark.column + 1,
+            )
+    return value
+
+
+def _clip(text: str, keep: int = 40) -> str:
+    return text if len(text) <= keep else f"{text[:keep]}... ({len(text)} characters)"
+
+
+def _check_shape(loader_type: type[yaml.SafeLoader], text: str, file: str) -> None:
+    """Refuse deep nesting and alias bombs by reading events, before any node is composed.
+
+    Why events: libyaml's composer recurses once per nesting level (50,000 ``[`` kill the
+    process) and an alias is a shared node that the data builder would copy each time it is
+    met (nine aliases of nine aliases of ... use gigabytes). The event parser keeps its own
+    stack, so it can count the depth and the size every alias stands for first.
+    """
+    cap = limits()
+    loader = loader_type(text)
+    try:
+        sizes: dict[str, int] = {}  # anchor -> nodes it stands for, aliases expanded
+        stack: list[list[Any]] = []  # [anchor, nodes so far] per open collection
+        while True:
+            event: Any = loader.get_event()  # type: ignore[no-untyped-call]
+            if event is None or isinstance(event, yaml.StreamEndEvent):
+                return
+            if isinstance(event, yaml.DocumentEndEvent):
+                sizes.clear()
+                continue
+            mark: Any = event.start_mark
+            if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
+                if len(stack) >= cap.max_yaml_depth:
+                    raise RobotSpecError(
+                        f"YAML nested too deeply (more than {cap.max_yaml_depth} levels; "
+                        f"set {env_name('max_yaml_depth')} to raise it)",
+                        file=file,
+                        line=mark.line + 1,
+                        column=mark.column + 1,
+                    )
+                stack.append([event.anchor, 1])
+                continue
+            if isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
+                anchor, count = stack.pop()
+            elif isinstance(event, yaml.ScalarEvent):
+                anchor, count = event.anchor, 1
+            elif isinstance(event, yaml.AliasEvent):
+                anchor, count = None, sizes.get(event.anchor or "", 1)
+            else:
+                continue
+            if anchor:
+                sizes[anchor] = count
+            if stack:
+                stack[-1][1] += count
+                count = stack[-1][1]
+            if count > cap.max_yaml_nodes:
+                raise RobotSpecError(
+                    f"YAML document too large with its aliases expanded (more than "
+                    f"{cap.max_yaml_nodes} nodes; set {env_name('max_yaml_nodes')} to raise it)",
+                    file=file,
+                    line=mark.line + 1,
+                    column=mark.column + 1,
+                )
+    finally:
+        loader.dispose()
 
 
 def _build(
@@ -87,7 +184,7 @@ def _build(
     file: str,
     depth: int,
 ) -> Any:
-    if depth > 100:
+    if depth > limits().max_yaml_depth:  # _check_shape refused such documents already
         raise RobotSpecError("YAML nested too deeply", file=file, line=node.start_mark.line + 1)
     marks[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
     if node.tag not in _PLAIN_TAGS:
@@ -102,7 +199,7 @@ def _build(
         loader.flatten_mapping(node)
         out: dict[Any, Any] = {}
         for key_node, value_node in node.value:
-            key = _scalar(key_node, loader) if isinstance(key_node, yaml.ScalarNode) else None
+            key = _scalar(key_node, loader, file) if isinstance(key_node, yaml.ScalarNode) else None
             if not isinstance(key, (str, int, float, bool)) or key is None:
                 raise RobotSpecError(
                     "mapping keys must be plain scalars",
@@ -129,15 +226,21 @@ def _build(
             _build(item, loader, (*path, i), marks, key_marks, file, depth + 1)
             for i, item in enumerate(node.value)
         ]
-    value = _scalar(node, loader)  # type: ignore[arg-type]
+    value = _scalar(node, loader, file)  # type: ignore[arg-type]
     return value
 
 
 def load_yaml_text(text: str, file: str = "<string>") -> LocatedYaml:
     """Parse one YAML document from ``text`` safely, keeping node positions."""
-    if len(text.encode("utf-8", errors="replace")) > MAX_YAML_BYTES:
-        raise RobotSpecError(f"YAML file larger than {MAX_YAML_BYTES} bytes", file=file)
+    cap = limits().max_yaml_bytes
+    if len(text) > cap or len(text.encode("utf-8", errors="replace")) > cap:
+        raise RobotSpecError(
+            f"YAML document larger than {cap} bytes (set {env_name('max_yaml_bytes')} to raise it)",
+            file=file,
+            kind="size",
+        )
     try:
+        _check_shape(_SafeComposer, text, file)
         return _compose(_SafeComposer, text, file)
     except yaml.YAMLError as fast_error:
         if _SafeComposer.__mro__[1] is yaml.SafeLoader:
@@ -184,18 +287,22 @@ def _yaml_error(exc: yaml.YAMLError, file: str) -> RobotSpecError:
 
 def load_yaml(path: str | Path) -> LocatedYaml:
     """Read and parse a YAML file safely; a missing or unreadable file is a RobotSpecError."""
-    p = Path(path)
+    data = read_bounded(
+        path, cap=limits().max_yaml_bytes, cap_name="max_yaml_bytes", what="a YAML file"
+    )
     try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise missing_file(path) from None
-    except IsADirectoryError:
-        raise RobotSpecError("is a directory, not a YAML file", file=str(path)) from None
+        text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise RobotSpecError(f"not UTF-8 text ({exc.reason})", file=str(path)) from None
-    except OSError as exc:
-        raise RobotSpecError(f"cannot read file: {exc.strerror}", file=str(path)) from None
     return load_yaml_text(text, file=str(path))
+
+
+def check_yaml_shape(text: str, file: str) -> None:
+    """Refuse a YAML text too deep or too large with aliases expanded (before composing it)."""
+    try:
+        _check_shape(_SafeComposer, text, file)
+    except yaml.YAMLError as exc:
+        raise _yaml_error(exc, file) from None
 
 
 def _loc_text(loc: Sequence[str | int]) -> str:

@@ -121,9 +121,12 @@ class World:
             depth[c.child] = depth[c.parent] + 1
         self._depth = tuple(depth)
         self._annotations: list[object] = []
-        self._children: tuple[tuple[int, ...], ...] = tuple(
-            tuple(c.child for c in self._connections if c.parent == b.index) for b in self._bodies
-        )
+        # One pass over the connections (linear in the tree's size; 60,000 links are routine
+        # for generated descriptions, and a scan per body was quadratic).
+        children: list[list[int]] = [[] for _ in self._bodies]
+        for c in self._connections:
+            children[c.parent].append(c.child)
+        self._children: tuple[tuple[int, ...], ...] = tuple(map(tuple, children))
 
     # ----------------------------------------------------------------- records and lookups
     @property

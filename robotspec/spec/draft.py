@@ -8,12 +8,14 @@ say (SRDF groups, end effectors, the virtual joint, optical frames), marks each 
 
 from __future__ import annotations
 
+import json
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from robotspec.description.srdf import Srdf
+from robotspec.errors import printable
 from robotspec.model.world import Body, World
 
 __all__ = ["Draft", "draft_spec", "render_draft"]
@@ -255,7 +257,14 @@ def draft_spec(
 def _q(text: str) -> str:
     """A YAML scalar: plain when safe, else double-quoted."""
     safe = text and all(ch.isalnum() or ch in "_-./:" for ch in text) and not text[0].isdigit()
-    return text if safe else '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    # JSON strings are YAML double-quoted scalars: newlines and control characters escaped,
+    # so a name from a downloaded URDF cannot start a new YAML line.
+    return text if safe else json.dumps(text, ensure_ascii=False)
+
+
+def _c(text: object) -> str:
+    """Text for a YAML comment: one line, control characters escaped."""
+    return printable(str(text))
 
 
 def render_draft(d: Draft, *, schema_hint: str | None) -> str:
@@ -264,11 +273,12 @@ def render_draft(d: Draft, *, schema_hint: str | None) -> str:
     if schema_hint:
         out.append(f"# yaml-language-server: $schema={schema_hint}")
     out.append(
-        f"# Drafted by `robotspec init` from {d.urdf}" + (f" and {d.srdf}" if d.srdf else "")
+        f"# Drafted by `robotspec init` from {_c(d.urdf)}"
+        + (f" and {_c(d.srdf)}" if d.srdf else "")
     )
     out.append("# Lines marked DECIDE are guesses: check them, then delete the mark.")
     for note in d.notes:
-        out.append(f"# Note: {note}.")
+        out.append(f"# Note: {_c(note)}.")
     out += ["robotspec: 1", f"name: {_q(d.name)}", "description:", f"  urdf: {_q(d.urdf)}"]
     if d.srdf:
         out.append(f"  srdf: {_q(d.srdf)}")
@@ -283,9 +293,9 @@ def render_draft(d: Draft, *, schema_hint: str | None) -> str:
     if d.chains:
         out.append("chains:")
         for c in d.chains:
-            out.append(f"  {_q(c.name)}:  # from {c.source}")
+            out.append(f"  {_q(c.name)}:  # from {_c(c.source)}")
             if c.group is not None:
-                out.append(f"    group: {_q(c.group)}  # {c.root} -> {c.tip}")
+                out.append(f"    group: {_q(c.group)}  # {_c(c.root)} -> {_c(c.tip)}")
             else:
                 out.append(f"    root: {_q(c.root)}  # DECIDE: where the chain starts")
                 out.append(f"    tip: {_q(c.tip)}")
@@ -300,7 +310,7 @@ def render_draft(d: Draft, *, schema_hint: str | None) -> str:
     if d.manipulators:
         out.append("manipulators:")
         for m in d.manipulators:
-            out.append(f"  {_q(m.name)}:  # from the {m.source}")
+            out.append(f"  {_q(m.name)}:  # from the {_c(m.source)}")
             out.append("    type: generic  # DECIDE: parallel_gripper, with finger and thumb?")
             out.append(f"    root: {_q(m.root)}")
             mark = "  # DECIDE: no tool frame link found; add one under frames:" * (

@@ -7,19 +7,41 @@ any node, in the extending file first; the JSON Schema for editors is produced h
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+import os
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from pydantic import ValidationError
 
-from robotspec.errors import NotFoundError, SpecError
+from robotspec.errors import NotFoundError, RobotSpecError, SpecError, raise_collected
 from robotspec.files.yamlio import LocatedYaml, load_yaml, validation_errors
 from robotspec.shipped import shipped_spec_files
 from robotspec.spec.models import RobotSpec
 
-__all__ = ["LoadedSpec", "json_schema", "json_schema_text", "load_spec", "merge_data"]
+__all__ = [
+    "ForeignPath",
+    "LoadedSpec",
+    "check_package_paths",
+    "json_schema",
+    "json_schema_text",
+    "load_spec",
+    "merge_data",
+]
+
+
+@dataclass(frozen=True)
+class ForeignPath:
+    """A spec's ``package_paths`` entry that lies outside the spec's own folder tree."""
+
+    given: str
+    path: Path
+    folder: Path
+    file: str
+    line: int | None
+    column: int | None
+    location: tuple[str | int, ...]
 
 
 @dataclass(frozen=True)
@@ -29,6 +51,9 @@ class LoadedSpec:
     spec: RobotSpec
     file: Path
     documents: tuple[LocatedYaml, ...]
+    #: ``package_paths`` entries (of this file and the files it extends) outside their spec's
+    #: folder tree; :func:`check_package_paths` refuses them unless the user allowed the folder.
+    foreign_paths: tuple[ForeignPath, ...] = ()
 
     def position(self, loc: tuple[str | int, ...]) -> tuple[str, int | None, int | None]:
         """``(file, line, column)`` of a spec node, looking in the extending file first."""
@@ -86,6 +111,74 @@ def _absolutize(data: dict[str, Any], folder: Path) -> None:
                 _absolute_paths(part, folder, ("urdf", "srdf", "spec"))
 
 
+def _inside(path: str, folder: str) -> bool:
+    return path == folder or path.startswith(folder.rstrip(os.sep) + os.sep)
+
+
+def _foreign_paths(doc: LocatedYaml, folder: Path) -> list[ForeignPath]:
+    """The document's package folders that lie outside its own folder tree (symlinks followed).
+
+    Why: allowed read roots come from the user, never from the input. A spec downloaded with a
+    robot may point inside its own tree; anything else must be allowed by the user.
+    """
+    data = doc.data
+    where: list[tuple[tuple[str | int, ...], Any]] = []
+    desc = data.get("description") if isinstance(data, Mapping) else None
+    if isinstance(desc, Mapping):
+        where.append((("description", "package_paths"), desc.get("package_paths")))
+    parts = data.get("parts") if isinstance(data, Mapping) else None
+    if isinstance(parts, Mapping):
+        for name, part in parts.items():
+            if isinstance(part, Mapping):
+                where.append((("parts", name, "package_paths"), part.get("package_paths")))
+    real_folder = os.path.realpath(folder)
+    out: list[ForeignPath] = []
+    for loc, values in where:
+        if not isinstance(values, list):
+            continue
+        for i, value in enumerate(values):
+            if not isinstance(value, str):
+                continue
+            target = os.path.realpath(folder / value)
+            if _inside(target, real_folder):
+                continue
+            line, col = doc.position((*loc, i))
+            out.append(ForeignPath(value, Path(target), folder, doc.file, line, col, (*loc, i)))
+    return out
+
+
+def check_package_paths(loaded: LoadedSpec, package_paths: Sequence[str | Path] = ()) -> None:
+    """Refuse spec package folders outside the spec's tree that the user did not allow.
+
+    The user allows a folder with ``-P``/``package_paths`` (``package_paths`` here), the
+    ``ROS_PACKAGE_PATH``/``AMENT_PREFIX_PATH`` environment or an installed data package; a spec
+    entry inside one of those is accepted.
+    """
+    if not loaded.foreign_paths:
+        return
+    from robotspec.files.packages import user_roots
+
+    roots = [os.path.realpath(r) for r in user_roots(package_paths)]
+    problems: list[RobotSpecError] = []
+    for fp in loaded.foreign_paths:
+        if any(_inside(str(fp.path), r) for r in roots):
+            continue
+        problems.append(
+            SpecError(
+                f"package path '{fp.given}' lies outside the spec's folder {fp.folder}; a spec "
+                f"may only name folders inside its own tree (allow this one with "
+                f"-P/--package-path {fp.path}, or ROS_PACKAGE_PATH)",
+                file=fp.file,
+                line=fp.line,
+                column=fp.column,
+                kind="package path",
+                name=fp.given,
+                location=fp.location,
+            )
+        )
+    raise_collected(problems)
+
+
 def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
     """Read, merge (``extends``) and validate a spec file; every problem raised at once."""
     p = Path(path).resolve()
@@ -97,6 +190,7 @@ def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
         raise SpecError("a spec must be a YAML mapping", file=doc.file, line=1)
     data: Any = doc.data
     documents: tuple[LocatedYaml, ...] = (doc,)
+    foreign = _foreign_paths(doc, p.parent)
     base_file = data.get("extends")
     if isinstance(base_file, str):
         base_path = (p.parent / base_file).resolve()
@@ -123,11 +217,12 @@ def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
         data = merge_data(base_data, {k: v for k, v in data.items() if k != "extends"})
         data["extends"] = base_file
         documents = (doc, *base.documents)
+        foreign += base.foreign_paths
     try:
         spec = RobotSpec.model_validate(data)
     except ValidationError as exc:
         raise validation_errors(exc, doc, RobotSpec, SpecError) from None
-    return LoadedSpec(spec=spec, file=p, documents=documents)
+    return LoadedSpec(spec=spec, file=p, documents=documents, foreign_paths=tuple(foreign))
 
 
 def json_schema() -> dict[str, Any]:

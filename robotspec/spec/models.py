@@ -12,6 +12,7 @@ import math
 from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -47,7 +48,16 @@ __all__ = [
 
 SPEC_VERSION = 1
 
-Name = Annotated[str, Field(min_length=1, max_length=256)]
+
+def _no_control(value: str) -> str:
+    """Names are echoed to terminals and written into YAML and XML: no control characters."""
+    if not value.isprintable():
+        bad = next(c for c in value if not c.isprintable())
+        raise ValueError(f"names must not contain control characters (found U+{ord(bad):04X})")
+    return value
+
+
+Name = Annotated[str, Field(min_length=1, max_length=256), AfterValidator(_no_control)]
 JointValues = dict[Name, float]
 States = dict[Name, JointValues]
 
@@ -59,7 +69,11 @@ def _finite(values: tuple[float, ...]) -> tuple[float, ...]:
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+    # NaN and infinity are refused wherever a number enters (``abs(x - y) > tol`` is False for
+    # NaN, so a NaN would pass every later check).
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, populate_by_name=True, allow_inf_nan=False
+    )
 
 
 class FrameSpec(_Model):

@@ -60,7 +60,7 @@ def read_description_xml(
     cap = limits()
     data = read_bounded(
         path,
-        cap=max(cap.max_urdf_bytes, cap.max_xacro_include_bytes),
+        cap=cap.max_urdf_bytes,
         cap_name="max_urdf_bytes",
         what="a URDF file",
         error_type=DescriptionError,
@@ -202,7 +202,7 @@ def world_from_urdf_xml(
 def _limits(j: JointRecord, jtype: ConnectionType) -> tuple[float, float, float, float]:
     lower, upper = -math.inf, math.inf
     vel, eff = math.inf, math.inf
-    if j.element.find("limit") is not None:
+    if j.has_limit:
         if jtype in (ConnectionType.REVOLUTE, ConnectionType.PRISMATIC):
             lower = 0.0 if j.lower is None else j.lower
             upper = 0.0 if j.upper is None else j.upper

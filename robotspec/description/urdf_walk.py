@@ -85,6 +85,8 @@ class JointRecord:
     effort: float | None
     #: (leader joint, multiplier, offset), or None.
     mimic: tuple[str, float, float] | None
+    #: Whether the joint has a ``<limit>`` element at all.
+    has_limit: bool
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,7 +104,14 @@ def parse_floats(
     """Parse exactly ``count`` finite numbers from an attribute value, or raise a located error."""
     if text is None:
         raise DescriptionError(f"{what} is missing", file=file, line=line_of(el))
-    parts = text.replace(",", " ").split()
+    parts = (text.replace(",", " ") if "," in text else text).split()
+    if len(parts) == count:  # the common case, checked at once
+        try:
+            fast = [float(p) for p in parts]
+        except ValueError:
+            fast = []
+        if fast and all(map(math.isfinite, fast)):
+            return fast
     if len(parts) != count:
         shown = text if len(text) <= 80 else f"{text[:80]}..."
         raise DescriptionError(
@@ -179,9 +188,19 @@ class _Walk:
         if el.get("rpy") is not None:
             got = self.floats(el, "rpy", 3, f"{what}: origin rpy")
             rpy = (got[0], got[1], got[2]) if got else rpy
-        t = np.eye(4)
-        t[:3, :3] = rpy_to_matrix(*rpy)
-        t[:3, 3] = xyz
+        if rpy == (0.0, 0.0, 0.0):
+            t = np.array(
+                [
+                    [1.0, 0.0, 0.0, xyz[0]],
+                    [0.0, 1.0, 0.0, xyz[1]],
+                    [0.0, 0.0, 1.0, xyz[2]],
+                    [0.0, 0.0, 0.0, 1.0],
+                ]
+            )
+        else:
+            t = np.eye(4)
+            t[:3, :3] = rpy_to_matrix(*rpy)
+            t[:3, 3] = xyz
         t.setflags(write=False)
         return t
 
@@ -337,7 +356,19 @@ class _Walk:
         if len(self.errors) > before or jtype is None:
             return None
         return JointRecord(
-            name, el, jtype, ends[0], ends[1], origin, axis, lower, upper, vel, eff, mimic
+            name,
+            el,
+            jtype,
+            ends[0],
+            ends[1],
+            origin,
+            axis,
+            lower,
+            upper,
+            vel,
+            eff,
+            mimic,
+            limit is not None,
         )
 
     def mimics(self, joints: dict[str, etree._Element]) -> None:

@@ -93,13 +93,25 @@ def _guarded_open(resolver: PackageResolver, xacro: Any, budget: Budget) -> Call
             )
         if not os.path.lexists(path):  # an OSError: xacro skips optional includes on it
             raise FileNotFoundError(2, "No such file or directory", str(filename))
-        data = read_bounded(
-            path,
-            cap=budget.limits.max_xacro_include_bytes,
-            cap_name="max_xacro_include_bytes",
-            what="a xacro file",
-            error_type=DescriptionError,
-        )
+        try:
+            data = read_bounded(
+                path,
+                cap=budget.limits.max_xacro_include_bytes,
+                cap_name="max_xacro_include_bytes",
+                what="a xacro file",
+                error_type=DescriptionError,
+            )
+        except RobotSpecError as exc:
+            # The includer named the file: point at it, not at the spec that named the top file.
+            stack = [str(f) for f in (getattr(xacro, "filestack", None) or []) if f]
+            includer = stack[-2] if len(stack) > 1 else None
+            raise DescriptionError(
+                f"xacro include '{path}' {exc.message}",
+                file=includer,
+                line=_line_of(includer, re.compile(re.escape(os.path.basename(path)))),
+                kind="xacro include",
+                name=str(filename),
+            ) from None
         refuse_entities(data, path, DescriptionError)
         return io.BytesIO(data)
 
@@ -293,8 +305,9 @@ def _convert(exc: BaseException, xacro: Any, top: Path) -> RobotSpecError:
     file = _current_file(xacro) or str(top)
     for inner in _chain(exc):
         if isinstance(inner, RobotSpecError):
-            if inner.file is None:
-                return inner.located(file=file, line=_expression_line(exc, file))
+            if inner.line is None:
+                where = inner.file or file
+                return inner.located(file=where, line=_expression_line(exc, where))
             return inner
     for inner in _chain(exc):
         if isinstance(inner, ArgException):

@@ -310,3 +310,35 @@ def test_generic_ur_xacro_with_args_matches_ur5e() -> None:
         process_xacro(source, resolver, {})
     assert info.value.message == "xacro argument 'robot_model' is not set; pass it as xacro_args"
     assert (info.value.file, info.value.line) == (str(source), 2)
+
+
+def test_the_xacro_hooks_robotspec_swaps_still_exist() -> None:
+    # pyproject.toml pins xacro below 2.2 because robotspec/files/xacro.py swaps these.
+    import xacro
+    import xacro.substitution_args as subst
+
+    for name in (
+        "create_global_symbols",
+        "_global_symbols",
+        "safe_eval",
+        "handle_macro_call",
+        "abs_filename_spec",
+        "all_includes",
+        "NameSpace",
+        "YamlDictWrapper",
+        "YamlListWrapper",
+        "ConstructUnits",
+        "substitution_args_context",
+        "process_file",
+    ):
+        assert hasattr(xacro, name), name
+    assert hasattr(subst, "_eval_find") and isinstance(subst._eval_dict, dict)
+    assert "math" in xacro.create_global_symbols()
+
+
+def test_each_document_gets_a_fresh_namespace(tmp_path: Path) -> None:
+    evil = write(tmp_path / "evil.xacro", '<link name="${python.list.append}"/>')
+    with pytest.raises(DescriptionError, match="attribute 'append'"):
+        expand(evil)
+    victim = write(tmp_path / "victim.xacro", '<link name="l${int(math.pi * 100)}"/>')
+    assert b'name="l314"' in expand(victim)

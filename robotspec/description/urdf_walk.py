@@ -141,6 +141,16 @@ def geometry_element(geom: etree._Element | None) -> etree._Element | None:
     return next((c for c in geom if isinstance(c.tag, str)), None)
 
 
+def _children(el: etree._Element) -> dict[str, etree._Element]:
+    """The first child element of each tag (what ``find`` returns), in one pass."""
+    out: dict[str, etree._Element] = {}
+    for child in el:
+        tag = child.tag
+        if isinstance(tag, str) and tag not in out:
+            out[tag] = child
+    return out
+
+
 _IDENTITY = np.eye(4)
 _IDENTITY.setflags(write=False)
 
@@ -176,8 +186,7 @@ class _Walk:
         got = self.floats(el, attr, 1, what)
         return None if got is None else got[0]
 
-    def origin(self, parent: etree._Element, what: str) -> Matrix:
-        el = parent.find("origin")
+    def origin(self, el: etree._Element | None, what: str) -> Matrix:
         if el is None:
             return _IDENTITY
         xyz = (0.0, 0.0, 0.0)
@@ -207,7 +216,7 @@ class _Walk:
     # ------------------------------------------------------------------------ links
     def link(self, el: etree._Element, name: str) -> LinkRecord:
         mass = None
-        inertial = el.find("inertial")
+        inertial = _children(el).get("inertial")
         if inertial is not None:
             mass_el = inertial.find("mass")
             if mass_el is not None:
@@ -216,24 +225,26 @@ class _Walk:
                     self.error(f"link '{name}': mass must not be negative, got {m}", mass_el)
                 mass = 0.0 if m is None else m
         shapes: dict[str, list[ShapeRecord]] = {"visual": [], "collision": []}
-        for kind, out in shapes.items():
-            for shape_el in el.iterfind(kind):
-                rec = self.shape(shape_el, kind, name)
+        for shape_el in el:
+            out = shapes.get(shape_el.tag) if isinstance(shape_el.tag, str) else None
+            if out is not None:
+                rec = self.shape(shape_el, str(shape_el.tag), name)
                 if rec is not None:
                     out.append(rec)
         return LinkRecord(name, el, mass, tuple(shapes["visual"]), tuple(shapes["collision"]))
 
     def shape(self, el: etree._Element, kind: str, link: str) -> ShapeRecord | None:
         what = f"link '{link}' {kind}"
-        origin = self.origin(el, what)
-        inner = geometry_element(el.find("geometry"))
+        parts = _children(el)
+        origin = self.origin(parts.get("origin"), what)
+        inner = geometry_element(parts.get("geometry"))
         if inner is None:
             self.error(f"link '{link}': <{kind}> has no geometry", el, kind="link", name=link)
             return None
         values = self.geometry(inner, what)
         rgba = None
         if kind == "visual":
-            material = el.find("material")
+            material = parts.get("material")
             color = None if material is None else material.find("color")
             if color is not None and color.get("rgba") is None:
                 rgba = (1.0, 1.0, 1.0, 1.0)  # urdfdom's default colour: opaque white
@@ -294,8 +305,9 @@ class _Walk:
                 )
             )
         ends: list[str] = []
+        parts = _children(el)
         for role in ("parent", "child"):
-            ref = el.find(role)
+            ref = parts.get(role)
             link = None if ref is None else ref.get("link")
             if not link:
                 self.error(f"joint '{name}' has no <{role} link=...>", el, kind="joint", name=name)
@@ -312,9 +324,9 @@ class _Walk:
                 )
             else:
                 ends.append(link)
-        origin = self.origin(el, f"joint '{name}'")
+        origin = self.origin(parts.get("origin"), f"joint '{name}'")
         axis = (1.0, 0.0, 0.0)
-        axis_el = el.find("axis")
+        axis_el = parts.get("axis")
         if axis_el is not None and axis_el.get("xyz") is not None:
             xyz = self.floats(axis_el, "xyz", 3, f"joint '{name}': axis")
             if xyz is not None:
@@ -323,7 +335,7 @@ class _Walk:
                         f"joint '{name}': axis must not be zero", axis_el, kind="joint", name=name
                     )
                 axis = (xyz[0], xyz[1], xyz[2])
-        limit = el.find("limit")
+        limit = parts.get("limit")
         lower = upper = vel = eff = None
         if jtype in ("revolute", "prismatic") and limit is None:
             self.error(f"{jtype} joint '{name}' has no <limit>", el, kind="joint", name=name)
@@ -344,7 +356,7 @@ class _Walk:
                 if value is not None and value < 0:
                     self.error(f"joint '{name}': limit {label} must not be negative", limit)
         mimic = None
-        mimic_el = el.find("mimic")
+        mimic_el = parts.get("mimic")
         if mimic_el is not None:
             mult = self.number(mimic_el, "multiplier", f"joint '{name}': mimic multiplier")
             off = self.number(mimic_el, "offset", f"joint '{name}': mimic offset")

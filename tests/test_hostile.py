@@ -40,7 +40,9 @@ class Result:
         return self.out + self.err
 
 
-def run_cli(tmp: Path, *args: str, cwd: Path | None = None, env: dict[str, str] | None = None) -> Result:
+def run_cli(
+    tmp: Path, *args: str, cwd: Path | None = None, env: dict[str, str] | None = None
+) -> Result:
     log = tmp / "opened.log"
     environ = {
         k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH")
@@ -167,8 +169,11 @@ def test_xacro_namespace_does_not_leak_between_documents(tmp: Path) -> None:
     work = tmp / "work"
     xacro(work / "evil", '<link name="l${math.update(pi=0.5) or 1}"/>')
     spec(work / "evil", "r.urdf.xacro")
-    xacro(work / "victim", '<link name="l${int(math.pi * 1000)}"/>\n'
-          '<joint name="j" type="fixed"><parent link="base"/><child link="l3141"/></joint>')
+    xacro(
+        work / "victim",
+        '<link name="l${int(math.pi * 1000)}"/>\n'
+        '<joint name="j" type="fixed"><parent link="base"/><child link="l3141"/></joint>',
+    )
     spec(work / "victim", "r.urdf.xacro")
     r = run_cli(tmp, "validate", "evil/spec.yaml", "victim/spec.yaml")
     fenced(r, tmp)
@@ -348,9 +353,7 @@ def test_a_file_over_its_cap_is_refused_with_the_variable_that_raises_it(tmp: Pa
         ),
     ],
 )
-def test_numbers_and_names_are_checked_where_they_enter(
-    tmp: Path, line: str, message: str
-) -> None:
+def test_numbers_and_names_are_checked_where_they_enter(tmp: Path, line: str, message: str) -> None:
     work = tmp / "work"
     write(work / "r.urdf", '<robot name="r"><link name="base"/></robot>\n')
     write(
@@ -366,7 +369,7 @@ def test_numbers_and_names_are_checked_where_they_enter(
 def test_terminal_escapes_in_names_are_echoed_escaped(tmp: Path) -> None:
     work = tmp / "work"
     write(work / "r.urdf", '<robot name="r"><link name="base"/></robot>\n')
-    spec(work, "r.urdf", "chains: {arm: {root: base, tip: \"x\\e]0;pwned\\a\"}}\n")
+    spec(work, "r.urdf", 'chains: {arm: {root: base, tip: "x\\e]0;pwned\\a"}}\n')
     r = run_cli(tmp, "validate", "spec.yaml")
     assert r.code == 1
     assert "\x1b" not in r.text and "\x07" not in r.text
@@ -422,8 +425,30 @@ def test_deep_srdf_groups_and_a_long_chain_are_no_internal_errors(tmp: Path) -> 
 
 # --------------------------------------------------------------------------- property tests
 FRAGMENTS = st.sampled_from(
-    ["[", "]", "{", "}", "&a ", "*a", "!!python/object ", "- ", ": ", "\n", "  ", ",", "x",
-     "9" * 50, ".nan", "2024-13-45", "<<: *a", "'", '"', "\\e", "\t", "? "]
+    [
+        "[",
+        "]",
+        "{",
+        "}",
+        "&a ",
+        "*a",
+        "!!python/object ",
+        "- ",
+        ": ",
+        "\n",
+        "  ",
+        ",",
+        "x",
+        "9" * 50,
+        ".nan",
+        "2024-13-45",
+        "<<: *a",
+        "'",
+        '"',
+        "\\e",
+        "\t",
+        "? ",
+    ]
 )
 
 
@@ -441,9 +466,24 @@ def test_any_yaml_text_is_a_located_error_or_valid(tmp: Path, parts: list[str]) 
 
 
 EXPRESSIONS = st.sampled_from(
-    ["9**9**9", "'a'*10**9", "[0]*10**9", "math.pi", "python.type(0)", "xacro.load_yaml",
-     "'{0}'.format(1)", "(1).__class__", "[x for x in range(10**7)]", "1<<10**9",
-     "'%0999999d' % 1", "str(10**400)", "1/0", "math.update(pi=1)", "lambda: 1", "abs(-1)"]
+    [
+        "9**9**9",
+        "'a'*10**9",
+        "[0]*10**9",
+        "math.pi",
+        "python.type(0)",
+        "xacro.load_yaml",
+        "'{0}'.format(1)",
+        "(1).__class__",
+        "[x for x in range(10**7)]",
+        "1<<10**9",
+        "'%0999999d' % 1",
+        "str(10**400)",
+        "1/0",
+        "math.update(pi=1)",
+        "lambda: 1",
+        "abs(-1)",
+    ]
 )
 
 

@@ -72,7 +72,7 @@ def _is_spec(text: str) -> bool:
 
 
 @pytest.fixture(scope="module")
-def app():  # noqa: ANN201 - the typer app
+def app():
     from robotspec.cli.app import _register, app
 
     _register()
@@ -152,7 +152,7 @@ def test_examples_run(
                 )
         elif b.lang == "python":
             namespace: dict[str, object] = {"__name__": "__docs__"}
-            exec(compile(b.text, where, "exec"), namespace)  # noqa: S102 - the docs' own code
+            exec(compile(b.text, where, "exec"), namespace)
             capsys.readouterr()
         elif b.lang == "yaml" and _is_spec(b.text) and "fragment" not in b.marks:
             spec = tmp_path / b.marks.get("file", f"block_{b.line}.yaml")

@@ -74,7 +74,7 @@ def run_app(app: typer.Typer, argv: Sequence[str] | None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("Interrupted.\n")
         return 130
-    except Exception as exc:  # a bug: say so plainly, traceback only on request
+    except Exception as exc:  # noqa: BLE001 - a bug: say so plainly, traceback only on request
         if _verbose(args):
             traceback.print_exc()
         sys.stderr.write(

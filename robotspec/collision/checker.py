@@ -67,7 +67,7 @@ class _Compiled:
 
     model: GeometryModel
     geom_body: I64  # (G,) body index in the world
-    body_T_geom: F64  # (G, 4, 4)
+    body_T_geom: F64  # noqa: N815 - frame notation a_T_b; (G, 4, 4)
     aabb_center: F64  # (G, 3) in the body frame
     aabb_half: F64  # (G, 3)
     pair_geom1: I64  # (Q,) geometry indices of each geometry pair

@@ -335,13 +335,7 @@ def spec_reference() -> str:
             if rule.group in groups:
                 raise DocgenError(f"the rules of group '{rule.group}' are not numbered together")
             groups.append(rule.group)
-            lines += [
-                "",
-                f"### {rule.group}",
-                "",
-                "| rule | line 3 | output |",
-                "| --- | --- | --- |",
-            ]
+            lines += ["", f"### {rule.group}", "", "| rule | line 3 | output |", "| --- " * 3 + "|"]
         shown = "<br>".join(f"`{_cell(m)}`" for m in rule.output)
         lines.append(f"| {_cell(rule.rule)} | `{_cell(rule.change)}` | {shown} |")
     lines.append("")
@@ -474,12 +468,8 @@ def generate_pages() -> dict[str, str]:
 def stale_pages(docs: Path, pages: dict[str, str] | None = None) -> list[str]:
     """Names of generated pages whose file in ``docs`` is missing or differs."""
     pages = generate_pages() if pages is None else pages
-    stale = []
-    for name, text in pages.items():
-        path = docs / name
-        if not path.is_file() or path.read_text(encoding="utf-8") != text:
-            stale.append(name)
-    return stale
+    current = {p.name: p.read_text(encoding="utf-8") for p in docs.glob("*.md")}
+    return [name for name, text in pages.items() if current.get(name) != text]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -11,9 +11,8 @@ from hypothesis import strategies as st
 
 from robotspec.collision import CollisionRules
 from robotspec.compiler import check_spec, compile_robot
-from robotspec.description.srdf import write_srdf
 from robotspec.errors import RobotSpecError
-from robotspec.export.srdf import srdf_from_robot
+from robotspec.export.srdf import srdf_from_robot, write_srdf
 from robotspec.export.urdf import bundle, joined_urdf, urdf_text
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World

@@ -19,9 +19,8 @@ from robotspec.description.srdf import (
     check_srdf_against,
     check_srdf_references,
     parse_srdf_bytes,
-    write_srdf,
 )
-from robotspec.export.srdf import srdf_from_robot
+from robotspec.export.srdf import srdf_from_robot, write_srdf
 from robotspec.semantic import AbstractRobot
 
 from .conftest import erd_robots, shared_path

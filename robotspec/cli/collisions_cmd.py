@@ -174,7 +174,7 @@ def generate(
     it) goes to stderr.
     """
     from robotspec.collision import Progress, compare_pairs, generate_for_robot
-    from robotspec.description.srdf import write_srdf
+    from robotspec.export.srdf import write_srdf
 
     robot = load_robot(spec, package_path)
     if merge and robot.srdf is None:

@@ -90,8 +90,7 @@ def srdf(
     virtual joint.
     """
     from robotspec.compiler import compile_robot
-    from robotspec.description.srdf import write_srdf
-    from robotspec.export.srdf import srdf_from_robot
+    from robotspec.export.srdf import srdf_from_robot, write_srdf
 
     robot = compile_robot(spec, package_paths=package_path or ())
     exported = srdf_from_robot(robot)

@@ -73,9 +73,8 @@ def _is_spec(text: str) -> bool:
 
 @pytest.fixture(scope="module")
 def app():
-    from robotspec.cli.app import _register, app
+    from robotspec.cli.app import app
 
-    _register()
     return app
 
 

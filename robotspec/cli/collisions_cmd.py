@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import (
     JsonFlag,
     PackagePath,
@@ -24,6 +23,10 @@ from robotspec.errors import CollisionError
 
 if TYPE_CHECKING:
     pass
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 collisions_app = typer.Typer(
     help="Self-collision checks and collision matrices (coal).", no_args_is_help=True

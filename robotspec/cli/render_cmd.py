@@ -8,11 +8,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import PackagePath, SkipMeshes, SpecArg, load_robot
 
 if TYPE_CHECKING:
     pass
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 StateOpt = Annotated[
     list[str] | None,

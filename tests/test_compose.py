@@ -682,7 +682,6 @@ def test_one_package_name_in_two_parts_resolves_per_part(tmp_path: Path) -> None
     )
     result = check_spec(spec)
     assert result.warnings == ()
-    assert result.robot is not None
     w = result.robot.world
     paths = {}
     for name in ("a_link", "b_link"):

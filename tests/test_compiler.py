@@ -125,13 +125,17 @@ def test_strict_turns_warnings_into_errors(path: Path, tmp_path: Path) -> None:
     checked = checked_file(path, tmp_path)
     # not strict: the spec compiles, with the warning
     result = check_spec(checked)
-    assert result.robot is not None
     assert neutral(rendered(result.warnings), tmp_path) == warning
     # strict: the same messages, as errors, raised
     with pytest.raises(RobotSpecError) as info:
         check_spec(checked, strict=True)
     errors = [w.replace(": warning: ", ": error: ") for w in warning]
     assert neutral(rendered(info.value), tmp_path) == errors
+
+
+def test_shipped_specs_have_no_warnings() -> None:
+    for name in ("pr2", "tiago", "panda", "ur5"):
+        assert check_spec(name, strict=True).warnings == (), name
 
 
 FIVE_PROBLEMS = f"""\

@@ -29,6 +29,9 @@ from tests.conftest import SHARED, erd_robots
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 PAGES = sorted(DOCS.glob("*.md"))
+README = DOCS.parent / "README.md"
+#: Pages whose examples run: the docs and the README (style rule: every shown example is tested).
+RUN_PAGES = [*PAGES, README]
 HSRB_PACKAGES = SHARED / "robots" / "hsrb"
 
 _FENCE = re.compile(r"^```(\w*)\s*$")
@@ -73,9 +76,8 @@ def _is_spec(text: str) -> bool:
 
 @pytest.fixture(scope="module")
 def app():
-    from robotspec.cli.app import _register, app
+    from robotspec.cli.app import app
 
-    _register()
     return app
 
 
@@ -105,7 +107,7 @@ def test_shown_example_files_match(page: Path) -> None:
             )
 
 
-@pytest.mark.parametrize("page", PAGES, ids=[p.name for p in PAGES])
+@pytest.mark.parametrize("page", RUN_PAGES, ids=[p.name for p in RUN_PAGES])
 def test_examples_run(
     page: Path,
     app: object,

@@ -33,7 +33,7 @@ pytest.importorskip(
 )
 
 from robotspec.cli import render
-from robotspec.cli.app import _register, app
+from robotspec.cli.app import app
 from robotspec.driver.robot_info import load_robot_info
 from robotspec.driver.sim import Fault, SimRobot
 from robotspec.driver.state import CommandMode, StateFlags
@@ -435,7 +435,6 @@ def test_cli_port_taken_exits_1_without_traceback(
 ) -> None:
     busy, port = _busy_port()
     try:
-        _register()
         code = render.run_app(
             app,
             [
@@ -727,7 +726,6 @@ def test_cli_passes_public_through(
             seen.append(self.options)
 
     monkeypatch.setattr(service_cli, "RobotServer", Recording)
-    _register()
     for extra in ([], ["--public"]):
         code = render.run_app(
             app,

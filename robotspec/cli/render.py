@@ -14,7 +14,6 @@ from robotspec.errors import ErrorDetail, RobotSpecError
 
 EXIT_OK = 0
 EXIT_INVALID = 1
-EXIT_USAGE = 2
 EXIT_INTERNAL = 3
 
 

@@ -19,7 +19,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.collision.rules import CollisionRules, pair_key
-from robotspec.collision.sampling import state_configuration
 from robotspec.collision.shapes import (
     GeometryModel,
     MeshLibrary,
@@ -30,6 +29,7 @@ from robotspec.collision.shapes import (
 from robotspec.errors import CollisionError, RobotSpecError
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
+from robotspec.semantic.states import state_configuration
 
 if TYPE_CHECKING:
     from robotspec.semantic.robot import AbstractRobot

@@ -37,7 +37,7 @@ class CompileResult:
     """What ``robotspec validate`` reports: the robot (if it compiled) and every warning."""
 
     loaded: LoadedSpec
-    robot: AbstractRobot | None
+    robot: AbstractRobot
     warnings: tuple[RobotSpecError, ...]
 
 
@@ -259,7 +259,6 @@ def compile_robot(
     result = _compile(
         load_spec(resolve_spec(ref)), package_paths=package_paths, robot_class=robot_class
     )
-    assert result.robot is not None
     return result.robot
 
 
@@ -282,5 +281,4 @@ def compile_spec_for_world(
         world=world,
         robot_class=robot_class,
     )
-    assert result.robot is not None
     return result.robot

@@ -39,7 +39,7 @@ def read_triangles(
         raise
     try:
         mesh = trimesh.load(io.BytesIO(data), file_type=suffix, force="mesh", process=False)
-    except Exception as exc:  # trimesh and its readers raise anything on a corrupt file
+    except Exception as exc:  # noqa: BLE001 - trimesh's readers raise anything on a corrupt file
         raise error_type(
             f"cannot read mesh: {type(exc).__name__}: {exc}", file=path, kind="mesh"
         ) from None

@@ -146,7 +146,8 @@ def _load_yaml(resolver: PackageResolver, xacro: Any, budget: Budget) -> Callabl
         check_yaml_shape(text, path)
         xacro.filestack.append(name)
         try:
-            return xacro.YamlListWrapper.wrap(yaml.load(text, Loader=Loader))  # noqa: S506
+            # A SafeLoader subclass: only plain data and the unit tags.
+            return xacro.YamlListWrapper.wrap(yaml.load(text, Loader=Loader))
         except yaml.YAMLError as exc:
             raise DescriptionError(f"invalid YAML: {exc}", file=path) from None
         finally:
@@ -395,7 +396,7 @@ def _expand(xacro: Any, top: Path, mappings: dict[str, str]) -> bytes:
         raise DescriptionError(
             "xacro recursion too deep (a macro or include calls itself)", file=str(top)
         ) from None
-    except Exception as exc:  # xacro raises anything; all become ours
+    except Exception as exc:  # noqa: BLE001 - xacro raises anything; all become ours
         raise _convert(exc, xacro, top) from None
     finally:
         xacro.filestack = None

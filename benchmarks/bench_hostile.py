@@ -1,6 +1,6 @@
 """Loading a generated 60,000-link URDF (a branching tree with box geometry), against yourdfpy.
 
-Run: ``python benchmarks/bench_hostile.py [--links N]`` (needs the dev extra: yourdfpy).
+Run: ``python benchmarks/bench_hostile.py [--links N] [--bare]`` (needs the dev extra: yourdfpy).
 A plain 6 MB URDF of this size once hung robotspec (the world's child lists were built in
 quadratic time). One run: robotspec's ``load_urdf`` (bounded read, one checked walk, world
 build) and yourdfpy's ``URDF.load`` (no meshes, no scene graph) on the same file, interleaved;
@@ -15,10 +15,16 @@ import time
 from pathlib import Path
 
 
-def generated_urdf(n: int) -> str:
-    """A tree of ``n`` links: each link hangs below link ``(i - 1) // 3`` by a revolute joint."""
+def generated_urdf(n: int, *, bare: bool = False) -> str:
+    """A tree of ``n`` links: each link hangs below link ``(i - 1) // 3`` by a revolute joint.
+
+    ``bare``: links without geometry or mass (about 6 MB for 60,000 links, the issue's file).
+    """
     parts = ['<robot name="big">']
     for i in range(n):
+        if bare:
+            parts.append(f'<link name="l{i}"/>')
+            continue
         parts.append(
             f'<link name="l{i}"><visual><origin xyz="0 0 0.05" rpy="0 0 0"/><geometry>'
             '<box size="0.1 0.1 0.1"/></geometry></visual>'
@@ -37,6 +43,7 @@ def generated_urdf(n: int) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--links", type=int, default=60_000)
+    parser.add_argument("--bare", action="store_true", help="links without geometry (6 MB)")
     args = parser.parse_args()
 
     import yourdfpy
@@ -45,7 +52,7 @@ def main() -> None:
 
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "big.urdf"
-        path.write_text(generated_urdf(args.links))
+        path.write_text(generated_urdf(args.links, bare=args.bare))
         size = path.stat().st_size
         t = time.perf_counter()
         world = load_urdf(path, meshes="keep")

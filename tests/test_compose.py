@@ -329,7 +329,7 @@ def test_replaced_root_keeps_the_mass_where_it_was(tmp_path: Path) -> None:
     for replace in (False, True):
         spec = _fixture(tmp_path, ARM_AND_HAND.replace("REPLACE", str(replace).lower()))
         urdf = tmp_path / f"joined_{replace}.urdf"
-        urdf.write_text(urdf_text(joined_urdf(load_spec(spec)), comment="test"))
+        urdf.write_text(urdf_text(joined_urdf(load_spec(spec), package_paths=[ur]), comment="test"))
         model = pin.buildModelFromUrdf(str(urdf))
         inertias.append(model.inertias[model.getJointId("wrist")])
     welded, replaced = inertias
@@ -481,7 +481,7 @@ chains:
     assert rules.why_disabled("torso_plate", "arm_base_link_inertia") == "Adjacent"
     assert rules.is_checked("stand_base", "hand_palm_link")
     urdf = tmp_path / "joined.urdf"
-    urdf.write_text(urdf_text(joined_urdf(load_spec(spec)), comment="test"))
+    urdf.write_text(urdf_text(joined_urdf(load_spec(spec), package_paths=[ur]), comment="test"))
     q = np.random.default_rng(11).uniform(-1.5, 1.5, len(robot.world.degrees_of_freedom))
     theirs = _pin_poses(urdf, robot.world, q, "stand_base")
     kin = Kinematics(robot.world)

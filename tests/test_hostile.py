@@ -453,7 +453,7 @@ FRAGMENTS = st.sampled_from(
 
 
 @settings(
-    max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
 @given(st.lists(FRAGMENTS, min_size=1, max_size=60))
 def test_any_yaml_text_is_a_located_error_or_valid(tmp: Path, parts: list[str]) -> None:
@@ -488,7 +488,7 @@ EXPRESSIONS = st.sampled_from(
 
 
 @settings(
-    max_examples=10, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
 @given(st.lists(EXPRESSIONS, min_size=1, max_size=3), st.sampled_from([" + ", " * ", ", "]))
 def test_any_xacro_expression_is_a_located_error_or_a_value(

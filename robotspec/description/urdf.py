@@ -14,7 +14,6 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
-import numpy as np
 from lxml import etree
 
 from robotspec.errors import DescriptionError, RobotSpecError, raise_collected
@@ -140,7 +139,7 @@ def world_from_urdf_xml(
     dofs: list[DegreeOfFreedom] = []
     own_dofs: dict[str, tuple[int, ...]] = {}
     for j in records.joints:
-        jtype = ConnectionType(j.type)
+        jtype = _TYPES[j.type]
         if j.name in leaders or jtype.dof_count == 0:
             continue
         start = len(dofs)
@@ -160,7 +159,7 @@ def world_from_urdf_xml(
         own_dofs[j.name] = tuple(range(start, len(dofs)))
     connections: list[Connection] = []
     for j in records.joints:
-        jtype = ConnectionType(j.type)
+        jtype = _TYPES[j.type]
         mimic = None
         dof_idx = own_dofs.get(j.name, ())
         if j.name in leaders:
@@ -179,8 +178,10 @@ def world_from_urdf_xml(
                     )
                 )
                 continue
-        axis = np.asarray(j.axis, dtype=np.float64)
-        axis = axis / np.linalg.norm(axis) if jtype is not ConnectionType.FIXED else axis
+        x, y, z = j.axis
+        if jtype is not ConnectionType.FIXED:  # the walk refused zero axes of moving joints
+            norm = math.sqrt(x * x + y * y + z * z)
+            x, y, z = x / norm, y / norm, z / norm
         connections.append(
             Connection(
                 name=j.name,
@@ -189,7 +190,7 @@ def world_from_urdf_xml(
                 parent=body_index[j.parent],
                 child=body_index[j.child],
                 origin=j.origin,
-                axis=(float(axis[0]), float(axis[1]), float(axis[2])),
+                axis=(x, y, z),
                 dofs=dof_idx,
                 mimic=mimic,
                 line=line_of(j.element),
@@ -197,6 +198,9 @@ def world_from_urdf_xml(
         )
     raise_collected(problems)
     return World(records.name, bodies, connections, dofs, source=file)
+
+
+_TYPES = {t.value: t for t in ConnectionType}
 
 
 def _limits(j: JointRecord, jtype: ConnectionType) -> tuple[float, float, float, float]:

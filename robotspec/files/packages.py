@@ -26,6 +26,7 @@ from robotspec.errors import (
     closest_names,
     did_you_mean,
 )
+from robotspec.files.reading import read_head
 
 __all__ = ["PackageResolver", "user_roots"]
 
@@ -52,9 +53,8 @@ def _declared_name(folder: Path) -> str:
     Why the fallback: a broken manifest should not hide a package whose folder is named right,
     which is the usual case.
     """
-    try:
-        data = (folder / "package.xml").read_bytes()[:_MANIFEST_HEAD]
-    except OSError:
+    data = read_head(folder / "package.xml", _MANIFEST_HEAD)  # never a FIFO or a device
+    if data is None:
         return folder.name
     # A text search, not an XML parse: every search folder's manifests are read on each load,
     # and the name is plain text near the top (no entities are expanded either way).

@@ -18,7 +18,7 @@ from pathlib import Path
 from robotspec.errors import RobotSpecError, missing_file
 from robotspec.files.limits import env_name
 
-__all__ = ["read_bounded", "refuse_entities"]
+__all__ = ["read_bounded", "read_head", "refuse_entities"]
 
 
 def read_bounded(
@@ -74,6 +74,27 @@ def read_bounded(
         return b"".join(chunks)
     except OSError as exc:
         raise error_type(_reason(exc), file=shown, kind="file") from None
+    finally:
+        os.close(fd)
+
+
+def read_head(path: str | Path, size: int) -> bytes | None:
+    """The first ``size`` bytes of a regular file, or ``None`` if it cannot be read as one.
+
+    For peeking (a ``package.xml``'s name, a line number for a message), where a missing or
+    odd file is not an error of its own.
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError:
+        return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        return os.read(fd, size)
+    except OSError:
+        return None
     finally:
         os.close(fd)
 

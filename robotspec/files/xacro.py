@@ -42,7 +42,7 @@ from xml.parsers import expat
 from robotspec.errors import DescriptionError, PathOutsideRootsError, RobotSpecError
 from robotspec.files.limits import limits
 from robotspec.files.packages import PackageResolver
-from robotspec.files.reading import read_bounded, refuse_entities
+from robotspec.files.reading import read_bounded, read_head, refuse_entities
 from robotspec.files.xacro_sandbox import Budget, math_limits, unbounded_math
 
 __all__ = ["process_xacro"]
@@ -286,10 +286,10 @@ def _line_of(file: str | None, needle: re.Pattern[str]) -> int | None:
     """The first line of ``file`` matching ``needle``; xacro itself reports no lines."""
     if file is None:
         return None
-    try:
-        text = Path(file).read_text(encoding="utf-8", errors="replace")
-    except OSError:
+    data = read_head(file, limits().max_xacro_include_bytes)
+    if data is None:
         return None
+    text = data.decode("utf-8", errors="replace")
     found = needle.search(text)
     return None if found is None else text.count("\n", 0, found.start()) + 1
 

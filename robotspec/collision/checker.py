@@ -347,9 +347,14 @@ class SelfCollisionChecker:
         hits = self._scan(self._as_batch(qs), margin=margin, first_only=True)
         return np.asarray(hits.any(axis=1), dtype=np.bool_)
 
-    def collisions_batch(self, qs: object, *, margin: float = 0.0) -> Bools:
-        """Per configuration and checked pair (N, P): whether the pair collides."""
-        return self._scan(self._as_batch(qs), margin=margin)
+    def collisions_batch(
+        self, qs: object, *, margin: float = 0.0, pair_mask: Bools | None = None
+    ) -> Bools:
+        """Per configuration and checked pair (N, P): whether the pair collides.
+
+        ``pair_mask`` (P,) limits the pairs tested; the others read ``False``.
+        """
+        return self._scan(self._as_batch(qs), margin=margin, pair_mask=pair_mask)
 
     def ever_colliding(
         self, qs: object, *, pair_mask: Bools | None = None, margin: float = 0.0

@@ -23,6 +23,7 @@ from robotspec.semantic.sensors import Camera, Sensor
 
 if TYPE_CHECKING:
     from robotspec.description.srdf import Srdf
+    from robotspec.interop.pinocchio import PinocchioRobot
 
 __all__ = ["AbstractRobot", "CollisionCheckingConfig", "EmptyChainWarning"]
 
@@ -247,6 +248,16 @@ class AbstractRobot:
         for item in srdf.disable_default_collisions:
             if self.world.has_body(item.link):
                 self.disabled_collision_bodies.add(item.link)
+
+    def to_pinocchio(self) -> PinocchioRobot:
+        """The robot as a pinocchio model and collision model, with its semantic frames' ids.
+
+        Needs pinocchio (``pip install 'robotspec[pinocchio]'``); see
+        :mod:`robotspec.interop.pinocchio` for how the world maps onto it.
+        """
+        from robotspec.interop.pinocchio import robot_to_pinocchio
+
+        return robot_to_pinocchio(self)
 
     @classmethod
     def from_world(cls, world: World) -> AbstractRobot:

@@ -4,8 +4,9 @@ How a query runs: forward kinematics (the C core) gives every body pose; each ge
 body-frame bounding box is moved with its body and tested against its partners' (a broad phase
 over all samples and all pairs in one C call: world-aligned bounds, then the oriented boxes'
 separating axes); coal's narrow phase (a precomputed ``ComputeCollision`` per geometry pair, the
-functor pinocchio uses) runs only for pairs whose boxes come within the margin. Results are per *body* pair: a
-pair collides when any of their geometries do, and its distance is the minimum over them.
+functor pinocchio uses) runs only for pairs whose boxes come within the margin. Results are per
+*body* pair: a pair collides when any of their geometries do, and its distance is the minimum
+over them.
 
 Everything is built on the first query (meshes read once), so constructing a checker is cheap.
 """

@@ -90,7 +90,7 @@ class PinocchioRobot:
 
 
 def world_to_pinocchio(world: World) -> tuple[Any, dict[str, int], tuple[int, ...]]:
-    """pinocchio model of ``world``, the frame id of every body, and the configuration order.
+    """The pinocchio model of ``world``, the frame id of every body, and the configuration order.
 
     The order: entry ``i`` of a pinocchio configuration is entry ``order[i]`` of robotspec's.
     """
@@ -231,9 +231,7 @@ def robot_to_pinocchio(
     world = robot.world
     model, frames, order = world_to_pinocchio(world)
     _set_limits(model, world, order)
-    checker = SelfCollisionChecker.from_robot(
-        robot, meshes=meshes, on_missing_mesh=on_missing_mesh
-    )
+    checker = SelfCollisionChecker.from_robot(robot, meshes=meshes, on_missing_mesh=on_missing_mesh)
     gmodel = pin.GeometryModel()
     geoms = checker.geometry.geometries
     index_of: list[int] = []

@@ -145,7 +145,8 @@ class Kinematics:
         if relative_to is None:
             return pose
         ref = self.chain(root, relative_to).fk(q)
-        return np.linalg.solve(ref, pose)
+        relative: F64 = np.linalg.solve(ref, pose)
+        return relative
 
     def chain(self, root: Body | str, tip: Body | str) -> ChainKinematics:
         """Kinematics of the root-to-tip chain (cached per pair)."""

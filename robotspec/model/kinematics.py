@@ -145,7 +145,7 @@ class Kinematics:
         if relative_to is None:
             return pose
         ref = self.chain(root, relative_to).fk(q)
-        relative: F64 = np.linalg.solve(ref, pose)
+        relative: F64 = np.asarray(np.linalg.solve(ref, pose), dtype=np.float64)
         return relative
 
     def chain(self, root: Body | str, tip: Body | str) -> ChainKinematics:

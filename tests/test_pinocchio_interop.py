@@ -193,3 +193,19 @@ def test_floating_and_planar_bases_match() -> None:
             for body in moved.bodies:
                 theirs = data.oMf[frames[body.name]].homogeneous
                 np.testing.assert_allclose(ours[body.index], theirs, atol=1e-9, err_msg=root)
+
+
+def test_robot_level_queries() -> None:
+    """The robot's own entry points: cached kinematics, chain kinematics by name, a checker."""
+    erd_robots()
+    robot, pr = _compiled("pr2")
+    assert robot.kinematics is robot.kinematics
+    chain = robot.chain_kinematics("right_arm")
+    q = _samples(robot, 1, seed=5)[0]
+    data = pr.model.createData()
+    pin.framesForwardKinematics(pr.model, data, pr.configuration(q))
+    tip = data.oMf[pr.chain_tips["right_arm"]].homogeneous
+    root = data.oMf[pr.frames[robot.get_chain("right_arm").root.name]].homogeneous
+    np.testing.assert_allclose(chain.fk(q), np.linalg.solve(root, tip), atol=1e-9)
+    checker = robot.collision_checker()
+    assert checker.active_pairs == SelfCollisionChecker.from_robot(robot).active_pairs

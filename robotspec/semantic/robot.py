@@ -23,7 +23,9 @@ from robotspec.semantic.sensors import Camera, Sensor
 
 if TYPE_CHECKING:
     from robotspec.description.srdf import Srdf
+    from robotspec.collision.checker import SelfCollisionChecker
     from robotspec.interop.pinocchio import PinocchioRobot
+    from robotspec.model.kinematics import ChainKinematics, Kinematics
 
 __all__ = ["AbstractRobot", "CollisionCheckingConfig", "EmptyChainWarning"]
 
@@ -65,6 +67,7 @@ class AbstractRobot:
     srdf: Srdf | None = field(default=None, kw_only=True, repr=False)
     drive_type: str = field(default="fixed", kw_only=True)
     controlled_joint_names: tuple[str, ...] | None = field(default=None, kw_only=True)
+    _kinematics: Kinematics | None = field(default=None, init=False, repr=False, compare=False)
 
     #: The shipped spec a subclass compiles in ``from_world`` (set by robotspec.robots).
     spec_name: ClassVar[str | None] = None
@@ -248,6 +251,30 @@ class AbstractRobot:
         for item in srdf.disable_default_collisions:
             if self.world.has_body(item.link):
                 self.disabled_collision_bodies.add(item.link)
+
+    # ------------------------------------------------------------------------- queries
+    @property
+    def kinematics(self) -> Kinematics:
+        """Forward kinematics of the robot's world, built once (see :class:`Kinematics`).
+
+        ``robot.kinematics.forward(q)`` gives every body's pose, ``.pose(q, name)`` one frame's.
+        """
+        if self._kinematics is None:
+            from robotspec.model.kinematics import Kinematics
+
+            self._kinematics = Kinematics(self.world)
+        return self._kinematics
+
+    def chain_kinematics(self, name: str) -> ChainKinematics:
+        """The tip pose (``.fk(q)``) and Jacobian (``.jacobian(q)``) of a chain, by chain name."""
+        chain = self.get_chain(name)
+        return self.kinematics.chain(chain.root, chain.tip)
+
+    def collision_checker(self) -> SelfCollisionChecker:
+        """A self-collision checker with the robot's own rules; build it once and reuse it."""
+        from robotspec.collision.checker import SelfCollisionChecker
+
+        return SelfCollisionChecker.from_robot(self)
 
     def to_pinocchio(self) -> PinocchioRobot:
         """The robot as a pinocchio model and collision model, with its semantic frames' ids.

@@ -22,8 +22,8 @@ from robotspec.semantic.manipulators import Manipulator
 from robotspec.semantic.sensors import Camera, Sensor
 
 if TYPE_CHECKING:
-    from robotspec.description.srdf import Srdf
     from robotspec.collision.checker import SelfCollisionChecker
+    from robotspec.description.srdf import Srdf
     from robotspec.interop.pinocchio import PinocchioRobot
     from robotspec.model.kinematics import ChainKinematics, Kinematics
 

@@ -169,7 +169,8 @@ def robot_rows(name: str, rounds: int, n_configs: int) -> list[Row]:
                 assert (dist[p] < 0) == (p in ours_pairs), (name, p, dist[p])
             print(
                 f"note: {name}: pinocchio disagrees on {sorted(ours_pairs ^ theirs_pairs)}, "
-                "robotspec matches the signed distance"
+                "robotspec matches the signed distance",
+                file=sys.stderr,
             )
         else:
             assert checker.in_collision(q) == pin_any(pq)
@@ -257,6 +258,28 @@ def batch_rows(samples: int, collision_configs: int, rounds: int) -> list[Row]:
             f"pr2: batched FK, {samples} configs, all bodies",
             t[0],
             "same loop, every pose copied into an array",
+            t[1],
+        )
+    )
+    arm = robot.get_chain("right_arm")
+    chain = kin.chain(arm.root, arm.tip)
+    root_id, tip_id = pr.frames[arm.root.name], pr.chain_tips["right_arm"]
+
+    def pin_tips(_: object) -> np.ndarray:
+        out = np.empty((len(pqs), 4, 4))
+        for k, q in enumerate(pqs):
+            pin.forwardKinematics(model, data, q)
+            root = pin.updateFramePlacement(model, data, root_id)
+            out[k] = root.actInv(pin.updateFramePlacement(model, data, tip_id)).homogeneous
+        return out
+
+    np.testing.assert_allclose(chain.fk_batch(qs[:50]), pin_tips(0)[:50], atol=1e-9)
+    t = duel(lambda _: chain.fk_batch(qs), [0], pin_tips, [0], rounds)
+    rows.append(
+        Row(
+            f"pr2: batched chain tip pose (right_arm), {samples} configs",
+            t[0],
+            "loop of FK + 2 updateFramePlacement + actInv",
             t[1],
         )
     )

@@ -419,20 +419,7 @@ static PyObject *py_chain(PyObject *self, PyObject *args) {
     return cap;
 }
 
-static PyObject *py_chain_fk(PyObject *self, PyObject *args) {
-    PyObject *cap, *qobj;
-    if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
-    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
-    if (c == NULL) return NULL;
-    PyArrayObject *q = as_config(qobj, 1, c->n_dof);
-    if (q == NULL) return NULL;
-    const double *qv = PyArray_DATA(q);
-    npy_intp dims[2] = {4, 4};
-    PyArrayObject *out = (PyArrayObject *)PyArray_SimpleNew(2, dims, NPY_DOUBLE);
-    if (out == NULL) {
-        Py_DECREF(q);
-        return NULL;
-    }
+static void chain_run(const Chain *c, const double *qv, double *o) {
     double t[16], u[16];
     identity(t);
     for (Py_ssize_t i = 0; i < c->n; i++) {
@@ -440,9 +427,41 @@ static PyObject *py_chain_fk(PyObject *self, PyObject *args) {
         apply_motion(u, (int)c->kind[i], c->axis + 3 * i, qv[c->dof[i]] * c->mul[i] + c->off[i]);
         memcpy(t, u, 12 * sizeof(double));
     }
-    double *o = PyArray_DATA(out);
     mul34(t, c->post, o);
     last_row(o);
+}
+
+static PyObject *py_chain_fk(PyObject *self, PyObject *args) {
+    PyObject *cap, *qobj;
+    if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
+    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
+    if (c == NULL) return NULL;
+    PyArrayObject *q = as_config(qobj, 1, c->n_dof);
+    if (q == NULL) return NULL;
+    npy_intp dims[2] = {4, 4};
+    PyArrayObject *out = (PyArrayObject *)PyArray_SimpleNew(2, dims, NPY_DOUBLE);
+    if (out != NULL) chain_run(c, PyArray_DATA(q), PyArray_DATA(out));
+    Py_DECREF(q);
+    return (PyObject *)out;
+}
+
+static PyObject *py_chain_fk_batch(PyObject *self, PyObject *args) {
+    PyObject *cap, *qobj;
+    if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
+    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
+    if (c == NULL) return NULL;
+    PyArrayObject *q = as_config(qobj, 2, c->n_dof);
+    if (q == NULL) return NULL;
+    npy_intp n = PyArray_DIM(q, 0);
+    npy_intp dims[3] = {n, 4, 4};
+    PyArrayObject *out = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_DOUBLE);
+    if (out != NULL) {
+        const double *qv = PyArray_DATA(q);
+        double *ov = PyArray_DATA(out);
+        Py_BEGIN_ALLOW_THREADS
+        for (npy_intp i = 0; i < n; i++) chain_run(c, qv + i * c->n_dof, ov + 16 * i);
+        Py_END_ALLOW_THREADS
+    }
     Py_DECREF(q);
     return (PyObject *)out;
 }
@@ -741,6 +760,7 @@ static PyMethodDef methods[] = {
     {"fk_batch", py_fk_batch, METH_VARARGS, "Every output pose (N, B, 4, 4) of a batch."},
     {"chain", py_chain, METH_VARARGS, "Compile a chain program."},
     {"chain_fk", py_chain_fk, METH_VARARGS, "root_T_tip (4, 4) of one configuration."},
+    {"chain_fk_batch", py_chain_fk_batch, METH_VARARGS, "root_T_tip (N, 4, 4) of a batch."},
     {"chain_jacobian", py_chain_jacobian, METH_VARARGS, "The chain's Jacobian (6, n)."},
     {"geoms", py_geoms, METH_VARARGS, "Compile the geometries and pairs of a checker."},
     {"broad", py_broad, METH_VARARGS, "Candidate (sample, pair)s and geometry poses."},

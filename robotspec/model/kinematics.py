@@ -99,27 +99,13 @@ class Kinematics:
         self._tree = _tree_program(world)
         self._chains: dict[tuple[int, int], ChainKinematics] = {}
 
-    def _check_q(self, q: object, batch: bool) -> F64:
-        arr = np.asarray(q, dtype=np.float64)
-        want = 2 if batch else 1
-        if arr.ndim != want or arr.shape[-1] != self._nd:
-            shape = "(N, D)" if batch else "(D,)"
-            raise KinematicsError(
-                f"configuration must have shape {shape} with D = {self._nd} degrees of freedom "
-                f"of world '{self.world.name}', got {arr.shape}"
-            )
-        if not np.all(np.isfinite(arr)):
-            raise KinematicsError("configuration contains NaN or infinite values")
-        return arr
-
     # -------------------------------------------------------------------------- queries
     def forward(self, q: object) -> F64:
         """``root_T_body`` for every body (B, 4, 4) at configuration ``q`` (D,)."""
         try:
             poses: F64 = _kincore.fk(self._tree, q)
         except (ValueError, TypeError):
-            self._check_q(q, batch=False)  # names the problem; re-raise if it finds none
-            raise
+            raise _bad_configuration(q, self._nd, self.world.name, False) from None
         return poses
 
     def forward_batch(self, q: object) -> F64:
@@ -130,8 +116,7 @@ class Kinematics:
         try:
             poses: F64 = _kincore.fk_batch(self._tree, q)
         except (ValueError, TypeError):
-            self._check_q(q, batch=True)
-            raise
+            raise _bad_configuration(q, self._nd, self.world.name, True) from None
         return poses
 
     def pose(self, q: object, body: str, relative_to: str | None = None) -> F64:
@@ -157,6 +142,19 @@ class Kinematics:
         if chain is None:
             chain = self._chains[key] = ChainKinematics(self.world, r, t)
         return chain
+
+
+def _bad_configuration(q: object, nd: int, world: str, batch: bool) -> KinematicsError:
+    """The error for a configuration the C core refused: what is wrong with it, in words."""
+    shape = "(N, D)" if batch else "(D,)"
+    want = f"shape {shape} with D = {nd} degrees of freedom of world '{world}'"
+    try:
+        arr = np.asarray(q, dtype=np.float64)
+    except (ValueError, TypeError) as exc:
+        return KinematicsError(f"configuration must be numbers of {want}: {exc}")
+    if arr.ndim != (2 if batch else 1) or arr.shape[-1] != nd:
+        return KinematicsError(f"configuration must have {want}, got {arr.shape}")
+    return KinematicsError("configuration contains NaN or infinite values")
 
 
 def _tree_program(world: World) -> object:
@@ -269,22 +267,21 @@ class ChainKinematics:
             self._nd,
         )
 
-    def _bad_q(self, q: object) -> KinematicsError:
-        arr = np.asarray(q, dtype=np.float64)
-        if arr.ndim != 1 or arr.shape[0] != self._nd:
-            return KinematicsError(
-                f"configuration must have shape (D,) with D = {self._nd} degrees of freedom "
-                f"of world '{self._world_name}', got {arr.shape}"
-            )
-        return KinematicsError("configuration contains NaN or infinite values")
-
     def fk(self, q: object) -> F64:
         """``root_T_tip`` (4, 4) for the world configuration ``q`` (D,)."""
         try:
             pose: F64 = _kincore.chain_fk(self._program, q)
         except (ValueError, TypeError):
-            raise self._bad_q(q) from None
+            raise _bad_configuration(q, self._nd, self._world_name, False) from None
         return pose
+
+    def fk_batch(self, q: object) -> F64:
+        """``root_T_tip`` (N, 4, 4) for each configuration of ``q`` (N, D), in one C loop."""
+        try:
+            poses: F64 = _kincore.chain_fk_batch(self._program, q)
+        except (ValueError, TypeError):
+            raise _bad_configuration(q, self._nd, self._world_name, True) from None
+        return poses
 
     def jacobian(self, q: object) -> F64:
         """Geometric Jacobian (6, n) of the tip origin in the root frame; columns = dof_indices.
@@ -295,5 +292,5 @@ class ChainKinematics:
         try:
             jac: F64 = _kincore.chain_jacobian(self._program, q)
         except (ValueError, TypeError):
-            raise self._bad_q(q) from None
+            raise _bad_configuration(q, self._nd, self._world_name, False) from None
         return jac

@@ -15,8 +15,8 @@ import pytest
 from robotspec.collision import SelfCollisionChecker, random_configurations
 from robotspec.collision.rules import pair_key
 from robotspec.errors import KinematicsError
-from robotspec.interop.pinocchio import PinocchioRobot
 from robotspec.model.kinematics import Kinematics
+from robotspec.model.pinocchio import PinocchioRobot
 from robotspec.semantic import AbstractRobot
 from tests.conftest import erd_robots, shared_path
 
@@ -180,7 +180,7 @@ def test_floating_and_planar_bases_match() -> None:
         (ConnectionType.PLANAR, (0.0, 0.6, 0.8)),
     ):
         moved = world.with_base_connection("base_joint", "odom", kind, axis=axis)
-        from robotspec.interop.pinocchio import world_to_pinocchio
+        from robotspec.model.pinocchio import world_to_pinocchio
 
         model, frames, order = world_to_pinocchio(moved)
         data = model.createData()
@@ -196,7 +196,7 @@ def test_floating_and_planar_bases_match() -> None:
 
 
 def test_robot_level_queries() -> None:
-    """The robot's own entry points: cached kinematics, chain kinematics by name, a checker."""
+    """The robot's own entry points: cached kinematics, chain kinematics by name."""
     erd_robots()
     robot, pr = _compiled("pr2")
     assert robot.kinematics is robot.kinematics
@@ -207,5 +207,3 @@ def test_robot_level_queries() -> None:
     tip = data.oMf[pr.chain_tips["right_arm"]].homogeneous
     root = data.oMf[pr.frames[robot.get_chain("right_arm").root.name]].homogeneous
     np.testing.assert_allclose(chain.fk(q), np.linalg.solve(root, tip), atol=1e-9)
-    checker = robot.collision_checker()
-    assert checker.active_pairs == SelfCollisionChecker.from_robot(robot).active_pairs

@@ -12,7 +12,7 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING
 
 from robotspec.errors import KinematicsError, NotFoundError
 from robotspec.model.world import Body, Connection, World
@@ -22,10 +22,9 @@ from robotspec.semantic.manipulators import Manipulator
 from robotspec.semantic.sensors import Camera, Sensor
 
 if TYPE_CHECKING:
-    from robotspec.collision.checker import SelfCollisionChecker
     from robotspec.description.srdf import Srdf
-    from robotspec.interop.pinocchio import PinocchioRobot
     from robotspec.model.kinematics import ChainKinematics, Kinematics
+    from robotspec.model.pinocchio import PinocchioRobot
 
 __all__ = ["AbstractRobot", "CollisionCheckingConfig", "EmptyChainWarning"]
 
@@ -68,9 +67,6 @@ class AbstractRobot:
     drive_type: str = field(default="fixed", kw_only=True)
     controlled_joint_names: tuple[str, ...] | None = field(default=None, kw_only=True)
     _kinematics: Kinematics | None = field(default=None, init=False, repr=False, compare=False)
-
-    #: The shipped spec a subclass compiles in ``from_world`` (set by robotspec.robots).
-    spec_name: ClassVar[str | None] = None
 
     # ----------------------------------------------------------------------- structure
     @property
@@ -270,12 +266,6 @@ class AbstractRobot:
         chain = self.get_chain(name)
         return self.kinematics.chain(chain.root, chain.tip)
 
-    def collision_checker(self) -> SelfCollisionChecker:
-        """A self-collision checker with the robot's own rules; build it once and reuse it."""
-        from robotspec.collision.checker import SelfCollisionChecker
-
-        return SelfCollisionChecker.from_robot(self)
-
     def to_pinocchio(self) -> PinocchioRobot:
         """The robot as a pinocchio model and collision model, with its semantic frames' ids.
 
@@ -288,12 +278,16 @@ class AbstractRobot:
 
     @classmethod
     def from_world(cls, world: World) -> AbstractRobot:
-        """Build the robot over ``world`` from its shipped spec (subclasses set ``spec_name``)."""
-        if cls.spec_name is None:
-            raise TypeError(f"{cls.__name__} has no spec; use robotspec.compile_robot(spec, world)")
-        from robotspec.compiler import compile_spec_for_world
+        """Build the robot over ``world``: the seed leaves this to subclasses.
 
-        return compile_spec_for_world(cls.spec_name, world, robot_class=cls)
+        The semantic model never calls the compiler (it sits below it); the shipped robots
+        (:mod:`robotspec.robots`) implement it with their spec, and any spec does the same
+        through :func:`robotspec.compile_spec_for_world`.
+        """
+        raise TypeError(
+            f"{cls.__name__} has no spec of its own; use "
+            f"robotspec.compile_spec_for_world(spec, world) or a class of robotspec.robots"
+        )
 
     def __hash__(self) -> int:
         return hash((type(self).__name__, tuple(sorted(b.name for b in self.bodies))))

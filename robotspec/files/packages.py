@@ -481,9 +481,7 @@ class PackageResolver:
                 )
         return self.check_allowed(candidate, uri=uri, file=file, line=line)
 
-    def _from_package_root(
-        self, inner: str, uri: str, file: str | None, line: int | None
-    ) -> Path:
+    def _from_package_root(self, inner: str, uri: str, file: str | None, line: int | None) -> Path:
         """``package:///PKG/path`` (an empty package name): a path that starts at a package root.
 
         Why: pinocchio joins everything after ``package://`` to each of its package folders, so

@@ -242,6 +242,8 @@ class AbstractRobot:
             return
         with_geometry = {b.name for b in self.bodies_with_collisions}
         for pair in srdf.disabled_collisions:
+            if pair.link1 == pair.link2:
+                continue  # a link against itself (validation warns); no pair to disable
             if pair.link1 in with_geometry and pair.link2 in with_geometry:
                 self.disabled_collision_pairs.add(frozenset((pair.link1, pair.link2)))
         for item in srdf.disable_default_collisions:

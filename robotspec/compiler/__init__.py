@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from robotspec.compiler.arm_sides import check_arm_sides
 from robotspec.compiler.build import Build, build_robot
 from robotspec.description.srdf import Srdf
 from robotspec.diagnostics import Diagnostics
@@ -251,6 +252,7 @@ def _compile(
         loaded=loaded, world=prepared, diag=diag, srdf=srdf, presets=load_camera_presets()
     )
     robot = build_robot(build, robot_class)
+    check_arm_sides(robot, diag)
     diag.raise_if_failed(strict=strict)
     return CompileResult(
         loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))

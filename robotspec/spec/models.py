@@ -257,6 +257,11 @@ class ChainSpec(_Model):
     tip: Name | None = None
     group: Name | None = Field(default=None, description="an SRDF group with one chain")
     manipulator: Name | None = None
+    side: Literal["left", "right"] | None = Field(
+        default=None,
+        description="which arm of a two-arm robot this is (default: by position seen from the "
+        "root in the default pose)",
+    )
     sensors: list[Name] = Field(default_factory=list)
     states: States = Field(default_factory=dict)
 

@@ -198,6 +198,12 @@ FIELD_NOTES: dict[tuple[str, str], FieldNote] = {
     ("ChainSpec", "manipulator"): FieldNote(
         "", "manipulator: left_gripper", "name of the manipulator (from `manipulators`) at its tip"
     ),
+    ("ChainSpec", "side"): FieldNote(
+        "",
+        "side: left",
+        "which arm of a two-arm robot this is, for `left_arm` / `right_arm`; default: the arm "
+        "lying on the root's +y side in the default pose",
+    ),
     ("ChainSpec", "sensors"): FieldNote(
         "", "sensors: [hand_camera]", "names of sensors (from `sensors`) the chain carries"
     ),

@@ -1,4 +1,4 @@
-"""SRDF names as robots ship them: a robot prefix the URDF lacks, and a link disabled against itself.
+"""SRDF names as robots ship them: a robot prefix the URDF lacks, a link disabled against itself.
 
 Why: SRDFs are often written for a namespaced robot (Baxter's in example-robot-data says
 ``baxter/head_pan`` for the URDF's ``head_pan``, as a ``tf_prefix`` or a multi-robot launch

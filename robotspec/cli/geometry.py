@@ -12,7 +12,6 @@ import sys
 from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
-from robotspec.description.mesh_report import missing_geometry_message, unresolved_mesh_bodies
 from robotspec.errors import ErrorDetail, RobotSpecError
 
 if TYPE_CHECKING:
@@ -29,6 +28,8 @@ def check_missing_geometry(
     Returns the URIs already reported, so the per-element skips of the geometry builders are
     not printed again.
     """
+    from robotspec.description.mesh_report import missing_geometry_message, unresolved_mesh_bodies
+
     missing = unresolved_mesh_bodies(
         robot.world, collision=collision, bodies=[b.name for b in robot.bodies]
     )

@@ -435,3 +435,31 @@ def test_a_spec_neck_without_sensors_is_an_error(
         f"{spec}:9:3: error: neck: a neck carries the head's sensors; list them under 'sensors' "
         "(a chain without sensors belongs under 'chains')"
     )
+
+
+def test_imported_srdf_states_skip_joints_the_urdf_lacks(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    (tmp_path / "robot.urdf").write_text(ABSENT_URDF.read_text())
+    (tmp_path / "robot.srdf").write_text(
+        '<robot name="a">\n  <group name="arm"><chain base_link="base_link" tip_link="hand"/>'
+        '</group>\n  <group_state name="home" group="arm">\n'
+        '    <joint name="shoulder" value="0.5"/>\n    <joint name="ghost_joint" value="1"/>\n'
+        "  </group_state>\n</robot>\n"
+    )
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(
+        (OWN / "self_pair.yaml")
+        .read_text()
+        .replace("absent_meshes.urdf", "robot.urdf")
+        .replace("self_pair.srdf", "robot.srdf")
+        + "import_srdf_group_states: true\n"
+    )
+    code, out, _ = run(capsys, "validate", str(spec))
+    assert code == 0
+    assert (
+        f"{tmp_path / 'robot.srdf'}:5: warning: joint 'ghost_joint' not found in robot.urdf"
+        in out
+    )
+    robot = compile_robot(spec)
+    assert robot.joint_states["arm.home"].joints == (("shoulder", 0.5),)

@@ -134,16 +134,19 @@ def check_velocity(b: Build, robot_joints: list[Connection]) -> dict[str, float]
 def srdf_state_values(b: Build, gs: GroupState) -> dict[str, float]:
     """The 1-DOF values of an SRDF group state a spec imports, mimic joints taken out.
 
-    Why: MoveIt group states list mimic joints beside their leaders (Baxter's fingers); a spec
-    state sets only leaders. A mimic value that agrees with its leader's is dropped silently; one
+    Joints the URDF lacks are left out: the SRDF check warns about each at its own line, so the
+    spec's ``import_srdf_group_states`` line does not collect one error per joint. MoveIt group
+    states list mimic joints beside their leaders (Baxter's fingers); a spec state sets only
+    leaders. A mimic value that agrees with its leader's is dropped silently; one
     that disagrees (or whose leader is absent) is dropped with a warning at the SRDF's line.
     """
     values = {j: v[0] for j, v in gs.joint_values if len(v) == 1}
     lines = dict(zip((j for j, _ in gs.joint_values), gs.joint_lines, strict=False))
     out: dict[str, float] = {}
     for name, value in values.items():
-        c = b.world.get_connection_by_name(name) if b.world.has_connection(name) else None
-        mimic = None if c is None else c.mimic
+        if not b.world.has_connection(name):
+            continue  # warned at the SRDF's line already; MoveIt ignores it the same way
+        mimic = b.world.get_connection_by_name(name).mimic
         if mimic is None:
             out[name] = value
             continue

@@ -458,8 +458,7 @@ def test_imported_srdf_states_skip_joints_the_urdf_lacks(
     code, out, _ = run(capsys, "validate", str(spec))
     assert code == 0
     assert (
-        f"{tmp_path / 'robot.srdf'}:5: warning: joint 'ghost_joint' not found in robot.urdf"
-        in out
+        f"{tmp_path / 'robot.srdf'}:5: warning: joint 'ghost_joint' not found in robot.urdf" in out
     )
     robot = compile_robot(spec)
     assert robot.joint_states["arm.home"].joints == (("shoulder", 0.5),)

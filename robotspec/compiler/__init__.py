@@ -39,7 +39,7 @@ class CompileResult:
     """What ``robotspec validate`` reports: the robot (if it compiled) and every warning."""
 
     loaded: LoadedSpec
-    robot: AbstractRobot | None
+    robot: AbstractRobot
     warnings: tuple[RobotSpecError, ...]
 
 
@@ -252,7 +252,7 @@ def _compile(
         loaded=loaded, world=prepared, diag=diag, srdf=srdf, presets=load_camera_presets()
     )
     robot = build_robot(build, robot_class)
-    check_arm_sides(robot, diag)
+    check_arm_sides(robot, loaded.spec.chains, diag)
     diag.raise_if_failed(strict=strict)
     return CompileResult(
         loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))
@@ -270,17 +270,16 @@ def compile_robot(
     ref: str | Path,
     *,
     package_paths: Sequence[str | Path] = (),
-    robot_class: type[AbstractRobot] | None = None,
+    robot_class: type[AbstractRobot] = AbstractRobot,
 ) -> AbstractRobot:
-    """Compile a spec file, or a shipped robot by name, into an ``AbstractRobot``."""
-    if robot_class is None:
-        from robotspec.robots import robot_class_for
+    """Compile a spec file, or a shipped robot by name, into an ``AbstractRobot``.
 
-        robot_class = robot_class_for(ref)
+    ``robot_class`` is the class built; :func:`robotspec.robots.load` picks the shipped robot's
+    own class (the compiler does not know the registry of shipped robots).
+    """
     result = _compile(
         load_spec(resolve_spec(ref)), package_paths=package_paths, robot_class=robot_class
     )
-    assert result.robot is not None
     return result.robot
 
 
@@ -303,5 +302,4 @@ def compile_spec_for_world(
         world=world,
         robot_class=robot_class,
     )
-    assert result.robot is not None
     return result.robot

@@ -6,17 +6,21 @@ compiled chains; a declared side that contradicts the geometry is most likely a 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from robotspec.diagnostics import Diagnostics
 from robotspec.errors import KinematicsError
 from robotspec.semantic import AbstractRobot
 from robotspec.semantic.sides import arm_sides, lateral_offset
+from robotspec.spec.models import ChainSpec
 
 __all__ = ["check_arm_sides"]
 
 
-def check_arm_sides(robot: AbstractRobot, diag: Diagnostics) -> None:
+def check_arm_sides(
+    robot: AbstractRobot, chains: Mapping[str, ChainSpec], diag: Diagnostics
+) -> None:
     """Record the problems of the spec's ``side`` entries and of telling the arms apart."""
-    chains = diag.loaded.spec.chains
     declared = {name: c.side for name, c in chains.items() if c.side is not None}
     arms = robot.arms
     arm_names = {a.name for a in arms}

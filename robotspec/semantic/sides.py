@@ -34,7 +34,7 @@ def lateral_offset(world: World, root: Body, chain: KinematicChain) -> float:
     from robotspec.model.kinematics import Kinematics
 
     kin = Kinematics(world)
-    q = world.configuration()
+    q = world.default_configuration()
     bodies = [b for b in chain.bodies if b.name != chain.root.name] or [chain.tip]
     ys = [float(kin.pose(q, b.name, relative_to=root.name)[1, 3]) for b in bodies]
     return float(np.mean(ys))

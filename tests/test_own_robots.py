@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from robotspec.cli.app import _register, app
+from robotspec.cli.app import app
 from robotspec.cli.render import run_app
 from robotspec.compiler import check_spec, compile_robot
 from robotspec.description.srdf import parse_srdf_bytes
@@ -34,7 +34,6 @@ FIX = (
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
     """Run ``robotspec ARGV`` in-process; returns (exit code, stdout, stderr)."""
-    _register()
     code = run_app(app, list(argv))
     out = capsys.readouterr()
     return code, out.out, out.err
@@ -462,3 +461,40 @@ def test_imported_srdf_states_skip_joints_the_urdf_lacks(
     )
     robot = compile_robot(spec)
     assert robot.joint_states["arm.home"].joints == (("shoulder", 0.5),)
+
+
+TWO_ARM_SPEC = """\
+robotspec: 1
+name: {name}
+description:
+  urdf: package://example-robot-data/robots/{urdf}
+root: base_footprint
+chains:
+  arm_a: {{root: torso_lift_link, tip: arm_right_7_link, manipulator: hand_a}}
+  arm_b: {{root: torso_lift_link, tip: arm_left_7_link, manipulator: hand_b}}
+manipulators:
+  hand_a: {{type: generic, root: {right}, tool_frame: {right}}}
+  hand_b: {{type: generic, root: {left}, tool_frame: {left}}}
+"""
+
+
+@pytest.mark.parametrize(
+    ("name", "urdf", "hand"),
+    [
+        ("TiagoDual", "tiago_description/robots/tiago_dual.urdf", "hand_{}_palm_link"),
+        ("TiagoPro", "tiago_pro_description/robots/tiago_pro.urdf", "gripper_{}_base_link"),
+    ],
+)
+def test_dual_arm_tiagos_have_left_and_right_by_position(
+    tmp_path: Path, name: str, urdf: str, hand: str
+) -> None:
+    erd_robots()
+    spec = tmp_path / "two_arms.yaml"
+    spec.write_text(
+        TWO_ARM_SPEC.format(
+            name=name, urdf=urdf, right=hand.format("right"), left=hand.format("left")
+        )
+    )
+    robot = compile_robot(spec)
+    # Neutral chain names: the sides come from where the arms are, seen from the base.
+    assert (robot.left_arm.name, robot.right_arm.name) == ("arm_b", "arm_a")

@@ -430,10 +430,7 @@ def test_a_spec_neck_without_sensors_is_an_error(
     spec.write_text((OWN / "baxter.yaml").read_text().replace("  sensors: [head_camera]\n", ""))
     code, out, _ = run(capsys, "validate", str(spec))
     assert code == 1
-    assert out.splitlines()[0] == (
-        f"{spec}:9:3: error: neck: a neck carries the head's sensors; list them under 'sensors' "
-        "(a chain without sensors belongs under 'chains')"
-    )
+    assert out.splitlines()[0] == f"{spec}:9:3: error: neck: a neck must carry at least one sensor"
 
 
 def test_imported_srdf_states_skip_joints_the_urdf_lacks(
@@ -498,3 +495,22 @@ def test_dual_arm_tiagos_have_left_and_right_by_position(
     robot = compile_robot(spec)
     # Neutral chain names: the sides come from where the arms are, seen from the base.
     assert (robot.left_arm.name, robot.right_arm.name) == ("arm_b", "arm_a")
+
+
+def test_meshes_missing_from_a_found_package_are_one_warning(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    pkg = tmp_path / "absent_mesh_pkg"
+    pkg.mkdir()
+    (pkg / "package.xml").write_text("<package><name>absent_mesh_pkg</name></package>")
+    write_stl(tmp_path / "absent_root_pkg" / "meshes" / "hand.stl")
+    code, out, _ = run(capsys, "validate", "-P", str(tmp_path), str(OWN / "absent_meshes.yaml"))
+    real = pkg.resolve()
+    assert code == 0
+    assert out.splitlines() == [
+        f"{ABSENT_URDF}:8: warning: 4 meshes of 'absent_mesh_pkg' not found (first: mesh "
+        f"'package://absent_mesh_pkg/meshes/upper_arm.stl' resolves to "
+        f"'{real}/meshes/upper_arm.stl', which does not exist); 4 meshes of 2 bodies "
+        "(upper_arm, forearm) have no geometry",
+        "1 of 1 spec valid; 0 errors, 1 warning",
+    ]

@@ -66,12 +66,6 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
                     f"'{body.name}' is not on the neck chain '{n.root}' -> '{n.tip}'",
                     name=body.name,
                 )
-        if not n.sensors:
-            diag.error(
-                ("neck",),
-                "a neck carries the head's sensors; list them under 'sensors' "
-                "(a chain without sensors belongs under 'chains')",
-            )
         if b.chain_ok(("neck",), "neck", nr, nt) and nr is not None and nt is not None:
             neck_ends = (nr, nt)
             conns = b.world.compute_chain_of_connections(nr, nt)

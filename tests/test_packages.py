@@ -265,8 +265,11 @@ def test_empty_package_name_starts_at_a_package_root() -> None:
         f"searched: {searched}"
     )
     assert (info.value.file, info.value.line, info.value.name) == ("robot.urdf", 9, "no_such_pkg")
-    with pytest.raises(PathOutsideRootsError):
+    # No search folder may be left: '..' is probed nowhere and is no package name.
+    with pytest.raises(PackageNotFoundError, match="package '..' not found"):
         r.resolve("package:///../../../../../../etc/passwd")
+    with pytest.raises(PathOutsideRootsError):
+        r.resolve("package:///beta_meshes/../../../../../../../../etc/passwd")
 
 
 def test_talos_full_v2_meshes_resolve_from_the_package_root() -> None:
@@ -296,13 +299,18 @@ def test_allowed_roots_include_the_description_and_its_package() -> None:
 SEGMENT = st.sampled_from(["..", ".", "meshes", "box.stl", "x", "", "..."])
 
 
-@given(st.lists(SEGMENT, min_size=1, max_size=10), st.sampled_from(["package", "file", "plain"]))
+@given(
+    st.lists(SEGMENT, min_size=1, max_size=10),
+    st.sampled_from(["package", "root", "model", "file", "plain"]),
+)
 def test_dotdot_never_escapes(segments: list[str], form: str) -> None:
     r = isolated()
     rel = "/".join(segments)
     base = ALPHA / "urdf"
     uri = {
         "package": f"package://beta_meshes/{rel}",
+        "root": f"package:///{rel}",
+        "model": f"model://beta_meshes/{rel}",
         "file": f"file://{rel}",
         "plain": rel,
     }[form]
@@ -310,7 +318,7 @@ def test_dotdot_never_escapes(segments: list[str], form: str) -> None:
         return
     try:
         path = r.resolve(uri, relative_to=base)
-    except PathOutsideRootsError:
+    except (PathOutsideRootsError, PackageNotFoundError):
         return
     real = Path(os.path.realpath(path))
     assert any(real == root or real.is_relative_to(root) for root in r.allowed_roots)

@@ -491,11 +491,10 @@ class PackageResolver:
         finds the file, the error names that first segment as the missing package.
         """
         rel = inner.lstrip("/")
-        if _has_dotdot(rel):  # never probe outside a folder; the fence below reports it
-            return Path(f"{self.search_folders[0] if self.search_folders else '/'}/{rel}")
         for folder in self.search_folders:
             candidate = Path(f"{folder}/{rel}")
-            if candidate.exists():
+            # Fenced before it is probed: nothing outside the roots is even looked at.
+            if self.is_allowed(candidate) and candidate.exists():
                 return candidate
         first, _, below = rel.partition("/")
         try:

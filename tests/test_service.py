@@ -634,7 +634,7 @@ def test_publisher_thread_sends_every_step_in_order(short_tmp: Path, client_node
     )
     with server:
         service = server.service
-        assert service is not None and service.publisher_thread.is_alive()
+        assert service is not None and service.publisher.thread.is_alive()
         robot = client_node.ConnectService(server.url)
         try:
             wire = robot.robot_state.Connect()
@@ -643,15 +643,15 @@ def test_publisher_thread_sends_every_step_in_order(short_tmp: Path, client_node
             try:
                 for _ in range(20):
                     driver.step()  # stepped here: no loop thread
-                wait_until(lambda: service.published == 20)
+                wait_until(lambda: service.publisher.published == 20)
                 wait_until(lambda: bool(seqnos) and seqnos[-1] == driver.robot_state.seqno)
             finally:
                 wire.Close()
             assert seqnos == sorted(seqnos)
-            assert service.publish_dropped == 0 and service.publish_errors == 0
+            assert service.publisher.dropped == 0 and service.publisher.errors == 0
         finally:
             client_node.DisconnectService(robot)
-    assert not service.publisher_thread.is_alive()  # stopped with the server
+    assert not service.publisher.thread.is_alive()  # stopped with the server
 
 
 def _own_sockets(kind: str) -> list[tuple[str, int]]:
@@ -717,7 +717,7 @@ def test_loopback_only_without_public_and_discoverable_with_it(
 def test_cli_passes_public_through(
     short_tmp: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from robotspec.service import cli as service_cli
+    from robotspec.service import serve as service_serve
 
     seen: list[ServeOptions] = []
 
@@ -726,7 +726,7 @@ def test_cli_passes_public_through(
             super().__init__(*args, **kw)
             seen.append(self.options)
 
-    monkeypatch.setattr(service_cli, "RobotServer", Recording)
+    monkeypatch.setattr(service_serve, "RobotServer", Recording)
     _register()
     for extra in ([], ["--public"]):
         code = render.run_app(

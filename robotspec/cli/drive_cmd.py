@@ -85,7 +85,7 @@ def drive(
         raise typer.BadParameter(
             f"unknown log format '{log.suffix}' (use .csv or .jsonl)", param_hint="--log"
         )
-    from robotspec.service.cli import serve_option_problem
+    from robotspec.service.serve import serve_option_problem
 
     problem = serve_option_problem(
         serve=serve,
@@ -155,7 +155,7 @@ def drive(
     try:
         driver.step()
         if serve:
-            from robotspec.service.cli import serve_driver
+            from robotspec.service.serve import serve_driver
 
             serve_driver(
                 driver,

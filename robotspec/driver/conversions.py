@@ -90,10 +90,7 @@ def twist_vector(velocity: Any) -> Any:
 
 def convert_command(cmd: RobotJointCommand, n: int, units: dict[str, float]) -> FloatArray | None:
     """A streamed command in SI units, or None when it must be ignored."""
-    try:
-        values = np.array(cmd.command, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        return None
+    values = cmd.command  # a float64 vector (RobotJointCommand converts anything else)
     if values.shape[0] != n or not np.all(np.isfinite(values)):
         return None
     if len(cmd.units) not in (0, n):

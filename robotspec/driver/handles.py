@@ -34,12 +34,27 @@ NEXT_TIMEOUT_S = 5.0
 
 @dataclass(frozen=True)
 class RobotJointCommand:
-    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""
+    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire.
+
+    ``command`` is kept as a float64 array, taken as is when it already is one (the service
+    hands over the array Robot Raconteur decoded: no copy, no list on the way); anything else
+    (a list, a tuple) is converted once here. Values are checked by the loop, which ignores a
+    sample of the wrong length or with NaN, as every invalid stream sample is ignored.
+    """
 
     seqno: int
     state_seqno: int
-    command: Sequence[float]
+    command: FloatArray
     units: Sequence[str] = ()
+
+    def __post_init__(self) -> None:
+        cmd = self.command
+        if not (isinstance(cmd, np.ndarray) and cmd.dtype == np.float64 and cmd.ndim == 1):
+            try:
+                arr = np.asarray(cmd, dtype=np.float64).reshape(-1)
+            except (TypeError, ValueError):
+                arr = np.zeros(0)  # never accepted: no joint count is 0
+            object.__setattr__(self, "command", arr)
 
 
 @dataclass(frozen=True)

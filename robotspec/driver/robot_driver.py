@@ -468,9 +468,16 @@ class RobotDriver(DriverLoop):
 
     # ------------------------------------------------------------------ streaming
 
-    def set_position_command(self, command: RobotJointCommand) -> None:
-        """Write the position-command wire (used in ``position_command`` mode only)."""
+    def set_position_command(self, command: RobotJointCommand, *, new_client: bool = False) -> None:
+        """Write the position-command wire (used in ``position_command`` mode only).
+
+        ``new_client``: the sample comes from another client than the previous one. Its seqno
+        counter is its own, so the ordering check restarts with it (as the reference does when
+        another endpoint writes the wire); the Robot Raconteur service sets it.
+        """
         with self._lock:
+            if new_client:
+                self._stream_last_seqno = -1
             if self._command_mode is CommandMode.position_command:
                 self._stream_position = command
 

@@ -126,7 +126,7 @@ def joint_command_from_rr(cmd: Any, unit_names: dict[int, str]) -> RobotJointCom
     return RobotJointCommand(
         seqno=int(cmd.seqno),
         state_seqno=int(cmd.state_seqno),
-        command=np.asarray(cmd.command, dtype=np.float64).reshape(-1).tolist(),
+        command=np.asarray(cmd.command, dtype=np.float64).reshape(-1),  # RR's array, no copy
         units=units,
     )
 

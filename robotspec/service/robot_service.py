@@ -3,7 +3,8 @@
 Every member delegates to the :class:`~robotspec.driver.robot_driver.RobotDriver` that
 ``drive --sim`` runs; nothing about the robot's behaviour is implemented here. The adapter only
 converts values (:mod:`robotspec.service.convert`), maps the driver's errors to the Robot
-Raconteur exceptions of the same name, and publishes each step's state on the wires and the pipe.
+Raconteur exceptions of the same name, and hands each step's state to its publisher thread
+(:mod:`robotspec.service.publisher`), which sends it on the wires and the pipe.
 
 Threading: RR calls members from its thread pool; the driver's own lock serialises them against
 the loop thread. Calls that block until the robot has done something (``jog_*`` with
@@ -21,7 +22,6 @@ they are packed and sent by a publisher thread of the adapter's own, not by the 
 
 from __future__ import annotations
 
-import queue
 import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -38,6 +38,7 @@ from robotspec.driver.state import ActionStatus, RobotState
 from robotspec.errors import RobotSpecError
 from robotspec.service import convert
 from robotspec.service.node import companion, rr
+from robotspec.service.publisher import StatePublisher
 
 __all__ = ["ROBOT_SERVICE_TYPE", "RobotService", "to_rr_error"]
 
@@ -53,14 +54,6 @@ _RR_EXCEPTIONS = {
 }
 
 Handler = Callable[..., None]
-
-#: How often (loop steps) the adapter asks RR which streams have clients connected.
-CONNECTION_CHECK_STEPS = 8
-#: Streams nobody is connected to are still refreshed this often (s), for ``PeekInValue()``.
-IDLE_REFRESH_S = 0.1
-#: Steps the publisher thread may fall behind before the oldest are dropped (wires only ever
-#: carry the latest value; the sensor-data pipe loses those samples, counted).
-PUBLISH_BACKLOG = 8
 
 
 def to_rr_error(exc: BaseException) -> BaseException:
@@ -245,14 +238,8 @@ class RobotService:
         self._device_info = rr_info.device_info
         self._executor = ThreadPoolExecutor(max_blocking_calls, thread_name_prefix="robotspec-rr")
         self.run_async = _Async(self._executor)
-        self._structs = convert.StateStructs(node, info, wall_epoch)
         dt_util = companion("Util.DateTimeUtil").DateTimeUtil(node)
-        sd_util = companion("Util.SensorDataUtil").SensorDataUtil(node)
         self._datetime_util = dt_util
-        self._sensor_data_util = sd_util
-        self._sensor_data_type = node.GetStructureType(
-            "com.robotraconteur.robotics.robot.RobotStateSensorData"
-        )
         self._isoch_info_type = node.GetStructureType("com.robotraconteur.device.isoch.IsochInfo")
         self._isoch_epoch = dt_util.TimeSpec2Now(self._device_info)
         joints = node.GetConstants("com.robotraconteur.robotics.joints")
@@ -262,24 +249,10 @@ class RobotService:
         self._rr_tools: list[Any] = [c.current_tool for c in rr_info.chains]
         self._rr_payloads: list[Any] = [c.current_payload for c in rr_info.chains]
         self._info_seqno = -1
-        self._downsampler: Any = None
-        self._context: Any = None
-        self._wires_ready = False
-        self._steps_since_check = CONNECTION_CHECK_STEPS
-        self._ars_connected = self._pipe_connected = self._clock_connected = False
-        self._last_idle_refresh = -float("inf")
         self._stream_ep = {"position": -1, "velocity": -1}
-        self.publish_errors = 0
-        self.last_publish_error = ""
-        #: States handed to the publisher thread, and those it dropped because it fell behind.
-        self.published = 0
-        self.publish_dropped = 0
-        self._queue: queue.SimpleQueue[RobotState | None] = queue.SimpleQueue()
-        #: The thread that packs and sends the states (its CPU time is the publishing cost).
-        self.publisher_thread = threading.Thread(
-            target=self._publisher_loop, name="robotspec-rr-publisher", daemon=True
-        )
-        self.publisher_thread.start()
+        self._stream_lock = threading.Lock()
+        #: Packs and sends each step's state on the wires and the pipe, from its own thread.
+        self.publisher = StatePublisher(self, node, info, self._device_info, wall_epoch)
         self.tool_changed = rrmod.EventHook()
         self.payload_changed = rrmod.EventHook()
         self.param_changed = rrmod.EventHook()
@@ -287,128 +260,20 @@ class RobotService:
     # ------------------------------------------------------------------ RR lifecycle
 
     def RRServiceObjectInit(self, context: Any, service_path: str) -> None:  # noqa: N802
-        """Called by RR once the wires exist: stream receivers, backlog."""
+        """Called by RR once the wires exist: stream receivers, backlog, publishing."""
         self.robot_state_sensor_data.MaxBacklog = 3
-        self._context = context
         self.position_command.InValueChanged += self._on_position_command
         self.velocity_command.InValueChanged += self._on_velocity_command
-        self._wires_ready = True
-
-    def _get_downsampler(self) -> Any:
-        """The broadcast downsampler, created when a client first asks for downsampling.
-
-        Why lazily: stepping it costs every loop step, and until somebody sets
-        ``isoch_downsample`` every client receives every step anyway.
-        """
-        with self._info_lock:
-            if self._downsampler is None:
-                ds = rr().BroadcastDownsampler(self._context, 0)
-                ds.AddWireBroadcaster(self.robot_state)
-                ds.AddWireBroadcaster(self.advanced_robot_state)
-                ds.AddPipeBroadcaster(self.robot_state_sensor_data)
-                ds.AddWireBroadcaster(self.device_clock_now)
-                self._downsampler = ds
-            return self._downsampler
+        self.publisher.attach(context)
 
     def close(self) -> None:
         """Stop publishing and accepting blocking calls (pending ones end with the driver)."""
-        self._wires_ready = False
-        self._queue.put(None)
-        if self.publisher_thread is not threading.current_thread():
-            self.publisher_thread.join(timeout=2.0)
+        self.publisher.close()
         self._executor.shutdown(wait=False, cancel_futures=True)
 
-    # ------------------------------------------------------------------ publishing
-
     def publish(self, st: RobotState) -> None:
-        """Hand one step's state to the publisher thread (a driver state listener).
-
-        Why a thread of its own: Robot Raconteur packs a structure the moment it is assigned to
-        a wire, about 0.15 ms or more per structure on a small VM, most of a step's cost. The
-        control loop only queues the (immutable) snapshot; it never waits for serialisation or
-        for the network, and its timing does not depend on how many clients read.
-        """
-        if self._wires_ready:
-            self._queue.put(st)
-
-    def _publisher_loop(self) -> None:
-        """Publisher thread: send every queued state in order; wires get only the latest."""
-        q = self._queue
-        while True:
-            batch = [q.get()]
-            while True:
-                try:
-                    batch.append(q.get_nowait())
-                except queue.Empty:
-                    break
-            states = [st for st in batch if st is not None]
-            if len(states) > PUBLISH_BACKLOG:
-                self.publish_dropped += len(states) - PUBLISH_BACKLOG
-                states = states[-PUBLISH_BACKLOG:]
-            for i, st in enumerate(states):
-                self._publish_step(st, latest=i == len(states) - 1)
-            self.published += len(states)
-            if len(states) != len(batch):  # the close() sentinel
-                return
-
-    def _publish_step(self, st: RobotState, latest: bool) -> None:
-        """Send one step's state to the clients (never raises).
-
-        ``robot_state`` is set every step. ``advanced_robot_state`` and ``device_clock_now`` are
-        set every step while a client is connected to them, and otherwise refreshed at
-        :data:`IDLE_REFRESH_S` intervals so that ``PeekInValue()`` still answers; the sensor
-        data pipe is fed only while connected. Who is connected is asked every
-        :data:`CONNECTION_CHECK_STEPS` steps. Why: packing a structure is most of the cost, so
-        only what somebody reads is packed. When the publisher has fallen behind, wires are set
-        for the ``latest`` state only (a wire carries the latest value anyway), unless a client
-        asked for downsampling.
-        """
-        if not self._wires_ready:
-            return
-        try:
-            ds = self._downsampler
-            if ds is not None:
-                ds.BeginStep()
-            try:
-                # With a downsampler every step counts (each client gets every n-th): none of
-                # the wires may be skipped then.
-                self._publish(st, latest or ds is not None)
-            finally:
-                if ds is not None:
-                    ds.EndStep()
-        except Exception as exc:  # noqa: BLE001 - the publisher must keep going
-            # Counted and kept for diagnosis; the next step tries again.
-            self.publish_errors += 1
-            self.last_publish_error = f"{type(exc).__name__}: {exc}"
-
-    def _publish(self, st: RobotState, latest: bool = True) -> None:
-        if latest:
-            self.robot_state.OutValue = self._structs.robot_state(st)
-        self._steps_since_check += 1
-        if self._steps_since_check >= CONNECTION_CHECK_STEPS:
-            self._steps_since_check = 0
-            self._ars_connected = self.advanced_robot_state.ActiveWireConnectionCount > 0
-            self._pipe_connected = self.robot_state_sensor_data.ActivePipeEndpointCount > 0
-            self._clock_connected = self.device_clock_now.ActiveWireConnectionCount > 0
-        idle_refresh = latest and st.ts - self._last_idle_refresh >= IDLE_REFRESH_S
-        if idle_refresh:
-            self._last_idle_refresh = st.ts
-        ars_wire = (self._ars_connected or idle_refresh) and latest
-        if ars_wire or self._pipe_connected:
-            ars = self._structs.advanced_robot_state(st)
-            if ars_wire:
-                self.advanced_robot_state.OutValue = ars
-            if self._pipe_connected:
-                data = self._sensor_data_type()
-                data.data_header = self._sensor_data_util.FillSensorDataHeader(
-                    self._device_info, st.seqno
-                )
-                data.robot_state = ars
-                self.robot_state_sensor_data.AsyncSendPacket(data, _ignore)
-        if (self._clock_connected or idle_refresh) and latest:
-            self.device_clock_now.OutValue = self._datetime_util.FillDeviceTime(
-                self._device_info, st.seqno
-            )
+        """Hand one step's state to the publisher thread (a driver state listener)."""
+        self.publisher.publish(st)
 
     # ------------------------------------------------------------------ info and modes
 
@@ -484,7 +349,7 @@ class RobotService:
     def isoch_downsample(self) -> int:
         """This client's downsample: it receives every (n+1)-th state."""
         rrmod = rr()
-        ds = self._downsampler
+        ds = self.publisher.current_downsampler
         if ds is None:
             return 0
         return int(ds.GetClientDownsample(rrmod.ServerEndpoint.GetCurrentEndpoint()))
@@ -494,7 +359,7 @@ class RobotService:
         rrmod = rr()
         if not 0 <= int(value) <= 1000:
             raise rrmod.InvalidArgumentException("isoch_downsample must be within 0-1000")
-        ds = self._get_downsampler()
+        ds = self.publisher.downsampler()
         ds.SetClientDownsample(rrmod.ServerEndpoint.GetCurrentEndpoint(), int(value))
 
     # ------------------------------------------------------------------ simple functions
@@ -573,22 +438,19 @@ class RobotService:
     # ------------------------------------------------------------------ streaming
 
     def _on_stream(self, which: str, value: Any, ep: int) -> None:
-        driver = self.driver
         names = self._pos_unit_names if which == "position" else self._vel_unit_names
         try:
             cmd = convert.joint_command_from_rr(value, names)
         except (TypeError, ValueError, AttributeError):
             return  # a malformed command is ignored, as every invalid stream sample is
-        with driver._lock:
-            if ep != self._stream_ep[which]:
-                # A new client restarts its seqno: accept it (the reference does the same).
-                self._stream_ep[which] = ep
-                if which == "position":
-                    driver._stream_last_seqno = -1
+        with self._stream_lock:
+            # A new client restarts its seqno: the driver accepts it (the reference does too).
+            new_client = ep != self._stream_ep[which]
+            self._stream_ep[which] = ep
             if which == "position":
-                driver.set_position_command(cmd)
+                self.driver.set_position_command(cmd, new_client=new_client)
             else:
-                driver.set_velocity_command(cmd)
+                self.driver.set_velocity_command(cmd)
 
     def _on_position_command(self, value: Any, ts: Any, ep: int) -> None:
         self._on_stream("position", value, ep)
@@ -659,7 +521,3 @@ class RobotService:
         """Set a signal (not implemented by the simulated robot)."""
         with _rr_errors():
             self.driver.setf_signal(str(signal_name), value)
-
-
-def _ignore(*_: Any) -> None:
-    """Completion handler for fire-and-forget pipe packets."""

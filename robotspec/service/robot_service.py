@@ -30,11 +30,11 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError, error_kind
-from robotspec.driver.handles import NEXT_TIMEOUT_S, Completion, TrajectoryGenerator
+from robotspec.driver.errors import InvalidArgumentError, error_kind
+from robotspec.driver.handles import HomingGenerator, TrajectoryGenerator
 from robotspec.driver.robot_driver import RobotDriver
-from robotspec.driver.robot_info import RobotCapability, RobotInfo
-from robotspec.driver.state import ActionStatus, RobotState
+from robotspec.driver.robot_info import RobotInfo
+from robotspec.driver.state import RobotState
 from robotspec.errors import RobotSpecError
 from robotspec.service import convert
 from robotspec.service.node import companion, rr
@@ -154,49 +154,30 @@ class TrajectoryGeneratorService:
 
 
 class HomingGeneratorService:
-    """The ``ActionStatusCode{generator}`` returned by ``home()``.
+    """The ``ActionStatusCode{generator}`` returned by ``home()``: a driver HomingGenerator.
 
     The first ``Next()`` starts homing (the robot must be in ``homing`` mode); each ``Next()``
     answers ``complete`` once homed, or ``running`` every 5 s until then; StopIteration after.
     """
 
-    def __init__(self, service: RobotService) -> None:
+    def __init__(self, service: RobotService, gen: HomingGenerator) -> None:
         self._service = service
-        self._completion: Completion | None = None
-        self._reported = False
-        self._lock = threading.Lock()
-
-    def _next(self) -> int:
-        driver = self._service.driver
-        with self._lock:
-            if self._reported:
-                raise StopIteration
-            if self._completion is None:
-                self._completion = driver.home(wait=False)
-            completion = self._completion
-        driver._wait_for(lambda: completion.done, NEXT_TIMEOUT_S)
-        if not completion.done:
-            return int(ActionStatus.running)
-        with self._lock:
-            self._reported = True
-        if completion.error is not None:
-            raise completion.error
-        return int(ActionStatus.complete)
+        self._gen = gen
 
     def AsyncNext(self, handler: Handler) -> None:  # noqa: N802 - RR generator API
         """Start homing (first call), then wait for it."""
-        self._service.run_async.value(self._next, handler)
+        gen = self._gen
+        self._service.run_async.value(lambda: int(gen.Next()), handler)
 
     def Abort(self) -> None:  # noqa: N802
         """Stop homing: mode ``halt`` (a waiting ``Next()`` fails with OperationAborted)."""
         with _rr_errors():
-            self._service.driver.halt()
+            self._gen.Abort()
 
     def Close(self) -> None:  # noqa: N802
         """Stop homing, as :meth:`Abort`."""
         with _rr_errors():
-            if self._completion is not None and not self._completion.done:
-                self._service.driver.halt()
+            self._gen.Close()
 
 
 class RobotService:
@@ -431,9 +412,8 @@ class RobotService:
     def home(self) -> HomingGeneratorService:
         """Home the robot (needs ``homing`` mode); the client drives it with ``Next()``."""
         with _rr_errors():
-            if not self.driver.robot_info.has(RobotCapability.homing_command):
-                raise InvalidOperationError("Robot does not support homing")
-        return HomingGeneratorService(self)
+            gen = self.driver.homing_generator()
+        return HomingGeneratorService(self, gen)
 
     # ------------------------------------------------------------------ streaming
 
@@ -503,14 +483,16 @@ class RobotService:
     # ------------------------------------------------------------------ parameters and signals
 
     def getf_param(self, param_name: str) -> Any:
-        """A driver parameter (the simulated robot has none)."""
+        """A driver parameter as a ``varvalue`` (the simulator's: ``fault.NAME``, a bool)."""
         with _rr_errors():
-            return self.driver.getf_param(str(param_name))
+            return convert.to_varvalue(self.driver.getf_param(str(param_name)))
 
     def setf_param(self, param_name: str, value: Any) -> None:
-        """Set a driver parameter (the simulated robot has none)."""
+        """Set a driver parameter (the simulator's: ``fault.NAME`` to true or false)."""
+        name = str(param_name)
         with _rr_errors():
-            self.driver.setf_param(str(param_name), value)
+            self.driver.setf_param(name, convert.from_varvalue(value))
+        self.param_changed.fire(name)
 
     def getf_signal(self, signal_name: str) -> Any:
         """A signal value (not implemented by the simulated robot)."""

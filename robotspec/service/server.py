@@ -167,10 +167,7 @@ class RobotServer:
             self.driver._stop_robot()
         if service is not None:
             service.close()
-            try:
-                self.driver._listeners.remove(service.publish)
-            except ValueError:
-                pass
+            self.driver.remove_state_listener(service.publish)
         server, self._server = self._server, None
         if server is not None:
             server.shutdown()

@@ -80,6 +80,12 @@ def is_set(s: Served, name: str) -> bool:
     return bool(np.asarray(value.data).reshape(-1)[0])
 
 
+def next_state(s: Served) -> None:
+    """Wait for the next published state."""
+    before = int(s.state().seqno)
+    wait_until(lambda: s.state().seqno > before)
+
+
 def wait_state(s: Served, **want: int) -> Any:
     """Wait for a published state whose fields have these values; return it."""
     found: list[Any] = []
@@ -271,3 +277,52 @@ def test_two_concurrent_homing_next_calls_get_one_completion(rrp: Served) -> Non
     errors = [v for kind, v in results if kind == "error"]
     assert values == [int(ActionStatus.complete)], results
     assert len(errors) == 1 and isinstance(errors[0], rr_exception("StopIterationException"))
+
+
+# ----------------------------------------------------------------------------- the position stream
+
+
+def test_huge_seqno_over_rr_does_not_lock_the_position_stream(rrp: Served) -> None:
+    r = rrp.robot
+    r.command_mode = int(CommandMode.position_command)
+    wire = r.position_command.Connect()
+    try:
+        cmd = rrp.struct("com.robotraconteur.robotics.robot.RobotJointCommand")
+        cmd.units = np.array([], dtype=np.uint8)
+        cmd.command = rrp.q()
+
+        def send(seqno: int, state_seqno: int | None = None) -> None:
+            cmd.seqno = seqno
+            cmd.state_seqno = rrp.state().seqno if state_seqno is None else state_seqno
+            wire.OutValue = cmd
+
+        def accepted_once(seqno: int) -> None:
+            """Send ``seqno`` until the loop has taken it (the flag on a later state)."""
+            for _ in range(500):
+                send(seqno)
+                next_state(rrp)
+                next_state(rrp)
+                if rrp.state().robot_state_flags & int(StateFlags.valid_position_command):
+                    return
+            raise AssertionError(f"seqno {seqno} never accepted")
+
+        # A sample with the largest uint64 seqno, taken by the loop; then one with the largest
+        # state_seqno (stale, ignored).
+        accepted_once(2**64 - 1)
+        send(5, state_seqno=2**64 - 1)
+        # The client's ordinary count afterwards drives the arm (the reference ignores it all).
+        target = rrp.q() + np.array([0.03, 0.0, 0.0])
+        cmd.command = target
+        reached = False
+        for seqno in range(1, 300):
+            send(seqno)
+            st = rrp.state()
+            if st.robot_state_flags & int(StateFlags.valid_position_command) and np.allclose(
+                st.joint_position, target, atol=1e-4
+            ):
+                reached = True
+                break
+            next_state(rrp)
+        assert reached, (rrp.q(), target)
+    finally:
+        wire.Close()

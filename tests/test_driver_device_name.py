@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from robotspec.cli.app import _register, app
+from robotspec.cli.app import app
 from robotspec.cli.render import run_app
 from robotspec.driver.robot_info import read_robot_info, read_robot_info_text
 from robotspec.driver.rr_names import (
@@ -35,7 +35,6 @@ def with_device(name_yaml: str) -> str:
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    _register()
     code = run_app(app, list(argv))
     out = capsys.readouterr()
     return code, out.out, out.err

@@ -26,10 +26,10 @@ pytest.importorskip(
     reason="robotraconteurcompanion is not installed (pip install robotspec[robotraconteur])",
 )
 
-import RobotRaconteur as RR  # noqa: E402
+import RobotRaconteur as RR
 
-from robotspec.driver.faults import Fault  # noqa: E402
-from robotspec.driver.state import (  # noqa: E402
+from robotspec.driver.faults import Fault
+from robotspec.driver.state import (
     ActionStatus,
     CommandMode,
     ControllerState,
@@ -37,8 +37,8 @@ from robotspec.driver.state import (  # noqa: E402
     StateFlags,
 )
 
-from .driver_support import RRP, robotinfo  # noqa: E402
-from .service_support import (  # noqa: E402
+from .driver_support import RRP, robotinfo
+from .service_support import (
     Served,
     client_node,
     rr_exception,

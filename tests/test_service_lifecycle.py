@@ -27,13 +27,13 @@ pytest.importorskip(
     reason="robotraconteurcompanion is not installed (pip install robotspec[robotraconteur])",
 )
 
-from robotspec.driver.robot_info import Identifier, load_robot_info  # noqa: E402
-from robotspec.driver.sim import SimRobot  # noqa: E402
-from robotspec.driver.state import CommandMode  # noqa: E402
-from robotspec.service.server import RobotServer, ServeOptions  # noqa: E402
+from robotspec.driver.robot_info import Identifier, load_robot_info
+from robotspec.driver.sim import SimRobot
+from robotspec.driver.state import CommandMode
+from robotspec.service.server import RobotServer, ServeOptions
 
-from .driver_support import RRP  # noqa: E402
-from .service_support import client_node, short_tmp  # noqa: E402
+from .driver_support import RRP
+from .service_support import client_node, short_tmp
 
 __all__ = ["client_node", "short_tmp"]  # fixtures from service_support, used by the tests below
 

@@ -12,24 +12,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from robotspec.description.urdf import MeshPolicy, read_description_xml, world_from_urdf_xml
 from robotspec.errors import DescriptionError, RobotSpecError, missing_file
-from robotspec.urdf import MeshPolicy, read_description_xml, world_from_urdf_xml
-from robotspec.world import ConnectionType, World
+from robotspec.model.world import World
 
 if TYPE_CHECKING:
     from lxml import etree
 
-    from robotspec.packages import PackageResolver
-    from robotspec.srdf import Srdf
+    from robotspec.description.srdf import Srdf
+    from robotspec.files.packages import PackageResolver
 
 __all__ = ["Description", "load_description", "read_urdf_tree"]
-
-#: SRDF virtual joint types and the world connection each becomes.
-VIRTUAL_JOINT_TYPES = {
-    "planar": ConnectionType.PLANAR,
-    "floating": ConnectionType.FLOATING,
-    "fixed": ConnectionType.FIXED,
-}
 
 
 @dataclass(frozen=True)
@@ -41,11 +34,6 @@ class Description:
     srdf: Srdf | None
     resolver: PackageResolver = field(repr=False)
     warnings: tuple[RobotSpecError, ...] = ()
-
-    @property
-    def urdf_world(self) -> World:
-        """The world as the URDF alone describes it (kept for symmetry; same as ``world``)."""
-        return self.world
 
 
 def resolve_file(
@@ -71,7 +59,7 @@ def read_urdf_tree(
     Relative paths and ``package_paths`` start at ``base_folder``. ``share_crawls_with``: a
     resolver of the same compilation whose package-folder crawls are reused.
     """
-    from robotspec.packages import PackageResolver
+    from robotspec.files.packages import PackageResolver
 
     extra = [p if Path(p).is_absolute() else base_folder / p for p in map(str, package_paths)]
     urdf_ref = str(urdf)
@@ -107,7 +95,7 @@ def load_description(
     )
     srdf_data = None
     if srdf is not None:
-        from robotspec.srdf import load_srdf
+        from robotspec.description.srdf import load_srdf
 
         srdf_path = resolve_file(str(srdf), base, resolver)
         srdf_data = load_srdf(srdf_path, strict=False)

@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from robotspec.geometry import Matrix, Shape
+from robotspec.model.geometry import Matrix, Shape
 
 __all__ = ["Body", "Connection", "ConnectionType", "DegreeOfFreedom", "Mimic"]
 

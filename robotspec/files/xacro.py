@@ -9,7 +9,7 @@ is expanded, robotspec therefore swaps a few of xacro's module-level hooks, unde
 restores them afterwards:
 
 * ``substitution_args._eval_find`` (and the ``find`` of ``$(eval ...)``) asks the
-  :class:`~robotspec.packages.PackageResolver`.
+  :class:`~robotspec.files.packages.PackageResolver`.
 * ``open`` inside ``xacro`` (used for the top file, every ``<xacro:include>`` and
   ``xacro.load_yaml``) is shadowed by a guard that refuses paths outside the resolver's allowed
   roots and XML that declares entities, before minidom sees a byte.
@@ -36,8 +36,8 @@ from typing import Any
 from xml.parsers import expat
 
 from robotspec.errors import DescriptionError, PathOutsideRootsError, RobotSpecError
-from robotspec.packages import PackageResolver
-from robotspec.xmlsafe import MAX_XML_BYTES
+from robotspec.files.packages import PackageResolver
+from robotspec.files.xmlsafe import MAX_XML_BYTES
 
 __all__ = ["process_xacro"]
 
@@ -55,7 +55,7 @@ def _current_file(xacro: Any) -> str | None:
 
 
 def _check_entities(data: bytes, file: str) -> None:
-    """Refuse XML declaring entities, with :mod:`robotspec.xmlsafe`'s wording.
+    """Refuse XML declaring entities, with :mod:`robotspec.files.xmlsafe`'s wording.
 
     Why here: xacro parses with minidom (expat), which expands internal entities.
     """
@@ -299,7 +299,7 @@ def process_xacro(
             raise DescriptionError(
                 "xacro recursion too deep (a macro or include calls itself)", file=str(top)
             ) from None
-        except Exception as exc:  # xacro raises anything; all become ours
+        except Exception as exc:  # noqa: BLE001 - xacro raises anything; all become ours
             raise _convert(exc, xacro, top) from None
         finally:
             xacro.filestack = None

@@ -17,7 +17,7 @@ from typing import Any
 from lxml import etree
 
 from robotspec.compiler import CompileResult
-from robotspec.spec import LoadedSpec, load_spec
+from robotspec.spec.load import LoadedSpec, load_spec
 
 __all__ = ["Bundle", "bundle", "joined_urdf", "urdf_text"]
 
@@ -87,8 +87,7 @@ def bundle(
     """
     import yaml
 
-    from robotspec.srdf import write_srdf
-    from robotspec.srdf_export import srdf_from_robot
+    from robotspec.export.srdf import srdf_from_robot, write_srdf
 
     robot = result.robot
     assert robot is not None

@@ -13,8 +13,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from robotspec.srdf import Srdf
-from robotspec.world import Body, World
+from robotspec.description.srdf import Srdf
+from robotspec.model.world import Body, World
 
 __all__ = ["Draft", "draft_spec", "render_draft"]
 

@@ -8,27 +8,21 @@ kept (``yamlio``) so the compiler can report ``file:line:col`` for any name it c
 
 from __future__ import annotations
 
-import json
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass
-from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
-    ValidationError,
     field_validator,
     model_validator,
 )
 
-from robotspec.errors import NotFoundError, SpecError
-from robotspec.yamlio import LocatedYaml, load_yaml, validation_errors
+from robotspec.errors import SpecError
 
 if TYPE_CHECKING:
-    from robotspec.geometry import Matrix
+    from robotspec.model.geometry import Matrix
 
 __all__ = [
     "AttachSpec",
@@ -42,7 +36,6 @@ __all__ = [
     "FrameSpec",
     "GenericManipulatorSpec",
     "GenericSensorSpec",
-    "LoadedSpec",
     "NeckSpec",
     "ParallelGripperSpec",
     "PartSpec",
@@ -50,8 +43,6 @@ __all__ = [
     "SPEC_VERSION",
     "TorsoSpec",
     "VelocityLimitsSpec",
-    "json_schema",
-    "load_spec",
 ]
 
 SPEC_VERSION = 1
@@ -96,7 +87,7 @@ def _pose(
     quaternion: tuple[float, float, float, float] | None,
 ) -> Matrix:
     # Imported here: reading and validating a spec needs no numpy (the CLI starts faster).
-    from robotspec.geometry import pose_from_xyz_quaternion, pose_from_xyz_rpy
+    from robotspec.model.geometry import pose_from_xyz_quaternion, pose_from_xyz_rpy
 
     if quaternion is not None:
         return pose_from_xyz_quaternion(xyz, quaternion)
@@ -366,141 +357,3 @@ class RobotSpec(_Model):
         if self.root is None:
             raise SpecError(f"spec '{self.name}' names no root link")
         return self.root
-
-
-@dataclass(frozen=True)
-class LoadedSpec:
-    """A validated spec with where it came from, for located errors and relative paths."""
-
-    spec: RobotSpec
-    file: Path
-    documents: tuple[LocatedYaml, ...]
-
-    def position(self, loc: tuple[str | int, ...]) -> tuple[str, int | None, int | None]:
-        """``(file, line, column)`` of a spec node, looking in the extending file first."""
-        for doc in self.documents:
-            if loc in doc.marks:
-                line, col = doc.marks[loc]
-                return doc.file, line, col
-        # Fall back to the nearest ancestor that exists in some document.
-        for cut in range(len(loc) - 1, -1, -1):
-            for doc in self.documents:
-                if loc[:cut] in doc.marks:
-                    line, col = doc.marks[loc[:cut]]
-                    return doc.file, line, col
-        return str(self.file), None, None
-
-    @property
-    def folder(self) -> Path:
-        """The folder relative paths in the spec are resolved against."""
-        return self.file.parent
-
-
-def merge_data(base: Any, child: Any) -> Any:
-    """``child`` over ``base``, mapping by mapping (``extends`` and composed specs' overrides)."""
-    if isinstance(base, Mapping) and isinstance(child, Mapping):
-        out = dict(base)
-        for k, v in child.items():
-            out[k] = merge_data(base[k], v) if k in base else v
-        return out
-    return child
-
-
-def _absolute_paths(desc: dict[str, Any], folder: Path, keys: tuple[str, ...]) -> None:
-    for key in keys:
-        value = desc.get(key)
-        if isinstance(value, str) and "://" not in value and not Path(value).is_absolute():
-            if key == "spec" and not (folder / value).is_file():
-                continue  # a shipped robot's name, not a path
-            desc[key] = str((folder / value).resolve())
-    paths = desc.get("package_paths")
-    if isinstance(paths, list):
-        desc["package_paths"] = [
-            str((folder / v).resolve()) if not Path(v).is_absolute() else v for v in paths
-        ]
-
-
-def _absolutize(data: dict[str, Any], folder: Path) -> None:
-    """Rewrite a base spec's relative file paths so they stay right inside the child spec."""
-    desc = data.get("description")
-    if isinstance(desc, dict):
-        _absolute_paths(desc, folder, ("urdf", "srdf"))
-    parts = data.get("parts")
-    if isinstance(parts, dict):
-        for part in parts.values():
-            if isinstance(part, dict):
-                _absolute_paths(part, folder, ("urdf", "srdf", "spec"))
-
-
-def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
-    """Read, merge (``extends``) and validate a spec file; every problem raised at once."""
-    p = Path(path).resolve()
-    if p in _seen:
-        chain = " -> ".join(x.name for x in (*_seen, p))
-        raise SpecError(f"'extends' forms a cycle: {chain}", file=str(path))
-    doc = load_yaml(path)
-    if not isinstance(doc.data, Mapping):
-        raise SpecError("a spec must be a YAML mapping", file=doc.file, line=1)
-    data: Any = doc.data
-    documents: tuple[LocatedYaml, ...] = (doc,)
-    base_file = data.get("extends")
-    if isinstance(base_file, str):
-        base_path = (p.parent / base_file).resolve()
-        shipped = shipped_spec_files()
-        if not base_path.is_file() and base_file.lower() in shipped:
-            base_path = shipped[base_file.lower()]  # a shipped robot, by name
-        if not base_path.is_file():
-            line, col = doc.position(("extends",))
-            siblings = [f.name for f in p.parent.glob("*.y*ml")]
-            raise NotFoundError(
-                "spec",
-                base_file,
-                [*siblings, *shipped],
-                where="this folder or the shipped robots",
-                file=doc.file,
-                line=line,
-                column=col,
-                location=("extends",),
-            )
-        base = load_spec(base_path, _seen=(*_seen, p))
-        base_data = base.spec.model_dump(mode="json", exclude_unset=True, by_alias=True)
-        base_data.pop("extends", None)
-        _absolutize(base_data, base.folder)
-        data = merge_data(base_data, {k: v for k, v in data.items() if k != "extends"})
-        data["extends"] = base_file
-        documents = (doc, *base.documents)
-    try:
-        spec = RobotSpec.model_validate(data)
-    except ValidationError as exc:
-        raise validation_errors(exc, doc, RobotSpec, SpecError) from None
-    return LoadedSpec(spec=spec, file=p, documents=documents)
-
-
-def json_schema() -> dict[str, Any]:
-    """The JSON Schema of the spec format, for editors (the YAML language server)."""
-    schema = RobotSpec.model_json_schema()
-    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    schema["title"] = "robotspec robot spec"
-    return schema
-
-
-def json_schema_text() -> str:
-    """The schema as stable, pretty JSON text (what ships in the package)."""
-    return json.dumps(json_schema(), indent=2, sort_keys=True) + "\n"
-
-
-def shipped_spec_files() -> dict[str, Path]:
-    """The robots shipped with robotspec: name -> spec file (``extends: pr2`` works)."""
-    folder = Path(__file__).resolve().parent / "specs"
-    return {f.stem: f for f in sorted(folder.glob("*.yaml"))}
-
-
-def shipped_part_files() -> dict[str, Path]:
-    """Parts shipped with robotspec for composed robots (``spec: allegro_right_hand``)."""
-    folder = Path(__file__).resolve().parent / "specs" / "parts"
-    return {f.stem: f for f in sorted(folder.glob("*.yaml"))}
-
-
-def shipped_schema_path() -> Path:
-    """Where the installed package keeps the schema (specs written by robotspec point here)."""
-    return Path(__file__).resolve().parent / "data" / "robotspec.schema.json"

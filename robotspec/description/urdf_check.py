@@ -20,7 +20,7 @@ from robotspec.errors import (
     RobotSpecError,
     raise_collected,
 )
-from robotspec.xmlsafe import line_of
+from robotspec.files.xmlsafe import line_of
 
 __all__ = ["JOINT_TYPES", "check_urdf_tree", "geometry_element", "parse_floats"]
 

@@ -1,10 +1,10 @@
-"""Build a :class:`~robotspec.world.World` from a URDF or xacro file.
+"""Build a :class:`~robotspec.model.world.World` from a URDF or xacro file.
 
 The pipeline is: read the file safely (``xmlsafe``; xacro first if it is one), check the element
 tree with line numbers (``urdf_check``), let yourdfpy interpret the elements into its records, and
 turn those into frozen world records. Mesh URIs are resolved through one
-:class:`~robotspec.packages.PackageResolver`, so ``package://``, ``file://`` and relative paths
-all stay inside the allowed roots.
+:class:`~robotspec.files.packages.PackageResolver`, so ``package://``, ``file://`` and relative
+paths all stay inside the allowed roots.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 from lxml import etree
 
 from robotspec.errors import DescriptionError, RobotSpecError, missing_file, raise_collected
-from robotspec.geometry import (
+from robotspec.model.geometry import (
     Box,
     Capsule,
     Cylinder,
@@ -30,10 +30,10 @@ from robotspec.geometry import (
 )
 
 if TYPE_CHECKING:
-    from robotspec.packages import PackageResolver
-from robotspec.urdf_check import check_urdf_tree, geometry_element, parse_floats
-from robotspec.world import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic, World
-from robotspec.xmlsafe import line_of, parse_xml_bytes
+    from robotspec.files.packages import PackageResolver
+from robotspec.description.urdf_check import check_urdf_tree, geometry_element, parse_floats
+from robotspec.files.xmlsafe import line_of, parse_xml_bytes
+from robotspec.model.world import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic, World
 
 __all__ = ["MeshPolicy", "is_xacro", "load_urdf", "read_description_xml", "world_from_urdf_xml"]
 
@@ -65,7 +65,7 @@ def read_description_xml(
     except OSError as exc:
         raise DescriptionError(f"cannot read file: {exc.strerror}", file=str(path)) from None
     if is_xacro(path, data):
-        from robotspec.xacro_io import process_xacro
+        from robotspec.files.xacro import process_xacro
 
         # Xacro's input is checked as XML first (entities refused) and its output again.
         parse_xml_bytes(data, str(path))
@@ -86,7 +86,7 @@ def load_urdf(
 ) -> World:
     """Load a URDF or xacro file into a world (the robot's own tree, no virtual joint)."""
     p = Path(path)
-    from robotspec.packages import PackageResolver
+    from robotspec.files.packages import PackageResolver
 
     res = resolver or PackageResolver.create(p)
     root = read_description_xml(p, res, xacro_args)

@@ -1,4 +1,4 @@
-"""Forward kinematics and Jacobians over a :class:`~robotspec.world.World`, in numpy.
+"""Forward kinematics and Jacobians over a :class:`~robotspec.model.world.World`, in numpy.
 
 Why this shape: the world is parsed once into flat arrays (one row per connection, in topological
 order), and every query is a handful of vectorised numpy operations over those arrays. Batched FK
@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.errors import KinematicsError
-from robotspec.world import Body, Connection, ConnectionType, World
+from robotspec.model.world import Body, Connection, ConnectionType, World
 
 __all__ = ["ChainKinematics", "Kinematics"]
 

@@ -582,6 +582,49 @@ def test_publisher_thread_sends_every_step_in_order(short_tmp: Path, client_node
     assert not service.publisher.thread.is_alive()  # stopped with the server
 
 
+def test_publisher_that_fell_behind_keeps_publishing(short_tmp: Path, client_node: Any) -> None:
+    # Regression: a publisher more than PUBLISH_BACKLOG steps behind (a CPU hiccup) dropped the
+    # oldest states and then ended its thread, as if closed: the wires froze for good.
+    from robotspec.service.publisher import PUBLISH_BACKLOG
+
+    info = load_robot_info(RRP)
+    driver = SimRobot(info, update_period=PERIOD)
+    server = RobotServer(
+        driver, info, ServeOptions(port=0, state_dir=short_tmp / "rr"), start_loop=False
+    )
+    with server:
+        service = server.service
+        assert service is not None
+        publisher = service.publisher
+        entered, release = threading.Event(), threading.Event()
+        inner = publisher._publish_step
+
+        def stalled(st: Any, latest: bool) -> None:
+            entered.set()
+            release.wait(WAIT)  # the first state stalls the publisher thread
+            inner(st, latest)
+
+        publisher._publish_step = stalled  # type: ignore[method-assign]
+        driver.step()
+        assert entered.wait(WAIT)
+        for _ in range(PUBLISH_BACKLOG + 12):
+            driver.step()  # queued behind the stalled one
+        publisher._publish_step = inner  # type: ignore[method-assign]
+        release.set()
+        wait_until(lambda: publisher.dropped == 12)
+        driver.step()  # after falling behind, a new step is still sent
+        wait_until(lambda: publisher.published == 1 + PUBLISH_BACKLOG + 1)
+        assert publisher.thread.is_alive()
+        robot = client_node.ConnectService(server.url)
+        try:
+            driver.step()
+            want = driver.robot_state.seqno
+            wait_until(lambda: robot.robot_state.PeekInValue()[0].seqno == want)
+        finally:
+            client_node.DisconnectService(robot)
+    assert not publisher.thread.is_alive()
+
+
 def _own_sockets(kind: str) -> list[tuple[str, int]]:
     """(local address in /proc hex, port) of this process's ``tcp`` or ``udp`` sockets."""
     inodes = set()

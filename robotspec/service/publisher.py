@@ -132,13 +132,15 @@ class StatePublisher:
                 except queue.Empty:
                     break
             states = [st for st in batch if st is not None]
+            closing = len(states) != len(batch)  # the close() sentinel was among them
             if len(states) > PUBLISH_BACKLOG:
+                # Fallen behind (a CPU hiccup): the oldest are dropped, and publishing goes on.
                 self.dropped += len(states) - PUBLISH_BACKLOG
                 states = states[-PUBLISH_BACKLOG:]
             for i, st in enumerate(states):
                 self._publish_step(st, latest=i == len(states) - 1)
             self.published += len(states)
-            if len(states) != len(batch):  # the close() sentinel
+            if closing:
                 return
 
     def _publish_step(self, st: RobotState, latest: bool) -> None:

@@ -34,7 +34,6 @@ from robotspec.driver.errors import InvalidArgumentError, error_kind
 from robotspec.driver.handles import HomingGenerator, TrajectoryGenerator
 from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
-from robotspec.driver.state import RobotState
 from robotspec.errors import RobotSpecError
 from robotspec.service import convert
 from robotspec.service.node import companion, rr
@@ -251,10 +250,6 @@ class RobotService:
         """Stop publishing and accepting blocking calls (pending ones end with the driver)."""
         self.publisher.close()
         self._executor.shutdown(wait=False, cancel_futures=True)
-
-    def publish(self, st: RobotState) -> None:
-        """Hand one step's state to the publisher thread (a driver state listener)."""
-        self.publisher.publish(st)
 
     # ------------------------------------------------------------------ info and modes
 

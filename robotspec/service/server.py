@@ -155,7 +155,8 @@ class RobotServer:
             service = RobotService(self.driver, node, self.info, rr_info, wall_epoch)
             node.RegisterService(opts.service_name, ROBOT_SERVICE_TYPE, service)
             self.service = service
-            self.driver.add_state_listener(service.publish)
+            # The loop calls the publisher directly: one queue put per step, nothing more.
+            self.driver.add_state_listener(service.publisher.publish)
             if self._start_loop:
                 self.driver._start_robot()
         except BaseException:
@@ -170,7 +171,7 @@ class RobotServer:
             self.driver._stop_robot()
         if service is not None:
             service.close()
-            self.driver.remove_state_listener(service.publish)
+            self.driver.remove_state_listener(service.publisher.publish)
         server, self._server = self._server, None
         if server is not None:
             name = self.info.device_info.device.name

@@ -3,8 +3,9 @@
 Every member delegates to the :class:`~robotspec.driver.robot_driver.RobotDriver` that
 ``drive --sim`` runs; nothing about the robot's behaviour is implemented here. The adapter only
 converts values (:mod:`robotspec.service.convert`), maps the driver's errors to the Robot
-Raconteur exceptions of the same name, and hands each step's state to its publisher thread
-(:mod:`robotspec.service.publisher`), which sends it on the wires and the pipe.
+Raconteur exceptions of the same name (:mod:`robotspec.service.calls`), and hands each step's
+state to its publisher thread (:mod:`robotspec.service.publisher`), which sends it on the wires
+and the pipe.
 
 Threading: RR calls members from its thread pool; the driver's own lock serialises them against
 the loop thread. Calls that block until the robot has done something (``jog_*`` with
@@ -23,160 +24,27 @@ they are packed and sent by a publisher thread of the adapter's own, not by the 
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager
 from typing import Any
 
-from pydantic import ValidationError
-
-from robotspec.driver.errors import InvalidArgumentError, error_kind
-from robotspec.driver.handles import HomingGenerator, TrajectoryGenerator
+from robotspec.driver.errors import InvalidArgumentError
 from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
-from robotspec.errors import RobotSpecError
 from robotspec.service import convert
+from robotspec.service.calls import (
+    AsyncCalls,
+    Handler,
+    HomingGeneratorService,
+    TrajectoryGeneratorService,
+    rr_errors,
+    to_rr_error,
+)
 from robotspec.service.node import companion, rr
 from robotspec.service.publisher import StatePublisher
 
 __all__ = ["ROBOT_SERVICE_TYPE", "RobotService", "to_rr_error"]
 
 ROBOT_SERVICE_TYPE = "com.robotraconteur.robotics.robot.Robot"
-
-#: Robot Raconteur exception class names by the driver error's ``rr_name``.
-_RR_EXCEPTIONS = {
-    "InvalidArgument": "InvalidArgumentException",
-    "InvalidOperation": "InvalidOperationException",
-    "OperationAborted": "OperationAbortedException",
-    "OperationFailed": "OperationFailedException",
-    "NotImplemented": "NotImplementedException",
-}
-
-Handler = Callable[..., None]
-
-
-def to_rr_error(exc: BaseException) -> BaseException:
-    """The Robot Raconteur exception a client should see for ``exc``.
-
-    Driver errors keep their kind (InvalidArgument, OperationAborted, ...) and message; other
-    robotspec errors become OperationFailed; anything else (a bug) becomes OperationFailed naming
-    the exception type, rather than RR's opaque UnknownException.
-    """
-    rrmod = rr()
-    rr_base: type[BaseException] = rrmod.RobotRaconteurException
-    if isinstance(exc, rr_base):
-        return exc
-    err: BaseException
-    if isinstance(exc, StopIteration):
-        err = rrmod.StopIterationException("")
-    elif isinstance(exc, RobotSpecError):
-        cls_name = _RR_EXCEPTIONS.get(error_kind(exc), "OperationFailedException")
-        err = getattr(rrmod, cls_name)(exc.message)
-    else:
-        err = rrmod.OperationFailedException(f"{type(exc).__name__}: {exc}")
-    return err
-
-
-@contextmanager
-def _rr_errors() -> Iterator[None]:
-    """Re-raise driver errors as the Robot Raconteur exceptions clients expect."""
-    try:
-        yield
-    except StopIteration:
-        raise to_rr_error(StopIteration()) from None
-    except ValidationError as exc:
-        raise to_rr_error(InvalidArgumentError(str(exc.errors()[0]["msg"]))) from None
-    except Exception as exc:  # noqa: BLE001 - every error must reach the client typed
-        raise to_rr_error(exc) from None
-
-
-class _Async:
-    """Runs blocking driver calls on the adapter's executor and answers RR's handlers."""
-
-    def __init__(self, executor: ThreadPoolExecutor) -> None:
-        self._executor = executor
-
-    def void(self, fn: Callable[[], None], handler: Handler, blocking: bool) -> None:
-        def run() -> None:
-            try:
-                fn()
-            except BaseException as exc:  # noqa: BLE001 - delivered to the client
-                handler(to_rr_error(_unwrap(exc)))
-                return
-            handler(None)
-
-        if blocking:
-            self._executor.submit(run)
-        else:
-            run()
-
-    def value(self, fn: Callable[[], Any], handler: Handler) -> None:
-        def run() -> None:
-            try:
-                ret = fn()
-            except BaseException as exc:  # noqa: BLE001 - delivered to the client
-                handler(None, to_rr_error(_unwrap(exc)))
-                return
-            handler(ret, None)
-
-        self._executor.submit(run)
-
-
-def _unwrap(exc: BaseException) -> BaseException:
-    if isinstance(exc, ValidationError):
-        return InvalidArgumentError(str(exc.errors()[0]["msg"]))
-    return exc
-
-
-class TrajectoryGeneratorService:
-    """The ``TrajectoryStatus{generator}`` a client drives with Next / Abort / Close."""
-
-    def __init__(self, service: RobotService, gen: TrajectoryGenerator) -> None:
-        self._service = service
-        self._gen = gen
-
-    def AsyncNext(self, handler: Handler) -> None:  # noqa: N802 - RR generator API
-        """Start or continue the trajectory; answers when it ends, fails, or after 5 s."""
-        node = self._service.node
-        gen = self._gen
-        self._service.run_async.value(lambda: convert.trajectory_status(node, gen.Next()), handler)
-
-    def Abort(self) -> None:  # noqa: N802
-        """Stop the robot (mode ``halt``); ``Next()`` then fails with OperationAborted."""
-        with _rr_errors():
-            self._gen.Abort()
-
-    def Close(self) -> None:  # noqa: N802
-        """Cancel this trajectory; the mode stays ``trajectory``."""
-        with _rr_errors():
-            self._gen.Close()
-
-
-class HomingGeneratorService:
-    """The ``ActionStatusCode{generator}`` returned by ``home()``: a driver HomingGenerator.
-
-    The first ``Next()`` starts homing (the robot must be in ``homing`` mode); each ``Next()``
-    answers ``complete`` once homed, or ``running`` every 5 s until then; StopIteration after.
-    """
-
-    def __init__(self, service: RobotService, gen: HomingGenerator) -> None:
-        self._service = service
-        self._gen = gen
-
-    def AsyncNext(self, handler: Handler) -> None:  # noqa: N802 - RR generator API
-        """Start homing (first call), then wait for it."""
-        gen = self._gen
-        self._service.run_async.value(lambda: int(gen.Next()), handler)
-
-    def Abort(self) -> None:  # noqa: N802
-        """Stop homing: mode ``halt`` (a waiting ``Next()`` fails with OperationAborted)."""
-        with _rr_errors():
-            self._gen.Abort()
-
-    def Close(self) -> None:  # noqa: N802
-        """Stop homing, as :meth:`Abort`."""
-        with _rr_errors():
-            self._gen.Close()
 
 
 class RobotService:
@@ -217,7 +85,7 @@ class RobotService:
         self._rr_info = rr_info
         self._device_info = rr_info.device_info
         self._executor = ThreadPoolExecutor(max_blocking_calls, thread_name_prefix="robotspec-rr")
-        self.run_async = _Async(self._executor)
+        self.run_async = AsyncCalls(self._executor)
         dt_util = companion("Util.DateTimeUtil").DateTimeUtil(node)
         self._datetime_util = dt_util
         self._isoch_info_type = node.GetStructureType("com.robotraconteur.device.isoch.IsochInfo")
@@ -279,7 +147,7 @@ class RobotService:
 
     @command_mode.setter
     def command_mode(self, value: int) -> None:
-        with _rr_errors():
+        with rr_errors():
             self.driver.set_command_mode(int(value))
 
     @property
@@ -309,7 +177,7 @@ class RobotService:
 
     @speed_ratio.setter
     def speed_ratio(self, value: float) -> None:
-        with _rr_errors():
+        with rr_errors():
             self.driver.speed_ratio = float(value)
 
     @property
@@ -342,22 +210,22 @@ class RobotService:
 
     def halt(self) -> None:
         """Stop motion: mode ``halt`` (brakes at the acceleration limits)."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.halt()
 
     def enable(self) -> None:
         """Enable the drives."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.enable()
 
     def disable(self) -> None:
         """Disable the drives."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.disable()
 
     def reset_errors(self) -> None:
         """Clear driver faults and the robot's errors."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.reset_errors()
 
     # ------------------------------------------------------------------ motion
@@ -400,15 +268,15 @@ class RobotService:
 
     def execute_trajectory(self, trajectory: Any) -> TrajectoryGeneratorService:
         """Check and queue a trajectory; the client drives it with ``Next()``."""
-        with _rr_errors():
+        with rr_errors():
             gen = self.driver.execute_trajectory(convert.trajectory_from_rr(trajectory))
-        return TrajectoryGeneratorService(self, gen)
+        return TrajectoryGeneratorService(self.run_async, self.node, gen)
 
     def home(self) -> HomingGeneratorService:
         """Home the robot (needs ``homing`` mode); the client drives it with ``Next()``."""
-        with _rr_errors():
+        with rr_errors():
             gen = self.driver.homing_generator()
-        return HomingGeneratorService(self, gen)
+        return HomingGeneratorService(self.run_async, gen)
 
     # ------------------------------------------------------------------ streaming
 
@@ -437,7 +305,7 @@ class RobotService:
 
     def tool_attached(self, chain: int, tool: Any) -> None:
         """A tool was attached to ``chain``; its TCP now defines the chain's endpoint."""
-        with _rr_errors():
+        with rr_errors():
             model = convert.tool_from_rr(tool)
             self.driver.tool_attached(int(chain), model)
             assert model is not None
@@ -448,7 +316,7 @@ class RobotService:
 
     def tool_detached(self, chain: int, tool_name: str) -> None:
         """The tool ``tool_name`` (or "" for whichever) was detached from ``chain``."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.tool_detached(int(chain), str(tool_name))
             with self._info_lock:
                 self._rr_tools[int(chain)] = None
@@ -457,7 +325,7 @@ class RobotService:
 
     def payload_attached(self, chain: int, payload: Any, pose: Any) -> None:
         """A payload was attached to the tool of ``chain`` at ``pose`` relative to the TCP."""
-        with _rr_errors():
+        with rr_errors():
             model = convert.payload_from_rr(payload)
             self.driver.payload_attached(int(chain), model, convert.pose_from_rr(pose))
             assert model is not None
@@ -468,7 +336,7 @@ class RobotService:
 
     def payload_detached(self, chain: int, payload_name: str) -> None:
         """The payload ``payload_name`` (or "") was detached from ``chain``."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.payload_detached(int(chain), str(payload_name))
             with self._info_lock:
                 self._rr_payloads[int(chain)] = None
@@ -479,22 +347,22 @@ class RobotService:
 
     def getf_param(self, param_name: str) -> Any:
         """A driver parameter as a ``varvalue`` (the simulator's: ``fault.NAME``, a bool)."""
-        with _rr_errors():
+        with rr_errors():
             return convert.to_varvalue(self.driver.getf_param(str(param_name)))
 
     def setf_param(self, param_name: str, value: Any) -> None:
         """Set a driver parameter (the simulator's: ``fault.NAME`` to true or false)."""
         name = str(param_name)
-        with _rr_errors():
+        with rr_errors():
             self.driver.setf_param(name, convert.from_varvalue(value))
         self.param_changed.fire(name)
 
     def getf_signal(self, signal_name: str) -> Any:
         """A signal value (not implemented by the simulated robot)."""
-        with _rr_errors():
+        with rr_errors():
             return self.driver.getf_signal(str(signal_name))
 
     def setf_signal(self, signal_name: str, value: Any) -> None:
         """Set a signal (not implemented by the simulated robot)."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.setf_signal(str(signal_name), value)

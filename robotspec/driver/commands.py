@@ -129,6 +129,7 @@ class CommandGuard:
         self._max_step = limits.velocity * period
         self._neg_max_step = -self._max_step
         self._max_step_l: list[float] = self._max_step.tolist()
+        self._velocity_l: list[float] = limits.velocity.tolist()
         self._lower_l: list[float] = limits.lower.tolist()
         self._upper_l: list[float] = limits.upper.tolist()
         self._neg_velocity = -limits.velocity
@@ -137,21 +138,26 @@ class CommandGuard:
         self.clamped = 0
         self.refused = 0
 
-    def position(self, cmd: FloatArray, reference: FloatArray) -> FloatArray | None:
+    def position(
+        self, cmd: FloatArray, reference: FloatArray, dt: float | None = None
+    ) -> FloatArray | None:
         """The safe position command for ``cmd``, given the previous command or measured q.
 
-        Per joint in plain floats (the loop calls this every step; on a few joints that is
-        several times faster than numpy calls); the clamps propagate NaN as numpy's do.
+        ``dt`` is the time the step covers (default: the period): the velocity limit allows
+        ``velocity * dt`` of motion. Per joint in plain floats (the loop calls this every step;
+        on a few joints that is several times faster than numpy calls); the clamps propagate NaN
+        as numpy's do.
         """
         c = cmd.tolist()
         if not all(map(math.isfinite, c)):
             self.refused += 1
             return None
         r = reference.tolist()
+        steps = self._max_step_l
+        if dt is not None and dt != self.period:
+            steps = [v * dt for v in self._velocity_l]
         out = []
-        for x, ref, step, lo, hi in zip(
-            c, r, self._max_step_l, self._lower_l, self._upper_l, strict=True
-        ):
+        for x, ref, step, lo, hi in zip(c, r, steps, self._lower_l, self._upper_l, strict=True):
             d = x - ref
             d = -step if d < -step else d
             d = step if d > step else d

@@ -29,7 +29,8 @@ from collections.abc import Callable
 import numpy as np
 import numpy.typing as npt
 
-from robotspec.driver.clock import Clock, RealClock
+from robotspec.driver.cartesian import DIRECTION_TOLERANCE_DEG, chain_reach, twist_rates
+from robotspec.driver.clock import Clock, RealClock, step_duration
 from robotspec.driver.commands import (
     CommandGuard,
     JointLimitArrays,
@@ -56,7 +57,7 @@ from robotspec.driver.handles import (
     TrajectoryTask,
 )
 from robotspec.driver.hp_kinematics import HPChain, quat_to_rot, rot_to_quat_tuple
-from robotspec.driver.profiles import JogMotion
+from robotspec.driver.profiles import JogMotion, StreamLimiter
 from robotspec.driver.robot_info import (
     PayloadInfo,
     Pose,
@@ -92,6 +93,16 @@ FloatArray = npt.NDArray[np.float64]
 STREAM_STALE_SEQNOS = 10
 #: A blocking call in manual stepping mode gives up after this much (simulated) time.
 MAX_WAIT_S = 3600.0
+#: A waiting jog returns once the measured position is within this of where the jog ended, on
+#: every joint (rad or m) ...
+JOG_ARRIVAL_TOLERANCE = 1e-4
+#: ... and every joint's measured speed is below this (rad/s or m/s).
+JOG_ARRIVAL_SPEED = 1e-3
+#: A waiting jog whose arm has not arrived this long after its profile ended fails.
+JOG_SETTLE_TIMEOUT_S = 1.0
+#: A velocity-stream command must let the joint stop at its limit even if it stays applied for
+#: this many periods (the next command may come a period late).
+VELOCITY_HORIZON_PERIODS = 2.0
 
 
 class DriverLoop(ABC):
@@ -133,6 +144,7 @@ class DriverLoop(ABC):
         chains = robot_info.chains
         self._chain_joints = [np.array(c.joint_numbers, dtype=np.intp) for c in chains]
         self._hp: list[HPChain] = []
+        self._reach: list[float] = []
         for c in chains:
             fp = c.flange_pose or Pose()
             self._hp.append(
@@ -144,6 +156,7 @@ class DriverLoop(ABC):
                     flange_position=np.array(fp.position.as_tuple()),
                 )
             )
+            self._reach.append(chain_reach(self._hp[-1].p, self._hp[-1].flange_p))
         self._current_tool: list[ToolInfo | None] = [c.current_tool for c in chains]
         self._current_payload: list[PayloadInfo | None] = [c.current_payload for c in chains]
         self._current_payload_pose: list[Pose | None] = [None for _ in chains]
@@ -195,6 +208,14 @@ class DriverLoop(ABC):
         self._prev_mode = CommandMode.halt
         self._jog: JogMotion | None = None
         self._jog_waiter: Completion | None = None
+        #: When the profile of a waited-for jog has ended: the arm must arrive by this time.
+        self._jog_settle_deadline: float | None = None
+        self._stream_limiter: StreamLimiter | None = None
+        self._stream_target: tuple[float, list[float]] | None = None
+        self._stream_used: RobotJointCommand | None = None
+        #: The duration of the current step (real elapsed time, see clock.step_duration).
+        self._step_dt = update_period
+        self._last_step_now: float | None = None
         self._jog_cartesian: tuple[int, FloatArray] | None = None
         self._halt_ramp: JogMotion | None = None
         self._homing: Completion | None = None
@@ -212,6 +233,7 @@ class DriverLoop(ABC):
         # the position sent the step before _last_sent, or the velocity command sent.
         self._prev_sent: FloatArray | None = None
         self._sent_velocity: FloatArray | None = None
+        self._sent_dt = update_period
         self._sent_last_step = False
         self._epoch = self._clock.now()
         self._next_deadline = self._epoch
@@ -388,6 +410,8 @@ class DriverLoop(ABC):
         """
         with self._lock:
             self._state_seqno += 1
+            self._step_dt = step_duration(now, self._last_step_now, self._update_period)
+            self._last_step_now = now
         try:
             self._read_feedback(now)
             with self._lock:
@@ -411,6 +435,7 @@ class DriverLoop(ABC):
         if pos is not None:
             consecutive = self._last_sent is not None and self._sent_last_step
             self._prev_sent = self._last_sent if consecutive else None
+            self._sent_dt = self._step_dt
             self._sent_velocity = None
             self._last_sent = pos
             self._sent_last_step = True
@@ -429,13 +454,13 @@ class DriverLoop(ABC):
         """The velocity of the last command sent (zero when none went out last step).
 
         The velocity command, or the difference of the last two consecutive position commands
-        over the period. Why computed on demand: only a starting jog or halt ramp reads it,
-        not every step.
+        over the step between them. Why computed on demand: only a starting jog or halt ramp
+        reads it, not every step.
         """
         if self._sent_velocity is not None:
             return self._sent_velocity
-        if self._prev_sent is not None and self._last_sent is not None:
-            velocity: FloatArray = (self._last_sent - self._prev_sent) / self._update_period
+        if self._prev_sent is not None and self._last_sent is not None and self._sent_dt > 0.0:
+            velocity: FloatArray = (self._last_sent - self._prev_sent) / self._sent_dt
             return velocity
         return np.zeros(self._joint_count)
 
@@ -577,6 +602,7 @@ class DriverLoop(ABC):
         if self._jog_waiter is not None:
             self._jog_waiter.fail(error)
             self._jog_waiter = None
+        self._jog_settle_deadline = None
         self._jog = None
         self._jog_cartesian = None
         if self._traj_active is not None:
@@ -625,23 +651,25 @@ class DriverLoop(ABC):
             self._stream_last_seqno = -1
         if mode is not CommandMode.velocity_command:
             self._stream_velocity = None
+        if mode is not CommandMode.position_command and mode is not CommandMode.velocity_command:
+            self._stream_limiter = None
         if mode is CommandMode.halt:
             if prev in _MOTION_MODES and self._sent_last_step and self._last_sent is not None:
                 self._halt_ramp = self._new_motion(self._last_sent, self._last_sent_velocity)
                 self._halt_ramp.at_velocity(np.zeros(self._joint_count), 0.0)
             if self._halt_ramp is not None:
-                q = self._halt_ramp.step()
+                q = self._halt_ramp.step(self._step_dt)
                 if self._halt_ramp.done:
                     self._halt_ramp = None
                 return True, q, None
             return True, None, None
         self._halt_ramp = None
         if mode is CommandMode.jog:
-            return True, self._fill_jog(), None
+            return True, self._fill_jog(now), None
         if mode is CommandMode.trajectory:
             return True, self._fill_trajectory(now), None
         if mode is CommandMode.position_command:
-            return True, self._fill_position_stream(), None
+            return True, self._fill_position_stream(now), None
         if mode is CommandMode.velocity_command:
             return True, None, self._fill_velocity_stream()
         if mode is CommandMode.homing:
@@ -649,10 +677,19 @@ class DriverLoop(ABC):
         return False, None, None
 
     def _start_point(self) -> tuple[FloatArray, FloatArray]:
-        """Where a new jog starts: the last command if one went out last step, else measured."""
+        """Where a new motion starts: the last command if one went out last step, else measured.
+
+        The velocity is the last command's, or else the measured one (an arm braking by itself
+        after its commands stopped is still moving).
+        """
         if self._sent_last_step and self._last_sent is not None:
             return self._last_sent.copy(), self._last_sent_velocity.copy()
-        return self._joint_position.copy(), np.zeros(self._joint_count)
+        n = self._joint_count
+        if self._sent_velocity is not None:
+            return self._joint_position.copy(), self._sent_velocity.copy()
+        if self._joint_velocity.shape[0] == n:
+            return self._joint_position.copy(), self._joint_velocity.copy()
+        return self._joint_position.copy(), np.zeros(n)
 
     def _new_motion(self, q: FloatArray, v: FloatArray) -> JogMotion:
         vlim, alim = self._jog_limits()
@@ -660,42 +697,123 @@ class DriverLoop(ABC):
             q, v, vlim, alim, self._limits.lower, self._limits.upper, self._update_period
         )
 
-    def _fill_jog(self) -> FloatArray | None:
+    def _fill_jog(self, now: float) -> FloatArray | None:
         motion = self._jog
         if motion is None:
             # Hold where the last jog ended, so a lagging arm settles there instead of braking.
+            if self._jog_waiter is not None:
+                self._check_jog_arrival(now)
             return self._jog_hold
-        if self._jog_cartesian is not None:
+        if self._jog_cartesian is not None and motion.t < motion.velocity_until:
             self._update_cartesian_jog(motion)
-        q = motion.step()  # a new array, never modified afterwards
+        q = motion.step(self._step_dt)  # a new array, never modified afterwards
         self._jog_hold = q
+        if self._jog_cartesian is not None and motion.limit_braking:
+            self._stop_cartesian_jog(motion, self._limit_reason(q))
         if motion.done:
             self._jog = None
             self._jog_cartesian = None
             if self._jog_waiter is not None:
-                self._jog_waiter.succeed()
-                self._jog_waiter = None
+                self._jog_settle_deadline = now + JOG_SETTLE_TIMEOUT_S
         return q
 
-    def _update_cartesian_jog(self, motion: JogMotion) -> None:
-        assert self._jog_cartesian is not None
-        chain, twist = self._jog_cartesian
+    def _check_jog_arrival(self, now: float) -> None:
+        """A waited-for jog whose profile ended: succeed once the arm is there, or time out.
+
+        Why wait for the arm and not for the profile: the command leads the arm by a period (more
+        under jitter), so a caller told "done" when the profile ended found the arm short of the
+        target and still moving.
+        """
+        waiter, hold = self._jog_waiter, self._jog_hold
+        if waiter is None or hold is None:
+            return
+        q, v = self._joint_position.tolist(), self._joint_velocity.tolist()
+        n = self._joint_count
+        if len(q) == n and len(v) == n:
+            err = [abs(a - b) for a, b in zip(q, hold.tolist(), strict=True)]
+            if max(err) <= JOG_ARRIVAL_TOLERANCE and max(map(abs, v)) <= JOG_ARRIVAL_SPEED:
+                waiter.succeed()
+                self._jog_waiter = None
+                self._jog_settle_deadline = None
+                return
+        deadline = self._jog_settle_deadline
+        if deadline is not None and now > deadline:
+            worst = max(range(n), key=lambda i: abs(q[i] - float(hold[i]))) if len(q) == n else 0
+            off = abs(q[worst] - float(hold[worst])) if len(q) == n else math.nan
+            waiter.fail(
+                OperationFailedError(
+                    f"Jog did not arrive: joint '{self._joint_names[worst]}' is {off:.3g} from "
+                    f"where the jog ended {JOG_SETTLE_TIMEOUT_S:g} s after the motion finished "
+                    f"(tolerance {JOG_ARRIVAL_TOLERANCE:g})"
+                )
+            )
+            self._jog_waiter = None
+            self._jog_settle_deadline = None
+
+    def _limit_reason(self, q: FloatArray) -> str:
+        lo, hi = self._limits.lower, self._limits.upper
+        worst = int(np.argmin(np.minimum(q - lo, hi - q)))
+        side = "lower" if q[worst] - lo[worst] < hi[worst] - q[worst] else "upper"
+        return f"joint '{self._joint_names[worst]}' reached its {side} limit"
+
+    def _stop_cartesian_jog(self, motion: JogMotion, reason: str) -> None:
+        """End a Cartesian jog that cannot go on: brake (along the path), fail its waiter."""
+        chain = self._jog_cartesian[0] if self._jog_cartesian is not None else 0
+        self._jog_cartesian = None
+        motion.at_velocity(np.zeros(self._joint_count), 0.0)
+        if self._jog_waiter is not None:
+            self._jog_waiter.fail(
+                OperationFailedError(f"Cartesian jog of chain {chain} stopped: {reason}")
+            )
+            self._jog_waiter = None
+
+    def _cartesian_rates(self, chain: int, q: FloatArray, twist: FloatArray) -> FloatArray | str:
+        """Joint velocities (all joints) for ``twist`` at ``q``, or why it cannot be done."""
         idx = self._chain_joints[chain]
         tf = self._tool_tf[chain]
         _, _, jac = self._hp[chain].fk_jacobian(
-            motion.q[idx], None if tf is None else tf[0], None if tf is None else tf[1]
+            q[idx], None if tf is None else tf[0], None if tf is None else tf[1]
         )
-        lam = 0.01
-        jjt = jac @ jac.T + lam * lam * np.eye(6)
-        qd_chain = jac.T @ np.linalg.solve(jjt, twist)
+        sol = twist_rates(jac, twist, self._reach[chain])
+        if sol.direction_error_deg > DIRECTION_TOLERANCE_DEG:
+            why = (
+                f"chain {chain} cannot move along the requested twist at this pose: the closest "
+                f"motion it can make is {sol.direction_error_deg:.1f} degrees off "
+                f"(tolerance {DIRECTION_TOLERANCE_DEG:g})"
+            )
+            if sol.singular:
+                why += (
+                    f"; the chain is at or near a singular configuration (smallest singular "
+                    f"value {sol.sigma_min:.3g} m)"
+                )
+            elif len(idx) < 6:
+                why += f"; a chain of {len(idx)} joints cannot follow every twist"
+            return why
+        qd_chain = sol.rates
         vlim = self._jog_limits()[0][idx]
         scale = float(np.max(np.abs(qd_chain) / vlim)) if qd_chain.size else 0.0
         if scale > 1.0:
             qd_chain = qd_chain / scale
         qd = np.zeros(self._joint_count)
         qd[idx] = qd_chain
-        if motion.target_velocity is not None:
-            motion.target_velocity = qd
+        lo, hi = self._limits.lower, self._limits.upper
+        for i in idx.tolist():
+            if (qd[i] > 0.0 and q[i] >= hi[i]) or (qd[i] < 0.0 and q[i] <= lo[i]):
+                side = "upper" if qd[i] > 0.0 else "lower"
+                return (
+                    f"chain {chain} cannot move along the requested twist: joint "
+                    f"'{self._joint_names[i]}' is at its {side} limit"
+                )
+        return qd
+
+    def _update_cartesian_jog(self, motion: JogMotion) -> None:
+        assert self._jog_cartesian is not None
+        chain, twist = self._jog_cartesian
+        qd = self._cartesian_rates(chain, motion.q, twist)
+        if isinstance(qd, str):
+            self._stop_cartesian_jog(motion, qd)
+            return
+        motion.target_velocity = qd
 
     def _fill_trajectory(self, now: float) -> FloatArray | None:
         task = self._traj_active
@@ -738,7 +856,20 @@ class DriverLoop(ABC):
                 self._traj_active.start_time = now + self._update_period
         return q
 
-    def _fill_position_stream(self) -> FloatArray | None:
+    def _stream_limiter_now(self) -> StreamLimiter:
+        """The stream's limiter, restarted from the current motion when the stream was idle."""
+        lim = self._stream_limiter
+        if lim is None or not (self._sent_last_step or self._sent_velocity is not None):
+            q0, v0 = self._start_point()
+            alim = self._limits.acceleration
+            lim = StreamLimiter(
+                q0, v0, self._limits.velocity, alim, self._limits.lower, self._limits.upper
+            )
+            self._stream_limiter = lim
+            self._stream_target = None
+        return lim
+
+    def _fill_position_stream(self, now: float) -> FloatArray | None:
         cmd = self._stream_position
         if cmd is None:
             return None
@@ -751,7 +882,19 @@ class DriverLoop(ABC):
             return None
         self._stream_last_seqno = cmd.seqno
         self._stream_valid = StateFlags.valid_position_command
-        return q
+        limiter = self._stream_limiter_now()
+        target = q.tolist()
+        # The stream's own velocity, from its last two distinct samples: a steadily moving
+        # stream is followed without lag; a held one is braked onto.
+        target_velocity = None
+        if cmd is not self._stream_used:
+            prev = self._stream_target
+            if prev is not None and now > prev[0]:
+                span = now - prev[0]
+                target_velocity = [(a - b) / span for a, b in zip(target, prev[1], strict=True)]
+            self._stream_target = (now, target)
+            self._stream_used = cmd
+        return limiter.position(target, target_velocity, self._step_dt)
 
     def _fill_velocity_stream(self) -> FloatArray | None:
         cmd = self._stream_velocity
@@ -760,10 +903,17 @@ class DriverLoop(ABC):
         if abs(cmd.state_seqno - self._state_seqno) > STREAM_STALE_SEQNOS:
             return None
         v = convert_command(cmd, self._joint_count, VELOCITY_UNITS)
-        if v is None:
+        if v is None or self._joint_position.shape[0] != self._joint_count:
             return None
         self._stream_valid = StateFlags.valid_velocity_command
-        return v * self._speed_ratio
+        limiter = self._stream_limiter_now()
+        horizon = max(self._step_dt, VELOCITY_HORIZON_PERIODS * self._update_period)
+        return limiter.velocity(
+            (v * self._speed_ratio).tolist(),
+            self._joint_position.tolist(),
+            self._step_dt,
+            horizon,
+        )
 
     def _guard_command(
         self, pos: FloatArray | None, vel: FloatArray | None
@@ -777,7 +927,7 @@ class DriverLoop(ABC):
                 if self._joint_position.shape[0] != self._joint_count:
                     return None, None
                 ref = self._joint_position
-            out = self._guard.position(pos, ref)
+            out = self._guard.position(pos, ref, self._step_dt)
             if out is None:
                 self._fault_message = "non-finite joint position command refused"
             return out, None

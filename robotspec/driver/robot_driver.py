@@ -323,6 +323,7 @@ class RobotDriver(DriverLoop):
         if self._jog_waiter is not None:
             self._jog_waiter.fail(OperationAbortedError("Operation interrupted by new jog command"))
         self._jog = motion
+        self._jog_settle_deadline = None
         waiter = Completion() if wait else None
         self._jog_waiter = waiter
         return waiter
@@ -398,6 +399,7 @@ class RobotDriver(DriverLoop):
         motion.vmax = vlim.copy()
         motion.amax = np.minimum(alim * self._speed_ratio, alim)
         motion.t = 0.0
+        motion.coordinated = False
         motion.at_velocity(qd, timeout)
         return self._install_jog(motion, wait)
 
@@ -406,8 +408,12 @@ class RobotDriver(DriverLoop):
     ) -> None:
         """Jog a chain's TCP at spatial ``velocity`` ``[wx, wy, wz, vx, vy, vz]`` (base frame).
 
-        The joint velocities come from the chain's Jacobian (damped least squares), scaled down
-        together when one would exceed its limit, recomputed every step.
+        The joint velocities come from the chain's Jacobian (damped least squares, see
+        :mod:`robotspec.driver.cartesian`), scaled down together when one would exceed its limit,
+        recomputed every step; all joints speed up and brake together, so the tool keeps its
+        direction. Refused (InvalidArgument) when the chain cannot move along ``velocity`` at this
+        pose (near a singularity, too few joints, a joint at its limit); a jog that reaches such
+        a pose on its way brakes to a stop, and a waiting caller gets OperationFailed.
         """
         with self._lock:
             self._jog_preamble(OperationAbortedError)
@@ -416,8 +422,15 @@ class RobotDriver(DriverLoop):
             if t <= 0.0:
                 raise InvalidArgumentError("Invalid jog timeout specified")
             self._check_chain(chain, "jog")
+            q_start = self._jog.q if self._jog is not None else self._start_point()[0]
+            rates = self._cartesian_rates(chain, q_start, twist)
+            if isinstance(rates, str):
+                raise InvalidArgumentError(f"jog_cartesian refused: {rates}")
             vlim, alim = self._jog_limits()
             waiter = self._velocity_jog(np.zeros(self._joint_count), t, wait, vlim, alim)
+            assert self._jog is not None
+            self._jog.coordinated = True
+            self._jog.target_velocity = rates
             self._jog_cartesian = (chain, twist)
         if waiter is not None:
             self._wait_completion(waiter)

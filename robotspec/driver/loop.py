@@ -101,7 +101,7 @@ JOG_ARRIVAL_SPEED = 1e-3
 #: A waiting jog whose arm has not arrived this long after its profile ended fails.
 JOG_SETTLE_TIMEOUT_S = 1.0
 #: A velocity-stream command must let the joint stop at its limit even if it stays applied for
-#: this many periods (the next command may come a period late).
+#: this many periods (the next command may come late; steps up to twice this keep the guarantee).
 VELOCITY_HORIZON_PERIODS = 2.0
 
 
@@ -807,12 +807,32 @@ class DriverLoop(ABC):
         return qd
 
     def _update_cartesian_jog(self, motion: JogMotion) -> None:
+        """New joint rates for the twist at the commanded pose, and a look ahead.
+
+        Why look ahead: braking takes time, and near a singular pose the rates that keep the tool
+        on course change fast. The twist is also checked at the pose where the arm would come
+        to rest if it braked now; if the tool could not follow it there, braking starts now,
+        while the direction is still good.
+        """
         assert self._jog_cartesian is not None
         chain, twist = self._jog_cartesian
         qd = self._cartesian_rates(chain, motion.q, twist)
         if isinstance(qd, str):
             self._stop_cartesian_jog(motion, qd)
             return
+        v = motion.v
+        if np.any(v):
+            # All joints brake together (coordinated), each covering v t_stop / 2.
+            t_stop = float(np.max(np.abs(v) / motion.amax))
+            ahead = motion.q + v * (0.5 * t_stop + 2.0 * self._step_dt)
+            lo, hi = self._limits.lower, self._limits.upper
+            if np.any(ahead > hi) or np.any(ahead < lo):
+                self._stop_cartesian_jog(motion, self._limit_reason(np.clip(ahead, lo, hi)))
+                return
+            later = self._cartesian_rates(chain, ahead, twist)
+            if isinstance(later, str):
+                self._stop_cartesian_jog(motion, later)
+                return
         motion.target_velocity = qd
 
     def _fill_trajectory(self, now: float) -> FloatArray | None:
@@ -907,7 +927,9 @@ class DriverLoop(ABC):
             return None
         self._stream_valid = StateFlags.valid_velocity_command
         limiter = self._stream_limiter_now()
-        horizon = max(self._step_dt, VELOCITY_HORIZON_PERIODS * self._update_period)
+        # A fixed horizon: the braking guarantee holds for steps up to twice as long (see
+        # profiles.StreamLimiter.velocity); the arm's own soft limits cover longer stalls.
+        horizon = VELOCITY_HORIZON_PERIODS * self._update_period
         return limiter.velocity(
             (v * self._speed_ratio).tolist(),
             self._joint_position.tolist(),

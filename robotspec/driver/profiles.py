@@ -216,7 +216,11 @@ class JogMotion:
             q_new = q + x * dt
             if tgt_l is not None:
                 t_i = tgt_l[i]
-                if abs(t_i - q_new) <= SNAP_FRACTION * a * dt * dt:
+                # Snap onto the target when it is that close and the snap keeps the joint
+                # able to stop at its limits (a target on a limit is approached, not snapped).
+                if abs(t_i - q_new) <= SNAP_FRACTION * a * dt * dt and (
+                    cap_lo <= (t_i - q) / dt <= cap_hi
+                ):
                     q_new = t_i
                 if q_new != t_i:
                     all_landed = False
@@ -299,7 +303,10 @@ class StreamLimiter:
             x = v - adt if x < v - adt else (v + adt if x > v + adt else x)
             x = _limit_cap(x, q, lo, hi, a, dt)
             q_new = q + x * dt
-            if abs(tgt - q_new) <= SNAP_FRACTION * a * dt * dt:
+            if (
+                abs(tgt - q_new) <= SNAP_FRACTION * a * dt * dt
+                and _limit_cap((tgt - q) / dt, q, lo, hi, a, dt) == (tgt - q) / dt
+            ):
                 q_new = tgt
             q_new = lo if q_new < lo else (hi if q_new > hi else q_new)
             v_l[i] = (q_new - q) / dt
@@ -313,8 +320,9 @@ class StreamLimiter:
         """The next velocity command for the streamed ``command`` at position ``measured``.
 
         ``dt`` is the time since the last command (the acceleration budget); ``horizon`` the time
-        the command may stay applied before the next one (a late period included), over which
-        the joint must still be able to stop at its limit.
+        the command may stay applied before the next one, over which the joint must still be
+        able to stop at its limit. Keep ``horizon`` fixed: the set of states braked this way is
+        invariant for every step up to ``2 * horizon`` long (a varying horizon breaks that).
         """
         v_l = self.v
         out = [0.0] * len(v_l)

@@ -438,9 +438,16 @@ class RobotDriver(DriverLoop):
     # ------------------------------------------------------------------ trajectories
 
     def execute_trajectory(self, trajectory: JointTrajectory) -> TrajectoryGenerator:
-        """Check and queue a trajectory; drive it by calling ``Next()`` on the generator."""
+        """Check and queue a trajectory; drive it by calling ``Next()`` on the generator.
+
+        The waypoint checks and the interpolation setup run *outside* the loop's lock (they only
+        read the immutable limits and the speed ratio, sampled once): a client uploading 50,000
+        waypoints must not make the loop miss its periods. Only the start-point and mode checks
+        and the queueing take the lock.
+        """
+        ratio = self._speed_ratio
+        interp = load_trajectory(trajectory, self._joint_names, self._limits, ratio)
         with self._lock:
-            interp = load_trajectory(trajectory, self._joint_names, self._limits, self._speed_ratio)
             measured = self._joint_position
             if measured.shape[0] != self._joint_count or np.any(
                 np.abs(measured - interp.positions[0]) > self._trajectory_error_tol

@@ -80,10 +80,14 @@ from robotspec.driver.handles import (
 )
 from robotspec.driver.loop import DriverLoop, FloatArray
 from robotspec.driver.profiles import JogMotion
+from robotspec.driver.hp_kinematics import quat_to_rot
 from robotspec.driver.robot_info import (
+    MAX_OFFSET_M,
+    QUAT_TOL,
     DeviceInfo,
     PayloadInfo,
     Pose,
+    Quaternion,
     RobotCapability,
     RobotInfo,
     ToolInfo,
@@ -514,8 +518,10 @@ class RobotDriver(DriverLoop):
             self._check_chain(chain, "tool")
             if self._current_tool[chain] is not None:
                 raise InvalidArgumentError(f"Tool already attached to kinematic chain {chain}")
+            tf = tool_transform(tool)
+            _check_frame(f"tool '{tool.name}' tcp", tool.tcp.rotation, tf)
             self._current_tool[chain] = tool
-            self._tool_tf[chain] = tool_transform(tool)
+            self._tool_tf[chain] = tf
             self._tool_tf_lists[chain] = as_lists(self._tool_tf[chain])
             self._config_seqno += 1
             self.events.append(("tool_changed", chain, tool.name))
@@ -551,6 +557,10 @@ class RobotDriver(DriverLoop):
                 )
             if self._current_payload[chain] is not None:
                 raise InvalidArgumentError(f"Payload already attached to kinematic chain {chain}")
+            if pose is not None:
+                p = pose.position
+                tf_p = (quat_to_rot(pose.orientation.as_tuple()), np.array([p.x, p.y, p.z]))
+                _check_frame(f"payload '{payload.name}' pose", pose.orientation, tf_p)
             self._current_payload[chain] = payload
             self._current_payload_pose[chain] = pose or Pose()
             self._config_seqno += 1
@@ -589,3 +599,24 @@ class RobotDriver(DriverLoop):
     def setf_signal(self, signal_name: str, value: Any) -> None:
         """Signals are not implemented by the base driver."""
         raise NotImplementedDriverError("Not implemented")
+
+
+def _check_frame(
+    what: str, rotation: Quaternion, frame: tuple[FloatArray, FloatArray] | None
+) -> None:
+    """Refuse a tool TCP or payload pose with NaN, infinity, a non-unit rotation or an absurd
+    offset.
+
+    Why here as well as in the models: a ``ToolInfo`` built with ``model_construct`` (or by
+    another front end) skips validation, and a NaN TCP would be published as a NaN pose.
+    """
+    q = rotation.as_tuple()
+    if frame is None:
+        return
+    values = [*q, *frame[1].tolist()]
+    if not all(math.isfinite(v) for v in values):
+        raise InvalidArgumentError(f"{what} must not contain NaN or infinite values")
+    if abs(math.hypot(*q) - 1.0) > QUAT_TOL:
+        raise InvalidArgumentError(f"{what}: rotation must be a unit quaternion")
+    if max(abs(v) for v in frame[1].tolist()) > MAX_OFFSET_M:
+        raise InvalidArgumentError(f"{what}: offset beyond {MAX_OFFSET_M:g} m")

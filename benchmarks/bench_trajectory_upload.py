@@ -1,6 +1,6 @@
 """The driver loop's worst period while a client uploads a 50,000-waypoint trajectory.
 
-Run: ``python benchmarks/bench_trajectory_upload.py [--waypoints 50000] [--rate 100] [--uploads 3]``.
+Run: ``python benchmarks/bench_trajectory_upload.py [--waypoints N] [--rate HZ] [--uploads K]``.
 
 A simulated ABB IRB1200 (``../shared/robotinfo``; the tests' self-made RRP arm when that folder is
 absent) runs its loop in its own thread on the real clock, in trajectory mode, as in production.

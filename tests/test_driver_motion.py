@@ -145,9 +145,7 @@ def make_robot(
     path: Path, jitter: float, seed: int, start: list[float] | None = None, period: float = 0.01
 ) -> SimRobot:
     """A simulated robot whose loop wakes up late by ``jitter`` periods on average."""
-    clock = (
-        JitteryClock(jitter * period, 1.5 * period, seed=seed) if jitter > 0 else SimClock()
-    )
+    clock = JitteryClock(jitter * period, 1.5 * period, seed=seed) if jitter > 0 else SimClock()
     info = _info(path)
     lim = JointLimitArrays.from_info(info)
     q0 = None
@@ -447,7 +445,11 @@ def test_cartesian_jog_at_baxters_singular_zero_pose() -> None:
     outcomes = []
     for axis in range(3):
         for sign in (1.0, -1.0):
-            robot = SimRobot(_info(path), clock=SimClock(), initial_position=np.zeros(len(_info(path).joint_info)))
+            robot = SimRobot(
+                _info(path),
+                clock=SimClock(),
+                initial_position=np.zeros(len(_info(path).joint_info)),
+            )
             robot.step()
             robot.step()
             to_mode(robot, CommandMode.jog)
@@ -475,7 +477,7 @@ def test_cartesian_jog_at_wrist_singularity_refuses_or_follows(name: str) -> Non
         q0[4] = 0.0  # ABB wrist singularity: joint 5 at zero
     rng = np.random.default_rng(5)
     seen = set()
-    for trial in range(10):
+    for _ in range(10):
         robot = SimRobot(info, clock=SimClock(), initial_position=q0)
         robot.step()
         robot.step()

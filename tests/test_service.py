@@ -9,7 +9,6 @@ the robot's own state, not timing.
 from __future__ import annotations
 
 import math
-
 import os
 import shutil
 import socket

@@ -78,9 +78,9 @@ from robotspec.driver.handles import (
     TrajectoryGenerator,
     TrajectoryTask,
 )
+from robotspec.driver.hp_kinematics import quat_to_rot
 from robotspec.driver.loop import DriverLoop, FloatArray
 from robotspec.driver.profiles import JogMotion
-from robotspec.driver.hp_kinematics import quat_to_rot
 from robotspec.driver.robot_info import (
     MAX_OFFSET_M,
     QUAT_TOL,
@@ -604,8 +604,7 @@ class RobotDriver(DriverLoop):
 def _check_frame(
     what: str, rotation: Quaternion, frame: tuple[FloatArray, FloatArray] | None
 ) -> None:
-    """Refuse a tool TCP or payload pose with NaN, infinity, a non-unit rotation or an absurd
-    offset.
+    """Refuse a tool TCP or payload pose with NaN, infinity, bad rotation or absurd offset.
 
     Why here as well as in the models: a ``ToolInfo`` built with ``model_construct`` (or by
     another front end) skips validation, and a NaN TCP would be published as a NaN pose.

@@ -577,15 +577,20 @@ def _semantic_checks(
         for i, h in enumerate(chain.H):
             norm = math.hypot(h.x, h.y, h.z)  # no OverflowError for 1e200
             if abs(norm - 1.0) > UNIT_TOL:
-                err(f"{where}.H[{i}] must be a unit vector (norm is {norm:.6g})", ("chains", c, "H", i))
-        offsets = [(f"P[{i}]", ("chains", c, "P", i), p) for i, p in enumerate(chain.P)]
+                err(
+                    f"{where}.H[{i}] must be a unit vector (norm is {norm:.6g})",
+                    ("chains", c, "H", i),
+                )
+        offsets: list[tuple[str, tuple[str | int, ...], Vector3]] = [
+            (f"P[{i}]", ("chains", c, "P", i), p) for i, p in enumerate(chain.P)
+        ]
         if chain.flange_pose is not None:
             loc_f: tuple[str | int, ...] = ("chains", c, "flange_pose", "position")
             offsets.append(("flange_pose.position", loc_f, chain.flange_pose.position))
         for label, loc_p, p in offsets:
             big = max(abs(p.x), abs(p.y), abs(p.z))
             if big > MAX_OFFSET_M:
-                err(f"{where}.{label} is {big:g} m from its frame (at most {MAX_OFFSET_M:g})", loc_p)
+                err(f"{where}.{label} is {big:g} m from its frame (max {MAX_OFFSET_M:g})", loc_p)
         if len(chain.H) != n:
             err(
                 f"{where}.H has {len(chain.H)} axes but the chain has {n} joints (joint_numbers)",

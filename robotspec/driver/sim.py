@@ -208,10 +208,10 @@ class SimRobot(RobotDriver):
             v = v_l[i] + dv
             # Soft limits: never faster toward a limit than the arm can stop at it.
             acc = acc_l[i]
-            cap = braking_speed(upper_l[i] - q_l[i], acc, dt)
-            v = cap if v > cap else v
-            cap = -braking_speed(q_l[i] - lower_l[i], acc, dt)
-            v = cap if v < cap else v
+            brake = braking_speed(upper_l[i] - q_l[i], acc, dt)
+            v = brake if v > brake else v
+            brake = -braking_speed(q_l[i] - lower_l[i], acc, dt)
+            v = brake if v < brake else v
             q = q_l[i] + v * dt
             if q < lower_l[i]:
                 q, v = lower_l[i], 0.0

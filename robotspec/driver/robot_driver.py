@@ -12,9 +12,10 @@ Deliberate deviations from the reference (its defects, §1.11 of the note), each
 2. ``halt()``, ``home()``, and the ``operational_mode``, ``controller_state`` and
    ``current_errors`` properties work.
 3. Limits: ``jog_joint`` checks ``|velocity|`` (both signs) against the limit of the operational
-   mode; ``jog_freespace`` refuses targets outside the joint limits; jogs brake before a joint
-   limit; the position stream is clamped to the limits; every command passes
-   :class:`~robotspec.driver.commands.CommandGuard`. NaN and infinity are refused everywhere.
+   mode; ``jog_freespace`` refuses targets outside the joint limits; jogs and both streams respect
+   the acceleration limits and brake before a joint limit (:mod:`robotspec.driver.profiles`);
+   every command passes :class:`~robotspec.driver.commands.CommandGuard`. NaN and infinity are
+   refused everywhere.
    A speed ratio above 1 never raises jog speed or acceleration beyond the joint limits.
 4. Trajectories: the final waypoint is commanded exactly; a tracking failure fails the task with
    OperationFailed, clears ``trajectory_running``, cancels the queue and drops to ``halt``;
@@ -29,8 +30,9 @@ Deliberate deviations from the reference (its defects, §1.11 of the note), each
 6. Tools: ``tool_detached`` accepts the attached tool's name (or ""); tools and payloads work on
    every chain; ``robot_info.config_seqno`` follows the attachments.
 7. A waiting jog interrupted by halt, an error, an e-stop or lost communication raises
-   OperationAborted instead of returning success; ``Abort()`` takes the lock; leaving a motion
-   mode for ``halt`` brakes at the acceleration limits instead of stopping dead.
+   OperationAborted instead of returning success; a waiting jog returns when the arm (not the
+   command) has arrived; ``Abort()`` takes the lock; leaving a motion mode for ``halt`` brakes at
+   the acceleration limits instead of stopping dead.
 8. Capabilities are checked: ``trajectory_command`` for trajectory mode (also on the homing route
    out of ``invalid_state``), ``software_enable`` for ``enable()``/``disable()``,
    ``software_reset_errors`` for ``reset_errors()`` (a driver-internal fault can always be reset).
@@ -38,7 +40,8 @@ Deliberate deviations from the reference (its defects, §1.11 of the note), each
    files declares them, yet every reference driver honours both.
 9. ``velocity_command`` mode works (the reference's loop thread dies on the first command); it
    scales by the speed ratio and sets ``valid_velocity_command``.
-10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares).
+10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares), and refuses a
+    twist the chain cannot follow at its pose.
 11. The simulated robot (:class:`~robotspec.driver.sim.SimRobot`) has a command watchdog, like a
     real controller: when the driver sends no command for ``command_timeout`` (default 0.1 s; the
     driver stops sending once feedback is lost), the arm drops its last command and brakes to

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
+from robotspec.driver.chain_kinematics import HPChain, quat_to_rot
 from robotspec.driver.clock import SimClock
 from robotspec.driver.export import (
     DEFAULT_ACCELERATION_FACTOR,
@@ -16,7 +17,6 @@ from robotspec.driver.export import (
     export_chain,
     robot_info_from_chain,
 )
-from robotspec.driver.hp_kinematics import HPChain, quat_to_rot
 from robotspec.driver.robot_info import (
     JointType,
     RobotInfo,

@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from robotspec.driver.commands import RobotJointCommand
 from robotspec.driver.errors import InvalidArgumentError
-from robotspec.driver.handles import RobotJointCommand
 from robotspec.driver.robot_info import (
     DeviceInfo,
     Identifier,

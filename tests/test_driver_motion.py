@@ -26,9 +26,8 @@ from hypothesis import strategies as st
 
 from robotspec.driver.cartesian import DIRECTION_TOLERANCE_DEG
 from robotspec.driver.clock import JitteryClock, SimClock
-from robotspec.driver.commands import JointLimitArrays
+from robotspec.driver.commands import JointLimitArrays, RobotJointCommand
 from robotspec.driver.errors import InvalidArgumentError, OperationFailedError
-from robotspec.driver.handles import RobotJointCommand
 from robotspec.driver.loop import JOG_ARRIVAL_SPEED, JOG_ARRIVAL_TOLERANCE
 from robotspec.driver.robot_info import RobotCapability, RobotInfo, load_robot_info
 from robotspec.driver.sim import Fault, SimRobot

@@ -9,7 +9,7 @@ document) and the behaviour recorded in the reference note, with the reference's
 * :mod:`~robotspec.driver.commands` -- validation of client commands and the send-path guard;
 * :mod:`~robotspec.driver.profiles` -- online jog profiles (time-optimal, limit-aware);
 * :mod:`~robotspec.driver.trajectory` -- joint trajectory checks and interpolation;
-* :mod:`~robotspec.driver.hp_kinematics` -- forward kinematics and Jacobians of H/P chains;
+* :mod:`~robotspec.driver.chain_kinematics` -- forward kinematics and Jacobians of H/P chains;
 * :mod:`~robotspec.driver.clock` -- real and simulated clocks;
 * :mod:`~robotspec.driver.loop` -- the timestep pipeline and state machine;
 * :mod:`~robotspec.driver.robot_driver` -- the driver base class: the seed's client API;

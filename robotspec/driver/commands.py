@@ -10,6 +10,7 @@ non-finite values outright.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,11 +23,22 @@ from robotspec.driver.robot_info import RobotInfo
 __all__ = [
     "CommandGuard",
     "JointLimitArrays",
+    "RobotJointCommand",
     "check_speed_ratio",
     "joint_array",
 ]
 
 FloatArray = npt.NDArray[np.float64]
+
+@dataclass(frozen=True)
+class RobotJointCommand:
+    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""
+
+    seqno: int
+    state_seqno: int
+    command: Sequence[float]
+    units: Sequence[str] = ()
+
 
 #: Speed ratio range, inclusive (reference: InvalidArgument "Invalid speed_ratio" outside).
 SPEED_RATIO_MIN = 0.1

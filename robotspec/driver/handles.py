@@ -7,7 +7,7 @@ internals; the generator's methods step or wait on the driver that made it.
 from __future__ import annotations
 
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -24,22 +24,12 @@ from robotspec.errors import DriverError
 if TYPE_CHECKING:
     from robotspec.driver.robot_driver import RobotDriver
 
-__all__ = ["Completion", "RobotJointCommand", "TrajectoryGenerator", "TrajectoryStatus"]
+__all__ = ["Completion", "TrajectoryGenerator", "TrajectoryStatus"]
 
 FloatArray = npt.NDArray[np.float64]
 
 #: ``Next()`` returns ``running`` after this long without an outcome (reference: 5 s).
 NEXT_TIMEOUT_S = 5.0
-
-
-@dataclass(frozen=True)
-class RobotJointCommand:
-    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""
-
-    seqno: int
-    state_seqno: int
-    command: Sequence[float]
-    units: Sequence[str] = ()
 
 
 @dataclass(frozen=True)
@@ -74,10 +64,6 @@ class Completion:
         if not self._event.is_set():
             self.error = error
             self._event.set()
-
-    def wait_event(self, timeout: float | None) -> bool:
-        """Block on the event (loop-thread mode)."""
-        return self._event.wait(timeout)
 
 
 class TrajectoryTask:

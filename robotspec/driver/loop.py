@@ -30,10 +30,12 @@ import numpy as np
 import numpy.typing as npt
 
 from robotspec.driver.cartesian import DIRECTION_TOLERANCE_DEG, chain_reach, twist_rates
+from robotspec.driver.chain_kinematics import HPChain, quat_to_rot, rot_to_quat_tuple
 from robotspec.driver.clock import Clock, RealClock, step_duration
 from robotspec.driver.commands import (
     CommandGuard,
     JointLimitArrays,
+    RobotJointCommand,
 )
 from robotspec.driver.conversions import (
     POSITION_UNITS,
@@ -51,12 +53,10 @@ from robotspec.driver.errors import (
 )
 from robotspec.driver.handles import (
     Completion,
-    RobotJointCommand,
     TrajectoryGenerator,
     TrajectoryStatus,
     TrajectoryTask,
 )
-from robotspec.driver.hp_kinematics import HPChain, quat_to_rot, rot_to_quat_tuple
 from robotspec.driver.profiles import JogMotion, StreamLimiter
 from robotspec.driver.robot_info import (
     PayloadInfo,

@@ -56,8 +56,10 @@ from typing import Any
 
 import numpy as np
 
+from robotspec.driver.chain_kinematics import quat_to_rot
 from robotspec.driver.commands import (
     JointLimitArrays,
+    RobotJointCommand,
     check_speed_ratio,
     finite_scalar,
     joint_array,
@@ -77,11 +79,9 @@ from robotspec.driver.errors import (
 )
 from robotspec.driver.handles import (
     Completion,
-    RobotJointCommand,
     TrajectoryGenerator,
     TrajectoryTask,
 )
-from robotspec.driver.hp_kinematics import quat_to_rot
 from robotspec.driver.loop import DriverLoop, FloatArray
 from robotspec.driver.profiles import JogMotion
 from robotspec.driver.robot_info import (

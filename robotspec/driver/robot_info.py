@@ -18,7 +18,6 @@ without ``flange_pose`` (identity is used, as the reference does silently) and `
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -673,7 +672,3 @@ def load_robot_info(path: str | Path) -> RobotInfo:
     """Load and validate a RobotInfo YAML file; warnings are dropped (see ``read_robot_info``)."""
     return read_robot_info(path).info
 
-
-def chain_joint_indices(info: RobotInfo) -> Sequence[tuple[int, ...]]:
-    """The global joint indices of each chain, in chain order."""
-    return [tuple(c.joint_numbers) for c in info.chains]

@@ -30,6 +30,7 @@ __all__ = [
 
 FloatArray = npt.NDArray[np.float64]
 
+
 @dataclass(frozen=True)
 class RobotJointCommand:
     """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""

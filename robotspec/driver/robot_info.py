@@ -671,4 +671,3 @@ def read_robot_info_text(text: str, file: str = "<string>") -> LoadedRobotInfo:
 def load_robot_info(path: str | Path) -> RobotInfo:
     """Load and validate a RobotInfo YAML file; warnings are dropped (see ``read_robot_info``)."""
     return read_robot_info(path).info
-

@@ -62,6 +62,7 @@ CALLS: dict[str, tuple[frozenset[str], frozenset[str]]] = {
     "payload_detached": (frozenset(), frozenset({"chain", "name"})),
 }
 
+
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -390,4 +391,3 @@ def mismatch_errors(loaded: LoadedScenario, results: list[StepResult]) -> list[R
         for r in results
         if not r.ok
     ]
-

@@ -45,7 +45,7 @@ def main() -> None:
         random_configurations,
     )
     from robotspec.compiler import check_spec
-    from robotspec.urdf import load_urdf
+    from robotspec.description.urdf import load_urdf
 
     share = Path(str(md.distribution("example-robot-data").locate_file("cmeel.prefix/share")))
     urdf = share / "example-robot-data/robots/pr2_description/urdf/pr2.urdf"

@@ -97,7 +97,7 @@ def main() -> None:
     import tempfile
 
     from robotspec.compiler import check_spec
-    from robotspec.description_export import bundle
+    from robotspec.export.urdf import bundle
 
     folder = Path(tempfile.mkdtemp(prefix="bench-compose-"))
     out = bundle(check_spec("b1_ur5_allegro"), name="b1")

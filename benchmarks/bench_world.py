@@ -36,8 +36,8 @@ def main() -> None:
     import pinocchio as pin
     import yourdfpy
 
-    from robotspec.kinematics import Kinematics
-    from robotspec.urdf import load_urdf
+    from robotspec.description.urdf import load_urdf
+    from robotspec.model.kinematics import Kinematics
 
     share = Path(
         str(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robotspec.world import World
+from robotspec.model.world import World
 
 
 class PinOracle:

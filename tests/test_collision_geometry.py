@@ -18,9 +18,9 @@ from robotspec.collision import (
     adjacent_pairs,
     build_geometry_model,
 )
+from robotspec.description.srdf import parse_srdf_bytes
+from robotspec.description.urdf import load_urdf
 from robotspec.errors import CollisionError
-from robotspec.srdf import parse_srdf_bytes
-from robotspec.urdf import load_urdf
 
 URDF = """<?xml version="1.0"?>
 <robot name="toy">

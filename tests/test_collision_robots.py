@@ -17,10 +17,10 @@ from robotspec.collision import (
     random_configurations,
     state_configuration,
 )
+from robotspec.description.urdf import load_urdf
 from robotspec.errors import CollisionError, NotFoundError
+from robotspec.model.world import World
 from robotspec.semantic import AbstractRobot
-from robotspec.urdf import load_urdf
-from robotspec.world import World
 from tests.conftest import erd_robots, shared_path
 from tests.pin_oracle import PinOracle
 

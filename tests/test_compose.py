@@ -11,14 +11,13 @@ from hypothesis import strategies as st
 
 from robotspec.collision import CollisionRules
 from robotspec.compiler import check_spec, compile_robot
-from robotspec.description_export import bundle, joined_urdf, urdf_text
 from robotspec.errors import RobotSpecError
-from robotspec.kinematics import Kinematics
+from robotspec.export.srdf import srdf_from_robot, write_srdf
+from robotspec.export.urdf import bundle, joined_urdf, urdf_text
+from robotspec.model.kinematics import Kinematics
+from robotspec.model.world import World
 from robotspec.semantic import AbstractRobot
-from robotspec.spec import load_spec
-from robotspec.srdf import write_srdf
-from robotspec.srdf_export import srdf_from_robot
-from robotspec.world import World
+from robotspec.spec.load import load_spec
 
 from .conftest import erd_robots
 
@@ -87,7 +86,7 @@ def test_composed_fk_equals_pinocchio_on_exported_urdf(
 
 
 def _spec_file(name: str) -> Path:
-    from robotspec.spec import shipped_spec_files
+    from robotspec.shipped import shipped_spec_files
 
     return shipped_spec_files()[name]
 
@@ -665,7 +664,7 @@ def test_the_composed_spec_changes_a_parts_entry_key_by_key(tmp_path: Path) -> N
 
 def test_one_package_name_in_two_parts_resolves_per_part(tmp_path: Path) -> None:
     """Two vendors' packages called 'tools': each part's meshes stay its own."""
-    from robotspec.geometry import Mesh
+    from robotspec.model.geometry import Mesh
 
     for vendor, mesh in (("a", "one.stl"), ("b", "two.stl")):
         pkg = tmp_path / vendor / "tools"
@@ -683,7 +682,6 @@ def test_one_package_name_in_two_parts_resolves_per_part(tmp_path: Path) -> None
     )
     result = check_spec(spec)
     assert result.warnings == ()
-    assert result.robot is not None
     w = result.robot.world
     paths = {}
     for name in ("a_link", "b_link"):
@@ -741,7 +739,7 @@ def test_pinocchio_reads_the_exported_urdf_and_srdf_to_the_same_checked_pairs(
     """
     import pinocchio as pin
 
-    from robotspec.packages import PackageResolver
+    from robotspec.files.packages import PackageResolver
 
     erd_robots()
     result = check_spec(name)

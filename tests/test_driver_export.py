@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
+from robotspec.description.urdf import load_urdf
 from robotspec.driver.chain_kinematics import HPChain, quat_to_rot
 from robotspec.driver.clock import SimClock
 from robotspec.driver.export import (
@@ -26,9 +27,8 @@ from robotspec.driver.robot_info import (
 from robotspec.driver.sim import SimRobot
 from robotspec.driver.state import CommandMode
 from robotspec.errors import KinematicsError, RobotInfoError
-from robotspec.kinematics import ChainKinematics
-from robotspec.urdf import load_urdf
-from robotspec.world import World
+from robotspec.model.kinematics import ChainKinematics
+from robotspec.model.world import World
 from tests.conftest import erd_robots, shared_path
 
 CONFIGS = 50
@@ -226,7 +226,7 @@ def test_ur5e_shared() -> None:
     # The published driver file is in UR's 'base' frame, 180 deg about z from base_link (note
     # §1(c)); from 'base' the exported flange at q = 0 agrees with it to the file's ~1 mm rounding.
     published = load_robot_info(shared_path("robotinfo", "ur5e.yml"))
-    from robotspec.kinematics import Kinematics
+    from robotspec.model.kinematics import Kinematics
 
     t_base = Kinematics(world).pose(np.zeros(6), "base", relative_to="base_link")
     r_ours, p_ours = hp_of(info).fk(np.zeros(6))
@@ -292,10 +292,9 @@ def test_yaml_is_reference_shaped(pr2: World) -> None:
 
 def run_cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
     """Run ``robotspec ARGV`` in-process; returns (exit code, stdout, stderr)."""
-    from robotspec.cli.app import _register, app
+    from robotspec.cli.app import app
     from robotspec.cli.render import run_app
 
-    _register()
     code = run_app(app, list(argv))
     out = capsys.readouterr()
     return code, out.out, out.err

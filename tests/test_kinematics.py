@@ -10,11 +10,11 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+from robotspec.description.urdf import world_from_urdf_xml
 from robotspec.errors import KinematicsError
-from robotspec.kinematics import Kinematics
-from robotspec.urdf import world_from_urdf_xml
-from robotspec.world import World
-from robotspec.xmlsafe import parse_xml_file
+from robotspec.files.xmlsafe import parse_xml_file
+from robotspec.model.kinematics import Kinematics
+from robotspec.model.world import World
 
 from .conftest import erd_robots, shared_path
 from .pin_oracle import PinOracle
@@ -118,7 +118,7 @@ def test_jacobian_of_mimic_chain(hsrb) -> None:
 
 
 def test_planar_and_floating_base(pr2) -> None:
-    from robotspec.world import ConnectionType
+    from robotspec.model.world import ConnectionType
 
     w = pr2[0]
     for kind, n in ((ConnectionType.PLANAR, 3), (ConnectionType.FLOATING, 6)):
@@ -132,7 +132,7 @@ def test_planar_and_floating_base(pr2) -> None:
             np.testing.assert_allclose(base[:3, 3], [0.3, 0.6, 0.0], atol=1e-12)
             np.testing.assert_allclose(base[:2, :2], [[c, -s], [s, c]], atol=1e-12)
         else:
-            from robotspec.geometry import pose_from_xyz_rpy
+            from robotspec.model.geometry import pose_from_xyz_rpy
 
             x, y, z, roll, pitch, yaw = q[:6]
             expected = pose_from_xyz_rpy((x, y, z), (roll, pitch, yaw))

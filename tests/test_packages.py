@@ -11,7 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from robotspec.errors import DescriptionError, PackageNotFoundError, PathOutsideRootsError
-from robotspec.packages import PackageResolver
+from robotspec.files.packages import PackageResolver
 
 from .conftest import DATA, erd_robots
 

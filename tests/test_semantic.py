@@ -14,6 +14,7 @@ import pytest
 
 from robotspec.compiler import compile_robot, shipped_specs
 from robotspec.errors import KinematicsError, NotFoundError
+from robotspec.model.world import Connection, World
 from robotspec.robots import PR2
 from robotspec.semantic import (
     AbstractRobot,
@@ -33,7 +34,6 @@ from robotspec.semantic import (
     Sensor,
     Torso,
 )
-from robotspec.world import Connection, World
 from tests.conftest import erd_robots
 
 

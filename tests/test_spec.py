@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from robotspec.errors import RobotSpecError, RobotSpecErrors, SpecError
-from robotspec.spec import json_schema_text, load_spec
+from robotspec.spec.load import json_schema_text, load_spec
 
 MINIMAL = """robotspec: 1
 name: arm

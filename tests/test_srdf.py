@@ -14,8 +14,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from robotspec.errors import NotFoundError, RobotSpecError, RobotSpecErrors, SrdfError
-from robotspec.srdf import (
+from robotspec.description.srdf import (
     DisabledCollision,
     DisableDefaultCollisions,
     EnabledCollision,
@@ -31,9 +30,10 @@ from robotspec.srdf import (
     check_srdf_references,
     load_srdf,
     parse_srdf_bytes,
-    write_srdf,
 )
-from robotspec.xmlsafe import parse_xml_file
+from robotspec.errors import NotFoundError, RobotSpecError, RobotSpecErrors, SrdfError
+from robotspec.export.srdf import write_srdf
+from robotspec.files.xmlsafe import parse_xml_file
 
 from .conftest import shared_path
 

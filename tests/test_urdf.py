@@ -10,10 +10,10 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from robotspec.description.urdf import world_from_urdf_xml
 from robotspec.errors import DescriptionError, RobotSpecError, RobotSpecErrors
-from robotspec.urdf import world_from_urdf_xml
-from robotspec.world import ConnectionType
-from robotspec.xmlsafe import parse_xml_bytes, parse_xml_file
+from robotspec.files.xmlsafe import parse_xml_bytes, parse_xml_file
+from robotspec.model.world import ConnectionType
 
 from .conftest import erd_robots, shared_path
 
@@ -257,7 +257,7 @@ def test_every_example_robot_data_urdf_loads(path: Path) -> None:
     model = pin.buildModelFromUrdf(str(path))
     movable = [c for c in w.connections if not c.is_fixed]
     assert len(movable) == model.njoints - 1
-    from robotspec.kinematics import Kinematics
+    from robotspec.model.kinematics import Kinematics
 
     poses = Kinematics(w).forward(w.configuration())
     assert np.all(np.isfinite(poses))

@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from robotspec.errors import DescriptionError, PackageNotFoundError, PathOutsideRootsError
-from robotspec.packages import PackageResolver
-from robotspec.xacro_io import process_xacro
-from robotspec.xmlsafe import parse_xml_bytes
+from robotspec.files.packages import PackageResolver
+from robotspec.files.xacro import process_xacro
+from robotspec.files.xmlsafe import parse_xml_bytes
 
 from .conftest import DATA, shared_path
 
@@ -94,7 +94,7 @@ def test_concurrent_expansions_agree() -> None:
     def run(prefix: str) -> None:
         try:
             results.append(expand(ROBOT_XACRO, {"prefix": prefix}))
-        except BaseException as exc:  # pragma: no cover - reported below
+        except BaseException as exc:  # noqa: BLE001 - reported below
             errors.append(exc)
 
     threads = [threading.Thread(target=run, args=(f"p{i}_",)) for i in range(6)]

@@ -8,8 +8,10 @@ from typing import Annotated
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import PackagePath, write_output
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
 
 
 @app.command()
@@ -31,11 +33,11 @@ def init(
 
     The draft validates as written; lines marked DECIDE are guesses a person should check.
     """
-    from robotspec.description import load_description
-    from robotspec.drafting import draft_spec, portable_ref, relative_path, render_draft
+    from robotspec.description.load import load_description
     from robotspec.errors import RobotSpecError
-    from robotspec.packages import PackageResolver
-    from robotspec.spec import shipped_schema_path
+    from robotspec.files.packages import PackageResolver
+    from robotspec.shipped import shipped_schema_path
+    from robotspec.spec.draft import draft_spec, portable_ref, relative_path, render_draft
 
     if output is not None and output.exists() and not force:
         raise RobotSpecError(

@@ -9,12 +9,15 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import JsonFlag, PackagePath, SpecArg, load_robot
 from robotspec.cli.table import render_table
 
 if TYPE_CHECKING:
     from robotspec.semantic import AbstractRobot, KinematicChain
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 inspect_app = typer.Typer(help="Show what a spec compiles to.", no_args_is_help=True)
 app.add_typer(inspect_app, name="inspect")
@@ -170,7 +173,7 @@ def sensors(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath 
 def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """The robot's moving joints with limits; velocities tightened by the spec end in '*'."""
     robot = load_robot(spec, package_path)
-    from robotspec.urdf import load_urdf  # noqa: F401  (keeps import cost inside the command)
+    from robotspec.description.urdf import load_urdf  # noqa: F401  (keeps import cost inside the command)
 
     w = robot.world
     original = _urdf_velocities(robot)
@@ -366,7 +369,7 @@ def parts(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = 
     """The parts of a composed robot: source, prefix, where each is welded, what it brings."""
     from robotspec.compiler import resolve_spec
     from robotspec.compose import compose
-    from robotspec.spec import load_spec
+    from robotspec.spec.load import load_spec
 
     loaded = load_spec(resolve_spec(spec))
     if not loaded.spec.parts:

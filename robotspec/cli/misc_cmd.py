@@ -8,15 +8,18 @@ from typing import Annotated
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import write_output
 from robotspec.cli.table import render_table
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
 
 
 @app.command("list")
 def list_robots() -> None:
     """The robots shipped with robotspec and the description each is built from."""
-    from robotspec.spec import load_spec, shipped_spec_files
+    from robotspec.shipped import shipped_spec_files
+    from robotspec.spec.load import load_spec
 
     rows = []
     for name, path in shipped_spec_files().items():
@@ -38,7 +41,7 @@ def schema(
     ] = None,
 ) -> None:
     """The JSON Schema of the spec format, for editors (YAML language server)."""
-    from robotspec.spec import json_schema_text
+    from robotspec.spec.load import json_schema_text
 
     text = json_schema_text()
     write_output(text, output)

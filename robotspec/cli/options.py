@@ -54,8 +54,9 @@ JsonFlag = Annotated[bool, typer.Option("--json", help="Print JSON instead of a 
 
 def complete_spec(incomplete: str) -> list[str]:
     """Shell completion of a spec argument: shipped robot names, then YAML files here."""
-    shipped = Path(__file__).resolve().parents[1] / "specs"
-    names = sorted(p.stem for p in shipped.glob("*.yaml"))
+    from robotspec.shipped import shipped_spec_files
+
+    names = sorted(shipped_spec_files())
     head = os.path.dirname(incomplete)
     try:
         files = sorted(
@@ -86,7 +87,7 @@ SkipMeshes = Annotated[
 
 
 def load_robot(spec: str, package_path: list[Path] | None) -> AbstractRobot:
-    """Compile a spec (or shipped robot) for a command; imports the compiler only when called."""
-    from robotspec.compiler import compile_robot
+    """Compile a spec (or shipped robot, as its class) for a command; imports lazily."""
+    from robotspec.robots import load
 
-    return compile_robot(spec, package_paths=package_path or ())
+    return load(spec, package_paths=package_path or ())

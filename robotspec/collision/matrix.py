@@ -41,11 +41,11 @@ from robotspec.collision.rules import (
 from robotspec.collision.sampling import default_configuration, random_configurations
 from robotspec.collision.shapes import MeshLibrary, MissingMeshPolicy
 from robotspec.errors import CollisionError, RobotSpecError
-from robotspec.world import World
+from robotspec.model.world import World
 
 if TYPE_CHECKING:
+    from robotspec.description.srdf import DisabledCollision, Srdf
     from robotspec.semantic.robot import AbstractRobot
-    from robotspec.srdf import DisabledCollision, Srdf
 
 __all__ = [
     "CollisionMatrix",
@@ -114,7 +114,7 @@ class CollisionMatrix:
 
     def disabled_collisions(self) -> tuple[DisabledCollision, ...]:
         """The entries as SRDF records."""
-        from robotspec.srdf import DisabledCollision
+        from robotspec.description.srdf import DisabledCollision
 
         return tuple(DisabledCollision(e.link1, e.link2, e.reason) for e in self.disabled)
 
@@ -126,7 +126,7 @@ class CollisionMatrix:
         reasons, win). With ``base`` and not ``merge``: ``base`` with its ``disable_collisions``
         replaced by the matrix (what the Setup Assistant does when it regenerates).
         """
-        from robotspec.srdf import Srdf
+        from robotspec.description.srdf import Srdf
 
         generated = self.disabled_collisions()
         if base is None:

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from robotspec.collision.checker import SelfCollisionChecker
 from robotspec.collision.rules import CollisionRules
 from robotspec.collision.shapes import MissingMeshPolicy
-from robotspec.world import Body, Connection, DegreeOfFreedom, World
+from robotspec.model.world import Body, Connection, DegreeOfFreedom, World
 
 __all__ = ["CheckerInputs", "default_processes", "ever_colliding_parallel"]
 

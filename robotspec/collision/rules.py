@@ -21,11 +21,11 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from robotspec.errors import CollisionError, closest_names
-from robotspec.world import World
+from robotspec.model.world import World
 
 if TYPE_CHECKING:
+    from robotspec.description.srdf import Srdf
     from robotspec.semantic.robot import AbstractRobot
-    from robotspec.srdf import Srdf
 
 __all__ = [
     "ADJACENT",

@@ -21,9 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.errors import CollisionError, RobotSpecError
-from robotspec.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
-from robotspec.mesh_files import read_triangles
-from robotspec.world import Body, World
+from robotspec.files.meshes import read_triangles
+from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
+from robotspec.model.world import Body, World
 
 if TYPE_CHECKING:
     import coal
@@ -75,7 +75,7 @@ class CollisionGeometry:
     body_index: int
     element: int
     geometry: Any = field(repr=False, compare=False)
-    body_T_geometry: F64 = field(repr=False, compare=False)
+    body_T_geometry: F64 = field(repr=False, compare=False)  # noqa: N815 - a_T_b notation
     aabb_center: F64 = field(repr=False, compare=False)
     aabb_half: F64 = field(repr=False, compare=False)
     kind: str = "mesh"

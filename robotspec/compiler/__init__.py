@@ -15,11 +15,12 @@ from pathlib import Path
 from typing import Any
 
 from robotspec.compiler.build import Build, build_robot
-from robotspec.compiler.diagnostics import Diagnostics
+from robotspec.diagnostics import Diagnostics
 from robotspec.errors import RobotSpecError, SpecError, missing_file
+from robotspec.model.world import ConnectionType, World
 from robotspec.semantic import AbstractRobot
-from robotspec.spec import LoadedSpec, load_spec, shipped_spec_files
-from robotspec.world import ConnectionType, World
+from robotspec.shipped import package_data, shipped_spec_files
+from robotspec.spec.load import LoadedSpec, load_spec
 
 __all__ = [
     "CompileResult",
@@ -36,12 +37,8 @@ class CompileResult:
     """What ``robotspec validate`` reports: the robot (if it compiled) and every warning."""
 
     loaded: LoadedSpec
-    robot: AbstractRobot | None
+    robot: AbstractRobot
     warnings: tuple[RobotSpecError, ...]
-
-
-def _package_data(*parts: str) -> Path:
-    return Path(__file__).resolve().parents[1].joinpath(*parts)
 
 
 def shipped_specs() -> dict[str, Path]:
@@ -74,9 +71,9 @@ def load_camera_presets() -> dict[str, dict[str, Any]]:
     Parsed once per version of the file: every compilation needs them, and parsing the YAML
     again cost more than the compiler's own checks.
     """
-    from robotspec.yamlio import load_yaml
+    from robotspec.files.yamlio import load_yaml
 
-    file = _package_data("templates", "cameras.yaml")
+    file = package_data("templates", "cameras.yaml")
     key = (str(file), file.stat().st_mtime_ns)
     if key not in _PRESETS:
         _PRESETS.clear()
@@ -152,8 +149,8 @@ def _compile(
     robot_class: type[AbstractRobot] = AbstractRobot,
     strict: bool = False,
 ) -> CompileResult:
-    from robotspec.description import load_description, resolve_file
-    from robotspec.srdf import check_srdf_against, check_srdf_references
+    from robotspec.description.load import load_description, resolve_file
+    from robotspec.description.srdf import check_srdf_against, check_srdf_references
 
     composition = None
     if loaded.spec.parts:
@@ -166,7 +163,7 @@ def _compile(
     diag = Diagnostics(loaded)
     paths = [*desc_spec.package_paths, *map(str, package_paths)]
     if world is None and composition is not None:
-        from robotspec.urdf import world_from_urdf_xml
+        from robotspec.description.urdf import world_from_urdf_xml
 
         issues: list[RobotSpecError] = []
         base_world = world_from_urdf_xml(
@@ -200,7 +197,7 @@ def _compile(
         # from_world: the caller's world is the description; the spec's URDF is not read
         # again (it may not even be on this machine's package path). The SRDF is found next
         # to the world's source file or on the package path.
-        from robotspec.packages import PackageResolver
+        from robotspec.files.packages import PackageResolver
 
         source = Path(world.source) if world.source else None
         folder = loaded.folder
@@ -211,7 +208,7 @@ def _compile(
         base_world, urdf_name = world, (world.source or world.name).rsplit("/", 1)[-1]
     srdf = None if composition is None else composition.srdf
     if composition is None and desc_spec.srdf is not None:
-        from robotspec.srdf import load_srdf
+        from robotspec.description.srdf import load_srdf
 
         try:
             srdf = load_srdf(resolve_file(desc_spec.srdf, loaded.folder, resolver), strict=False)
@@ -252,17 +249,16 @@ def compile_robot(
     ref: str | Path,
     *,
     package_paths: Sequence[str | Path] = (),
-    robot_class: type[AbstractRobot] | None = None,
+    robot_class: type[AbstractRobot] = AbstractRobot,
 ) -> AbstractRobot:
-    """Compile a spec file, or a shipped robot by name, into an ``AbstractRobot``."""
-    if robot_class is None:
-        from robotspec.robots import robot_class_for
+    """Compile a spec file, or a shipped robot by name, into an ``AbstractRobot``.
 
-        robot_class = robot_class_for(ref)
+    ``robot_class`` is the class built; :func:`robotspec.robots.load` picks the shipped robot's
+    own class (the compiler does not know the registry of shipped robots).
+    """
     result = _compile(
         load_spec(resolve_spec(ref)), package_paths=package_paths, robot_class=robot_class
     )
-    assert result.robot is not None
     return result.robot
 
 
@@ -285,5 +281,4 @@ def compile_spec_for_world(
         world=world,
         robot_class=robot_class,
     )
-    assert result.robot is not None
     return result.robot

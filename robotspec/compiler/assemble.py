@@ -11,6 +11,7 @@ from typing import TypedDict
 
 from robotspec.compiler.context import Build
 from robotspec.compiler.parts import CameraValues
+from robotspec.model.world import Body, World
 from robotspec.semantic import (
     AbstractRobot,
     Arm,
@@ -29,8 +30,7 @@ from robotspec.semantic import (
     Torso,
     front_facing_axis_of,
 )
-from robotspec.spec import CameraSpec, FingerSpec, ParallelGripperSpec
-from robotspec.world import Body, World
+from robotspec.spec.models import CameraSpec, FingerSpec, ParallelGripperSpec
 
 __all__ = ["Resolved", "assemble", "drive_type"]
 

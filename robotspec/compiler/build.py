@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from robotspec.compiler.assemble import Resolved, assemble
 from robotspec.compiler.context import Build, moved_by, subtree_joints
-from robotspec.compiler.diagnostics import Loc
 from robotspec.compiler.joints import check_states, check_velocity
 from robotspec.compiler.parts import (
     CameraValues,
@@ -18,9 +17,10 @@ from robotspec.compiler.parts import (
     check_manipulator,
     use_sensor,
 )
+from robotspec.diagnostics import Loc
+from robotspec.model.world import Body, Connection
 from robotspec.semantic import AbstractRobot
-from robotspec.spec import CameraSpec
-from robotspec.world import Body, Connection
+from robotspec.spec.models import CameraSpec
 
 __all__ = ["Build", "build_robot"]
 

@@ -2,19 +2,18 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from robotspec.compiler.diagnostics import Diagnostics, Loc
+from robotspec.description.srdf import Srdf
+from robotspec.diagnostics import Diagnostics, Loc
+from robotspec.model.world import Body, Connection, World
 from robotspec.semantic import JointState
-from robotspec.spec import LoadedSpec, RobotSpec
-from robotspec.srdf import Srdf
-from robotspec.world import Body, Connection, World
+from robotspec.spec.load import LoadedSpec
+from robotspec.spec.models import RobotSpec
 
-__all__ = ["AXIS_TOL", "UNIT_TOL", "Build", "moved_by", "subtree_joints", "unit_norm"]
+__all__ = ["AXIS_TOL", "Build", "moved_by", "subtree_joints"]
 
-UNIT_TOL = 1e-3
 AXIS_TOL = 1e-3
 
 
@@ -95,11 +94,6 @@ class Build:
             return self.world.get_connection_by_name(name)
         self.diag.not_found(loc, "joint", name, self.world.connection_names, self.where)
         return None
-
-
-def unit_norm(v: tuple[float, ...]) -> float:
-    """Euclidean norm of a spec's vector or quaternion (tuples, not arrays, in specs)."""
-    return math.sqrt(sum(x * x for x in v))
 
 
 def moved_by(world: World, connections: list[Connection]) -> set[str]:

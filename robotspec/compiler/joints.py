@@ -6,9 +6,9 @@ import math
 from collections.abc import Mapping
 
 from robotspec.compiler.context import Build
-from robotspec.compiler.diagnostics import Loc
+from robotspec.diagnostics import Loc
+from robotspec.model.world import Connection
 from robotspec.semantic import JointState
-from robotspec.world import Connection
 
 __all__ = ["check_states", "check_velocity"]
 

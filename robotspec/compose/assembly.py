@@ -18,8 +18,6 @@ from typing import Any
 from lxml import etree
 from pydantic import ValidationError
 
-from robotspec.compiler.context import UNIT_TOL, unit_norm
-from robotspec.compiler.diagnostics import Diagnostics, Loc
 from robotspec.compose.naming import PartNames
 from robotspec.compose.semantics import NAMED_SECTIONS, remap_marks, rename_semantics
 from robotspec.compose.srdf_merge import merge_srdfs, rename_srdf
@@ -31,21 +29,15 @@ from robotspec.compose.urdf_merge import (
     tree_facts,
     weld,
 )
+from robotspec.description.srdf import Srdf
+from robotspec.diagnostics import Diagnostics, Loc
 from robotspec.errors import RobotSpecError, SpecError
-from robotspec.packages import PackageResolver
-from robotspec.spec import (
-    AttachSpec,
-    DescriptionSpec,
-    LoadedSpec,
-    PartSpec,
-    RobotSpec,
-    load_spec,
-    merge_data,
-    shipped_part_files,
-    shipped_spec_files,
-)
-from robotspec.srdf import Srdf
-from robotspec.yamlio import LocatedYaml, validation_errors
+from robotspec.files.packages import PackageResolver
+from robotspec.files.yamlio import LocatedYaml, validation_errors
+from robotspec.model.geometry import UNIT_TOL, unit_norm
+from robotspec.shipped import shipped_part_files, shipped_spec_files
+from robotspec.spec.load import LoadedSpec, load_spec, merge_data
+from robotspec.spec.models import AttachSpec, DescriptionSpec, PartSpec, RobotSpec
 
 __all__ = ["ComposedPart", "Composition", "compose", "description_tree"]
 
@@ -113,8 +105,8 @@ def description_tree(
     Paths start at ``folder`` (the spec's). ``share_crawls_with``: a resolver of the same
     compilation whose package-folder crawls are reused (parts search the same folders).
     """
-    from robotspec.description import read_urdf_tree, resolve_file
-    from robotspec.urdf_check import check_urdf_tree
+    from robotspec.description.load import read_urdf_tree, resolve_file
+    from robotspec.description.urdf_check import check_urdf_tree
 
     tree, urdf, resolver = read_urdf_tree(
         desc.urdf,
@@ -132,7 +124,7 @@ def description_tree(
     )
     srdf = None
     if desc.srdf is not None:
-        from robotspec.srdf import load_srdf
+        from robotspec.description.srdf import load_srdf
 
         srdf = load_srdf(resolve_file(desc.srdf, folder, resolver), strict=False)
     return tree, urdf, resolver, srdf

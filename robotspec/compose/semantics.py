@@ -12,7 +12,7 @@ from typing import Any
 
 from robotspec.compose.naming import PartNames
 from robotspec.compose.urdf_merge import TreeFacts
-from robotspec.yamlio import LocatedYaml
+from robotspec.files.yamlio import LocatedYaml
 
 __all__ = ["NAMED_SECTIONS", "remap_marks", "rename_semantics"]
 

@@ -17,8 +17,8 @@ import numpy as np
 from lxml import etree
 
 from robotspec.compose.naming import PartNames
-from robotspec.geometry import Matrix, matrix_to_rpy, pose_from_xyz_rpy
-from robotspec.urdf_check import parse_floats
+from robotspec.description.urdf_check import parse_floats
+from robotspec.model.geometry import Matrix, matrix_to_rpy, pose_from_xyz_rpy
 
 __all__ = [
     "TreeFacts",

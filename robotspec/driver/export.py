@@ -57,7 +57,7 @@ from robotspec.driver.robot_info import (
     Vector3,
 )
 from robotspec.errors import RobotInfoError
-from robotspec.world import Body, Connection, ConnectionType, World
+from robotspec.model.world import Body, Connection, ConnectionType, World
 
 __all__ = [
     "DEFAULT_ACCELERATION_FACTOR",

@@ -92,7 +92,7 @@ class DriverLoop(CommandFill, ABC):
 
     # Every field is set up by LoopState.__init__ (same arguments).
 
-    def _read_feedback(self, now: float) -> None:  # noqa: B027 - optional hook
+    def _read_feedback(self, now: float) -> None:
         """Step 1: fill feedback fields from the robot (override, or update under ``_lock``)."""
 
     @abstractmethod

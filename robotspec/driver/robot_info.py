@@ -4,7 +4,8 @@ Why strict: the reference parser (Robot Raconteur Companion ``InfoParser``) sile
 keys, so a misspelt ``acceleraton`` leaves the acceleration at 0 and fails much later with a bare
 assertion. Here every model forbids extra keys, enums are checked by name, array lengths are checked
 against the chain's joint count, and every problem is a :class:`~robotspec.errors.RobotInfoError`
-with the file and line of the offending YAML node (through :func:`robotspec.yamlio.load_yaml`).
+with the file and line of the offending YAML node (through
+:func:`robotspec.files.yamlio.load_yaml`).
 
 The field names are the robdef field names (stdver 0.10), so any file the reference accepts and that
 has no typos loads here too. Loading never writes anywhere: unlike the reference ``InfoFileLoader``
@@ -35,7 +36,7 @@ from pydantic import (
 )
 
 from robotspec.errors import RobotInfoError, RobotSpecErrors, closest_names
-from robotspec.yamlio import LocatedYaml, load_yaml, load_yaml_text, validation_errors
+from robotspec.files.yamlio import LocatedYaml, load_yaml, load_yaml_text, validation_errors
 
 __all__ = [
     "CAPABILITY_BITS",

@@ -36,7 +36,7 @@ from robotspec.driver.sim import Fault, SimRobot
 from robotspec.driver.state import StateFlags
 from robotspec.driver.trajectory import JointTrajectory, Waypoint
 from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names
-from robotspec.yamlio import LocatedYaml, load_yaml, validation_errors
+from robotspec.files.yamlio import LocatedYaml, load_yaml, validation_errors
 
 __all__ = ["CALLS", "Scenario", "StepResult", "load_scenario", "run_scenario"]
 

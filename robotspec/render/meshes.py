@@ -17,9 +17,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.errors import DescriptionError, RobotSpecError
-from robotspec.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
-from robotspec.mesh_files import read_triangles
-from robotspec.world import Body
+from robotspec.files.meshes import read_triangles
+from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
+from robotspec.model.world import Body
 
 __all__ = ["MissingMeshPolicy", "Triangles", "TriangleLibrary", "cluster_decimate"]
 

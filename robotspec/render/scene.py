@@ -19,9 +19,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from robotspec.entities import ConnectionType
 from robotspec.errors import RobotSpecError
-from robotspec.kinematics import Kinematics
+from robotspec.model.entities import ConnectionType
+from robotspec.model.kinematics import Kinematics
 from robotspec.render.meshes import MissingMeshPolicy, TriangleLibrary, Triangles
 from robotspec.semantic import AbstractRobot, Camera
 
@@ -135,9 +135,7 @@ def _robot_size(robot: AbstractRobot, kin: Kinematics, parts: Sequence[Part]) ->
 
 def default_q(robot: AbstractRobot) -> F64:
     """The configuration the robot is shown in without a state (MoveIt's default pose)."""
-    from robotspec.collision.sampling import default_configuration
-
-    return default_configuration(robot.world)
+    return robot.world.default_configuration()
 
 
 def build_scene(
@@ -276,7 +274,7 @@ def _frustum(pose: F64, cam: Camera, depth: float) -> list[Segment]:
 
 def drive_directions(robot: AbstractRobot) -> tuple[list[F64], list[F64]]:
     """Translation directions and rotation axes of the drive, in the root body's frame."""
-    from robotspec.kinematics import _in_plane_axes
+    from robotspec.model.kinematics import _in_plane_axes
 
     drive = robot.drive
     if drive is None:
@@ -304,7 +302,7 @@ def drive_segments(robot: AbstractRobot, pose: F64, length: float) -> list[Segme
         out.append(Segment(_pt(o), _pt(tip), DRIVE_COLOUR, 2))
         out += _arrowhead(o, tip, rot @ _perp(d), 0.15 * length)
     for a in turns:
-        from robotspec.kinematics import _in_plane_axes
+        from robotspec.model.kinematics import _in_plane_axes
 
         u, w = _in_plane_axes(tuple(float(v) for v in a))
         r = 0.6 * length

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.errors import RobotSpecError, ServiceError
+from robotspec.model.world import ConnectionType
 from robotspec.render.meshes import MissingMeshPolicy, TriangleLibrary
 from robotspec.render.scene import (
     FRUSTUM_COLOUR,
@@ -34,7 +35,6 @@ from robotspec.render.scene import (
     drive_segments,
 )
 from robotspec.semantic import AbstractRobot
-from robotspec.world import ConnectionType
 
 __all__ = ["RobotViewer", "slider_range"]
 
@@ -290,7 +290,7 @@ class RobotViewer:
             self._refresh_pairs(q)
 
     def _apply_state(self, name: str) -> None:
-        from robotspec.collision.sampling import state_configuration
+        from robotspec.semantic.states import state_configuration
 
         states = () if name.startswith("(") else (name,)
         q = state_configuration(self.robot, states)

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from robotspec.errors import RobotSpecError
-from robotspec.world import Body, World
+from robotspec.model.world import Body, World
 
 if TYPE_CHECKING:
     from robotspec.semantic.robot import AbstractRobot

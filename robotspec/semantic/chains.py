@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from robotspec.model.world import Body, Connection, DegreeOfFreedom
 from robotspec.semantic.base import JointState, SemanticRobotAnnotation
-from robotspec.world import Body, Connection, DegreeOfFreedom
 
 if TYPE_CHECKING:
     from robotspec.semantic.manipulators import Manipulator

@@ -6,10 +6,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from robotspec.geometry import quaternion_to_matrix
+from robotspec.model.geometry import quaternion_to_matrix
+from robotspec.model.world import Body
 from robotspec.semantic.base import JointState, SemanticRobotAnnotation
 from robotspec.semantic.chains import Finger
-from robotspec.world import Body
 
 __all__ = ["GenericManipulator", "Manipulator", "ParallelGripper", "front_facing_axis_of"]
 

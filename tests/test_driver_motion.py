@@ -84,7 +84,7 @@ def traced(robot: SimRobot) -> Trace:
         seen[0] = len(robot.sent)
         pos = new[-1][1] if new else None
         vel = new[-1][2] if new else None
-        trace.t.append(robot._stopwatch_ellapsed_s())
+        trace.t.append(state.ts)  # the step's own time, as the profiles and the arm use
         trace.pos_cmd.append(None if pos is None else np.array(pos))
         trace.vel_cmd.append(None if vel is None else np.array(vel))
         trace.q.append(robot.sim_position)

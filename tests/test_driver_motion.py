@@ -521,3 +521,30 @@ def test_cartesian_refusal_of_an_underactuated_chain_names_the_reason() -> None:
     to_mode(robot, CommandMode.jog)
     with pytest.raises(InvalidArgumentError, match="a chain of 3 joints cannot follow"):
         robot.jog_cartesian([0.0, 0.0, 0.0, 0.0, 0.0, 0.05], 0.5)
+
+
+@pytest.mark.parametrize("every", [1, 3])
+def test_position_stream_follows_a_steady_ramp_without_lag_or_jerk(every: int) -> None:
+    # A client streaming a ramp, every step or every third step (slower than the loop): after
+    # the ramp-up, the arm moves at the ramp's speed, without braking toward each sample.
+    robot = make_robot(RRP, 0.0, 0)
+    to_mode(robot, CommandMode.position_command)
+    trace = traced(robot)
+    q0 = robot.sim_position
+    speed = 0.5  # rad/s on joint 0
+    dt = robot.update_period
+    k = 0
+    for step in range(120):
+        if step % every == 0:
+            k += 1
+            target = q0.copy()
+            target[0] += speed * step * dt
+            robot.set_position_command(
+                RobotJointCommand(k, robot.robot_state.seqno, target.tolist())
+            )
+        robot.step()
+    assert violations(trace, robot.limits) == []
+    v = np.array([x[0] for x in trace.v[-60:]])
+    np.testing.assert_allclose(v, speed, rtol=0.02)
+    lag = target[0] + speed * dt * (every - 1) - robot.sim_position[0]
+    assert abs(lag) < speed * dt * (every + 1.5)

@@ -257,17 +257,27 @@ class CommandFill(CartesianJog):
         self._stream_last_seqno = cmd.seqno
         self._stream_valid = StateFlags.valid_position_command
         limiter = self._stream_limiter_now()
-        target = q.tolist()
-        # The stream's own velocity, from its last two distinct samples: a steadily moving
-        # stream is followed without lag; a held one is braked onto.
-        target_velocity = None
+        sample = q.tolist()
+        # The stream's own velocity, from its last two samples: a steadily moving stream is
+        # followed without lag, also between the samples of a client slower than the loop (the
+        # target moves on at that velocity for at most one sample interval: a first-order hold);
+        # a stream that holds still is braked onto.
         if cmd is not self._stream_used:
             prev = self._stream_target
+            velocity = None
+            span = 0.0
             if prev is not None and now > prev[0]:
                 span = now - prev[0]
-                target_velocity = [(a - b) / span for a, b in zip(target, prev[1], strict=True)]
-            self._stream_target = (now, target)
+                velocity = [(a - b) / span for a, b in zip(sample, prev[1], strict=True)]
+            self._stream_target = (now, sample, velocity, span)
             self._stream_used = cmd
+        assert self._stream_target is not None
+        t_sample, _, velocity, span = self._stream_target
+        target, target_velocity = sample, None
+        age = now - t_sample
+        if velocity is not None and age < span:
+            target = [x + v * age for x, v in zip(sample, velocity, strict=True)]
+            target_velocity = velocity
         return limiter.position(target, target_velocity, self._step_dt)
 
     def _fill_velocity_stream(self) -> FloatArray | None:

@@ -153,7 +153,9 @@ class LoopState:
         #: When the profile of a waited-for jog has ended: the arm must arrive by this time.
         self._jog_settle_deadline: float | None = None
         self._stream_limiter: StreamLimiter | None = None
-        self._stream_target: tuple[float, list[float]] | None = None
+        #: The last stream sample: (arrival time, position, velocity from the sample before, the
+        #: interval between the two).
+        self._stream_target: tuple[float, list[float], list[float] | None, float] | None = None
         self._stream_used: RobotJointCommand | None = None
         #: The duration of the current step (real elapsed time, see clock.step_duration).
         self._step_dt = update_period

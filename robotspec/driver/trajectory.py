@@ -133,6 +133,7 @@ class TrajectoryInterpolator:
         self.n_waypoints = int(times.shape[0])
         h = np.diff(times)
         delta = np.diff(positions, axis=0) / h[:, None]
+        _yield()  # a large trajectory: let the loop thread in between whole-array steps
         d = np.zeros_like(positions)
         if positions.shape[0] > 2:
             h0 = h[:-1, None]
@@ -141,8 +142,10 @@ class TrajectoryInterpolator:
             w2 = h1 + 2.0 * h0
             d0, d1 = delta[:-1], delta[1:]
             same = d0 * d1 > 0.0
+            _yield()
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 hm = (w1 + w2) / (w1 / d0 + w2 / d1)
+            _yield()
             d[1:-1] = np.where(same & np.isfinite(hm), hm, 0.0)
         self._h = h
         self._slopes = d
@@ -261,6 +264,7 @@ def load_trajectory(
         raise InvalidArgumentError("Waypoint values must be numbers") from None
     finite = np.all(np.isfinite(pos), axis=1) & np.isfinite(raw) & vel_finite
     first(4, ~finite, "Waypoint {i} contains NaN or infinite values")
+    _yield()  # each whole-array step below takes a millisecond or two: yield between them
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         times = raw / speed_ratio
         dt = np.diff(times)
@@ -269,8 +273,10 @@ def load_trajectory(
         first(5, inc & finite, "Waypoint {i} time_from_start must be increasing")
         far = np.concatenate([[False], gap > MAX_WAYPOINT_GAP + _TIME_EPS])
         first(6, far & finite, "Waypoint {i} more than 100 ms from previous waypoint")
+        _yield()
         outside = np.any(pos < limits.lower, axis=1) | np.any(pos > limits.upper, axis=1)
         first(7, outside & finite, "Waypoint {i} exceeds joint limits")
+        _yield()
         fd = np.abs(np.diff(pos, axis=0)) / dt[:, None]
         fd_fast = np.concatenate([[False], np.any(fd > limits.velocity, axis=1)])
         first(8, (wp_fast | fd_fast) & finite, "Waypoint {i} exceeds joint velocity limits")

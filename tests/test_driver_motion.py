@@ -548,3 +548,24 @@ def test_position_stream_follows_a_steady_ramp_without_lag_or_jerk(every: int) -
     np.testing.assert_allclose(v, speed, rtol=0.02)
     lag = target[0] + speed * dt * (every - 1) - robot.sim_position[0]
     assert abs(lag) < speed * dt * (every + 1.5)
+
+
+def test_a_real_driver_sets_its_own_arrival_rule() -> None:
+    class Coarse(SimRobot):
+        jog_arrival_tolerance = 0.05
+        jog_settle_timeout = 0.2
+
+    robot = Coarse(_info(RRP), clock=SimClock())
+    robot.step()
+    robot.step()
+    to_mode(robot, CommandMode.jog)
+    robot.inject_fault(Fault.frozen)
+    target = robot.sim_position + np.array([0.3, 0.0, 0.0])
+    with pytest.raises(OperationFailedError, match=r"0\.2 s after the motion finished \(tolerance"):
+        robot.jog_freespace(target, robot.limits.velocity, wait=True)
+    robot.clear_fault(Fault.frozen)
+    to_mode(robot, CommandMode.jog)  # halt first: the next jog starts from the arm
+    robot.run_for(0.5)
+    target = robot.sim_position + np.array([0.02, 0.0, 0.0])
+    robot.jog_freespace(target, [1.0, 1.0, 0.1], True)
+    assert np.max(np.abs(robot.sim_position - target)) <= 0.05

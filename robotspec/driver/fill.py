@@ -53,7 +53,18 @@ VELOCITY_HORIZON_PERIODS = 2.0
 
 
 class CommandFill(CartesianJog):
-    """Step 4: the command for this step."""
+    """Step 4: the command for this step.
+
+    A driver of a real arm sets the arrival rule of waiting jogs to its robot (encoder
+    resolution, steady-state error) by overriding these class attributes.
+    """
+
+    #: A waiting jog has arrived when every joint is within this of where it ended (rad or m) ...
+    jog_arrival_tolerance: float = JOG_ARRIVAL_TOLERANCE
+    #: ... and every joint's measured speed is below this (rad/s or m/s).
+    jog_arrival_speed: float = JOG_ARRIVAL_SPEED
+    #: A waiting jog fails when the arm has not arrived this long after the motion finished (s).
+    jog_settle_timeout: float = JOG_SETTLE_TIMEOUT_S
 
     def _fill_robot_command(self, now: float) -> tuple[bool, FloatArray | None, FloatArray | None]:
         """Step 4: the command for this step from the mode and the client's requests."""
@@ -153,7 +164,7 @@ class CommandFill(CartesianJog):
             self._jog = None
             self._jog_cartesian = None
             if self._jog_waiter is not None:
-                self._jog_settle_deadline = now + JOG_SETTLE_TIMEOUT_S
+                self._jog_settle_deadline = now + self.jog_settle_timeout
         return q
 
     def _check_jog_arrival(self, now: float) -> None:
@@ -170,7 +181,8 @@ class CommandFill(CartesianJog):
         n = self._joint_count
         if len(q) == n and len(v) == n:
             err = [abs(a - b) for a, b in zip(q, hold.tolist(), strict=True)]
-            if max(err) <= JOG_ARRIVAL_TOLERANCE and max(map(abs, v)) <= JOG_ARRIVAL_SPEED:
+            tol, speed = self.jog_arrival_tolerance, self.jog_arrival_speed
+            if max(err) <= tol and max(map(abs, v)) <= speed:
                 waiter.succeed()
                 self._jog_waiter = None
                 self._jog_settle_deadline = None
@@ -182,8 +194,8 @@ class CommandFill(CartesianJog):
             waiter.fail(
                 OperationFailedError(
                     f"Jog did not arrive: joint '{self._joint_names[worst]}' is {off:.3g} from "
-                    f"where the jog ended {JOG_SETTLE_TIMEOUT_S:g} s after the motion finished "
-                    f"(tolerance {JOG_ARRIVAL_TOLERANCE:g})"
+                    f"where the jog ended {self.jog_settle_timeout:g} s after the motion "
+                    f"finished (tolerance {self.jog_arrival_tolerance:g})"
                 )
             )
             self._jog_waiter = None

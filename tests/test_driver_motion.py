@@ -569,3 +569,31 @@ def test_a_real_driver_sets_its_own_arrival_rule() -> None:
     target = robot.sim_position + np.array([0.02, 0.0, 0.0])
     robot.jog_freespace(target, [1.0, 1.0, 0.1], True)
     assert np.max(np.abs(robot.sim_position - target)) <= 0.05
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    a=st.floats(0.1, 50.0),
+    d0=st.floats(0.0, 5.0),
+    frac=st.floats(0.0, 1.0),
+    dts=st.lists(st.floats(1e-5, 0.1), min_size=1, max_size=60),
+)
+def test_braking_rule_is_invariant_for_any_step_durations(
+    a: float, d0: float, frac: float, dts: list[float]
+) -> None:
+    # From any state the rule allows, braking at the acceleration limit keeps every later state
+    # allowed and never crosses the stop point, whatever the step durations (the jitter).
+    from robotspec.driver.profiles import braking_speed
+
+    d = d0
+    v = frac * braking_speed(d, a, dts[0])
+    d -= v * dts[0]
+    for dt in dts[1:]:
+        assert d >= -1e-12
+        assert v * v <= 2 * a * max(d, 0.0) * (1 + 1e-9) + 1e-18
+        lowest = max(v - a * dt, 0.0)  # what braking at the limit reaches this step
+        cap = braking_speed(d, a, dt)
+        assert lowest <= cap * (1 + 1e-9) + 1e-12  # braking is always allowed
+        v = min(cap, v + a * dt)  # the fastest allowed step
+        d -= v * dt
+    assert d >= -1e-12

@@ -312,7 +312,7 @@ def test_shell_completion_of_commands_and_specs(
 def test_demo_scenario_passes_for_shipped_robots(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, robot: str, chain: str | None
 ) -> None:
-    # The README's demo drives the first arm through a generated scenario; run the same
+    # The README's demo drives the last arm through a generated scenario; run the same
     # scenario on virtual time (Panda's home sits on a joint limit: exact ends matter).
     erd_robots()
     from robotspec.cli.demo_cmd import demo_scenario

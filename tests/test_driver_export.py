@@ -10,6 +10,7 @@ import pytest
 import yaml
 
 from robotspec.description.urdf import load_urdf
+from robotspec.driver.chain_kinematics import HPChain, quat_to_rot
 from robotspec.driver.clock import SimClock
 from robotspec.driver.export import (
     DEFAULT_ACCELERATION_FACTOR,
@@ -17,7 +18,6 @@ from robotspec.driver.export import (
     export_chain,
     robot_info_from_chain,
 )
-from robotspec.driver.hp_kinematics import HPChain, quat_to_rot
 from robotspec.driver.robot_info import (
     JointType,
     RobotInfo,

@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robotspec.driver.chain_kinematics import HPChain, quat_to_rot, rot_to_quat, rot_to_quat_tuple
 from robotspec.driver.conversions import tool_transform
-from robotspec.driver.hp_kinematics import HPChain, quat_to_rot, rot_to_quat, rot_to_quat_tuple
 from robotspec.driver.robot_info import Pose, load_robot_info
 from robotspec.driver.sim import SimRobot
 from tests.driver_support import RRP, robotinfo, shared_robotinfo_files

@@ -8,6 +8,7 @@ the robot's own state, not timing.
 
 from __future__ import annotations
 
+import math
 import os
 import socket
 import subprocess
@@ -494,12 +495,13 @@ def test_home_through_the_homing_generator(served: Served) -> None:
     np.testing.assert_allclose(served.q(), home, atol=1e-6)
 
 
-def _spatial_velocity(served: Served, linear_x: float) -> Any:
+def _spatial_velocity(served: Served, linear_x: float, linear_y: float = 0.0) -> Any:
     dtype = served.node.GetNamedArrayDType(
         "com.robotraconteur.geometry.SpatialVelocity", served.robot
     )
     v = np.zeros(1, dtype=dtype)
     v[0]["linear"]["x"] = linear_x
+    v[0]["linear"]["y"] = linear_y
     return v
 
 
@@ -508,12 +510,18 @@ def test_jog_cartesian(served: Served) -> None:
     r.command_mode = int(CommandMode.jog)
     x0 = float(served.state().kin_chain_tcp[0]["position"]["x"])
     y0 = float(served.state().kin_chain_tcp[0]["position"]["y"])
-    r.jog_cartesian({0: _spatial_velocity(served, 0.05)}, 0.5, True)  # +x, along the slide
+    # The arm's base is yawed 0.1 rad at home: a pure +x translation needs a rotation this
+    # three-joint arm cannot avoid, so it is refused rather than driven the wrong way.
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="cannot move along"):
+        r.jog_cartesian({0: _spatial_velocity(served, 0.05)}, 0.5, True)
+    # Along the slide (yawed 0.1 rad) it can: the tool goes exactly that way.
+    c, s = 0.05 * math.cos(0.1), 0.05 * math.sin(0.1)
+    r.jog_cartesian({0: _spatial_velocity(served, c, s)}, 0.5, True)
     wait_until(lambda: not np.any(served.state().joint_velocity))
     tcp = served.state().kin_chain_tcp[0]["position"]
     dx, dy = float(tcp["x"]) - x0, float(tcp["y"]) - y0
     assert dx > 0.01
-    assert abs(dy) < 0.1 * dx  # mostly along x (damped least squares, from a yawed pose)
+    assert math.degrees(abs(math.atan2(dy, dx) - 0.1)) < 1.0
     with pytest.raises(rr_exception("InvalidArgumentException"), match="Invalid kinematic chain"):
         r.jog_cartesian({3: _spatial_velocity(served, 0.05)}, 0.5, True)
     with pytest.raises(rr_exception("InvalidArgumentException"), match="exactly one"):

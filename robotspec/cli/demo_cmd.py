@@ -72,7 +72,11 @@ def demo_scenario(info: RobotInfo) -> str:
 def demo(
     robot: Annotated[str, typer.Argument(help="A shipped robot or a spec file.")] = "pr2",
     chain: Annotated[
-        str | None, typer.Option("--chain", help="The chain to drive (default: the first arm).")
+        str | None,
+        typer.Option(
+            "--chain",
+            help="The chain to drive (default: the last arm the spec lists, the PR2's right arm).",
+        ),
     ] = None,
     package_path: PackagePath = None,
 ) -> None:
@@ -97,6 +101,7 @@ def demo(
         if not arms:
             sys.stdout.write("this robot has no chain to drive\n")
             return
+        # The last arm, as the help says: on the PR2 the right arm, the one the driver guide uses.
         chain = arms[-1].name
     info = export_spec_chain(robot, chain, package_path).info
     with tempfile.TemporaryDirectory(prefix="robotspec-demo-") as tmp:

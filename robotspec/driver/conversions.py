@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robotspec.driver.chain_kinematics import quat_to_rot
+from robotspec.driver.commands import RobotJointCommand
 from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError
-from robotspec.driver.handles import RobotJointCommand
-from robotspec.driver.hp_kinematics import quat_to_rot
 from robotspec.driver.robot_info import ToolInfo
 from robotspec.driver.state import CommandMode
 
@@ -74,12 +74,6 @@ def as_lists(
     if tf is None:
         return None
     return [float(x) for x in tf[0].reshape(9)], [float(x) for x in tf[1]]
-
-
-def read_only(a: FloatArray) -> FloatArray:
-    """Mark an array read-only: published state is shared with every listener."""
-    a.flags.writeable = False
-    return a
 
 
 def twist_vector(velocity: Any) -> Any:

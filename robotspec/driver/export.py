@@ -38,7 +38,7 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
-from robotspec.driver.hp_kinematics import rot_to_quat
+from robotspec.driver.chain_kinematics import rot_to_quat
 from robotspec.driver.robot_info import (
     DeviceClass,
     DeviceInfo,

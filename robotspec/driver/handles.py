@@ -7,7 +7,7 @@ internals; the generator's methods step or wait on the driver that made it.
 from __future__ import annotations
 
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -27,7 +27,6 @@ if TYPE_CHECKING:
 __all__ = [
     "Completion",
     "HomingGenerator",
-    "RobotJointCommand",
     "TrajectoryGenerator",
     "TrajectoryStatus",
 ]
@@ -36,31 +35,6 @@ FloatArray = npt.NDArray[np.float64]
 
 #: ``Next()`` returns ``running`` after this long without an outcome (reference: 5 s).
 NEXT_TIMEOUT_S = 5.0
-
-
-@dataclass(frozen=True)
-class RobotJointCommand:
-    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire.
-
-    ``command`` is kept as a float64 array, taken as is when it already is one (the service
-    hands over the array Robot Raconteur decoded: no copy, no list on the way); anything else
-    (a list, a tuple) is converted once here. Values are checked by the loop, which ignores a
-    sample of the wrong length or with NaN, as every invalid stream sample is ignored.
-    """
-
-    seqno: int
-    state_seqno: int
-    command: FloatArray
-    units: Sequence[str] = ()
-
-    def __post_init__(self) -> None:
-        cmd = self.command
-        if not (isinstance(cmd, np.ndarray) and cmd.dtype == np.float64 and cmd.ndim == 1):
-            try:
-                arr = np.asarray(cmd, dtype=np.float64).reshape(-1)
-            except (TypeError, ValueError):
-                arr = np.zeros(0)  # never accepted: no joint count is 0
-            object.__setattr__(self, "command", arr)
 
 
 @dataclass(frozen=True)
@@ -95,10 +69,6 @@ class Completion:
         if not self._event.is_set():
             self.error = error
             self._event.set()
-
-    def wait_event(self, timeout: float | None) -> bool:
-        """Block on the event (loop-thread mode)."""
-        return self._event.wait(timeout)
 
 
 class TrajectoryTask:

@@ -12,9 +12,10 @@ Deliberate deviations from the reference (its defects, §1.11 of the note), each
 2. ``halt()``, ``home()``, and the ``operational_mode``, ``controller_state`` and
    ``current_errors`` properties work.
 3. Limits: ``jog_joint`` checks ``|velocity|`` (both signs) against the limit of the operational
-   mode; ``jog_freespace`` refuses targets outside the joint limits; jogs brake before a joint
-   limit; the position stream is clamped to the limits; every command passes
-   :class:`~robotspec.driver.commands.CommandGuard`. NaN and infinity are refused everywhere.
+   mode; ``jog_freespace`` refuses targets outside the joint limits; jogs and both streams respect
+   the acceleration limits and brake before a joint limit (:mod:`robotspec.driver.profiles`);
+   every command passes :class:`~robotspec.driver.commands.CommandGuard`. NaN and infinity are
+   refused everywhere.
    A speed ratio above 1 never raises jog speed or acceleration beyond the joint limits.
 4. Trajectories: the final waypoint is commanded exactly; a tracking failure fails the task with
    OperationFailed, clears ``trajectory_running``, cancels the queue and drops to ``halt``;
@@ -29,8 +30,9 @@ Deliberate deviations from the reference (its defects, §1.11 of the note), each
 6. Tools: ``tool_detached`` accepts the attached tool's name (or ""); tools and payloads work on
    every chain; ``robot_info.config_seqno`` follows the attachments.
 7. A waiting jog interrupted by halt, an error, an e-stop or lost communication raises
-   OperationAborted instead of returning success; ``Abort()`` takes the lock; leaving a motion
-   mode for ``halt`` brakes at the acceleration limits instead of stopping dead.
+   OperationAborted instead of returning success; a waiting jog returns when the arm (not the
+   command) has arrived; ``Abort()`` takes the lock; leaving a motion mode for ``halt`` brakes at
+   the acceleration limits instead of stopping dead.
 8. Capabilities are checked: ``trajectory_command`` for trajectory mode (also on the homing route
    out of ``invalid_state``), ``software_enable`` for ``enable()``/``disable()``,
    ``software_reset_errors`` for ``reset_errors()`` (a driver-internal fault can always be reset).
@@ -38,7 +40,8 @@ Deliberate deviations from the reference (its defects, §1.11 of the note), each
    files declares them, yet every reference driver honours both.
 9. ``velocity_command`` mode works (the reference's loop thread dies on the first command); it
    scales by the speed ratio and sets ``valid_velocity_command``.
-10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares).
+10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares), and refuses a
+    twist the chain cannot follow at its pose.
 11. The simulated robot (:class:`~robotspec.driver.sim.SimRobot`) has a command watchdog, like a
     real controller: when the driver sends no command for ``command_timeout`` (default 0.1 s; the
     driver stops sending once feedback is lost), the arm drops its last command and brakes to
@@ -54,8 +57,10 @@ from typing import Any
 
 import numpy as np
 
+from robotspec.driver.chain_kinematics import quat_to_rot
 from robotspec.driver.commands import (
     JointLimitArrays,
+    RobotJointCommand,
     check_speed_ratio,
     finite_scalar,
     joint_array,
@@ -76,16 +81,18 @@ from robotspec.driver.errors import (
 from robotspec.driver.handles import (
     Completion,
     HomingGenerator,
-    RobotJointCommand,
     TrajectoryGenerator,
     TrajectoryTask,
 )
 from robotspec.driver.loop import DriverLoop, FloatArray
 from robotspec.driver.profiles import JogMotion
 from robotspec.driver.robot_info import (
+    MAX_OFFSET_M,
+    QUAT_TOL,
     DeviceInfo,
     PayloadInfo,
     Pose,
+    Quaternion,
     RobotCapability,
     RobotInfo,
     ToolInfo,
@@ -334,6 +341,7 @@ class RobotDriver(DriverLoop):
         if self._jog_waiter is not None:
             self._jog_waiter.fail(OperationAbortedError("Operation interrupted by new jog command"))
         self._jog = motion
+        self._jog_settle_deadline = None
         waiter = Completion() if wait else None
         self._jog_waiter = waiter
         return waiter
@@ -409,6 +417,7 @@ class RobotDriver(DriverLoop):
         motion.vmax = vlim.copy()
         motion.amax = np.minimum(alim * self._speed_ratio, alim)
         motion.t = 0.0
+        motion.coordinated = False
         motion.at_velocity(qd, timeout)
         return self._install_jog(motion, wait)
 
@@ -417,8 +426,12 @@ class RobotDriver(DriverLoop):
     ) -> None:
         """Jog a chain's TCP at spatial ``velocity`` ``[wx, wy, wz, vx, vy, vz]`` (base frame).
 
-        The joint velocities come from the chain's Jacobian (damped least squares), scaled down
-        together when one would exceed its limit, recomputed every step.
+        The joint velocities come from the chain's Jacobian (damped least squares, see
+        :mod:`robotspec.driver.cartesian`), scaled down together when one would exceed its limit,
+        recomputed every step; all joints speed up and brake together, so the tool keeps its
+        direction. Refused (InvalidArgument) when the chain cannot move along ``velocity`` at this
+        pose (near a singularity, too few joints, a joint at its limit); a jog that reaches such
+        a pose on its way brakes to a stop, and a waiting caller gets OperationFailed.
         """
         with self._lock:
             self._jog_preamble(OperationAbortedError)
@@ -427,8 +440,15 @@ class RobotDriver(DriverLoop):
             if t <= 0.0:
                 raise InvalidArgumentError("Invalid jog timeout specified")
             self._check_chain(chain, "jog")
+            q_start = self._jog.q if self._jog is not None else self._start_point()[0]
+            rates = self._cartesian_rates(chain, q_start, twist)
+            if isinstance(rates, str):
+                raise InvalidArgumentError(f"jog_cartesian refused: {rates}")
             vlim, alim = self._jog_limits()
             waiter = self._velocity_jog(np.zeros(self._joint_count), t, wait, vlim, alim)
+            assert self._jog is not None
+            self._jog.coordinated = True
+            self._jog.target_velocity = rates
             self._jog_cartesian = (chain, twist)
         if waiter is not None:
             self._wait_completion(waiter)
@@ -436,9 +456,16 @@ class RobotDriver(DriverLoop):
     # ------------------------------------------------------------------ trajectories
 
     def execute_trajectory(self, trajectory: JointTrajectory) -> TrajectoryGenerator:
-        """Check and queue a trajectory; drive it by calling ``Next()`` on the generator."""
+        """Check and queue a trajectory; drive it by calling ``Next()`` on the generator.
+
+        The waypoint checks and the interpolation setup run *outside* the loop's lock (they only
+        read the immutable limits and the speed ratio, sampled once): a client uploading 50,000
+        waypoints must not make the loop miss its periods. Only the start-point and mode checks
+        and the queueing take the lock.
+        """
+        ratio = self._speed_ratio
+        interp = load_trajectory(trajectory, self._joint_names, self._limits, ratio)
         with self._lock:
-            interp = load_trajectory(trajectory, self._joint_names, self._limits, self._speed_ratio)
             measured = self._joint_position
             if measured.shape[0] != self._joint_count or np.any(
                 np.abs(measured - interp.positions[0]) > self._trajectory_error_tol
@@ -512,8 +539,10 @@ class RobotDriver(DriverLoop):
             self._check_chain(chain, "tool")
             if self._current_tool[chain] is not None:
                 raise InvalidArgumentError(f"Tool already attached to kinematic chain {chain}")
+            tf = tool_transform(tool)
+            _check_frame(f"tool '{tool.name}' tcp", tool.tcp.rotation, tf)
             self._current_tool[chain] = tool
-            self._tool_tf[chain] = tool_transform(tool)
+            self._tool_tf[chain] = tf
             self._tool_tf_lists[chain] = as_lists(self._tool_tf[chain])
             self._config_seqno += 1
             self.events.append(("tool_changed", chain, tool.name))
@@ -549,6 +578,10 @@ class RobotDriver(DriverLoop):
                 )
             if self._current_payload[chain] is not None:
                 raise InvalidArgumentError(f"Payload already attached to kinematic chain {chain}")
+            if pose is not None:
+                p = pose.position
+                tf_p = (quat_to_rot(pose.orientation.as_tuple()), np.array([p.x, p.y, p.z]))
+                _check_frame(f"payload '{payload.name}' pose", pose.orientation, tf_p)
             self._current_payload[chain] = payload
             self._current_payload_pose[chain] = pose or Pose()
             self._config_seqno += 1
@@ -596,3 +629,23 @@ class RobotDriver(DriverLoop):
     def setf_signal(self, signal_name: str, value: Any) -> None:
         """Signals are not implemented by the base driver."""
         raise NotImplementedDriverError("Not implemented")
+
+
+def _check_frame(
+    what: str, rotation: Quaternion, frame: tuple[FloatArray, FloatArray] | None
+) -> None:
+    """Refuse a tool TCP or payload pose with NaN, infinity, bad rotation or absurd offset.
+
+    Why here as well as in the models: a ``ToolInfo`` built with ``model_construct`` (or by
+    another front end) skips validation, and a NaN TCP would be published as a NaN pose.
+    """
+    q = rotation.as_tuple()
+    if frame is None:
+        return
+    values = [*q, *frame[1].tolist()]
+    if not all(math.isfinite(v) for v in values):
+        raise InvalidArgumentError(f"{what} must not contain NaN or infinite values")
+    if abs(math.hypot(*q) - 1.0) > QUAT_TOL:
+        raise InvalidArgumentError(f"{what}: rotation must be a unit quaternion")
+    if max(abs(v) for v in frame[1].tolist()) > MAX_OFFSET_M:
+        raise InvalidArgumentError(f"{what}: offset beyond {MAX_OFFSET_M:g} m")

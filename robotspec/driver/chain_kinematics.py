@@ -66,9 +66,6 @@ def rot_to_quat(r: FloatArray) -> FloatArray:
     return np.asarray(out / np.linalg.norm(out), dtype=np.float64)
 
 
-Pose3 = tuple[tuple[float, ...], tuple[float, float, float]]
-
-
 def rot_to_quat_tuple(r: Sequence[float]) -> tuple[float, float, float, float]:
     """Unit quaternion ``(w, x, y, z)``, w >= 0, of a row-major 9-tuple rotation (no numpy)."""
     m00, m01, m02, m10, m11, m12, m20, m21, m22 = r

@@ -253,13 +253,13 @@ FIELD_NOTES: dict[tuple[str, str], FieldNote] = {
     ),
     ("CameraSpec", "minimal_height"): FieldNote(
         "m",
-        "minimal_height: 1.27",
-        "lowest height of the camera above the robot's root (default: the preset's, else 0)",
+        "minimal_height: 1.166",
+        "lowest height of the camera's frame above the robot's root over the limits of the joints that move it (checked by FK; default: the preset's, else 0)",
     ),
     ("CameraSpec", "maximal_height"): FieldNote(
         "m",
-        "maximal_height: 1.60",
-        "highest height of the camera above the robot's root (default: the preset's, else 1)",
+        "maximal_height: 1.583",
+        "highest height of the camera's frame above the robot's root over the limits of the joints that move it (checked by FK; default: the preset's, else 1)",
     ),
     ("CameraSpec", "default"): FieldNote("", "default: true"),
     # FieldOfViewSpec
@@ -669,11 +669,81 @@ RULES: tuple[Rule, ...] = (
     ),
     Rule(
         "Sensors",
-        "optical frames look along +z (REP 103)",
+        "a frame optical by its rotation (REP 103: z forward, x right, y down) looks along +z; "
+        "by its name only: a warning",
         "sensors: {kinect: {forward_facing_axis: [1, 0, 0]}}",
-        "warning",
     ),
     Rule("Sensors", "minimal_height <= maximal_height", "sensors: {kinect: {minimal_height: 1.8}}"),
+    Rule(
+        "Sensors",
+        "a field of view is wider than tall (a landscape image)",
+        "sensors: {kinect: {field_of_view: {horizontal: 0.75049, vertical: 0.99483}}}",
+        "warning",
+    ),
+    Rule(
+        "Sensors",
+        "at most one default camera",
+        "sensors: {narrow: {type: camera, body: narrow_stereo_optical_frame, preset: kinect_v1, "
+        "default: true}}",
+    ),
+    Rule(
+        "Sensors",
+        "a sensor is on a chain or the neck",
+        "sensors: {narrow: {type: camera, body: narrow_stereo_optical_frame, preset: kinect_v1}}",
+        "warning",
+    ),
+    Rule(
+        "Sensors",
+        "two cameras are not on one frame",
+        "sensors: {kinect2: {type: camera, body: wide_stereo_optical_frame, preset: kinect_v1}}",
+        "warning",
+    ),
+    Rule(
+        "Sensors",
+        "a camera is not a laser or IMU frame (by the frame's or its mesh's name)",
+        "sensors: {laser: {type: camera, body: laser_tilt_link, preset: kinect_v1}}",
+        "warning",
+    ),
+    # Kinematics.
+    Rule(
+        "Kinematics",
+        "a camera's heights are FK's over the limits of every joint that moves it (exact "
+        "bounds for lifts, pans and one last joint, else sampled)",
+        "sensors: {kinect: {minimal_height: 0.75, maximal_height: 0.99}}",
+    ),
+    Rule(
+        "Kinematics",
+        "a sampled range: a height FK reaches is an error, one it never reached a warning",
+        "sensors: {kinect: {body: l_forearm_cam_optical_frame}}",
+    ),
+    Rule(
+        "Kinematics",
+        "a torso, neck or arm can move (a `kind: chain` or a finger that cannot: a warning)",
+        "chains: {mount: {root: base_link, tip: base_laser_link}}",
+    ),
+    Rule(
+        "Kinematics",
+        "low, mid, high states give increasing heights of the part's tip",
+        "torso: {states: {low: {torso_lift_joint: 0.3}, high: {torso_lift_joint: 0.0}}}",
+    ),
+    Rule(
+        "Kinematics",
+        "a gripper's open state is wider than its close state",
+        "manipulators: {left_gripper: {states: {open: {l_gripper_l_finger_joint: 0.0}, "
+        "close: {l_gripper_l_finger_joint: 0.5}}}}",
+    ),
+    # Copy-paste.
+    Rule(
+        "Parts",
+        "two parts do not have the same links",
+        "chains: {left_arm2: {root: torso_lift_link, tip: l_wrist_roll_link}}",
+    ),
+    Rule(
+        "Parts",
+        "two manipulators do not share a tool frame",
+        "manipulators: {spare: {type: generic, root: l_gripper_palm_link, "
+        "tool_frame: l_gripper_tool_frame}}",
+    ),
     Rule("Sensors", "a carried sensor exists", "chains: {left_arm: {sensors: [kinekt]}}"),
     Rule("Sensors", "a sensor has one carrier", "chains: {left_arm: {sensors: [kinect]}}"),
     # Joint states.
@@ -819,6 +889,18 @@ exit with code 1; warnings do not, unless `--strict` is given. A spec is checked
 first its shape (keys, types, bounds, as Pydantic validates it), then, once the shape is right,
 every name and every rule below. Problems in the SRDF itself (names the URDF lacks) are warnings
 pointing into the SRDF, as MoveIt treats them.
+
+Severity policy: an **error** when the spec is provably wrong (a name that does not exist, a chain
+that cannot move, a camera height FK proves wrong, two default cameras), a **warning** when it
+is only suspicious (a frame named like a laser, a field of view taller than wide, a part nobody
+carries). The kinematic checks evaluate forward kinematics: heights are the z coordinate of a
+frame's origin in the robot's root frame, over the limits of every joint that moves it
+(continuous joints over one turn, other joints at 0 or their nearest limit) and agree within
+1 cm. They are exact when every moving joint above the frame is a vertical lift or a pan,
+except a last joint (a tilt): the height is then a sum of terms, each bounded in closed form.
+Otherwise they are sampled (about 2,000 seeded configurations and the limit box's corners, the
+best refined joint by joint): a height the samples reach is proof (the message names the joint
+values), a spec height beyond them only a warning. The message says which method ran.
 
 Each example below is a complete file `broken.yaml` that changes the shipped PR2 by one line
 (line 3), and the exact output of `robotspec validate broken.yaml` for it:

@@ -313,7 +313,7 @@ def _order(
     items = list(values.items())
     for (s1, v1), (s2, v2) in zip(items, items[1:], strict=False):
         text = (
-            f"{what}'s state '{s2}' gives {measure} {v2:.3f} {unit}, state '{s1}' "
+            f"state '{s2}' of {what} gives {measure} {v2:.3f} {unit}, state '{s1}' "
             f"{v1:.3f} {unit}"
         )
         if v2 < v1 - 1e-6:

@@ -33,6 +33,7 @@ def _root(
 def _register() -> None:
     # Each command module adds its commands to ``app`` on import; the modules import nothing heavy.
     from robotspec.cli import (  # noqa: F401
+        audit_cmd,
         collisions_cmd,
         demo_cmd,
         drive_cmd,

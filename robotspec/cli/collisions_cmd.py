@@ -81,6 +81,14 @@ def check(
     distances: Annotated[
         bool, typer.Option("--distances", help="Also list every checked pair's distance.")
     ] = False,
+    ignore_srdf: Annotated[
+        bool,
+        typer.Option(
+            "--ignore-srdf",
+            help="Check the pairs the SRDF disables too (adjacent pairs stay unchecked); shows "
+            "the witnesses of `collisions audit`.",
+        ),
+    ] = False,
     as_json: JsonFlag = False,
     skip_missing_meshes: SkipMeshes = False,
     package_path: PackagePath = None,
@@ -97,6 +105,20 @@ def check(
         robot, on_missing_mesh="skip" if skip_missing_meshes else "error"
     )
     config = checker.configuration(state or (), _values(q))
+    if ignore_srdf:
+        from robotspec.collision import CollisionRules
+
+        rules = checker.rules
+        checker = SelfCollisionChecker(
+            robot.world,
+            CollisionRules(
+                bodies=rules.bodies,
+                adjacent=rules.adjacent,
+                disabled_bodies=rules.disabled_bodies,
+                buffer_distance=rules.buffer_distance,
+            ),
+            on_missing_mesh="skip" if skip_missing_meshes else "error",
+        )
     colliding = checker.colliding_pairs(config)
     _warn_skipped(checker.skipped)
     buffer = checker.rules.buffer_distance
@@ -164,6 +186,14 @@ def generate(
             "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
         ),
     ] = None,
+    compare: Annotated[
+        Path | None,
+        typer.Option(
+            "--compare",
+            help="An SRDF to compare with: precision, recall and each differing pair with its "
+            "reason (on stderr).",
+        ),
+    ] = None,
     skip_missing_meshes: SkipMeshes = False,
     package_path: PackagePath = None,
 ) -> None:
@@ -171,12 +201,15 @@ def generate(
 
     Without --merge the SRDF holds only the disable_collisions; with it, the robot's SRDF with
     the new pairs added. A summary (and, when the robot has an SRDF, precision and recall against
-    it) goes to stderr.
+    it) and a convergence report (pairs first seen colliding in the last half of the samples)
+    go to stderr.
     """
     from robotspec.collision import Progress, compare_pairs, generate_for_robot
-    from robotspec.description.srdf import write_srdf
+    from robotspec.collision.convergence import compare_with_srdf, convergence
+    from robotspec.description.srdf import load_srdf, write_srdf
 
     robot = load_robot(spec, package_path)
+    other = None if compare is None else load_srdf(compare, strict=False)
     if merge and robot.srdf is None:
         raise CollisionError(f"--merge: robot '{robot.name}' has no SRDF to merge into")
     bar = Progress(0, "collision matrix", enabled=progress)
@@ -215,6 +248,9 @@ def generate(
             f"against {Path(robot.srdf.file or 'the SRDF').name}: precision {precision:.3f}, "
             f"recall {recall:.3f} ({len(reference)} pairs there)"
         )
+    lines += convergence(matrix).lines()
+    if other is not None and compare is not None:
+        lines += compare_with_srdf(matrix, other, compare.name).lines()
     if output is not None:
         lines.append(f"wrote {output}")
     sys.stderr.write("\n".join(lines) + "\n")

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from robotspec.cli.app import app
+from robotspec.cli.collisions_cmd import QOpt, _values
 from robotspec.cli.options import PackagePath, SkipMeshes, SpecArg, load_robot
 
 if TYPE_CHECKING:
@@ -37,6 +38,7 @@ def _warn(skipped: tuple[Any, ...]) -> None:
 def render(
     spec: SpecArg,
     state: StateOpt = None,
+    q: QOpt = None,
     output: Annotated[Path, typer.Option("--output", "-o", help="The PNG file to write.")] = Path(
         "robot.png"
     ),
@@ -66,12 +68,12 @@ def render(
     if view not in VIEWS:
         raise typer.BadParameter(f"'{view}' is not one of {', '.join(VIEWS)}", param_hint="--view")
     robot = load_robot(spec, package_path)
-    q = state_configuration(robot, state or ())
+    config = state_configuration(robot, state or (), _values(q))
     scene = build_scene(robot, on_missing_mesh="skip" if skip_missing_meshes else "error")
     _warn(scene.skipped)
     title = robot.name + (f" · {', '.join(state)}" if state else "")
     picture = render_scene(
-        scene, q, RenderOptions(width=width, height=height, view=view, title=title)
+        scene, config, RenderOptions(width=width, height=height, view=view, title=title)
     )
     picture.save(output)
     sys.stdout.write(f"wrote {output} ({width}x{height}, {view} view)\n")
@@ -101,7 +103,7 @@ def view(
     from robotspec.render.viewer import RobotViewer
 
     robot = load_robot(spec, package_path)
-    q = state_configuration(robot, state or ())
+    config = state_configuration(robot, state or (), _values(q))
     viewer = RobotViewer(
         robot,
         q,

@@ -147,14 +147,14 @@ def _text(r: SrdfAudit, spec: str, show_ok: bool) -> str:
     if inert and not show_ok:
         by_body: dict[str, int] = {}
         for e in inert:
-            for x in dict.fromkeys((e.link1, e.link2)):
+            for x in e.culprits:
                 by_body[x] = by_body.get(x, 0) + 1
         top = sorted(by_body.items(), key=lambda kv: (-kv[1], kv[0]))
         shown = ", ".join(f"{b} ({n})" for b, n in top[:8])
         more = f", and {len(top) - 8} more bodies" if len(top) > 8 else ""
         lines.append(
-            f"inert: {len(inert)} entries name unknown links or links without collision "
-            f"geometry: {shown}{more} (--all lists them)"
+                f"inert: {len(inert)} entries name unknown links or links without collision "
+            f"geometry (entries per link): {shown}{more} (--all lists them)"
         )
     rows = [
         [e.line, e.link1, e.link2, e.reason, e.verdict, e.detail]

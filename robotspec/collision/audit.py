@@ -68,6 +68,7 @@ class AuditEntry:
     witness: Mapping[str, float] = field(default_factory=dict)
     valid: bool = False
     collisions: int = 0
+    culprits: tuple[str, ...] = ()  # the unknown or geometry-less links of an inert entry
 
 
 @dataclass(frozen=True)
@@ -117,15 +118,17 @@ def _static(robot: AbstractRobot, world: World) -> list[AuditEntry]:
     for d in srdf.disabled_collisions:
         key = pair_key(d.link1, d.link2)
         verdict, detail = OK, ""
+        culprits: tuple[str, ...] = ()
         unknown = [x for x in (d.link1, d.link2) if not world.has_body(x)]
         bare = [x for x in dict.fromkeys((d.link1, d.link2)) if x not in geometry]
         if unknown:
-            verdict = UNKNOWN
+            verdict, culprits = UNKNOWN, tuple(unknown)
             detail = ", ".join(f"'{x}'" for x in unknown) + " not in the URDF: the entry is inert"
         elif d.link1 == d.link2:
             verdict, detail = SELF_PAIR, "a body never collides with itself: the entry is inert"
+            culprits = (d.link1,)
         elif bare:
-            verdict = NO_GEOMETRY
+            verdict, culprits = NO_GEOMETRY, tuple(bare)
             detail = (
                 ", ".join(f"'{x}'" for x in bare)
                 + " has no collision geometry: the entry is inert"
@@ -142,7 +145,9 @@ def _static(robot: AbstractRobot, world: World) -> list[AuditEntry]:
                 f"{len(joints)} joints lie between them"
             )
         first_line.setdefault(key, d.line)
-        out.append(AuditEntry(d.link1, d.link2, d.reason, d.line, verdict, detail))
+        out.append(
+            AuditEntry(d.link1, d.link2, d.reason, d.line, verdict, detail, culprits=culprits)
+        )
     return out
 
 

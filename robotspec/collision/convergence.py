@@ -82,7 +82,7 @@ class SrdfComparison:
     recall: float
     reference_pairs: int
     generated_pairs: int
-    ignored: int  # SRDF entries outside the bodies with geometry, or naming a body twice
+    ignored: int  # SRDF entries naming unknown links or links without geometry
     differences: tuple[PairDifference, ...]
 
     def lines(self) -> list[str]:

@@ -254,12 +254,14 @@ FIELD_NOTES: dict[tuple[str, str], FieldNote] = {
     ("CameraSpec", "minimal_height"): FieldNote(
         "m",
         "minimal_height: 1.166",
-        "lowest height of the camera's frame above the robot's root over the limits of the joints that move it (checked by FK; default: the preset's, else 0)",
+        "lowest height of the camera's frame above the robot's root over the limits of the "
+        "joints that move it (checked by FK; default: the preset's, else 0)",
     ),
     ("CameraSpec", "maximal_height"): FieldNote(
         "m",
         "maximal_height: 1.583",
-        "highest height of the camera's frame above the robot's root over the limits of the joints that move it (checked by FK; default: the preset's, else 1)",
+        "highest height of the camera's frame above the robot's root over the limits of the "
+        "joints that move it (checked by FK; default: the preset's, else 1)",
     ),
     ("CameraSpec", "default"): FieldNote("", "default: true"),
     # FieldOfViewSpec

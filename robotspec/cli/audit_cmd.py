@@ -153,7 +153,7 @@ def _text(r: SrdfAudit, spec: str, show_ok: bool) -> str:
         shown = ", ".join(f"{b} ({n})" for b, n in top[:8])
         more = f", and {len(top) - 8} more bodies" if len(top) > 8 else ""
         lines.append(
-                f"inert: {len(inert)} entries name unknown links or links without collision "
+            f"inert: {len(inert)} entries name unknown links or links without collision "
             f"geometry (entries per link): {shown}{more} (--all lists them)"
         )
     rows = [

@@ -10,8 +10,8 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from robotspec.cli.app import app
-from robotspec.cli.options import JsonFlag, PackagePath, SpecArg, load_robot
 from robotspec.cli.notes import print_notes
+from robotspec.cli.options import JsonFlag, PackagePath, SpecArg, load_robot
 from robotspec.cli.table import render_table
 
 if TYPE_CHECKING:

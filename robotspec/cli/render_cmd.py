@@ -103,7 +103,7 @@ def view(
     from robotspec.render.viewer import RobotViewer
 
     robot = load_robot(spec, package_path)
-    config = state_configuration(robot, state or (), _values(q))
+    q = state_configuration(robot, state or ())
     viewer = RobotViewer(
         robot,
         q,

@@ -1,4 +1,4 @@
-"""What every ``disable_collisions`` entry of an SRDF actually does (``robotspec collisions audit``).
+"""What every ``disable_collisions`` entry of an SRDF really does (``collisions audit``).
 
 Why: an SRDF's collision matrix is trusted blindly by MoveIt and by robotspec's checker, yet it
 is usually generated once, for an older URDF, with too few samples, then edited by hand. An
@@ -130,8 +130,7 @@ def _static(robot: AbstractRobot, world: World) -> list[AuditEntry]:
         elif bare:
             verdict, culprits = NO_GEOMETRY, tuple(bare)
             detail = (
-                ", ".join(f"'{x}'" for x in bare)
-                + " has no collision geometry: the entry is inert"
+                ", ".join(f"'{x}'" for x in bare) + " has no collision geometry: the entry is inert"
             )
         elif key in first_line:
             line = first_line[key]

@@ -266,9 +266,7 @@ def generate_collision_matrix(
         processes=procs,
         seconds=time.perf_counter() - started,
         skipped=tuple(checker.skipped),
-        first_collision=tuple(
-            (*pair_key(*pairs[k]), start) for k, start in sorted(first.items())
-        ),
+        first_collision=tuple((*pair_key(*pairs[k]), start) for k, start in sorted(first.items())),
     )
 
 

@@ -1,5 +1,6 @@
-"""Checks that need the robot's kinematics: camera heights, optical frames, parts that cannot move,
-and named states in the wrong order.
+"""Checks that need the robot's kinematics: camera heights, optical frames, immobile parts.
+
+Named states in the wrong order are found the same way (FK of each state).
 
 Why after the name checks: every check here evaluates forward kinematics over resolved bodies, so
 it runs once the first pass has resolved them (a part whose names failed is skipped, its error is
@@ -94,8 +95,7 @@ def _immobile_parts(b: Build, r: KinematicInputs) -> None:
             continue
         names = ", ".join(f"'{c.name}'" for c in conns)
         message = (
-            f"{what} cannot move: every joint from '{root.name}' to '{tip.name}' is fixed "
-            f"({names})"
+            f"{what} cannot move: every joint from '{root.name}' to '{tip.name}' is fixed ({names})"
         )
         if must_move:
             b.diag.error(loc, message, name=root.name)
@@ -142,7 +142,7 @@ def _optical(
         (0, 1, 0): "down",
         (0, -1, 0): "up",
         (0, 0, -1): "backwards",
-    }.get(tuple(int(round(x)) for x in axis), "away from the lens")
+    }.get(_rounded(axis), "away from the lens")
     if spec.body.endswith("_optical_frame"):
         # The name-based warning of the first pass already points here; the rotation proves it.
         b.diag.warnings[:] = [
@@ -158,6 +158,11 @@ def _optical(
         f"the camera looks along +z; the axis {_vec(axis)} looks {looks}",
         name=spec.body,
     )
+
+
+def _rounded(axis: F64) -> tuple[int, int, int]:
+    x, y, z = (int(round(float(c))) for c in axis)
+    return (x, y, z)
 
 
 def _vec(v: object) -> str:
@@ -219,7 +224,10 @@ def _camera_heights(
             )
             + ("" if fk.method != "sampled" else " in the samples")
         )
-    message += " (" + "; ".join(reasons) + f"); use {fk.low:.3f}-{fk.high:.3f}"
+    if fk.method == "fixed":
+        reasons = []  # the first sentence already says where it is
+    detail = " (" + "; ".join(reasons) + ")" if reasons else ""
+    message += f"{detail}; use {fk.low:.3f}-{fk.high:.3f}"
     if fk.method == "sampled" and not missed:
         b.diag.warning(loc, message, name=spec.body)
     else:
@@ -290,12 +298,12 @@ def _state_order(b: Build, r: KinematicInputs, base: F64) -> None:
             continue
         chains = [w.compute_chain_of_connections(mroot, t) for t in tips]
         opening: dict[str, float] = {}
-        for key, aliases in (("closed", _CLOSED), ("open", _OPEN)):
-            s = next((a for a in aliases if a in m.states), None)
-            q = None if s is None else _state_config(b, base, m.states[s])
-            if s is not None and q is not None:
+        for aliases in (_CLOSED, _OPEN):
+            state = next((a for a in aliases if a in m.states), None)
+            q = None if state is None else _state_config(b, base, m.states[state])
+            if state is not None and q is not None:
                 p = [chain_fk_batch(c, q[None])[0, :3, 3] for c in chains]
-                opening[s] = float(np.linalg.norm(p[0] - p[1]))
+                opening[state] = float(np.linalg.norm(p[0] - p[1]))
         _order(
             b,
             ("manipulators", name, "states"),
@@ -313,8 +321,7 @@ def _order(
     items = list(values.items())
     for (s1, v1), (s2, v2) in zip(items, items[1:], strict=False):
         text = (
-            f"state '{s2}' of {what} gives {measure} {v2:.3f} {unit}, state '{s1}' "
-            f"{v1:.3f} {unit}"
+            f"state '{s2}' of {what} gives {measure} {v2:.3f} {unit}, state '{s1}' {v1:.3f} {unit}"
         )
         if v2 < v1 - 1e-6:
             b.diag.error(

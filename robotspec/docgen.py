@@ -991,9 +991,8 @@ def cli_reference() -> str:
     """The text of ``docs/cli.md``, walked from the typer app's click commands."""
     import typer.main
 
-    from robotspec.cli.app import _register, app
+    from robotspec.cli.app import app
 
-    _register()
     group = typer.main.get_command(app)
     out = [
         "# CLI reference",

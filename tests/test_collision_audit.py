@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from robotspec.cli.app import _register, app
+from robotspec.cli.app import app
 from robotspec.collision import CollisionRules, SelfCollisionChecker, default_configuration
 from robotspec.collision.audit import (
     COLLIDES,
@@ -163,11 +163,6 @@ def test_generator_records_first_collisions_and_compares_with_the_srdf(
 
 
 runner = CliRunner()
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _cli() -> None:
-    _register()
 
 
 def test_cli_audit_json_and_exit_code() -> None:

@@ -29,6 +29,9 @@ from tests.conftest import SHARED, erd_robots
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 PAGES = sorted(DOCS.glob("*.md"))
+README = DOCS.parent / "README.md"
+#: Pages whose examples run: the docs and the README (style rule: every shown example is tested).
+RUN_PAGES = [*PAGES, README]
 HSRB_PACKAGES = SHARED / "robots" / "hsrb"
 
 _FENCE = re.compile(r"^```(\w*)\s*$")
@@ -72,10 +75,9 @@ def _is_spec(text: str) -> bool:
 
 
 @pytest.fixture(scope="module")
-def app():  # noqa: ANN201 - the typer app
-    from robotspec.cli.app import _register, app
+def app():
+    from robotspec.cli.app import app
 
-    _register()
     return app
 
 
@@ -105,7 +107,7 @@ def test_shown_example_files_match(page: Path) -> None:
             )
 
 
-@pytest.mark.parametrize("page", PAGES, ids=[p.name for p in PAGES])
+@pytest.mark.parametrize("page", RUN_PAGES, ids=[p.name for p in RUN_PAGES])
 def test_examples_run(
     page: Path,
     app: object,
@@ -152,7 +154,7 @@ def test_examples_run(
                 )
         elif b.lang == "python":
             namespace: dict[str, object] = {"__name__": "__docs__"}
-            exec(compile(b.text, where, "exec"), namespace)  # noqa: S102 - the docs' own code
+            exec(compile(b.text, where, "exec"), namespace)
             capsys.readouterr()
         elif b.lang == "yaml" and _is_spec(b.text) and "fragment" not in b.marks:
             spec = tmp_path / b.marks.get("file", f"block_{b.line}.yaml")

@@ -198,9 +198,8 @@ def test_panda_flange_chain_cannot_move_and_gripper_order(tmp_path: Path) -> Non
 
 def test_inspect_notes_srdf_off_and_no_controlled_joints(tmp_path: Path) -> None:
     erd_robots()
-    from robotspec.cli.app import _register, app
+    from robotspec.cli.app import app
 
-    _register()
     spec = tmp_path / "quiet.yaml"
     spec.write_text(
         "robotspec: 1\nextends: pr2\ncollision: {use_srdf: false}\ncontrolled_joints: []\n"

@@ -10,12 +10,13 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import (
     JsonFlag,
     PackagePath,
+    QOpt,
     SkipMeshes,
     SpecArg,
+    joint_values,
     load_robot,
     write_output,
 )
@@ -24,6 +25,10 @@ from robotspec.errors import CollisionError
 
 if TYPE_CHECKING:
     pass
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 collisions_app = typer.Typer(
     help="Self-collision checks and collision matrices (coal).", no_args_is_help=True
@@ -40,30 +45,6 @@ StateOpt = Annotated[
         show_default=False,
     ),
 ]
-QOpt = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--q",
-        help="A joint value JOINT=VALUE (rad or m), applied after the states; repeatable.",
-        show_default=False,
-    ),
-]
-
-
-def _values(items: list[str] | None) -> dict[str, float]:
-    out: dict[str, float] = {}
-    for item in items or ():
-        name, sep, text = item.partition("=")
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not sep or not name.strip() or not math.isfinite(value):
-            raise CollisionError(
-                f"--q '{item}': expected JOINT=VALUE with a finite number", kind="option"
-            )
-        out[name.strip()] = value
-    return out
 
 
 def _warn_skipped(skipped: tuple[Any, ...]) -> None:
@@ -104,7 +85,7 @@ def check(
     checker = SelfCollisionChecker.from_robot(
         robot, on_missing_mesh="skip" if skip_missing_meshes else "error"
     )
-    config = checker.configuration(state or (), _values(q))
+    config = checker.configuration(state or (), joint_values(q))
     if ignore_srdf:
         from robotspec.collision import CollisionRules
 
@@ -206,7 +187,8 @@ def generate(
     """
     from robotspec.collision import Progress, compare_pairs, generate_for_robot
     from robotspec.collision.convergence import compare_with_srdf, convergence
-    from robotspec.description.srdf import load_srdf, write_srdf
+    from robotspec.description.srdf import load_srdf
+    from robotspec.export.srdf import write_srdf
 
     robot = load_robot(spec, package_path)
     other = None if compare is None else load_srdf(compare, strict=False)
@@ -254,3 +236,65 @@ def generate(
     if output is not None:
         lines.append(f"wrote {output}")
     sys.stderr.write("\n".join(lines) + "\n")
+
+
+@collisions_app.command("audit")
+def audit(
+    spec: SpecArg,
+    samples: Annotated[
+        int,
+        typer.Option(
+            "--samples", "-n", min=0, help="Random configurations for the regenerated matrix."
+        ),
+    ] = 10_000,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the sampler.")] = 0,
+    jobs: Annotated[
+        int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes (default: CPUs).")
+    ] = None,
+    show_ok: Annotated[
+        bool, typer.Option("--all", help="Also list the entries that are right.")
+    ] = False,
+    progress: Annotated[
+        bool | None,
+        typer.Option(
+            "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
+        ),
+    ] = None,
+    as_json: JsonFlag = False,
+    skip_missing_meshes: SkipMeshes = False,
+    package_path: PackagePath = None,
+) -> None:
+    """What each SRDF disable_collisions entry does. Exit code 1 when an entry is wrong.
+
+    Inert entries (unknown links, bodies without collision geometry, a link paired with
+    itself), duplicates, Adjacent entries whose bodies are not adjacent, Never entries whose
+    bodies collide in sampled configurations (each with a witness: joint values to pass to
+    `collisions check --q` or `render --q`), and the pairs a regenerated matrix would disable
+    that the SRDF does not.
+    """
+    from robotspec.cli.audit_report import audit_json, audit_text
+    from robotspec.collision import Progress
+    from robotspec.collision.audit import audit_srdf
+
+    robot = load_robot(spec, package_path)
+    bar = Progress(0, "audit", enabled=progress)
+
+    def report(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done - bar.done)
+
+    with bar:
+        result = audit_srdf(
+            robot,
+            samples=samples,
+            seed=seed,
+            processes=jobs,
+            progress=report,
+            on_missing_mesh="skip" if skip_missing_meshes else "error",
+        )
+    if as_json:
+        sys.stdout.write(json.dumps(audit_json(result), indent=2) + "\n")
+    else:
+        sys.stdout.write(audit_text(result, spec, show_ok))
+    if result.wrong:
+        raise typer.Exit(1)

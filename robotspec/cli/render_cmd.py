@@ -8,12 +8,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robotspec.cli.app import app
-from robotspec.cli.collisions_cmd import QOpt, _values
-from robotspec.cli.options import PackagePath, SkipMeshes, SpecArg, load_robot
+from robotspec.cli.options import PackagePath, QOpt, SkipMeshes, SpecArg, joint_values, load_robot
 
 if TYPE_CHECKING:
     pass
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 StateOpt = Annotated[
     list[str] | None,
@@ -59,16 +61,16 @@ def render(
 
     Needs no display: the picture is rasterized in software (numpy) and written with Pillow.
     """
-    from robotspec.collision.sampling import state_configuration
     from robotspec.render import VIEWS, RenderOptions, build_scene, parse_size, render_scene
     from robotspec.render.deps import require
+    from robotspec.semantic.states import state_configuration
 
     require("PIL", "Pillow", "render")
     width, height = parse_size(size)
     if view not in VIEWS:
         raise typer.BadParameter(f"'{view}' is not one of {', '.join(VIEWS)}", param_hint="--view")
     robot = load_robot(spec, package_path)
-    config = state_configuration(robot, state or (), _values(q))
+    config = state_configuration(robot, state or (), joint_values(q))
     scene = build_scene(robot, on_missing_mesh="skip" if skip_missing_meshes else "error")
     _warn(scene.skipped)
     title = robot.name + (f" · {', '.join(state)}" if state else "")
@@ -96,8 +98,8 @@ def view(
 
     Serves on localhost and prints the URL to open; Ctrl-C stops.
     """
-    from robotspec.collision.sampling import state_configuration
     from robotspec.render.deps import require
+    from robotspec.semantic.states import state_configuration
 
     require("viser", "viser", "view")
     from robotspec.render.viewer import RobotViewer

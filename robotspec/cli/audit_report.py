@@ -1,80 +1,15 @@
-"""``robotspec collisions audit``: what every SRDF ``disable_collisions`` entry actually does."""
+"""The report of `robotspec collisions audit`, as text and as JSON (the command: collisions_cmd)."""
 
 from __future__ import annotations
 
-import json
-import sys
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Any
 
-import typer
-
-from robotspec.cli.collisions_cmd import collisions_app
-from robotspec.cli.options import JsonFlag, PackagePath, SkipMeshes, SpecArg, load_robot
 from robotspec.cli.table import render_table
 
 if TYPE_CHECKING:
     from robotspec.collision.audit import AuditEntry, SrdfAudit
 
-
-@collisions_app.command("audit")
-def audit(
-    spec: SpecArg,
-    samples: Annotated[
-        int,
-        typer.Option(
-            "--samples", "-n", min=0, help="Random configurations for the regenerated matrix."
-        ),
-    ] = 10_000,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the sampler.")] = 0,
-    jobs: Annotated[
-        int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes (default: CPUs).")
-    ] = None,
-    show_ok: Annotated[
-        bool, typer.Option("--all", help="Also list the entries that are right.")
-    ] = False,
-    progress: Annotated[
-        bool | None,
-        typer.Option(
-            "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
-        ),
-    ] = None,
-    as_json: JsonFlag = False,
-    skip_missing_meshes: SkipMeshes = False,
-    package_path: PackagePath = None,
-) -> None:
-    """What each SRDF disable_collisions entry does. Exit code 1 when an entry is wrong.
-
-    Inert entries (unknown links, bodies without collision geometry, a link paired with
-    itself), duplicates, Adjacent entries whose bodies are not adjacent, Never entries whose
-    bodies collide in sampled configurations (each with a witness: joint values to pass to
-    `collisions check --q` or `render --q`), and the pairs a regenerated matrix would disable
-    that the SRDF does not.
-    """
-    from robotspec.collision import Progress
-    from robotspec.collision.audit import audit_srdf
-
-    robot = load_robot(spec, package_path)
-    bar = Progress(0, "audit", enabled=progress)
-
-    def report(done: int, total: int) -> None:
-        bar.total = total
-        bar.update(done - bar.done)
-
-    with bar:
-        result = audit_srdf(
-            robot,
-            samples=samples,
-            seed=seed,
-            processes=jobs,
-            progress=report,
-            on_missing_mesh="skip" if skip_missing_meshes else "error",
-        )
-    if as_json:
-        sys.stdout.write(json.dumps(_as_json(result), indent=2) + "\n")
-    else:
-        sys.stdout.write(_text(result, spec, show_ok))
-    if result.wrong:
-        raise typer.Exit(1)
+__all__ = ["audit_json", "audit_text"]
 
 
 def _summary(r: SrdfAudit) -> dict[str, int]:
@@ -104,7 +39,8 @@ def _entry_json(e: AuditEntry) -> dict[str, Any]:
     }
 
 
-def _as_json(r: SrdfAudit) -> dict[str, Any]:
+def audit_json(r: SrdfAudit) -> dict[str, Any]:
+    """The audit as JSON: summary, precision and recall, every entry, the missing pairs."""
     c = r.comparison
     return {
         "robot": r.robot,
@@ -127,7 +63,8 @@ def _witness_cmd(spec: str, e: AuditEntry) -> str:
     return f"robotspec collisions check {spec} --ignore-srdf {qs}"
 
 
-def _text(r: SrdfAudit, spec: str, show_ok: bool) -> str:
+def audit_text(r: SrdfAudit, spec: str, show_ok: bool) -> str:
+    """The audit for a terminal: summary, the wrong entries, witnesses, missing pairs."""
     from robotspec.collision.audit import COLLIDES, INERT, OK
 
     s = _summary(r)

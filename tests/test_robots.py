@@ -603,7 +603,7 @@ def test_users_own_spec_extending_pr2(
         f"extends: {shipped_specs()['pr2']}\n"
         "name: my_pr2\n"
         "sensors:\n"
-        "  kinect: {minimal_height: 1.0}\n"
+        "  kinect: {maximal_height: 1.58}\n"
         "velocity_limits: {default: 0.5}\n"
         "chains:\n"
         "  right_arm:\n"
@@ -614,7 +614,7 @@ def test_users_own_spec_extending_pr2(
     assert type(robot) is AbstractRobot  # a user's file is not the shipped class
     assert robot.name == "my_pr2"
     cam = camera(robot, "kinect")
-    assert (cam.minimal_height, cam.maximal_height) == (1.0, 1.6)
+    assert (cam.minimal_height, cam.maximal_height) == (1.166, 1.58)
     assert set(chain_by_name(robot, "right_arm").states) == {"park", "up"}
     assert velocity_of(robot.world, "head_pan_joint") == 0.5
     assert velocity_of(robot.world, "r_shoulder_pan_joint") == 0.15

@@ -213,3 +213,63 @@ def test_inspect_notes_srdf_off_and_no_controlled_joints(tmp_path: Path) -> None
     ]
     plain = CliRunner().invoke(app, ["inspect", "joints", "pr2"])
     assert plain.exit_code == 0 and "note:" not in plain.stderr
+
+
+def test_hsrb_two_default_cameras(tmp_path: Path) -> None:
+    hsrb = str(shared_path("robots", "hsrb"))
+    text = "robotspec: 1\nextends: hsrb\nsensors: {head_rgbd_camera: {default: true}}\n"
+    assert _problems(tmp_path, text, hsrb) == [
+        "broken.yaml:3:39: error: sensors.head_rgbd_camera.default: cameras "
+        "'head_center_camera' (hsrb.yaml:90) and 'head_rgbd_camera' are both the default camera; the "
+        "first would win silently: mark one"
+    ]
+
+
+def test_tiago_field_of_view_swapped_and_camera_copy(tmp_path: Path) -> None:
+    erd_robots()
+    text = (
+        "robotspec: 1\nextends: tiago\n"
+        "sensors: {head_camera: {field_of_view: {horizontal: 0.7854, vertical: 1.0123}}}\n"
+    )
+    assert _problems(tmp_path, text) == [
+        "broken.yaml:3:40: warning: sensors.head_camera.field_of_view: the field of view is "
+        "taller than wide (vertical 1.0123 > horizontal 0.7854 rad): swapped? a landscape image "
+        "is wider than tall"
+    ]
+    text = (
+        "robotspec: 1\nextends: tiago\nneck: {sensors: [head_camera, copy]}\n"
+        "sensors: {copy: {type: camera, body: xtion_optical_frame, preset: xtion_pro_live}}\n"
+    )
+    assert _problems(tmp_path, text) == [
+        "broken.yaml:4:38: warning: sensors.copy.body: cameras 'head_camera' and 'copy' are on "
+        "the same frame 'xtion_optical_frame' (a copy-paste?)"
+    ]
+
+
+def test_panda_copied_arm_and_tool_frame(tmp_path: Path) -> None:
+    erd_robots()
+    text = (
+        "robotspec: 1\nextends: panda\n"
+        "chains: {arm2: {root: panda_link0, tip: panda_link8, manipulator: hand2}}\n"
+        "manipulators: {hand2: {type: generic, root: panda_hand, tool_frame: panda_hand_tcp}}\n"
+    )
+    assert _problems(tmp_path, text) == [
+        "broken.yaml:3:16: error: chains.arm2: chain 'arm2' has the same links as chain 'arm' "
+        "('panda_link0' -> 'panda_link8'); a copy-paste? give each part its own root and tip",
+        "broken.yaml:4:69: error: manipulators.hand2.tool_frame: manipulators 'hand' and "
+        "'hand2' share the tool frame 'panda_hand_tcp'; one gripper has one tool frame",
+    ]
+
+
+def test_non_camera_hint_by_name_and_mesh() -> None:
+    from robotspec.compiler.part_checks import non_camera_hint
+    from robotspec.model.geometry import Mesh, Shape
+    from robotspec.model.world import Body
+
+    eye = np.eye(4)
+    scanner = Body(
+        "front_mount", 3, visuals=(Shape(Mesh("package://x/hokuyo_utm30lx.dae", None), eye),)
+    )
+    assert non_camera_hint(scanner) == "its mesh 'hokuyo_utm30lx.dae' is a Hokuyo laser scanner"
+    assert non_camera_hint(Body("base_imu_frame", 1)) == "its name says an IMU ('imu')"
+    assert non_camera_hint(Body("head_rgbd_sensor_link", 2)) is None

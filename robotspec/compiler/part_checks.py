@@ -131,7 +131,7 @@ def _cameras(b: Build, cameras: Mapping[str, CameraValues]) -> None:
         if s.default:
             if default is not None:
                 file, line, _ = b.loaded.position(("sensors", default, "default"))
-                at = f" (line {line})" if line is not None else ""
+                at = f" ({file.rsplit('/', 1)[-1]}:{line})" if line is not None else ""
                 b.diag.error(
                     (*loc, "default"),
                     f"cameras '{default}'{at} and '{name}' are both the default camera; the "

@@ -220,8 +220,8 @@ def test_hsrb_two_default_cameras(tmp_path: Path) -> None:
     text = "robotspec: 1\nextends: hsrb\nsensors: {head_rgbd_camera: {default: true}}\n"
     assert _problems(tmp_path, text, hsrb) == [
         "broken.yaml:3:39: error: sensors.head_rgbd_camera.default: cameras "
-        "'head_center_camera' (hsrb.yaml:90) and 'head_rgbd_camera' are both the default camera; the "
-        "first would win silently: mark one"
+        "'head_center_camera' (hsrb.yaml:90) and 'head_rgbd_camera' are both the default "
+        "camera; the first would win silently: mark one"
     ]
 
 

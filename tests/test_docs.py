@@ -83,10 +83,10 @@ def app():
 
 def test_generated_pages_are_current() -> None:
     erd_robots()
-    from robotspec.docgen import stale_pages
+    from tools.docgen import COMMAND, stale_pages
 
     stale = stale_pages(DOCS)
-    assert not stale, f"stale generated pages {stale}: run `python -m robotspec.docgen`"
+    assert not stale, f"stale generated pages {stale}: run `{COMMAND}`"
 
 
 def test_every_page_is_checked() -> None:

@@ -49,7 +49,7 @@ SAME_FLOOR_ALLOWED: frozenset[tuple[str, str]] = frozenset(
     }
 )
 #: Rooms that are the package's faces, not floors: they may import anything.
-FACES = frozenset({"__init__", "__main__", "docgen"})  # docgen: a dev tool, leaving for tools/
+FACES = frozenset({"__init__", "__main__"})
 
 
 def _room(module: str) -> str:

@@ -218,3 +218,21 @@ def test_audit_is_deterministic(arm: AbstractRobot, arm_audit: SrdfAudit) -> Non
     b = [dict(e.witness) for e in again.entries]
     assert a == b
     assert np.isfinite([v for w in a for v in w.values()]).all()
+
+
+def test_cli_audit_without_srdf_and_compare_with_a_missing_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from robotspec.cli.render import run_app
+
+    erd_robots()
+    code = run_app(app, ["collisions", "audit", "tiago", "-n", "10", "-j", "1"])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert "error: robot 'Tiago' has no SRDF to audit" in err
+    missing = tmp_path / "nowhere.srdf"
+    argv = ["collisions", "generate", str(ARM), "-n", "10", "-j", "1", "--compare", str(missing)]
+    code = run_app(app, argv)
+    err = capsys.readouterr().err
+    assert code == 1
+    assert "nowhere.srdf" in err and "Traceback" not in err

@@ -183,7 +183,8 @@ def test_panda_flange_chain_cannot_move_and_gripper_order(tmp_path: Path) -> Non
         "broken.yaml:3:18: warning: chains.flange: chain 'flange' has neither a manipulator nor "
         "a sensor",
         "broken.yaml:3:18: warning: chains.flange: chain 'flange' cannot move: every joint from "
-        "'panda_link7' to 'panda_link8' is fixed ('panda_joint8')",
+        "'panda_link7' to 'panda_link8' is fixed ('panda_joint8'); 'panda_joint7' moves "
+        "'panda_link7': start at 'panda_link6'?",
     ]
     text = (
         "robotspec: 1\nextends: panda\nmanipulators: {hand: {states: "
@@ -273,3 +274,18 @@ def test_non_camera_hint_by_name_and_mesh() -> None:
     assert non_camera_hint(scanner) == "its mesh 'hokuyo_utm30lx.dae' is a Hokuyo laser scanner"
     assert non_camera_hint(Body("base_imu_frame", 1)) == "its name says an IMU ('imu')"
     assert non_camera_hint(Body("head_rgbd_sensor_link", 2)) is None
+
+
+def test_baxter_finger_that_cannot_move_names_the_joint_above(tmp_path: Path) -> None:
+    erd_robots()
+    base = Path(__file__).resolve().parent / "data" / "own_robots" / "baxter.yaml"
+    text = (
+        f"robotspec: 1\nextends: {base}\n"
+        "manipulators: {left_gripper: {thumb: {root: l_gripper_l_finger}}}\n"
+    )
+    assert _problems(tmp_path, text) == [
+        "broken.yaml:3:38: warning: manipulators.left_gripper.thumb: thumb of 'left_gripper' "
+        "cannot move: every joint from 'l_gripper_l_finger' to 'l_gripper_l_finger_tip' is fixed "
+        "('l_gripper_l_finger_tip_joint'); 'l_gripper_l_finger_joint' moves 'l_gripper_l_finger': "
+        "start at 'left_gripper_base_link'?"
+    ]

@@ -97,6 +97,10 @@ def _immobile_parts(b: Build, r: KinematicInputs) -> None:
         message = (
             f"{what} cannot move: every joint from '{root.name}' to '{tip.name}' is fixed ({names})"
         )
+        above = b.world.parent_connection(root)
+        if above is not None and not above.is_fixed:
+            parent = b.world.bodies[above.parent].name
+            message += f"; '{above.name}' moves '{root.name}': start at '{parent}'?"
         if must_move:
             b.diag.error(loc, message, name=root.name)
         else:

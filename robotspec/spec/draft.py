@@ -187,8 +187,12 @@ def draft_spec(
                     if world.has_body(gc.base_link) and world.has_body(gc.tip_link)
                 )
             top = _top_link(world, links)
-            if top is None and world.has_body(ee.parent_link):
-                top = world.get_body_by_name(ee.parent_link)
+            if world.has_body(ee.parent_link):
+                parent = world.get_body_by_name(ee.parent_link)
+                if top is None or (top is not parent and world.is_ancestor(top, parent)):
+                    # The group is the limb itself (Talos' feet: group 'r_leg'), so its top is
+                    # the limb's root; the effector starts at its parent link.
+                    top = parent
             if top is None:
                 continue
             tool, guessed = _tool_frame(world, top)

@@ -122,8 +122,15 @@ def find_tool_frame(tree: Tree, top: Body, exclude: frozenset[int] = frozenset()
     """The best-named tool frame in ``top``'s subtree (``exclude``: bodies of other parts)."""
     world = tree.world
     candidates = [b for b in world.subtree(top) if b.index not in exclude]
+    joint = {b.index: world.parent_connection(b) for b in candidates}
     for hint in TOOL_HINTS:
-        hits = [b for b in candidates if _matches(hint, b.name)]
+        # The link's name, or its joint's (Baxter's 'right_gripper' hangs on 'right_endpoint').
+        hits = [
+            b
+            for b in candidates
+            if _matches(hint, b.name)
+            or ((c := joint[b.index]) is not None and c.is_fixed and _matches(hint, c.name))
+        ]
         if hits:
             return min(hits, key=lambda b: (world.depth(b), b.index))
     return None

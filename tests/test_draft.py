@@ -44,8 +44,8 @@ def test_baxter_without_srdf_has_two_arms_grippers_neck(tmp_path: Path) -> None:
     d, text = _draft("baxter_description/urdf/baxter.urdf", None, tmp_path)
     arms = {c.name: (c.root, c.tip, c.manipulator) for c in d.chains}
     assert arms == {
-        "left_arm": ("left_arm_mount", "left_wrist", "left_gripper"),
-        "right_arm": ("right_arm_mount", "right_wrist", "right_gripper"),
+        "left_arm": ("torso", "left_wrist", "left_gripper"),
+        "right_arm": ("torso", "right_wrist", "right_gripper"),
     }
     grippers = {m.name: m for m in d.manipulators}
     right = grippers["right_gripper"]

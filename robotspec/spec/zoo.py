@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import argparse
 import importlib.metadata
-import re
 import sys
+import sysconfig
 import tempfile
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -52,6 +52,7 @@ class ZooEntry:
     name: str  # "<package>/<urdf stem>"
     urdf: Path
     srdf: Path | None
+    robots: Path  # example-robot-data's robots folder
 
 
 @dataclass
@@ -99,17 +100,22 @@ def zoo_entries(robots: Path) -> list[ZooEntry]:
             key=len,
             default=None,
         )
-        out.append(ZooEntry(name, urdf, srdfs.get(stem) if stem else None))
+        out.append(ZooEntry(name, urdf, srdfs.get(stem) if stem else None, robots))
     return out
 
 
-def _clean(text: str, paths: Iterable[Path]) -> str:
-    """The first line of a message, without this machine's paths (the page is the same anywhere)."""
-    for p in paths:
-        text = text.replace(str(p), p.name)
+def _clean(text: str, robots: Path, folder: Path) -> str:
+    """The first line of a message, without this machine's folders (the page is the same anywhere).
+
+    The robots folder becomes ``robots/``; the temporary folder, site-packages and the Python
+    prefix are dropped; a list of searched folders is cut.
+    """
     line = text.splitlines()[0] if text else text
     line = line.split("; searched:")[0]
-    return re.sub(r"(?<![\w.])/(?:[\w.+-]+/)+", "", line)
+    line = line.replace(str(robots), "robots")
+    for p in (folder, Path(sysconfig.get_paths()["purelib"]), Path(sys.prefix)):
+        line = line.replace(str(p) + "/", "").replace(str(p), p.name)
+    return line
 
 
 def zoo_row(entry: ZooEntry, folder: Path) -> ZooRow:
@@ -120,7 +126,7 @@ def zoo_row(entry: ZooEntry, folder: Path) -> ZooRow:
     from robotspec.spec.draft.run import draft_from_files
 
     row = ZooRow(entry)
-    hide = [folder, entry.urdf.parents[2] if len(entry.urdf.parents) > 2 else entry.urdf.parent]
+    robots = entry.robots
     try:
         draft, desc = draft_from_files(
             str(entry.urdf),
@@ -129,7 +135,7 @@ def zoo_row(entry: ZooEntry, folder: Path) -> ZooRow:
             base_folder=folder,
         )
     except RobotSpecError as e:
-        row.problem = "does not load: " + _clean(str(e), hide)
+        row.problem = "does not load: " + _clean(str(e), robots, folder)
         return row
     world = desc.world
     row.bodies, row.dof = len(world.bodies), len(world.degrees_of_freedom)
@@ -147,7 +153,7 @@ def zoo_row(entry: ZooEntry, folder: Path) -> ZooRow:
     except RobotSpecError as e:
         problems = list(getattr(e, "errors", ()) or [e])
         row.errors = len(problems)
-        row.problem = _clean(str(problems[0]), hide)
+        row.problem = _clean(str(problems[0]), robots, folder)
     else:
         row.valid = True
         row.warnings = len(result.warnings)

@@ -28,6 +28,7 @@ LEG_WORDS = frozenset(
 #: Words also recognised inside longer words (``upperleg``, ``lowerleg``).
 INNER_WORDS = frozenset({"leg", "foot", "knee", "ankle", "thigh", "calf", "shank"})
 ARM_WORDS = frozenset({"arm", "shoulder", "elbow", "wrist", "forearm"})
+WORLD_WORDS = frozenset({"world", "map", "odom"})
 HEAD_WORDS = frozenset({"head", "neck", "eye", "eyes", "gaze"})
 #: Fewest actuated joints of a limb.
 MIN_LIMB_JOINTS = 3
@@ -81,7 +82,11 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     reach = tree.length(seg, cut)
     if reach < MIN_LIMB_LENGTH:
         return None
-    root = world.bodies[moving[0].parent]
+    # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.
+    root = seg.start
+    top = world.parent_connection(seg.bodies[0])
+    if root.index == tree.root.index and words(root.name) & WORLD_WORDS and top and top.is_fixed:
+        root = seg.bodies[0]
     tip = world.bodies[actuated[-1].child]
     hand: Body | None = None
     if cut is not None:

@@ -83,9 +83,7 @@ def test_panda_with_srdf_arm_group_and_parallel_gripper(tmp_path: Path) -> None:
 
 def test_talos_groups_of_joints_and_feet(tmp_path: Path) -> None:
     # The issue: groups listing joints plus a chain were skipped; the feet were rooted at base.
-    d, _ = _draft(
-        "talos_data/robots/talos_reduced.urdf", "talos_data/srdf/talos.srdf", tmp_path
-    )
+    d, _ = _draft("talos_data/robots/talos_reduced.urdf", "talos_data/srdf/talos.srdf", tmp_path)
     chains = {c.name: c for c in d.chains}
     assert set(chains) == {"l_arm", "r_arm", "l_leg", "r_leg"}
     assert chains["l_leg"].role == "leg" and chains["l_arm"].role == "arm"
@@ -183,8 +181,17 @@ def _world(names: list[str]) -> World:
             else:
                 dof = (len(dofs) - 1,)
         conns.append(
-            Connection(f"{names[i]}#joint", len(conns), kind, parent, i, origin, (0.0, 0.0, 1.0),
-                       dof, Mimic(mimic) if mimic else None)  # fmt: skip
+            Connection(
+                f"{names[i]}#joint",
+                len(conns),
+                kind,
+                parent,
+                i,
+                origin,
+                (0.0, 0.0, 1.0),
+                dof,
+                Mimic(mimic) if mimic else None,
+            )  # fmt: skip
         )
         return i
 

@@ -33,9 +33,9 @@ def init(
     the kinematic tree adds what the SRDF does not say. The draft validates as written; lines
     marked DECIDE are guesses a person should check.
     """
-    from robotspec.compiler import load_camera_presets
     from robotspec.errors import RobotSpecError
     from robotspec.spec.draft import render_draft
+    from robotspec.spec.draft.render import camera_presets
     from robotspec.spec.draft.run import draft_from_files
 
     if output is not None and output.exists() and not force:
@@ -46,7 +46,7 @@ def init(
     draft, _ = draft_from_files(
         urdf, srdf, folder=folder, package_paths=package_path or (), name=name
     )
-    text = render_draft(draft, presets=tuple(load_camera_presets()))
+    text = render_draft(draft, presets=camera_presets())
     if write_output(text, output):
         sys.stderr.write(
             f"wrote {output}: {len(draft.chains)} chains, {len(draft.manipulators)} manipulators, "

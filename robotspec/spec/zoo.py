@@ -120,9 +120,10 @@ def _clean(text: str, robots: Path, folder: Path) -> str:
 
 def zoo_row(entry: ZooEntry, folder: Path) -> ZooRow:
     """Load, draft (into ``folder``) and validate one robot; never raises on a bad robot."""
-    from robotspec.compiler import check_spec, load_camera_presets
+    from robotspec.compiler import check_spec
     from robotspec.errors import RobotSpecError
     from robotspec.spec.draft import render_draft
+    from robotspec.spec.draft.render import camera_presets
     from robotspec.spec.draft.run import draft_from_files
 
     row = ZooRow(entry)
@@ -145,7 +146,7 @@ def zoo_row(entry: ZooEntry, folder: Path) -> ZooRow:
     row.cameras = len(draft.cameras)
     row.torso, row.neck = draft.torso is not None, draft.neck is not None
     row.drive = draft.drive.type if draft.drive is not None else ""
-    row.draft = render_draft(draft, presets=tuple(load_camera_presets()))
+    row.draft = render_draft(draft, presets=camera_presets())
     spec = folder / (entry.name.replace("/", "__") + ".yaml")
     spec.write_text(row.draft, encoding="utf-8")
     try:

@@ -16,7 +16,7 @@ import yaml
 
 from robotspec.spec.draft.model import Draft, DraftChain, DraftManipulator, JointState
 
-__all__ = ["SCHEMA_FILE", "comment", "render_draft", "scalar"]
+__all__ = ["SCHEMA_FILE", "camera_presets", "comment", "render_draft", "scalar"]
 
 #: The schema's file name next to the spec (``robotspec schema -o robotspec.schema.json``).
 SCHEMA_FILE = "robotspec.schema.json"
@@ -59,11 +59,24 @@ def comment(text: str) -> str:
     return "".join(_escape_char(ch) if ch not in '\\"' else ch for ch in text.replace("\n", "\\n"))
 
 
+def camera_presets() -> tuple[str, ...]:
+    """Names of the camera models a spec's ``preset:`` may name (``templates/cameras.yaml``).
+
+    Read here rather than through the compiler, whose import would double ``init``'s start-up.
+    """
+    from robotspec.files.yamlio import load_yaml
+    from robotspec.shipped import package_data
+
+    data = load_yaml(package_data("templates", "cameras.yaml")).data
+    return tuple(str(k) for k in data) if isinstance(data, dict) else ()
+
+
 def _num(v: float) -> str:
     if not math.isfinite(v):  # never written: states are checked finite before they get here
         raise ValueError(f"not a finite number: {v}")
-    text = f"{v:.6g}"
-    return "0" if text == "-0" else text
+    if v == int(v) and abs(v) < 1e15:
+        return str(int(v))
+    return repr(float(v))  # the shortest text that reads back as the same number
 
 
 def _flow(values: JointState) -> str:

@@ -162,8 +162,14 @@ def _world(names: list[str]) -> World:
     conns: list[Connection] = []
     dofs: list[DegreeOfFreedom] = []
 
-    def add(parent: int | None, kind: ConnectionType, xyz: tuple[float, float, float],
-            rot: np.ndarray | None = None, mimic: str | None = None, geo: bool = True) -> int:  # fmt: skip
+    def add(
+        parent: int | None,
+        kind: ConnectionType,
+        xyz: tuple[float, float, float],
+        rot: np.ndarray | None = None,
+        mimic: str | None = None,
+        geo: bool = True,
+    ) -> int:
         i = len(bodies)
         bodies.append(Body(names[i], i, collisions=box if geo else ()))
         if parent is None:
@@ -175,8 +181,8 @@ def _world(names: list[str]) -> World:
         dof: tuple[int, ...] = ()
         if kind is not ConnectionType.FIXED:
             if mimic is None:
-                dofs.append(DegreeOfFreedom(f"{names[i]}#joint", len(dofs), f"{names[i]}#joint",
-                                            -1.0, 1.0))  # fmt: skip
+                joint = f"{names[i]}#joint"
+                dofs.append(DegreeOfFreedom(joint, len(dofs), joint, -1.0, 1.0))
                 dof = (len(dofs) - 1,)
             else:
                 dof = (len(dofs) - 1,)

@@ -154,7 +154,11 @@ def add_states(d: Drafter) -> None:
                 continue
             if not (joints <= values.keys() or (group is not None and group == part_group)):
                 continue
-            chosen = {j: v for j, v in values.items() if j in joints}
+            chosen = {
+                j: v
+                for j, v in values.items()
+                if j in joints and world.get_connection_by_name(j).is_1dof
+            }
             if not chosen:
                 continue
             bad = [j for j, v in chosen.items() if not _within(world, j, v)]

@@ -218,7 +218,7 @@ def run_reference(yaml_text: str, seconds: float, rate: float) -> LoopStats | st
             os.environ[f"ROBOTRACONTEUR_{kind}_{what}_DIR"] = os.path.join(tmp, kind, what)
     try:
         import general_robotics_toolbox as rox  # type: ignore[import-untyped]
-        import RobotRaconteur as RR  # type: ignore[import-untyped]  # noqa: N814
+        import RobotRaconteur as RR  # type: ignore[import-untyped]
         from robotraconteur_abstract_robot import (  # type: ignore[import-untyped]
             AbstractRobot,
         )
@@ -346,7 +346,7 @@ def _reference_trajectories(
     node: Any, robot: Any, a: np.ndarray, b: np.ndarray, end: float, period: float
 ) -> None:
     """Follow 1 s trajectories (21 waypoints, 50 ms apart) until ``end``, through AsyncNext."""
-    import RobotRaconteur as RR  # noqa: N814
+    import RobotRaconteur as RR
 
     # execute_trajectory records the calling client's endpoint, which only exists inside a
     # service call; in process there is none, so report endpoint 0 ("no client").

@@ -7,8 +7,10 @@ once per typo.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol
 
 from robotspec.errors import (
     NotFoundError,
@@ -17,14 +19,37 @@ from robotspec.errors import (
     SpecError,
     closest_names,
 )
-from robotspec.spec.load import LoadedSpec
 
-__all__ = ["Diagnostics", "Loc"]
+__all__ = ["Diagnostics", "Loc", "SpecSource", "loc_text"]
 
 Loc = tuple[str | int, ...]
 
 
-def _loc_text(loc: Loc) -> str:
+class _Document(Protocol):
+    @property
+    def file(self) -> str: ...
+
+
+class SpecSource(Protocol):
+    """Where a spec's nodes are: what the collector needs of a loaded spec (no import of it)."""
+
+    @property
+    def file(self) -> Path:
+        """The spec file the user named (its problems are listed first)."""
+        ...
+
+    @property
+    def documents(self) -> Sequence[_Document]:
+        """The spec's documents, the extending file first."""
+        ...
+
+    def position(self, loc: Loc) -> tuple[str, int | None, int | None]:
+        """``(file, line, column)`` of a spec node."""
+        ...
+
+
+def loc_text(loc: Sequence[str | int]) -> str:
+    """A spec path as a user reads it: ``chains.left_arm.tip``, ``joints[2]``."""
     out = ""
     for part in loc:
         out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
@@ -35,7 +60,7 @@ def _loc_text(loc: Loc) -> str:
 class Diagnostics:
     """Errors and warnings of one compilation, located in the spec's files."""
 
-    loaded: LoadedSpec
+    loaded: SpecSource
     errors: list[RobotSpecError] = field(default_factory=list)
     warnings: list[RobotSpecError] = field(default_factory=list)
 
@@ -55,7 +80,7 @@ class Diagnostics:
         file, line, col = self._at(loc)
         self.errors.append(
             SpecError(
-                f"{_loc_text(loc)}: {message}" if loc else message,
+                f"{loc_text(loc)}: {message}" if loc else message,
                 file=file,
                 line=line,
                 column=col,
@@ -71,7 +96,7 @@ class Diagnostics:
         file, line, col = self._at(loc)
         self.warnings.append(
             SpecError(
-                f"{_loc_text(loc)}: {message}" if loc else message,
+                f"{loc_text(loc)}: {message}" if loc else message,
                 file=file,
                 line=line,
                 column=col,

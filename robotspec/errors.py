@@ -277,7 +277,7 @@ class ServiceError(RobotSpecError):
     """A network service cannot start or run (port taken, node or device name in use)."""
 
 
-class RobotSpecErrors(RobotSpecError):
+class RobotSpecErrors(RobotSpecError):  # noqa: N818 - plural of RobotSpecError, by design
     """Several problems found in one run, raised together so a user fixes them all at once."""
 
     def __init__(self, errors: Sequence[RobotSpecError], *, summary: str | None = None) -> None:

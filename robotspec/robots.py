@@ -9,9 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import ClassVar, TypeVar
+from typing import TYPE_CHECKING, ClassVar, TypeVar
 
 from robotspec.semantic import AbstractRobot
+
+if TYPE_CHECKING:
+    from robotspec.model.world import World
 
 __all__ = [
     "HSRB",
@@ -22,6 +25,7 @@ __all__ = [
     "ShippedRobot",
     "Tiago",
     "UR5",
+    "load",
     "robot_class_for",
 ]
 
@@ -31,16 +35,31 @@ R = TypeVar("R", bound="ShippedRobot")
 class ShippedRobot(AbstractRobot):
     """A robot backed by a spec shipped with robotspec."""
 
+    #: The shipped spec (``specs/<spec_name>.yaml``) this class compiles.
     spec_name: ClassVar[str | None] = None
+
+    @classmethod
+    def _spec(cls) -> str:
+        if cls.spec_name is None:
+            raise TypeError(f"{cls.__name__} names no shipped spec (set spec_name)")
+        return cls.spec_name
 
     @classmethod
     def load(cls: type[R], *, package_paths: Sequence[str | Path] = ()) -> R:
         """Load the robot's description files and compile its spec."""
         from robotspec.compiler import compile_robot
 
-        robot = compile_robot(cls.spec_name or "", package_paths=package_paths, robot_class=cls)
-        assert isinstance(robot, cls)
+        robot = compile_robot(cls._spec(), package_paths=package_paths, robot_class=cls)
+        if not isinstance(robot, cls):  # the compiler builds robot_class; never false
+            raise TypeError(f"compiled {type(robot).__name__}, expected {cls.__name__}")
         return robot
+
+    @classmethod
+    def from_world(cls, world: World) -> AbstractRobot:
+        """The seed's factory: the shipped spec's semantics over an existing ``world``."""
+        from robotspec.compiler import compile_spec_for_world
+
+        return compile_spec_for_world(cls._spec(), world, robot_class=cls)
 
 
 class PR2(ShippedRobot):
@@ -97,3 +116,10 @@ def robot_class_for(ref: str | Path) -> type[AbstractRobot]:
     if isinstance(ref, str) and ref.lower() in _CLASSES and not Path(ref).is_file():
         return _CLASSES[ref.lower()]
     return AbstractRobot
+
+
+def load(ref: str | Path, *, package_paths: Sequence[str | Path] = ()) -> AbstractRobot:
+    """Compile a shipped robot (as its own class: ``load("pr2")`` is a :class:`PR2`) or a spec."""
+    from robotspec.compiler import compile_robot
+
+    return compile_robot(ref, package_paths=package_paths, robot_class=robot_class_for(ref))

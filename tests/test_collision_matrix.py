@@ -8,7 +8,8 @@ import pytest
 
 from robotspec.collision import CollisionMatrix, compare_pairs, generate_for_robot
 from robotspec.collision.rules import ADJACENT
-from robotspec.description.srdf import parse_srdf_bytes, write_srdf
+from robotspec.description.srdf import parse_srdf_bytes
+from robotspec.export.srdf import write_srdf
 from robotspec.semantic import AbstractRobot
 from tests.conftest import erd_robots
 
@@ -97,10 +98,9 @@ def test_srdf_output_and_merge(pr2: AbstractRobot, matrix: CollisionMatrix) -> N
 
 
 def test_cli_check_and_generate(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from robotspec.cli.app import _register, app
+    from robotspec.cli.app import app
     from robotspec.cli.render import run_app
 
-    _register()
     erd_robots()
     assert run_app(app, ["collisions", "check", "pr2", "--state", "park"]) == 0
     assert "collision-free" in capsys.readouterr().out

@@ -3,12 +3,19 @@
 ``tests/bad_specs/`` holds small specs with one problem each; the first line of each is
 ``# expect: <rendered message>`` (paths relative to ``tests/``). They use example-robot-data's PR2,
 so they run wherever the ``data`` extra is installed.
+
+``tests/bad_specs/rules/`` is the catalogue of compiler rules the spec reference shows
+(``tools/docgen.py`` reads it): each file is ``# group:``, ``# rule:`` and ``# expect:`` lines,
+then a ``broken.yaml`` that changes the shipped PR2 by its line 3. It is checked as the page shows
+it: its spec lines alone, as ``broken.yaml`` in an empty folder, with machine paths neutral
+(``$SITE_PACKAGES``, ``robotspec/specs/``) and no ROS package path set.
 """
 
 from __future__ import annotations
 
 import copy
 import math
+import sysconfig
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -21,11 +28,14 @@ from hypothesis import strategies as st
 
 from robotspec.compiler import check_spec, compile_robot, shipped_specs
 from robotspec.errors import RobotSpecError, RobotSpecErrors
+from robotspec.shipped import shipped_spec_files
 from tests.conftest import erd_robots
 
 TESTS = Path(__file__).resolve().parent
 BAD = TESTS / "bad_specs"
-BAD_SPECS = sorted(BAD.glob("*.yaml"))
+RULES = BAD / "rules"
+BAD_SPECS = sorted(BAD.glob("*.yaml")) + sorted(RULES.glob("*.yaml"))
+BAD_IDS = [str(p.relative_to(BAD).with_suffix("")) for p in BAD_SPECS]
 PR2_URDF = "package://example-robot-data/robots/pr2_description/urdf/pr2.urdf"
 PR2_SRDF = "package://example-robot-data/robots/pr2_description/srdf/pr2.srdf"
 
@@ -60,33 +70,67 @@ def _needs_erd() -> None:
     erd_robots()
 
 
+@pytest.fixture
+def no_ros_paths(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Package searches list the same folders on every machine."""
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
+
+
+def checked_file(path: Path, folder: Path) -> Path:
+    """The file to check for a bad spec: a rule file becomes ``folder/broken.yaml``."""
+    if path.parent != RULES:
+        return path
+    lines = path.read_text(encoding="utf-8").splitlines(keepends=True)
+    broken = folder / "broken.yaml"
+    broken.write_text("".join(ln for ln in lines if not ln.startswith("#")), encoding="utf-8")
+    return broken
+
+
+def neutral(lines: list[str], folder: Path) -> list[str]:
+    """Rendered problems without this machine's folders (the temporary one, site-packages)."""
+    site = sysconfig.get_paths()["purelib"]
+    specs = shipped_spec_files()["pr2"].parent
+    out = []
+    for line in lines:
+        for prefix in sorted({f"{folder}/", f"{folder.resolve()}/"}, key=len, reverse=True):
+            line = line.replace(prefix, "")
+        out.append(line.replace(f"{specs}/", "robotspec/specs/").replace(site, "$SITE_PACKAGES"))
+    return out
+
+
 # --------------------------------------------------------------------------- bad specs
 def test_bad_specs_folder_is_complete() -> None:
-    assert len(BAD_SPECS) >= 20
+    assert len(BAD_SPECS) >= 80
     for path in BAD_SPECS:
-        assert path.read_text(encoding="utf-8").startswith("# expect: "), path.name
+        head = "# group: " if path.parent == RULES else "# expect: "
+        assert path.read_text(encoding="utf-8").startswith(head), path.name
+        assert expected(path)
 
 
-@pytest.mark.parametrize("path", BAD_SPECS, ids=[p.stem for p in BAD_SPECS])
-def test_bad_spec_reports_exactly_its_problem(path: Path) -> None:
-    assert problems(path) == expected(path)
+@pytest.mark.parametrize("path", BAD_SPECS, ids=BAD_IDS)
+@pytest.mark.usefixtures("no_ros_paths")
+def test_bad_spec_reports_exactly_its_problem(path: Path, tmp_path: Path) -> None:
+    assert neutral(problems(checked_file(path, tmp_path)), tmp_path) == expected(path)
+
+
+WARNING_SPECS = [p for p in BAD_SPECS if all(": warning: " in w for w in expected(p))]
 
 
 @pytest.mark.parametrize(
-    "stem", [p.stem for p in BAD_SPECS if p.stem.startswith("warn_")] + ["velocity_loosens"]
+    "path", WARNING_SPECS, ids=[str(p.relative_to(BAD).with_suffix("")) for p in WARNING_SPECS]
 )
-def test_strict_turns_warnings_into_errors(stem: str) -> None:
-    path = BAD / f"{stem}.yaml"
+def test_strict_turns_warnings_into_errors(path: Path, tmp_path: Path) -> None:
     warning = expected(path)
-    assert all(": warning: " in w for w in warning)
+    checked = checked_file(path, tmp_path)
     # not strict: the spec compiles, with the warning
-    result = check_spec(path)
-    assert result.robot is not None
-    assert rendered(result.warnings) == warning
+    result = check_spec(checked)
+    assert neutral(rendered(result.warnings), tmp_path) == warning
     # strict: the same messages, as errors, raised
     with pytest.raises(RobotSpecError) as info:
-        check_spec(path, strict=True)
-    assert rendered(info.value) == [w.replace(": warning: ", ": error: ") for w in warning]
+        check_spec(checked, strict=True)
+    errors = [w.replace(": warning: ", ": error: ") for w in warning]
+    assert neutral(rendered(info.value), tmp_path) == errors
 
 
 def test_shipped_specs_have_no_warnings() -> None:

@@ -11,9 +11,8 @@ from hypothesis import strategies as st
 
 from robotspec.collision import CollisionRules
 from robotspec.compiler import check_spec, compile_robot
-from robotspec.description.srdf import write_srdf
 from robotspec.errors import RobotSpecError
-from robotspec.export.srdf import srdf_from_robot
+from robotspec.export.srdf import srdf_from_robot, write_srdf
 from robotspec.export.urdf import bundle, joined_urdf, urdf_text
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
@@ -683,7 +682,6 @@ def test_one_package_name_in_two_parts_resolves_per_part(tmp_path: Path) -> None
     )
     result = check_spec(spec)
     assert result.warnings == ()
-    assert result.robot is not None
     w = result.robot.world
     paths = {}
     for name in ("a_link", "b_link"):

@@ -29,6 +29,9 @@ from tests.conftest import SHARED, erd_robots
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 PAGES = sorted(DOCS.glob("*.md"))
+README = DOCS.parent / "README.md"
+#: Pages whose examples run: the docs and the README (style rule: every shown example is tested).
+RUN_PAGES = [*PAGES, README]
 HSRB_PACKAGES = SHARED / "robots" / "hsrb"
 
 _FENCE = re.compile(r"^```(\w*)\s*$")
@@ -72,19 +75,18 @@ def _is_spec(text: str) -> bool:
 
 
 @pytest.fixture(scope="module")
-def app():  # noqa: ANN201 - the typer app
-    from robotspec.cli.app import _register, app
+def app():
+    from robotspec.cli.app import app
 
-    _register()
     return app
 
 
 def test_generated_pages_are_current() -> None:
     erd_robots()
-    from robotspec.docgen import stale_pages
+    from tools.docgen import COMMAND, stale_pages
 
     stale = stale_pages(DOCS)
-    assert not stale, f"stale generated pages {stale}: run `python -m robotspec.docgen`"
+    assert not stale, f"stale generated pages {stale}: run `{COMMAND}`"
 
 
 def test_every_page_is_checked() -> None:
@@ -105,7 +107,7 @@ def test_shown_example_files_match(page: Path) -> None:
             )
 
 
-@pytest.mark.parametrize("page", PAGES, ids=[p.name for p in PAGES])
+@pytest.mark.parametrize("page", RUN_PAGES, ids=[p.name for p in RUN_PAGES])
 def test_examples_run(
     page: Path,
     app: object,
@@ -152,7 +154,7 @@ def test_examples_run(
                 )
         elif b.lang == "python":
             namespace: dict[str, object] = {"__name__": "__docs__"}
-            exec(compile(b.text, where, "exec"), namespace)  # noqa: S102 - the docs' own code
+            exec(compile(b.text, where, "exec"), namespace)
             capsys.readouterr()
         elif b.lang == "yaml" and _is_spec(b.text) and "fragment" not in b.marks:
             spec = tmp_path / b.marks.get("file", f"block_{b.line}.yaml")

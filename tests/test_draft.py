@@ -11,7 +11,7 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from robotspec.cli.app import _register, app
+from robotspec.cli.app import app
 from robotspec.cli.render import run_app
 from robotspec.compiler import check_spec
 from robotspec.model.entities import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic
@@ -272,7 +272,6 @@ def test_newline_in_a_link_name_does_not_inject_keys(
     )
     links = "".join(f'<link name="{n}"/>' for n in ("base", "l1", "l2", evil))
     urdf.write_text(f'<robot name="bad">{links}{joints}</robot>')
-    _register()
     out = tmp_path / "bad.yaml"
     assert run_app(app, ["init", str(urdf), "-o", str(out)]) == 0
     capsys.readouterr()
@@ -286,7 +285,6 @@ def test_newline_in_a_link_name_does_not_inject_keys(
 def test_no_machine_path_in_a_draft(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     # The issue: the draft pointed its schema at a file:// path of the author's machine.
     robots = erd_robots()
-    _register()
     out = tmp_path / "sub" / "ur5.yaml"
     out.parent.mkdir()
     urdf = robots / "ur_description/urdf/ur5_robot.urdf"

@@ -292,10 +292,9 @@ def test_yaml_is_reference_shaped(pr2: World) -> None:
 
 def run_cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
     """Run ``robotspec ARGV`` in-process; returns (exit code, stdout, stderr)."""
-    from robotspec.cli.app import _register, app
+    from robotspec.cli.app import app
     from robotspec.cli.render import run_app
 
-    _register()
     code = run_app(app, list(argv))
     out = capsys.readouterr()
     return code, out.out, out.err

@@ -40,7 +40,7 @@ def scene(pr2: AbstractRobot):  # type: ignore[no-untyped-def]
 
 
 def _q(robot: AbstractRobot, *states: str) -> np.ndarray:
-    from robotspec.collision.sampling import state_configuration
+    from robotspec.semantic.states import state_configuration
 
     return state_configuration(robot, states)
 

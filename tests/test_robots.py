@@ -18,6 +18,7 @@ from robotspec.description.urdf import load_urdf
 from robotspec.errors import KinematicsError
 from robotspec.model.world import ConnectionType, World
 from robotspec.robots import HSRB, PR2, UR5, Panda, ShippedRobot, Tiago, robot_class_for
+from robotspec.robots import load as load_robot
 from robotspec.semantic import (
     AbstractRobot,
     Arm,
@@ -165,8 +166,9 @@ def test_shipped_erd_robot_compiles(
     name: str, cls: type[ShippedRobot], counts: tuple[int, ...], drive: str
 ) -> None:
     erd_robots()
-    robot = compile_robot(name)
+    robot = load_robot(name)
     assert type(robot) is cls
+    assert type(compile_robot(name)) is AbstractRobot  # the compiler knows no shipped classes
     assert robot_class_for(name) is cls
     got = (
         len(robot.manipulators),

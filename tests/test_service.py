@@ -32,16 +32,16 @@ pytest.importorskip(
     reason="robotraconteurcompanion is not installed (pip install robotspec[robotraconteur])",
 )
 
-from robotspec.cli import render  # noqa: E402
-from robotspec.cli.app import _register, app  # noqa: E402
-from robotspec.driver.robot_info import load_robot_info  # noqa: E402
-from robotspec.driver.sim import Fault, SimRobot  # noqa: E402
-from robotspec.driver.state import CommandMode, StateFlags  # noqa: E402
-from robotspec.errors import ServiceError  # noqa: E402
-from robotspec.service.node import start_client_node  # noqa: E402
-from robotspec.service.server import RobotServer, ServeOptions  # noqa: E402
+from robotspec.cli import render
+from robotspec.cli.app import app
+from robotspec.driver.robot_info import load_robot_info
+from robotspec.driver.sim import Fault, SimRobot
+from robotspec.driver.state import CommandMode, StateFlags
+from robotspec.errors import ServiceError
+from robotspec.service.node import start_client_node
+from robotspec.service.server import RobotServer, ServeOptions
 
-from .driver_support import RRP  # noqa: E402
+from .driver_support import RRP
 
 PERIOD = 0.004
 WAIT = 5.0  # the longest any condition below is waited for, in seconds
@@ -435,7 +435,6 @@ def test_cli_port_taken_exits_1_without_traceback(
 ) -> None:
     busy, port = _busy_port()
     try:
-        _register()
         code = render.run_app(
             app,
             [
@@ -683,7 +682,7 @@ def _listen_addresses(port: int) -> set[str]:
 def test_loopback_only_without_public_and_discoverable_with_it(
     short_tmp: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import RobotRaconteur as RR  # noqa: N814
+    import RobotRaconteur as RR
 
     calls: list[str] = []
     for name in ("EnableNodeAnnounce", "EnableNodeDiscoveryListening"):
@@ -727,7 +726,6 @@ def test_cli_passes_public_through(
             seen.append(self.options)
 
     monkeypatch.setattr(service_cli, "RobotServer", Recording)
-    _register()
     for extra in ([], ["--public"]):
         code = render.run_app(
             app,

@@ -30,9 +30,9 @@ from robotspec.description.srdf import (
     check_srdf_references,
     load_srdf,
     parse_srdf_bytes,
-    write_srdf,
 )
 from robotspec.errors import NotFoundError, RobotSpecError, RobotSpecErrors, SrdfError
+from robotspec.export.srdf import write_srdf
 from robotspec.files.xmlsafe import parse_xml_file
 
 from .conftest import shared_path

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robotspec.cli.app import _register, app
+from robotspec.cli.app import app
 from robotspec.cli.render import run_app
 from robotspec.compiler import check_spec
 from robotspec.description.srdf import (
@@ -19,9 +19,8 @@ from robotspec.description.srdf import (
     check_srdf_against,
     check_srdf_references,
     parse_srdf_bytes,
-    write_srdf,
 )
-from robotspec.export.srdf import srdf_from_robot
+from robotspec.export.srdf import srdf_from_robot, write_srdf
 from robotspec.semantic import AbstractRobot
 
 from .conftest import erd_robots, shared_path
@@ -139,7 +138,6 @@ def test_cli_export_srdf_round_trips_through_init(
 ) -> None:
     # spec -> SRDF (export) -> spec (init) -> the same arms and grippers.
     robots = erd_robots()
-    _register()
     out = tmp_path / "pr2_out.srdf"
     assert run_app(app, ["export", "srdf", "pr2", "-o", str(out)]) == 0
     err = capsys.readouterr().err

@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 from robotspec.description.load import load_description
-from robotspec.spec.zoo import (
+from tools.zoo import (
+    COMMAND,
+    PAGE,
     SHIPPED_COMPARED,
     ZooEntry,
     ZooRow,
-    default_page,
     erd_robots_folder,
     zoo_entries,
     zoo_page,
@@ -125,7 +126,6 @@ def test_shipped_robots_are_compared() -> None:
 
 def test_zoo_page_is_current() -> None:
     text = zoo_page([_row(n) for n in NAMES])
-    page = default_page()
-    assert page.is_file() and page.read_text(encoding="utf-8") == text, (
-        f"{page} is stale: run `python -m robotspec.spec.zoo`"
+    assert PAGE.is_file() and PAGE.read_text(encoding="utf-8") == text, (
+        f"{PAGE} is stale: run `{COMMAND}`"
     )

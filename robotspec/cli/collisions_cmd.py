@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import (
     JsonFlag,
     PackagePath,
@@ -24,6 +23,10 @@ from robotspec.errors import CollisionError
 
 if TYPE_CHECKING:
     pass
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 collisions_app = typer.Typer(
     help="Self-collision checks and collision matrices (coal).", no_args_is_help=True
@@ -174,7 +177,7 @@ def generate(
     it) goes to stderr.
     """
     from robotspec.collision import Progress, compare_pairs, generate_for_robot
-    from robotspec.description.srdf import write_srdf
+    from robotspec.export.srdf import write_srdf
 
     robot = load_robot(spec, package_path)
     if merge and robot.srdf is None:

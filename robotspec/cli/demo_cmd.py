@@ -9,11 +9,14 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import PackagePath
 
 if TYPE_CHECKING:
     from robotspec.driver.robot_info import RobotInfo
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 #: How far the demo jogs each joint: this fraction of the way from home to mid-range.
 DEMO_REACH = 0.3
@@ -75,10 +78,10 @@ def demo(
 ) -> None:
     """Validate a robot's spec, show its chains, then drive its arm in simulation."""
     from robotspec.cli.drive_cmd import drive
-    from robotspec.cli.export_cmd import export_spec_chain
     from robotspec.cli.inspect_cmd import chains
     from robotspec.cli.validate_cmd import validate
     from robotspec.compiler import compile_robot
+    from robotspec.export.robotinfo import export_spec_chain
 
     def head(text: str) -> None:
         sys.stdout.write(f"\n== {text}\n")

@@ -9,11 +9,14 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import PackagePath
 
 if TYPE_CHECKING:
     from robotspec.driver.state import RobotState
+
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
 
 
 @app.command()
@@ -108,7 +111,7 @@ def drive(
     if spec is not None:
         # Export the chain in memory (H/P, limits, flange) and drive that: every robot
         # robotspec can compile can be driven, not only those that ship a RobotInfo.
-        from robotspec.cli.export_cmd import export_spec_chain
+        from robotspec.export.robotinfo import export_spec_chain
 
         assert chain is not None
         exported = export_spec_chain(spec, chain, package_path)

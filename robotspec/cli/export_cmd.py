@@ -2,48 +2,20 @@
 
 from __future__ import annotations
 
-import re
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import Annotated
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import OutputFile, PackagePath, SpecArg, write_file, write_output
 
-if TYPE_CHECKING:
-    from robotspec.driver.export import ExportedRobotInfo
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 export_app = typer.Typer(help="Export a compiled robot to other formats.", no_args_is_help=True)
 app.add_typer(export_app, name="export")
-
-
-def export_spec_chain(
-    spec: str, chain: str, package_paths: list[Path] | None = None
-) -> ExportedRobotInfo:
-    """Compile ``spec`` and export its chain ``chain`` as a RobotInfo (shared with ``drive``).
-
-    Why here and not in the driver package: it joins the compiler (spec → robot) with the export
-    (world chain → RobotInfo); the driver package stays free of the compiler.
-    """
-    from robotspec.compiler import compile_robot
-    from robotspec.driver.export import export_chain
-
-    robot = compile_robot(spec, package_paths=package_paths or ())
-    c = robot.get_chain(chain)
-    # Robot Raconteur device names must match ^[a-zA-Z][a-zA-Z0-9_.-]*$.
-    device = re.sub(r"[^A-Za-z0-9_.-]", "_", f"{robot.name}_{c.name}")
-    if not device[:1].isalpha():
-        device = f"robot_{device}"
-    return export_chain(
-        robot.world,
-        c.root,
-        c.tip,
-        device_name=device,
-        chain_name=c.name,
-        description=f"chain '{c.name}' of robot '{robot.name}'",
-    )
 
 
 @export_app.command("robotinfo")
@@ -61,6 +33,7 @@ def robotinfo(
     become revolute within +-2 pi. Each default used is reported on stderr.
     """
     from robotspec.driver.export import dump_robot_info_yaml
+    from robotspec.export.robotinfo import export_spec_chain
 
     ex = export_spec_chain(spec, chain, package_path)
     header = (
@@ -90,8 +63,7 @@ def srdf(
     virtual joint.
     """
     from robotspec.compiler import compile_robot
-    from robotspec.description.srdf import write_srdf
-    from robotspec.export.srdf import srdf_from_robot
+    from robotspec.export.srdf import srdf_from_robot, write_srdf
 
     robot = compile_robot(spec, package_paths=package_path or ())
     exported = srdf_from_robot(robot)

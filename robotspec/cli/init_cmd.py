@@ -8,8 +8,10 @@ from typing import Annotated
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import PackagePath, write_output
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
 
 
 @app.command()

@@ -9,12 +9,15 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import JsonFlag, PackagePath, SpecArg, load_robot
 from robotspec.cli.table import render_table
 
 if TYPE_CHECKING:
     from robotspec.semantic import AbstractRobot, KinematicChain
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 inspect_app = typer.Typer(help="Show what a spec compiles to.", no_args_is_help=True)
 app.add_typer(inspect_app, name="inspect")

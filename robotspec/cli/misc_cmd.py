@@ -8,9 +8,11 @@ from typing import Annotated
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import write_output
 from robotspec.cli.table import render_table
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
 
 
 @app.command("list")

@@ -87,7 +87,7 @@ SkipMeshes = Annotated[
 
 
 def load_robot(spec: str, package_path: list[Path] | None) -> AbstractRobot:
-    """Compile a spec (or shipped robot) for a command; imports the compiler only when called."""
-    from robotspec.compiler import compile_robot
+    """Compile a spec (or shipped robot, as its class) for a command; imports lazily."""
+    from robotspec.robots import load
 
-    return compile_robot(spec, package_paths=package_path or ())
+    return load(spec, package_paths=package_path or ())

@@ -14,7 +14,6 @@ from robotspec.errors import ErrorDetail, RobotSpecError
 
 EXIT_OK = 0
 EXIT_INVALID = 1
-EXIT_USAGE = 2
 EXIT_INTERNAL = 3
 
 
@@ -74,7 +73,7 @@ def run_app(app: typer.Typer, argv: Sequence[str] | None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("Interrupted.\n")
         return 130
-    except Exception as exc:  # a bug: say so plainly, traceback only on request
+    except Exception as exc:  # noqa: BLE001 - a bug: say so plainly, traceback only on request
         if _verbose(args):
             traceback.print_exc()
         sys.stderr.write(

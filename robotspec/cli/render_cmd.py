@@ -8,11 +8,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import PackagePath, SkipMeshes, SpecArg, load_robot
 
 if TYPE_CHECKING:
     pass
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
+
 
 StateOpt = Annotated[
     list[str] | None,
@@ -57,9 +60,9 @@ def render(
 
     Needs no display: the picture is rasterized in software (numpy) and written with Pillow.
     """
-    from robotspec.collision.sampling import state_configuration
     from robotspec.render import VIEWS, RenderOptions, build_scene, parse_size, render_scene
     from robotspec.render.deps import require
+    from robotspec.semantic.states import state_configuration
 
     require("PIL", "Pillow", "render")
     width, height = parse_size(size)
@@ -94,8 +97,8 @@ def view(
 
     Serves on localhost and prints the URL to open; Ctrl-C stops.
     """
-    from robotspec.collision.sampling import state_configuration
     from robotspec.render.deps import require
+    from robotspec.semantic.states import state_configuration
 
     require("viser", "viser", "view")
     from robotspec.render.viewer import RobotViewer

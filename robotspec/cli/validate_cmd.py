@@ -9,9 +9,11 @@ from typing import Annotated, Any
 
 import typer
 
-from robotspec.cli.app import app
 from robotspec.cli.options import PackagePath, complete_spec
 from robotspec.cli.render import styled
+
+#: This module's commands; robotspec.cli.app adds them to the root app.
+app = typer.Typer()
 
 
 class Format(StrEnum):

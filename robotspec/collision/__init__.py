@@ -20,7 +20,6 @@ from robotspec.collision.sampling import (
     default_configuration,
     random_configurations,
     sampling_bounds,
-    state_configuration,
 )
 from robotspec.collision.shapes import (
     CollisionGeometry,
@@ -28,6 +27,7 @@ from robotspec.collision.shapes import (
     MeshLibrary,
     build_geometry_model,
 )
+from robotspec.semantic.states import state_configuration  # where states live, re-exported
 
 __all__ = [
     "CollisionGeometry",

@@ -19,7 +19,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.collision.rules import CollisionRules, pair_key
-from robotspec.collision.sampling import state_configuration
 from robotspec.collision.shapes import (
     GeometryModel,
     MeshLibrary,
@@ -30,6 +29,7 @@ from robotspec.collision.shapes import (
 from robotspec.errors import CollisionError, RobotSpecError
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
+from robotspec.semantic.states import state_configuration
 
 if TYPE_CHECKING:
     from robotspec.semantic.robot import AbstractRobot
@@ -67,7 +67,7 @@ class _Compiled:
 
     model: GeometryModel
     geom_body: I64  # (G,) body index in the world
-    body_T_geom: F64  # (G, 4, 4)
+    body_T_geom: F64  # noqa: N815 - frame notation a_T_b; (G, 4, 4)
     aabb_center: F64  # (G, 3) in the body frame
     aabb_half: F64  # (G, 3)
     pair_geom1: I64  # (Q,) geometry indices of each geometry pair

@@ -75,7 +75,7 @@ class CollisionGeometry:
     body_index: int
     element: int
     geometry: Any = field(repr=False, compare=False)
-    body_T_geometry: F64 = field(repr=False, compare=False)
+    body_T_geometry: F64 = field(repr=False, compare=False)  # noqa: N815 - a_T_b notation
     aabb_center: F64 = field(repr=False, compare=False)
     aabb_half: F64 = field(repr=False, compare=False)
     kind: str = "mesh"

@@ -37,7 +37,7 @@ class CompileResult:
     """What ``robotspec validate`` reports: the robot (if it compiled) and every warning."""
 
     loaded: LoadedSpec
-    robot: AbstractRobot | None
+    robot: AbstractRobot
     warnings: tuple[RobotSpecError, ...]
 
 
@@ -249,17 +249,16 @@ def compile_robot(
     ref: str | Path,
     *,
     package_paths: Sequence[str | Path] = (),
-    robot_class: type[AbstractRobot] | None = None,
+    robot_class: type[AbstractRobot] = AbstractRobot,
 ) -> AbstractRobot:
-    """Compile a spec file, or a shipped robot by name, into an ``AbstractRobot``."""
-    if robot_class is None:
-        from robotspec.robots import robot_class_for
+    """Compile a spec file, or a shipped robot by name, into an ``AbstractRobot``.
 
-        robot_class = robot_class_for(ref)
+    ``robot_class`` is the class built; :func:`robotspec.robots.load` picks the shipped robot's
+    own class (the compiler does not know the registry of shipped robots).
+    """
     result = _compile(
         load_spec(resolve_spec(ref)), package_paths=package_paths, robot_class=robot_class
     )
-    assert result.robot is not None
     return result.robot
 
 
@@ -282,5 +281,4 @@ def compile_spec_for_world(
         world=world,
         robot_class=robot_class,
     )
-    assert result.robot is not None
     return result.robot

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -13,9 +12,8 @@ from robotspec.semantic import JointState
 from robotspec.spec.load import LoadedSpec
 from robotspec.spec.models import RobotSpec
 
-__all__ = ["AXIS_TOL", "UNIT_TOL", "Build", "moved_by", "subtree_joints", "unit_norm"]
+__all__ = ["AXIS_TOL", "Build", "moved_by", "subtree_joints"]
 
-UNIT_TOL = 1e-3
 AXIS_TOL = 1e-3
 
 
@@ -96,11 +94,6 @@ class Build:
             return self.world.get_connection_by_name(name)
         self.diag.not_found(loc, "joint", name, self.world.connection_names, self.where)
         return None
-
-
-def unit_norm(v: tuple[float, ...]) -> float:
-    """Euclidean norm of a spec's vector or quaternion (tuples, not arrays, in specs)."""
-    return math.sqrt(sum(x * x for x in v))
 
 
 def moved_by(world: World, connections: list[Connection]) -> set[str]:

@@ -8,16 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robotspec.compiler.context import (
-    AXIS_TOL,
-    UNIT_TOL,
-    Build,
-    moved_by,
-    subtree_joints,
-    unit_norm,
-)
+from robotspec.compiler.context import AXIS_TOL, Build, moved_by, subtree_joints
 from robotspec.compiler.joints import check_states
 from robotspec.diagnostics import Loc
+from robotspec.model.geometry import UNIT_TOL, unit_norm
 from robotspec.model.world import Body
 from robotspec.semantic import front_facing_axis_of
 from robotspec.spec.models import (

@@ -18,7 +18,6 @@ from typing import Any
 from lxml import etree
 from pydantic import ValidationError
 
-from robotspec.compiler.context import UNIT_TOL, unit_norm
 from robotspec.compose.naming import PartNames
 from robotspec.compose.semantics import NAMED_SECTIONS, remap_marks, rename_semantics
 from robotspec.compose.srdf_merge import merge_srdfs, rename_srdf
@@ -35,6 +34,7 @@ from robotspec.diagnostics import Diagnostics, Loc
 from robotspec.errors import RobotSpecError, SpecError
 from robotspec.files.packages import PackageResolver
 from robotspec.files.yamlio import LocatedYaml, validation_errors
+from robotspec.model.geometry import UNIT_TOL, unit_norm
 from robotspec.shipped import shipped_part_files, shipped_spec_files
 from robotspec.spec.load import LoadedSpec, load_spec, merge_data
 from robotspec.spec.models import AttachSpec, DescriptionSpec, PartSpec, RobotSpec

@@ -23,7 +23,7 @@ from robotspec.description.srdf import (
     Srdf,
 )
 
-__all__ = ["group_owner", "merge_srdfs", "rename_srdf"]
+__all__ = ["merge_srdfs", "rename_srdf"]
 
 
 def rename_srdf(srdf: Srdf, n: PartNames, *, keep_virtual: bool, keep_collisions: bool) -> Srdf:
@@ -111,12 +111,3 @@ def merge_srdfs(robot_name: str, parts: Sequence[Srdf]) -> Srdf:
         disable_default_collisions=tuple(d for s in parts for d in s.disable_default_collisions),
         enabled_collisions=tuple(e for s in parts for e in s.enabled_collisions),
     )
-
-
-def group_owner(parts: Sequence[tuple[str, Srdf]]) -> dict[str, list[str]]:
-    """Which parts define each group name (for clash errors naming both parts)."""
-    out: dict[str, list[str]] = {}
-    for part, srdf in parts:
-        for g in srdf.groups:
-            out.setdefault(g.name, []).append(part)
-    return out

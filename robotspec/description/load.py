@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from robotspec.description.urdf import MeshPolicy, read_description_xml, world_from_urdf_xml
 from robotspec.errors import DescriptionError, RobotSpecError, missing_file
-from robotspec.model.world import ConnectionType, World
+from robotspec.model.world import World
 
 if TYPE_CHECKING:
     from lxml import etree
@@ -23,13 +23,6 @@ if TYPE_CHECKING:
     from robotspec.files.packages import PackageResolver
 
 __all__ = ["Description", "load_description", "read_urdf_tree"]
-
-#: SRDF virtual joint types and the world connection each becomes.
-VIRTUAL_JOINT_TYPES = {
-    "planar": ConnectionType.PLANAR,
-    "floating": ConnectionType.FLOATING,
-    "fixed": ConnectionType.FIXED,
-}
 
 
 @dataclass(frozen=True)
@@ -41,11 +34,6 @@ class Description:
     srdf: Srdf | None
     resolver: PackageResolver = field(repr=False)
     warnings: tuple[RobotSpecError, ...] = ()
-
-    @property
-    def urdf_world(self) -> World:
-        """The world as the URDF alone describes it (kept for symmetry; same as ``world``)."""
-        return self.world
 
 
 def resolve_file(

@@ -1,4 +1,4 @@
-"""Read, check and write MoveIt SRDF files (Semantic Robot Description Format).
+"""Read and check MoveIt SRDF files (Semantic Robot Description Format).
 
 Why our own reader: srdfdom is C++ and ROS-only, and its Python port drops line numbers and logs
 problems instead of reporting them. This module parses the element tree safely (``xmlsafe``),
@@ -9,7 +9,8 @@ Two dialects are read. MoveIt's (``disable_collisions``, ``disable_default_colli
 ``enable_collisions``) and the Giskard one used by the semantic-digital-twin reference, whose
 ``disable_all_collisions link=`` and ``disable_self_collision link1= link2=`` are read as aliases
 of MoveIt's tags. Elements MoveIt does not know (pinocchio's ``rotor_params``, ``specificities``,
-``gripper``) are ignored, as MoveIt ignores them. The writer always writes MoveIt's dialect.
+``gripper``) are ignored, as MoveIt ignores them. The writer (:mod:`robotspec.export.srdf`)
+always writes MoveIt's dialect.
 
 Problems come in two grades. A malformed file (a missing required attribute, a number that is not
 a number, an unknown virtual joint type, two groups of one name, groups that contain each other)
@@ -56,7 +57,6 @@ __all__ = [
     "check_srdf_references",
     "load_srdf",
     "parse_srdf_bytes",
-    "write_srdf",
 ]
 
 #: The virtual joint types MoveIt knows (srdfdom compares them lower-cased).
@@ -702,62 +702,3 @@ def check_srdf_against(
             unique.append(err)
     unique.sort(key=_line_key)
     return unique
-
-
-# --------------------------------------------------------------------------------------------
-# Writing
-
-
-def write_srdf(srdf: Srdf) -> str:
-    """The SRDF as MoveIt writes it: one element kind after another, four-space indentation.
-
-    Deterministic (the records' order is kept), always in MoveIt's dialect, and read back by
-    :func:`parse_srdf_bytes` into an equal value (except ``file`` and line numbers).
-    """
-    root = etree.Element("robot", name=srdf.robot_name)
-    for g in srdf.groups:
-        el = etree.SubElement(root, "group", name=g.name)
-        for link in g.links:
-            etree.SubElement(el, "link", name=link)
-        for joint in g.joints:
-            etree.SubElement(el, "joint", name=joint)
-        for c in g.chains:
-            etree.SubElement(el, "chain", base_link=c.base_link, tip_link=c.tip_link)
-        for sub in g.subgroups:
-            etree.SubElement(el, "group", name=sub)
-    for s in srdf.group_states:
-        el = etree.SubElement(root, "group_state", name=s.name)
-        if s.group is not None:
-            el.set("group", s.group)
-        for joint, values in s.joint_values:
-            etree.SubElement(el, "joint", name=joint, value=" ".join(repr(v) for v in values))
-    for e in srdf.end_effectors:
-        el = etree.SubElement(
-            root, "end_effector", name=e.name, parent_link=e.parent_link, group=e.group
-        )
-        if e.parent_group is not None:
-            el.set("parent_group", e.parent_group)
-    for v in srdf.virtual_joints:
-        etree.SubElement(
-            root,
-            "virtual_joint",
-            name=v.name,
-            type=v.type,
-            parent_frame=v.parent_frame,
-            child_link=v.child_link,
-        )
-    for p in srdf.passive_joints:
-        etree.SubElement(root, "passive_joint", name=p.name)
-    for d in srdf.disable_default_collisions:
-        etree.SubElement(root, "disable_default_collisions", link=d.link)
-    tagged: list[tuple[EnabledCollision | DisabledCollision, str]] = [
-        *((e, "enable_collisions") for e in srdf.enabled_collisions),
-        *((d, "disable_collisions") for d in srdf.disabled_collisions),
-    ]
-    for pair, tag in tagged:
-        el = etree.SubElement(root, tag, link1=pair.link1, link2=pair.link2)
-        if pair.reason is not None:
-            el.set("reason", pair.reason)
-    etree.indent(root, space="    ")
-    body = etree.tostring(root, encoding="unicode")
-    return f'<?xml version="1.0"?>\n{body}\n'

@@ -9,9 +9,12 @@ disabled collision pairs and bodies with their reasons.
 
 from __future__ import annotations
 
+from lxml import etree
+
 from robotspec.description.srdf import (
     DisabledCollision,
     DisableDefaultCollisions,
+    EnabledCollision,
     EndEffector,
     Group,
     GroupChain,
@@ -22,7 +25,7 @@ from robotspec.description.srdf import (
 )
 from robotspec.semantic import AbstractRobot, Finger
 
-__all__ = ["WHOLE_ROBOT_GROUP", "srdf_from_robot"]
+__all__ = ["WHOLE_ROBOT_GROUP", "srdf_from_robot", "write_srdf"]
 
 #: The group that robot-level states (not owned by one part) are written against.
 WHOLE_ROBOT_GROUP = "whole_robot"
@@ -121,3 +124,59 @@ def _parent_link(robot: AbstractRobot, body: str) -> str:
     """The link above a manipulator that no chain carries (MoveIt needs a parent link)."""
     conn = robot.world.parent_connection(body)
     return body if conn is None else robot.world.bodies[conn.parent].name
+
+
+def write_srdf(srdf: Srdf) -> str:
+    """The SRDF as MoveIt writes it: one element kind after another, four-space indentation.
+
+    Deterministic (the records' order is kept), always in MoveIt's dialect, and read back by
+    :func:`robotspec.description.srdf.parse_srdf_bytes` into an equal value (except ``file``
+    and line numbers).
+    """
+    root = etree.Element("robot", name=srdf.robot_name)
+    for g in srdf.groups:
+        el = etree.SubElement(root, "group", name=g.name)
+        for link in g.links:
+            etree.SubElement(el, "link", name=link)
+        for joint in g.joints:
+            etree.SubElement(el, "joint", name=joint)
+        for c in g.chains:
+            etree.SubElement(el, "chain", base_link=c.base_link, tip_link=c.tip_link)
+        for sub in g.subgroups:
+            etree.SubElement(el, "group", name=sub)
+    for s in srdf.group_states:
+        el = etree.SubElement(root, "group_state", name=s.name)
+        if s.group is not None:
+            el.set("group", s.group)
+        for joint, values in s.joint_values:
+            etree.SubElement(el, "joint", name=joint, value=" ".join(repr(v) for v in values))
+    for e in srdf.end_effectors:
+        el = etree.SubElement(
+            root, "end_effector", name=e.name, parent_link=e.parent_link, group=e.group
+        )
+        if e.parent_group is not None:
+            el.set("parent_group", e.parent_group)
+    for v in srdf.virtual_joints:
+        etree.SubElement(
+            root,
+            "virtual_joint",
+            name=v.name,
+            type=v.type,
+            parent_frame=v.parent_frame,
+            child_link=v.child_link,
+        )
+    for p in srdf.passive_joints:
+        etree.SubElement(root, "passive_joint", name=p.name)
+    for d in srdf.disable_default_collisions:
+        etree.SubElement(root, "disable_default_collisions", link=d.link)
+    tagged: list[tuple[EnabledCollision | DisabledCollision, str]] = [
+        *((e, "enable_collisions") for e in srdf.enabled_collisions),
+        *((d, "disable_collisions") for d in srdf.disabled_collisions),
+    ]
+    for pair, tag in tagged:
+        el = etree.SubElement(root, tag, link1=pair.link1, link2=pair.link2)
+        if pair.reason is not None:
+            el.set("reason", pair.reason)
+    etree.indent(root, space="    ")
+    body = etree.tostring(root, encoding="unicode")
+    return f'<?xml version="1.0"?>\n{body}\n'

@@ -87,8 +87,7 @@ def bundle(
     """
     import yaml
 
-    from robotspec.description.srdf import write_srdf
-    from robotspec.export.srdf import srdf_from_robot
+    from robotspec.export.srdf import srdf_from_robot, write_srdf
 
     robot = result.robot
     assert robot is not None

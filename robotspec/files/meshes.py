@@ -28,7 +28,7 @@ def read_triangles(
         raise error_type("mesh file not found", file=path, kind="mesh") from None
     except OSError as exc:
         raise error_type(f"cannot read mesh: {exc.strerror}", file=path, kind="mesh") from None
-    except Exception as exc:  # trimesh and its readers raise anything on a corrupt file
+    except Exception as exc:  # noqa: BLE001 - trimesh's readers raise anything on a corrupt file
         raise error_type(
             f"cannot read mesh: {type(exc).__name__}: {exc}", file=path, kind="mesh"
         ) from None

@@ -299,7 +299,7 @@ def process_xacro(
             raise DescriptionError(
                 "xacro recursion too deep (a macro or include calls itself)", file=str(top)
             ) from None
-        except Exception as exc:  # xacro raises anything; all become ours
+        except Exception as exc:  # noqa: BLE001 - xacro raises anything; all become ours
             raise _convert(exc, xacro, top) from None
         finally:
             xacro.filestack = None

@@ -19,6 +19,7 @@ from typing import Annotated, Any, Union, get_args, get_origin
 import yaml
 from pydantic import BaseModel, ValidationError
 
+from robotspec.diagnostics import loc_text
 from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names, missing_file
 
 __all__ = ["LocatedYaml", "load_yaml", "load_yaml_text", "validation_errors"]
@@ -198,16 +199,6 @@ def load_yaml(path: str | Path) -> LocatedYaml:
     return load_yaml_text(text, file=str(path))
 
 
-def _loc_text(loc: Sequence[str | int]) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += f".{part}" if out else str(part)
-    return out
-
-
 def _leaves(annotation: Any) -> list[Any]:
     """An annotation without its wrappers: Annotated, Optional and unions flattened."""
     origin = get_origin(annotation)
@@ -265,7 +256,7 @@ def validation_errors(
         # Pydantic appends union member names and function tags to locs; keep real keys only.
         real_loc = _strip_to_document(loc, doc)
         full_loc = (*loc_prefix, *real_loc)
-        where = _loc_text(full_loc) or "(document)"
+        where = loc_text(full_loc) or "(document)"
         kind = err["type"]
         if kind == "extra_forbidden":
             key = str(real_loc[-1]) if real_loc else "?"
@@ -292,7 +283,7 @@ def validation_errors(
             continue
         line, col = doc.position(real_loc)
         if kind == "missing" and real_loc:
-            parent = _loc_text((*loc_prefix, *real_loc[:-1])) or "(document)"
+            parent = loc_text((*loc_prefix, *real_loc[:-1])) or "(document)"
             errors.append(
                 error_type(
                     f"{parent}: missing required key '{real_loc[-1]}'",

@@ -27,6 +27,8 @@ __all__ = [
     "matrix_to_rpy",
     "quaternion_to_matrix",
     "rpy_to_matrix",
+    "UNIT_TOL",
+    "unit_norm",
 ]
 
 Matrix = NDArray[np.float64]
@@ -162,3 +164,12 @@ class Shape:
     name: str | None = None
     line: int | None = None
     rgba: tuple[float, float, float, float] | None = None
+
+
+UNIT_TOL = 1e-3
+"""How far from 1 a spec's unit vector or quaternion may be (specs are typed by hand)."""
+
+
+def unit_norm(v: tuple[float, ...]) -> float:
+    """Euclidean norm of a spec's vector or quaternion (tuples, not arrays, in specs)."""
+    return math.sqrt(sum(x * x for x in v))

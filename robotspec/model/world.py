@@ -443,9 +443,24 @@ class World:
             dofs[d.index] = replace(d, velocity=min(d.velocity, float(value)))
         self._dofs = tuple(dofs)
 
+    def default_configuration(self) -> np.ndarray:
+        """The robot's one default pose, MoveIt's: 0 where the limits allow it, else mid-range.
+
+        An unbounded DOF whose range excludes 0 takes its finite limit. Collision sampling,
+        pictures and named states all start here, so "default" means one thing everywhere.
+        """
+        q = np.zeros(len(self._dofs), dtype=np.float64)
+        for d in self._dofs:
+            if d.lower > 0.0 or d.upper < 0.0:
+                if d.is_bounded:
+                    q[d.index] = (d.lower + d.upper) / 2.0
+                else:
+                    q[d.index] = d.lower if math.isfinite(d.lower) else d.upper
+        return q
+
     def configuration(self, values: Mapping[str, float] | None = None) -> np.ndarray:
-        """A configuration vector: zeros (clipped into limits), with ``values`` by DOF name."""
-        q = np.array([min(max(0.0, d.lower), d.upper) for d in self._dofs], dtype=np.float64)
+        """A configuration vector: the default pose, with ``values`` set by DOF name."""
+        q = self.default_configuration()
         for name, v in (values or {}).items():
             q[self.get_degree_of_freedom_by_name(name).index] = v
         return q

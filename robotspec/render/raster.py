@@ -12,7 +12,6 @@ interpolated for depth, and the nearest fragment per pixel wins across chunks of
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -219,12 +218,3 @@ def parse_size(text: str) -> tuple[int, int]:
             name="size",
         )
     return w, h
-
-
-def segments_to_pixels(
-    camera: ViewCamera, starts: Sequence[Sequence[float]], ends: Sequence[Sequence[float]]
-) -> tuple[F64, F64]:
-    """Pixel positions (N, 2) of segment end points through ``camera``."""
-    a = camera.project(np.asarray(starts, dtype=np.float64))[:, :2]
-    b = camera.project(np.asarray(ends, dtype=np.float64))[:, :2]
-    return a, b

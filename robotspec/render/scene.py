@@ -135,9 +135,7 @@ def _robot_size(robot: AbstractRobot, kin: Kinematics, parts: Sequence[Part]) ->
 
 def default_q(robot: AbstractRobot) -> F64:
     """The configuration the robot is shown in without a state (MoveIt's default pose)."""
-    from robotspec.collision.sampling import default_configuration
-
-    return default_configuration(robot.world)
+    return robot.world.default_configuration()
 
 
 def build_scene(

@@ -290,7 +290,7 @@ class RobotViewer:
             self._refresh_pairs(q)
 
     def _apply_state(self, name: str) -> None:
-        from robotspec.collision.sampling import state_configuration
+        from robotspec.semantic.states import state_configuration
 
         states = () if name.startswith("(") else (name,)
         q = state_configuration(self.robot, states)

@@ -12,7 +12,7 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING
 
 from robotspec.errors import KinematicsError, NotFoundError
 from robotspec.model.world import Body, Connection, World
@@ -64,9 +64,6 @@ class AbstractRobot:
     srdf: Srdf | None = field(default=None, kw_only=True, repr=False)
     drive_type: str = field(default="fixed", kw_only=True)
     controlled_joint_names: tuple[str, ...] | None = field(default=None, kw_only=True)
-
-    #: The shipped spec a subclass compiles in ``from_world`` (set by robotspec.robots).
-    spec_name: ClassVar[str | None] = None
 
     # ----------------------------------------------------------------------- structure
     @property
@@ -250,12 +247,16 @@ class AbstractRobot:
 
     @classmethod
     def from_world(cls, world: World) -> AbstractRobot:
-        """Build the robot over ``world`` from its shipped spec (subclasses set ``spec_name``)."""
-        if cls.spec_name is None:
-            raise TypeError(f"{cls.__name__} has no spec; use robotspec.compile_robot(spec, world)")
-        from robotspec.compiler import compile_spec_for_world
+        """Build the robot over ``world``: the seed leaves this to subclasses.
 
-        return compile_spec_for_world(cls.spec_name, world, robot_class=cls)
+        The semantic model never calls the compiler (it sits below it); the shipped robots
+        (:mod:`robotspec.robots`) implement it with their spec, and any spec does the same
+        through :func:`robotspec.compile_spec_for_world`.
+        """
+        raise TypeError(
+            f"{cls.__name__} has no spec of its own; use "
+            f"robotspec.compile_spec_for_world(spec, world) or a class of robotspec.robots"
+        )
 
     def __hash__(self) -> int:
         return hash((type(self).__name__, tuple(sorted(b.name for b in self.bodies))))

@@ -1,6 +1,6 @@
 """Drafting from files: load the robot, write portable references, decide, render.
 
-Shared by ``robotspec init`` and the robot zoo (``robotspec.spec.zoo``), so the zoo checks the
+Shared by ``robotspec init`` and the robot zoo (``tools/zoo.py``), so the zoo checks the
 very drafts users get.
 """
 

@@ -70,7 +70,7 @@ class Tree:
                 moves_below[c.parent] = True
         self._moves_below = moves_below
         self.inside = {b.index for b in world.subtree(root)}
-        self.poses = Kinematics(world).forward(world.configuration())
+        self.poses = Kinematics(world).forward(world.default_configuration())
         self._root_inv = np.linalg.inv(self.poses[root.index])
         self.segments = self._segments()
 

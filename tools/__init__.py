@@ -1,0 +1,1 @@
+"""Developer tools of the robotspec repository (not part of the package or its wheel)."""

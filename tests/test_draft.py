@@ -295,3 +295,84 @@ def test_no_machine_path_in_a_draft(capsys: pytest.CaptureFixture[str], tmp_path
     assert "file://" not in text and str(Path.home()) not in text and str(tmp_path) not in text
     assert str(robots) not in text and "templates" not in text.split("robotspec: 1")[0]
     assert "robotspec templates" not in text
+
+
+# ------------------------------------------------------------ SRDF forms, shared robots
+
+
+HOME = {1: 0.1, 2: 0.1, 3: 0.1, 4: -1.0, 5: 0.1, 6: 1.0, 7: 0.1}
+
+
+def test_srdf_groups_of_links_and_subgroups(tmp_path: Path) -> None:
+    # Every group form: links make the arm, subgroups a whole-robot group whose state is split.
+    robots = erd_robots()
+    srdf = tmp_path / "panda_links.srdf"
+    links = "".join(f'<link name="panda_link{i}"/>' for i in range(1, 8))
+    srdf.write_text(
+        '<robot name="panda">'
+        f'<group name="manipulator">{links}</group>'
+        '<group name="fingers"><joint name="panda_finger_joint1"/>'
+        '<joint name="panda_finger_joint2"/></group>'
+        '<group name="whole"><group name="manipulator"/><group name="fingers"/></group>'
+        '<group_state name="home" group="whole">'
+        + "".join(f'<joint name="panda_joint{i}" value="{v}"/>' for i, v in HOME.items())
+        + '<joint name="panda_finger_joint1" value="0.02"/></group_state>'
+        '<end_effector name="gripper" parent_link="panda_link8" group="fingers"'
+        ' parent_group="manipulator"/>'
+        "</robot>"
+    )
+    draft, _ = draft_from_files(
+        str(robots / "panda_description/urdf/panda.urdf"), str(srdf), folder=tmp_path
+    )
+    out = tmp_path / "d.yaml"
+    out.write_text(render_draft(draft))
+    check_spec(out)
+    (chain,) = draft.chains
+    assert (chain.name, chain.root, chain.tip) == ("manipulator", "panda_link0", "panda_link7")
+    assert chain.group is None  # not one <chain>: written as root and tip
+    assert chain.states == {"home": {f"panda_joint{i}": v for i, v in HOME.items()}}
+    (m,) = draft.manipulators
+    assert (m.name, m.is_gripper, m.root) == ("gripper", True, "panda_hand")
+    assert chain.manipulator == "gripper"
+    assert m.states == {"home": {"panda_finger_joint1": 0.02}}
+
+
+def test_pr2_from_its_tree_alone_matches_the_hand_written_parts(tmp_path: Path) -> None:
+    # The xacro-made PR2 without any SRDF: torso, neck and arms as specs/pr2.yaml has them.
+    from .conftest import shared_path
+
+    urdf = shared_path("robots", "pr2", "pr2.urdf")
+    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, package_paths=[urdf.parent])
+    assert draft.torso is not None and (draft.torso.root, draft.torso.tip) == (
+        "base_link",
+        "torso_lift_link",
+    )
+    assert draft.neck is not None and (draft.neck.root, draft.neck.tip) == (
+        "torso_lift_link",
+        "head_tilt_link",
+    )
+    arms = {c.name: (c.root, c.tip) for c in draft.chains}
+    assert arms == {
+        "left_arm": ("torso_lift_link", "l_wrist_roll_link"),
+        "right_arm": ("torso_lift_link", "r_wrist_roll_link"),
+    }
+    right = next(m for m in draft.manipulators if m.name == "right_gripper")
+    assert right.finger is not None and right.finger.tip == "r_gripper_r_finger_tip_link"
+    assert draft.drive is not None and draft.drive.type == "omni"
+
+
+def test_hsrb_neck_above_a_lift(tmp_path: Path) -> None:
+    # HSR-B's head rides on a lift that mimics the arm's: the neck is the two revolute joints.
+    from .conftest import shared_path
+
+    hsrb = shared_path("robots", "hsrb")
+    draft, _ = draft_from_files(
+        str(hsrb / "hsrb4s.urdf"),
+        str(hsrb / "hsrb_moveit_config/config/hsrb.srdf"),
+        folder=tmp_path,
+        package_paths=[hsrb],
+    )
+    n = draft.neck
+    assert n is not None and (n.root, n.tip) == ("torso_lift_link", "head_tilt_link")
+    assert (n.yaw_body, n.pitch_body) == ("head_pan_link", "head_tilt_link")
+    assert "head_rgbd_sensor" in n.sensors

@@ -59,13 +59,18 @@ def _has_geometry(tree: Tree, body: Body) -> bool:
 
 
 def _finger_tip(tree: Tree, branch: Body) -> Body:
-    """The deepest body of a finger branch that a moving joint carries."""
-    best = branch
-    for b in tree.world.subtree(branch):
-        c = tree.world.parent_connection(b)
-        if c is not None and not c.is_fixed and tree.world.depth(b) > tree.world.depth(best):
-            best = b
-    return best
+    """The deepest body of a finger branch that a moving joint carries, with geometry if any.
+
+    Geometry first: PR2's xacro hangs a bare frame on a prismatic joint below the finger tip.
+    """
+    world = tree.world
+    moved = [
+        b
+        for b in world.subtree(branch)
+        if (c := world.parent_connection(b)) is not None and not c.is_fixed
+    ]
+    solid = [b for b in moved if b.collisions or b.visuals]
+    return max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
 
 
 def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
@@ -99,7 +104,7 @@ def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
         rot = np.linalg.inv(tree.poses[body.index])
         ys = [(rot @ tree.poses[t.index])[1, 3] for t in tips]
         thumb_i = 0 if ys[0] >= ys[1] else 1
-        decide = "both fingers are driven; the thumb is the one on the left"
+        decide = "both fingers are driven; the thumb is the one on the hand's +y side"
     finger_i = 1 - thumb_i
     gripper = Gripper(
         root=body,

@@ -112,31 +112,40 @@ def _rigid_root(tree: Tree, body: Body) -> Body:
 
 
 def find_neck(tree: Tree, cameras: list[CameraFound], limb_tops: list[Body]) -> NeckFound | None:
-    """The neck carrying the most cameras: 1-3 revolute joints ending a branch, cameras on top."""
+    """The neck carrying the most cameras: 1-3 revolute joints ending a branch, cameras on top.
+
+    Of a run, only its last revolute joints count; what is below them (a lift) is not the neck.
+    """
     world = tree.world
     best: tuple[int, float, NeckFound] | None = None
     for seg in tree.segments:
-        most = 4 if any(words(b.name) & HEAD_WORDS for b in seg.bodies) else 3
-        if not 1 <= len(seg.joints) <= most or tree.moving_children(seg.end):
+        if tree.moving_children(seg.end) or not seg.joints:
             continue
-        if any(c.type.value not in ("revolute", "continuous") or c.is_mimic for c in seg.joints):
+        # The run's last revolute joints (HSR-B's head sits on a lift that mimics the arm's).
+        joints: list[Connection] = []
+        for c in reversed(seg.joints):
+            if c.type.value not in ("revolute", "continuous") or c.is_mimic:
+                break
+            joints.insert(0, c)
+        most = 4 if any(words(b.name) & HEAD_WORDS for b in seg.bodies) else 3
+        if not 1 <= len(joints) <= most:
             continue
         if any(world.is_ancestor(top, seg.start) for top in limb_tops):
             continue  # on an arm (a wrist camera's pan), not a neck
-        tip = world.bodies[seg.joints[-1].child]
+        tip = world.bodies[joints[-1].child]
         carried = [c for c in cameras if world.is_ancestor(tip, c.body)]
         if not carried:
             continue
-        root = world.bodies[seg.joints[0].parent]
+        root = world.bodies[joints[0].parent]
         yaw = pitch = None
-        for c in seg.joints:
+        for c in joints:
             axis = np.abs(tree.axis_in_root(c))
             child = world.bodies[c.child]
             if axis[2] > 0.9 and yaw is None:
                 yaw = child
             elif axis[1] > 0.9 and pitch is None:
                 pitch = child
-        neck = NeckFound(root, tip, seg.joints, yaw, pitch)
+        neck = NeckFound(root, tip, tuple(joints), yaw, pitch)
         key = (len(carried), float(tree.position(tip)[2]))
         if best is None or key > best[:2]:
             best = (key[0], key[1], neck)

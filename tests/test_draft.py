@@ -317,6 +317,9 @@ def test_srdf_groups_of_links_and_subgroups(tmp_path: Path) -> None:
         '<group_state name="home" group="whole">'
         + "".join(f'<joint name="panda_joint{i}" value="{v}"/>' for i, v in HOME.items())
         + '<joint name="panda_finger_joint1" value="0.02"/></group_state>'
+        '<group_state name="bad" group="manipulator">'
+        + "".join(f'<joint name="panda_joint{i}" value="0.1"/>' for i in range(1, 8))
+        + "</group_state>"
         '<end_effector name="gripper" parent_link="panda_link8" group="fingers"'
         ' parent_group="manipulator"/>'
         "</robot>"
@@ -331,6 +334,8 @@ def test_srdf_groups_of_links_and_subgroups(tmp_path: Path) -> None:
     assert (chain.name, chain.root, chain.tip) == ("manipulator", "panda_link0", "panda_link7")
     assert chain.group is None  # not one <chain>: written as root and tip
     assert chain.states == {"home": {f"panda_joint{i}": v for i, v in HOME.items()}}
+    # A state outside a joint's limits is left out, and the draft says why.
+    assert "SRDF state 'bad' of 'manipulator' left out: 'panda_joint4'" in " ".join(draft.notes)
     (m,) = draft.manipulators
     assert (m.name, m.is_gripper, m.root) == ("gripper", True, "panda_hand")
     assert chain.manipulator == "gripper"

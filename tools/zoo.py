@@ -260,7 +260,8 @@ def zoo_page(rows: Sequence[ZooRow]) -> str:
     lines += [
         "## Every robot",
         "",
-        "| robot | SRDF | bodies | DOF | drafted chains | grippers | cameras | torso | neck |"
+        "| robot | SRDF | bodies | DOF | drafted chains | grippers of manipulators | cameras"
+        " | torso | neck |"
         " drive | valid |",
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]

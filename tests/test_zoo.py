@@ -32,17 +32,12 @@ ROBOTS = erd_robots_folder()
 ENTRIES = zoo_entries(ROBOTS) if ROBOTS is not None else []
 NAMES = [e.name for e in ENTRIES]
 
-#: Robots whose drafts do not validate today, and why (the first problem, as the page shows it).
-#: Each is a loading problem of the files, not of the draft; remove a robot here once it passes.
+#: Robots whose drafts do not validate, and why (the first problem, as the page shows it): files
+#: that do not load. A robot here that starts to validate fails the test, to be removed here.
 KNOWN_INVALID = {
     # Broken files: a <robot> without links; mimic joints that name joints the URDF lacks.
     "ur_description/ur3": "does not load: ur3.urdf: 2 problems",
     "alex_description/alex_psyonic_hands": "does not load: alex_psyonic_hands.urdf: 8 problems",
-    # Mesh URIs robotspec does not resolve yet (issue 15, item 1): 'package:///...' (an empty
-    # package name) and a 'file://' path of the authors' machine.
-    "talos_data/talos_full_v2": "package '' not found",
-    "talos_data/talos_full_v2_box": "package '' not found",
-    "romeo_description/romeo_laas_small": "outside the allowed folders",
 }
 
 _TMP = Path(tempfile.mkdtemp(prefix="robotspec-zoo-test-"))

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from robotspec.cli.geometry import check_missing_geometry, report_skipped
 from robotspec.cli.options import (
     JsonFlag,
     PackagePath,
@@ -69,13 +70,6 @@ def _values(items: list[str] | None) -> dict[str, float]:
     return out
 
 
-def _warn_skipped(skipped: tuple[Any, ...]) -> None:
-    from robotspec.cli.render import print_error
-
-    for err in skipped:
-        print_error(err)
-
-
 @collisions_app.command("check")
 def check(
     spec: SpecArg,
@@ -96,12 +90,15 @@ def check(
     from robotspec.collision import SelfCollisionChecker
 
     robot = load_robot(spec, package_path)
+    reported = check_missing_geometry(
+        robot, skip=skip_missing_meshes, collision=True, command="check collisions"
+    )
     checker = SelfCollisionChecker.from_robot(
         robot, on_missing_mesh="skip" if skip_missing_meshes else "error"
     )
     config = checker.configuration(state or (), _values(q))
     colliding = checker.colliding_pairs(config)
-    _warn_skipped(checker.skipped)
+    report_skipped(checker.skipped, reported)
     buffer = checker.rules.buffer_distance
     near = [p for p in checker.buffer_violations(config) if p not in colliding] if buffer else []
     pair_d = checker.distances(config) if distances else ()
@@ -182,6 +179,9 @@ def generate(
     robot = load_robot(spec, package_path)
     if merge and robot.srdf is None:
         raise CollisionError(f"--merge: robot '{robot.name}' has no SRDF to merge into")
+    reported = check_missing_geometry(
+        robot, skip=skip_missing_meshes, collision=True, command="generate the matrix"
+    )
     bar = Progress(0, "collision matrix", enabled=progress)
 
     def report(done: int, total: int) -> None:
@@ -197,7 +197,7 @@ def generate(
             progress=report,
             on_missing_mesh="skip" if skip_missing_meshes else "error",
         )
-    _warn_skipped(matrix.skipped)
+    report_skipped(matrix.skipped, reported)
     text = write_srdf(matrix.to_srdf(robot.srdf if merge else None, merge=True))
     write_output(text, output)
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())

@@ -173,10 +173,8 @@ def sensors(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath 
 def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """The robot's moving joints with limits; velocities tightened by the spec end in '*'."""
     robot = load_robot(spec, package_path)
-    from robotspec.description.urdf import load_urdf  # noqa: F401  (keeps import cost inside the command)
-
     w = robot.world
-    original = _urdf_velocities(robot)
+    tightened = w.loaded_velocity_limits
     items = []
     for c in robot.connections:
         if c.is_fixed:
@@ -189,9 +187,7 @@ def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
             "lower": None if dof is None or c.mimic else _num(dof.lower),
             "upper": None if dof is None or c.mimic else _num(dof.upper),
             "velocity": None if dof is None or c.mimic else _num(dof.velocity),
-            "tightened": bool(
-                dof is not None and not c.mimic and dof.velocity < original.get(dof.name, math.inf)
-            ),
+            "tightened": bool(dof is not None and not c.mimic and dof.name in tightened),
             "controlled": c in robot.controlled_connections,
         }
         items.append(item)
@@ -208,11 +204,6 @@ def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
         for i in items
     ]
     _emit(items, ["joint", "type", "lower", "upper", "velocity"], rows, as_json)
-
-
-def _urdf_velocities(robot: AbstractRobot) -> dict[str, float]:
-    """Velocity limits before the spec tightened them (from the compiler's record)."""
-    return dict(getattr(robot, "urdf_velocity_limits", {}) or {})
 
 
 @inspect_app.command("groups")

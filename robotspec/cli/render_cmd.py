@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from robotspec.cli.geometry import check_missing_geometry, report_skipped
 from robotspec.cli.options import PackagePath, SkipMeshes, SpecArg, load_robot
 
 if TYPE_CHECKING:
@@ -27,13 +28,6 @@ StateOpt = Annotated[
         show_default=False,
     ),
 ]
-
-
-def _warn(skipped: tuple[Any, ...]) -> None:
-    from robotspec.cli.render import print_error
-
-    for err in skipped:
-        print_error(err)
 
 
 @app.command("render")
@@ -70,8 +64,11 @@ def render(
         raise typer.BadParameter(f"'{view}' is not one of {', '.join(VIEWS)}", param_hint="--view")
     robot = load_robot(spec, package_path)
     q = state_configuration(robot, state or ())
+    reported = check_missing_geometry(
+        robot, skip=skip_missing_meshes, collision=False, command="render"
+    )
     scene = build_scene(robot, on_missing_mesh="skip" if skip_missing_meshes else "error")
-    _warn(scene.skipped)
+    report_skipped(scene.skipped, reported)
     title = robot.name + (f" · {', '.join(state)}" if state else "")
     picture = render_scene(
         scene, q, RenderOptions(width=width, height=height, view=view, title=title)
@@ -105,6 +102,9 @@ def view(
 
     robot = load_robot(spec, package_path)
     q = state_configuration(robot, state or ())
+    reported = check_missing_geometry(
+        robot, skip=skip_missing_meshes, collision=False, command="view"
+    )
     viewer = RobotViewer(
         robot,
         q,
@@ -112,7 +112,7 @@ def view(
         port=port,
         on_missing_mesh="skip" if skip_missing_meshes else "error",
     )
-    _warn(viewer.skipped)
+    report_skipped(viewer.skipped, reported)
     sys.stdout.write(f"viewing {robot.name} at {viewer.url} ; Ctrl-C stops\n")
     sys.stdout.flush()
     try:

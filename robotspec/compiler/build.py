@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from robotspec.compiler.assemble import Resolved, assemble
 from robotspec.compiler.context import Build, moved_by, subtree_joints
-from robotspec.compiler.joints import check_states, check_velocity
+from robotspec.compiler.joints import check_states, check_velocity, srdf_state_values
 from robotspec.compiler.parts import (
     CameraValues,
     camera_values,
@@ -171,7 +171,7 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
         for gs in b.srdf.group_states:
             if gs.group is None:
                 continue  # a group-less state (lenient SRDF read) belongs to no part
-            single = {j: v[0] for j, v in gs.joint_values if len(v) == 1}
+            single = srdf_state_values(b, gs)
             b.add_states(
                 gs.group,
                 check_states(

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -31,6 +32,7 @@ from robotspec.model.geometry import (
 
 if TYPE_CHECKING:
     from robotspec.files.packages import PackageResolver
+from robotspec.description.mesh_report import MissingMesh, summarize_missing_meshes
 from robotspec.description.urdf_check import check_urdf_tree, geometry_element, parse_floats
 from robotspec.files.xmlsafe import line_of, parse_xml_bytes
 from robotspec.model.world import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic, World
@@ -104,7 +106,8 @@ def world_from_urdf_xml(
 ) -> World:
     """Interpret a checked URDF element tree as a world; all problems are raised together.
 
-    With ``meshes="report"``, unresolvable meshes are appended to ``issues`` as warnings.
+    With ``meshes="report"``, meshes that do not resolve are kept as ``Mesh(path=None)`` and
+    summarized into ``issues`` as warnings, one per missing package (never raised).
     ``checked=True`` skips :func:`check_urdf_tree` for a tree whose pieces were checked in their
     own files already (a composed robot's parts), where its line numbers would mislead.
     """
@@ -122,17 +125,15 @@ def world_from_urdf_xml(
     link_el = {el.get("name"): el for el in root.iterfind("link")}
     joint_el = {el.get("name", ""): el for el in root.iterfind("joint")}
     problems: list[RobotSpecError] = []
+    missing: list[MissingMesh] = []
     bodies: list[Body] = []
     body_index: dict[str, int] = {}
     base = Path(file).parent
     for link in robot.links:
         el = link_el[link.name]
-        visuals = _shapes(
-            link.visuals, el.iterfind("visual"), file, base, resolver, meshes, problems
-        )
-        collisions = _shapes(
-            link.collisions, el.iterfind("collision"), file, base, resolver, meshes, problems
-        )
+        where = _Where(file, base, resolver, meshes, problems, missing, link.name)
+        visuals = _shapes(link.visuals, el.iterfind("visual"), where)
+        collisions = _shapes(link.collisions, el.iterfind("collision"), where)
         mass = None
         if link.inertial is not None and link.inertial.mass is not None:
             mass = float(link.inertial.mass)
@@ -148,6 +149,8 @@ def world_from_urdf_xml(
             )
         )
     raise_collected(problems)
+    if missing and issues is not None:
+        issues.extend(summarize_missing_meshes(missing))
     joints = {j.name: j for j in robot.joints}
     leaders = _resolve_mimics(joints, joint_el, file)
     dofs: list[DegreeOfFreedom] = []
@@ -266,20 +269,29 @@ def _resolve_mimics(
     return out
 
 
-def _shapes(
-    records: list[Any],
-    elements: Any,
-    file: str,
-    base: Path,
-    resolver: PackageResolver | None,
-    meshes: MeshPolicy,
-    problems: list[RobotSpecError],
-) -> tuple[Shape, ...]:
+@dataclass(frozen=True)
+class _Where:
+    """What resolving one link's meshes needs, and where its problems go.
+
+    ``problems`` are errors (raised together); ``missing`` are meshes that did not resolve under
+    the ``report`` policy, summarized into one warning per package once every link is read.
+    """
+
+    file: str
+    base: Path
+    resolver: PackageResolver | None
+    meshes: MeshPolicy
+    problems: list[RobotSpecError]
+    missing: list[MissingMesh]
+    body: str
+
+
+def _shapes(records: list[Any], elements: Any, where: _Where) -> tuple[Shape, ...]:
     out: list[Shape] = []
     for rec, el in zip(records, elements, strict=True):
         geom_el = geometry_element(el.find("geometry"))
         assert geom_el is not None  # checked by check_urdf_tree
-        geometry = _geometry(rec.geometry, geom_el, file, base, resolver, meshes, problems)
+        geometry = _geometry(rec.geometry, geom_el, where)
         if geometry is None:
             continue
         origin = np.eye(4) if rec.origin is None else np.asarray(rec.origin, dtype=np.float64)
@@ -300,15 +312,8 @@ def _shapes(
     return tuple(out)
 
 
-def _geometry(
-    g: Any,
-    el: etree._Element,
-    file: str,
-    base: Path,
-    resolver: PackageResolver | None,
-    meshes: MeshPolicy,
-    problems: list[RobotSpecError],
-) -> GeometryShape | None:
+def _geometry(g: Any, el: etree._Element, where: _Where) -> GeometryShape | None:
+    file, resolver, meshes = where.file, where.resolver, where.meshes
     if el.tag == "capsule":
         return Capsule(radius=float(el.get("radius", "nan")), length=float(el.get("length", "nan")))
     if g.box is not None:
@@ -332,21 +337,25 @@ def _geometry(
             raise ValueError("resolving meshes needs a PackageResolver")
         report = meshes == "report"
         try:
-            resolved = resolver.resolve(uri, relative_to=base, file=file, line=line_of(el))
+            resolved = resolver.resolve(uri, relative_to=where.base, file=file, line=line_of(el))
         except RobotSpecError as exc:
-            problems.append(exc.with_severity("warning") if report else exc)
-            return Mesh(uri=uri, path=None, scale=scale) if report else None
+            if not report:
+                where.problems.append(exc)
+                return None
+            where.missing.append(MissingMesh(uri=uri, body=where.body, error=exc))
+            return Mesh(uri=uri, path=None, scale=scale)
         if not resolved.is_file():
-            problems.append(
-                DescriptionError(
-                    f"mesh '{uri}' resolves to '{resolved}', which does not exist",
-                    file=file,
-                    line=line_of(el),
-                    kind="mesh",
-                    name=uri,
-                    severity="warning" if report else "error",
-                )
+            err = DescriptionError(
+                f"mesh '{uri}' resolves to '{resolved}', which does not exist",
+                file=file,
+                line=line_of(el),
+                kind="mesh",
+                name=uri,
             )
-            return Mesh(uri=uri, path=None, scale=scale) if report else None
+            if not report:
+                where.problems.append(err)
+                return None
+            where.missing.append(MissingMesh(uri=uri, body=where.body, error=err))
+            return Mesh(uri=uri, path=None, scale=scale)
         path = str(resolved)
     return Mesh(uri=uri, path=path, scale=scale)

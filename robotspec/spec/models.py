@@ -397,6 +397,12 @@ class ChainSpec(_Model):
         description="name of the manipulator (from `manipulators`) at its tip",
         examples=["left_gripper"],
     )
+    side: Literal["left", "right"] | None = Field(
+        default=None,
+        description="which arm of a two-arm robot this is, for `left_arm` / `right_arm`; "
+        "default: the arm lying on the root's +y side in the default pose",
+        examples=["left"],
+    )
     sensors: list[Name] = Field(
         default_factory=list,
         description="names of sensors (from `sensors`) the chain carries",

@@ -28,7 +28,14 @@ from robotspec.spec.draft.model import (
     DraftFrame,
     DraftManipulator,
 )
-from robotspec.spec.draft.naming import join, role_by_name, side_labels, side_of, unique
+from robotspec.spec.draft.naming import (
+    join,
+    named_side,
+    role_by_name,
+    side_labels,
+    side_of,
+    unique,
+)
 from robotspec.spec.draft.parts import add_drive, add_sensors, add_states, add_torso
 from robotspec.spec.draft.srdf_groups import end_effector_root, group_chains
 from robotspec.spec.draft.tree import Tree, words
@@ -113,7 +120,8 @@ class Drafter:
             group = [lb for lb in rest if lb.kind == kind]
             if not group:
                 continue
-            for lb, label in zip(group, side_labels(self.tree, group), strict=True):
+            labels, by_name = side_labels(self.tree, group)
+            for lb, label in zip(group, labels, strict=True):
                 c = DraftChain(
                     unique(join(label, kind), self.names),
                     lb.root.name,
@@ -123,6 +131,12 @@ class Drafter:
                     joints=lb.joints,
                 )
                 c.decide.append(f"{'an arm' if kind == 'arm' else 'a leg'}: {lb.why}")
+                named = named_side(lb)
+                if by_name and kind == "arm" and label in ("left", "right"):
+                    c.side = label
+                    c.decide.append("the default pose does not tell the sides; its links do")
+                elif label in ("left", "right") and named not in (None, label):
+                    c.decide.append(f"{label} by position, but its links say {named}")
                 out.append((c, lb))
         return out
 

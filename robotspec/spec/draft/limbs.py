@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from robotspec.model.entities import Body, Connection
 from robotspec.spec.draft.tree import Segment, Tree, words
 
@@ -34,6 +36,8 @@ HEAD_WORDS = frozenset({"head", "neck", "eye", "eyes", "gaze"})
 MIN_LIMB_JOINTS = 3
 #: Shortest limb (sum of joint offsets, m): fingers are shorter.
 MIN_LIMB_LENGTH = 0.2
+#: A hand reaches no farther than this from where it splits into fingers (m).
+MAX_HAND_SPAN = 0.3
 #: A leg's end is this close to the lowest point of the robot (m) ...
 FOOT_CLEARANCE = 0.1
 #: ... and this far below where the leg starts (m).
@@ -51,6 +55,15 @@ class Limb:
     joints: frozenset[str]
     segment: Segment
     why: str
+
+
+def _span(tree: Tree, body: Body) -> float:
+    """How far the subtree of ``body`` reaches from it in the default pose (m)."""
+    here = tree.position(body)
+    return max(
+        (float(np.linalg.norm(tree.position(b) - here)) for b in tree.world.subtree(body)),
+        default=0.0,
+    )
 
 
 def _named(bodies: tuple[Body, ...], vocabulary: frozenset[str]) -> bool:
@@ -92,6 +105,8 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     if cut is not None:
         hand = seg.bodies[cut]
     elif len(tree.moving_children(seg.end)) >= 2:
+        if _span(tree, seg.end) > MAX_HAND_SPAN:
+            return None  # limbs branch off here: a trunk (simple_humanoid's waist), not an arm
         hand = seg.end
     if hand is None and _named(bodies, HEAD_WORDS) and not _named(bodies, ARM_WORDS):
         return None  # a head (see sensors.find_neck)

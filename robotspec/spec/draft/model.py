@@ -69,6 +69,7 @@ class DraftChain:
     manipulator: str | None = None
     sensors: list[str] = field(default_factory=list)
     states: dict[str, JointState] = field(default_factory=dict)
+    side: str | None = None  # written only when the default pose cannot tell the sides
     yaw_body: str | None = None
     pitch_body: str | None = None
     #: Actuated (non-mimic) joints between root and tip; the chain's identity when comparing.

@@ -6,10 +6,12 @@ is +y); when the pose cannot tell (shoulders at one point), from the limbs' own 
 
 from __future__ import annotations
 
+import numpy as np
+
 from robotspec.spec.draft.limbs import LEG_WORDS, Limb, is_named
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["join", "role_by_name", "side_labels", "side_of", "unique"]
+__all__ = ["join", "named_side", "role_by_name", "side_labels", "side_of", "unique"]
 
 
 def unique(name: str, taken: set[str]) -> str:
@@ -22,17 +24,31 @@ def unique(name: str, taken: set[str]) -> str:
     return out
 
 
-def side_labels(tree: Tree, limbs: list[Limb]) -> list[str]:
-    """``left``/``right`` (``front``/``hind`` too for four legs) by position in the default pose."""
+#: Two limbs whose mean lateral positions differ by less than this (m) have no side by position
+#: (the compiler's rule for ``left_arm`` / ``right_arm``, robotspec.semantic.sides).
+SIDE_TOLERANCE = 1e-6
+
+
+def _mean_position(tree: Tree, limb: Limb) -> np.ndarray:
+    """Mean position of a limb's bodies below its root, in the root's frame, default pose."""
+    bodies = tree.world.compute_chain_of_kinematic_structure_entities(limb.root, limb.tip)[1:]
+    mean: np.ndarray = np.mean([tree.position(b) for b in bodies or [limb.tip]], axis=0)
+    return mean
+
+
+def side_labels(tree: Tree, limbs: list[Limb]) -> tuple[list[str], bool]:
+    """Labels by position in the default pose, and whether they came from names instead.
+
+    ``left``/``right`` for two limbs (left: +y of the root, as the compiler decides), ``front``/
+    ``hind`` too for four legs; when the pose cannot tell two limbs apart, ``left``/``right`` from
+    their links' names (and the draft then declares ``side:``); else numbers.
+    """
     if len(limbs) == 1:
-        return [""]
-    pos = [tree.position(tree.world.bodies[lb.segment.joints[0].child]) for lb in limbs]
+        return [""], False
+    pos = [_mean_position(tree, lb) for lb in limbs]
     ys = [float(p[1]) for p in pos]
-    if max(ys) - min(ys) < 1e-3:  # shoulders at one point (joint offsets all zero): the tips
-        pos = [tree.position(lb.tip) for lb in limbs]
-        ys = [float(p[1]) for p in pos]
-    if len(limbs) == 2 and abs(ys[0] - ys[1]) > 1e-3:
-        return ["left", "right"] if ys[0] > ys[1] else ["right", "left"]
+    if len(limbs) == 2 and abs(ys[0] - ys[1]) >= SIDE_TOLERANCE:
+        return (["left", "right"] if ys[0] > ys[1] else ["right", "left"]), False
     if len(limbs) == 4:
         xs = [float(p[0]) for p in pos]
         mx, my = sum(xs) / 4, sum(ys) / 4
@@ -41,13 +57,13 @@ def side_labels(tree: Tree, limbs: list[Limb]) -> list[str]:
             for x, y in zip(xs, ys, strict=True)
         ]
         if len(set(labels)) == 4:
-            return labels
+            return labels, False
     if len(limbs) == 2:  # no side by position: the robot's own words, if it has them
-        sides = [_named_side(lb) for lb in limbs]
+        sides = [named_side(lb) for lb in limbs]
         if sorted(s for s in sides if s) == ["left", "right"]:
-            return [s or "" for s in sides]
+            return [s or "" for s in sides], True
     order = sorted(range(len(limbs)), key=lambda i: -ys[i])
-    return [str(order.index(i) + 1) for i in range(len(limbs))]
+    return [str(order.index(i) + 1) for i in range(len(limbs))], False
 
 
 def role_by_name(group: str) -> str:
@@ -57,7 +73,7 @@ def role_by_name(group: str) -> str:
     return "arm" if "arm" in words(group) else "chain"
 
 
-def _named_side(limb: Limb) -> str | None:
+def named_side(limb: Limb) -> str | None:
     """``left`` or ``right`` when the limb's links say so (``left_hand``, ``l_wrist``)."""
     for b in limb.segment.bodies:
         w = words(b.name)

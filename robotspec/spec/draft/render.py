@@ -103,6 +103,8 @@ def _chain_body(out: list[str], c: DraftChain, indent: str) -> None:
     if c.role in ("leg", "chain"):
         what = "a leg" if c.role == "leg" else "no hand found"
         out.append(f"{indent}kind: chain  # {what}")
+    if c.side is not None:
+        out.append(f"{indent}side: {c.side}")
     if c.yaw_body is not None:
         out.append(f"{indent}yaw_body: {scalar(c.yaw_body)}")
     if c.pitch_body is not None:

@@ -235,6 +235,7 @@ def zoo_page(rows: Sequence[ZooRow]) -> str:
         "matches pinocchio's forward kinematics on random configurations.",
         "",
         f"{len(rows)} robots; {loaded} load; {ok} drafts validate as written (warnings allowed).",
+        "Where a draft does not validate, the column `valid` shows the first problem.",
         "",
     ]
     compared = [r for r in rows if r.compared is not None]

@@ -381,3 +381,20 @@ def test_hsrb_neck_above_a_lift(tmp_path: Path) -> None:
     assert n is not None and (n.root, n.tip) == ("torso_lift_link", "head_tilt_link")
     assert (n.yaw_body, n.pitch_body) == ("head_pan_link", "head_tilt_link")
     assert "head_rgbd_sensor" in n.sensors
+
+
+def test_linkage_gripper_of_tiago_pro(tmp_path: Path) -> None:
+    # Robotiq-style: four branches (inner and outer links, two a side) moved by one actuator.
+    d, _ = _draft("tiago_pro_description/robots/tiago_pro.urdf", None, tmp_path)
+    left = next(m for m in d.manipulators if m.name == "left_gripper")
+    assert left.is_gripper
+    # The thumb is the side holding the driven joint (gripper_left_finger_joint).
+    assert left.thumb is not None and left.thumb.tip == "gripper_left_fingertip_left_link"
+    assert left.finger is not None and left.finger.tip == "gripper_left_fingertip_right_link"
+
+
+def test_a_one_motor_hand_with_a_thumb_is_not_a_gripper(tmp_path: Path) -> None:
+    d, _ = _draft(
+        "romeo_description/urdf/romeo.urdf", "romeo_description/srdf/romeo.srdf", tmp_path
+    )
+    assert not any(m.is_gripper for m in d.manipulators)

@@ -73,6 +73,44 @@ def _finger_tip(tree: Tree, branch: Body) -> Body:
     return max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
 
 
+def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | None:
+    """Finger branches grouped into two sides of the hand, or ``None`` if they are not two sides.
+
+    Two branches are two sides. A linkage gripper (Robotiq's, on Tiago Pro) has two branches a
+    side, an inner and an outer link: each branch goes to the side of the farther-apart pair of
+    tips it is nearer to, and a side holds at most two.
+    """
+    if len(branches) == 2:
+        return [[branches[0]], [branches[1]]]
+    if len(branches) != 4:
+        return None
+    world = tree.world
+    dofs = {
+        d
+        for k in branches
+        for b in world.subtree(k)
+        if (c := world.parent_connection(b)) is not None
+        for d in c.dofs
+    }
+    if len(dofs) != 1:
+        return None  # a linkage moves with one actuator; several make a hand of fingers
+    if any("thumb" in b.name.lower() for k in branches for b in world.subtree(k)):
+        return None  # a one-motor hand with a thumb and three fingers (Romeo's) is a hand
+    inv = np.linalg.inv(tree.poses[root.index])
+    at = {b.index: (inv @ tree.poses[_finger_tip(tree, b).index])[:3, 3] for b in branches}
+    pairs = [(a, b) for i, a in enumerate(branches) for b in branches[i + 1 :]]
+    a, b = max(pairs, key=lambda p: float(np.linalg.norm(at[p[0].index] - at[p[1].index])))
+    sides: list[list[Body]] = [[a], [b]]
+    for k in branches:
+        if k is a or k is b:
+            continue
+        near_a = np.linalg.norm(at[k.index] - at[a.index]) <= np.linalg.norm(
+            at[k.index] - at[b.index]
+        )
+        sides[0 if near_a else 1].append(k)
+    return sides if all(len(side) == 2 for side in sides) else None
+
+
 def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
     """A parallel gripper at or below ``hand``, or ``None`` and why not."""
     world = tree.world
@@ -83,24 +121,29 @@ def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
             break
         body = kids[0]
     branches = [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
-    if len(branches) != 2:
+    sides = _sides(tree, body, branches)
+    if sides is None:
         if not branches:
             return None, "no finger branches below it"
-        return None, f"{len(branches)} finger branches below '{body.name}', not two"
-    tips = [_finger_tip(tree, k) for k in branches]
-    leaders = []
-    for tip in tips:
-        first = next(
-            c
-            for c in world.compute_chain_of_connections(body, tip)
-            if not c.is_fixed  # the branch moves, so one of its joints does
+        return None, f"{len(branches)} finger branches below '{body.name}', not two sides"
+    # A side's tip is its deepest moving link; it is driven when one of its joints is not a mimic.
+    tips: list[Body] = []
+    leaders: list[bool] = []
+    for side in sides:
+        ends = [_finger_tip(tree, k) for k in side]
+        tips.append(max(ends, key=lambda b: (world.depth(b), -b.index)))
+        leaders.append(
+            any(
+                c.is_active
+                for k in side
+                for c in world.compute_chain_of_connections(body, _finger_tip(tree, k))
+            )
         )
-        leaders.append(first.is_active)
     decide = None
     if leaders[0] != leaders[1]:
         thumb_i = 0 if leaders[0] else 1
     else:
-        # Neither mimics the other: the thumb is the finger on the left seen from the hand.
+        # Neither mimics the other: the thumb is the finger on the hand's +y side.
         rot = np.linalg.inv(tree.poses[body.index])
         ys = [(rot @ tree.poses[t.index])[1, 3] for t in tips]
         thumb_i = 0 if ys[0] >= ys[1] else 1

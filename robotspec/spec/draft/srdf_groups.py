@@ -29,8 +29,21 @@ class GroupChain:
     single_chain: bool  # the group is exactly one <chain> (the spec may then name the group)
 
 
-def joint_set(world: World, srdf: Srdf, name: str, seen: frozenset[str] = frozenset()) -> set[str]:
-    """Every joint of group ``name`` that the world has, subgroups included (cycles cut)."""
+def joint_set(
+    world: World,
+    srdf: Srdf,
+    name: str,
+    seen: frozenset[str] = frozenset(),
+    memo: dict[str, frozenset[str]] | None = None,
+) -> set[str]:
+    """Every joint of group ``name`` that the world has, subgroups included (cycles cut).
+
+    ``memo`` keeps each group's joints once computed, so groups shared by many others (a
+    diamond of subgroups) cost one walk each, not one per path to them.
+    """
+    memo = {} if memo is None else memo
+    if name in memo:
+        return set(memo[name])
     groups = {g.name: g for g in srdf.groups}
     g = groups.get(name)
     if g is None or name in seen:
@@ -47,7 +60,8 @@ def joint_set(world: World, srdf: Srdf, name: str, seen: frozenset[str] = frozen
             if world.is_ancestor(base, tip):
                 out.update(c.name for c in world.compute_chain_of_connections(base, tip))
     for sub in g.subgroups:
-        out |= joint_set(world, srdf, sub, seen | {name})
+        out |= joint_set(world, srdf, sub, seen | {name}, memo)
+    memo[name] = frozenset(out)
     return out
 
 
@@ -81,8 +95,9 @@ def _serial(world: World, g: Group, joints: set[str]) -> GroupChain | None:
 def group_chains(world: World, srdf: Srdf) -> list[GroupChain]:
     """Every group that is a serial chain, in the SRDF's order."""
     out = []
+    memo: dict[str, frozenset[str]] = {}
     for g in srdf.groups:
-        found = _serial(world, g, joint_set(world, srdf, g.name))
+        found = _serial(world, g, joint_set(world, srdf, g.name, memo=memo))
         if found is not None:
             out.append(found)
     return out
@@ -103,7 +118,9 @@ def end_effector_root(world: World, srdf: Srdf, ee: EndEffector) -> Body | None:
     g = groups.get(ee.group)
     if g is not None:
         bodies.extend(world.get_body_by_name(n) for n in g.links if world.has_body(n))
-    tops = [b for b in bodies if not any(o is not b and world.is_ancestor(o, b) for o in bodies)]
+    inside = {b.index for b in bodies}
+    # A top has no other group body above it (one walk up per body: linear in the group's size).
+    tops = [b for b in bodies if not any(a.index in inside for a in world.ancestors(b)[1:])]
     top = min(tops, key=lambda b: world.depth(b)) if tops else None
     if top is not None and (parent is None or world.is_ancestor(parent, top)):
         return top

@@ -186,7 +186,7 @@ def bench_robotspec(info_path: Path, rate: float, seconds: float, warmup: float)
     with tempfile.TemporaryDirectory(prefix="rr-bench") as tmp:
         with RobotServer(driver, info, ServeOptions(port=0, state_dir=Path(tmp))) as server:
             assert server.service is not None
-            publisher = server.service.publisher_thread
+            publisher = server.service.publisher.thread
             return measure(timer, server.url, seconds, warmup, publisher)
 
 

@@ -88,7 +88,7 @@ def drive(
         raise typer.BadParameter(
             f"unknown log format '{log.suffix}' (use .csv or .jsonl)", param_hint="--log"
         )
-    from robotspec.service.cli import serve_option_problem
+    from robotspec.service.serve import serve_option_problem
 
     problem = serve_option_problem(
         serve=serve,
@@ -154,13 +154,14 @@ def drive(
     )
     results = []
     interrupted = False
+    stopped_by = "Ctrl-C"
     wall0 = time.perf_counter()
     try:
         driver.step()
         if serve:
-            from robotspec.service.cli import serve_driver
+            from robotspec.service.serve import serve_driver
 
-            serve_driver(
+            stop_signal = serve_driver(
                 driver,
                 info,
                 port=port,
@@ -170,6 +171,8 @@ def drive(
                 duration=duration,
                 fallback_name=fallback_name,
             )
+            if stop_signal is not None:
+                interrupted, stopped_by = True, stop_signal
         elif scenario is not None:
 
             def report(r: object) -> None:
@@ -199,7 +202,7 @@ def drive(
     sim_s = driver._stopwatch_ellapsed_s()
     wall = time.perf_counter() - wall0
     summary = (
-        f"{'stopped by Ctrl-C after' if interrupted else 'ran'} {st.seqno} steps, "
+        f"{f'stopped by {stopped_by} after' if interrupted else 'ran'} {st.seqno} steps, "
         f"{sim_s:.2f} s{' simulated' if virtual_time else ''} in {wall:.2f} s; "
         f"final mode {st.command_mode.name}, flags 0x{int(st.flags):x}"
     )

@@ -24,7 +24,13 @@ from robotspec.errors import DriverError
 if TYPE_CHECKING:
     from robotspec.driver.robot_driver import RobotDriver
 
-__all__ = ["Completion", "RobotJointCommand", "TrajectoryGenerator", "TrajectoryStatus"]
+__all__ = [
+    "Completion",
+    "HomingGenerator",
+    "RobotJointCommand",
+    "TrajectoryGenerator",
+    "TrajectoryStatus",
+]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -34,12 +40,27 @@ NEXT_TIMEOUT_S = 5.0
 
 @dataclass(frozen=True)
 class RobotJointCommand:
-    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""
+    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire.
+
+    ``command`` is kept as a float64 array, taken as is when it already is one (the service
+    hands over the array Robot Raconteur decoded: no copy, no list on the way); anything else
+    (a list, a tuple) is converted once here. Values are checked by the loop, which ignores a
+    sample of the wrong length or with NaN, as every invalid stream sample is ignored.
+    """
 
     seqno: int
     state_seqno: int
-    command: Sequence[float]
+    command: FloatArray
     units: Sequence[str] = ()
+
+    def __post_init__(self) -> None:
+        cmd = self.command
+        if not (isinstance(cmd, np.ndarray) and cmd.dtype == np.float64 and cmd.ndim == 1):
+            try:
+                arr = np.asarray(cmd, dtype=np.float64).reshape(-1)
+            except (TypeError, ValueError):
+                arr = np.zeros(0)  # never accepted: no joint count is 0
+            object.__setattr__(self, "command", arr)
 
 
 @dataclass(frozen=True)
@@ -147,6 +168,10 @@ class TrajectoryGenerator:
 
         d._wait_for(outcome, NEXT_TIMEOUT_S)
         with d._lock:
+            if task.outcome_reported:
+                # Another Next() waiting beside this one delivered the outcome: one completion
+                # per generator, so this caller gets the end of the iteration.
+                raise StopIteration
             if task.error is not None:
                 task.outcome_reported = True
                 raise task.error
@@ -185,3 +210,49 @@ class TrajectoryGenerator:
 
     def __next__(self) -> TrajectoryStatus:
         return self.Next()
+
+
+class HomingGenerator:
+    """The generator ``home()`` returns over Robot Raconteur (``ActionStatusCode{generator}``).
+
+    The first ``Next()`` starts homing (the robot must be in ``homing`` mode); each ``Next()``
+    answers ``complete`` once homed, or ``running`` every 5 s until then; the outcome (complete
+    or the error) is delivered to exactly one caller, however many wait concurrently, and every
+    later ``Next()`` raises StopIteration. ``Abort()`` and ``Close()`` stop homing (mode
+    ``halt``): a waiting ``Next()`` then fails with OperationAborted.
+    """
+
+    def __init__(self, driver: RobotDriver) -> None:
+        self._driver = driver
+        self._completion: Completion | None = None
+        self._reported = False
+        self._lock = threading.Lock()
+
+    def Next(self) -> ActionStatus:  # noqa: N802 - the Robot Raconteur generator API
+        """Start homing (first call), then wait up to 5 s for it to end."""
+        d = self._driver
+        with self._lock:
+            if self._reported:
+                raise StopIteration
+            if self._completion is None:
+                self._completion = d.home(wait=False)
+            completion = self._completion
+        d._wait_for(lambda: completion.done, NEXT_TIMEOUT_S)
+        if not completion.done:
+            return ActionStatus.running
+        with self._lock:
+            if self._reported:
+                raise StopIteration
+            self._reported = True
+        if completion.error is not None:
+            raise completion.error
+        return ActionStatus.complete
+
+    def Abort(self) -> None:  # noqa: N802
+        """Stop homing: mode ``halt``."""
+        self._driver.halt()
+
+    def Close(self) -> None:  # noqa: N802
+        """Stop homing if it is still going, as :meth:`Abort`."""
+        if self._completion is not None and not self._completion.done:
+            self._driver.halt()

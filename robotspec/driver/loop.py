@@ -39,6 +39,7 @@ from robotspec.driver.conversions import (
     VELOCITY_UNITS,
     as_lists,
     convert_command,
+    seqno_out_of_order,
     tool_transform,
 )
 from robotspec.driver.errors import (
@@ -742,7 +743,7 @@ class DriverLoop(ABC):
         cmd = self._stream_position
         if cmd is None:
             return None
-        if cmd.seqno < self._stream_last_seqno:
+        if seqno_out_of_order(cmd.seqno, self._stream_last_seqno):
             return None
         if abs(cmd.state_seqno - self._state_seqno) > STREAM_STALE_SEQNOS:
             return None

@@ -49,6 +49,7 @@ Deliberate deviations from the reference (its defects, §1.11 of the note), each
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -74,6 +75,7 @@ from robotspec.driver.errors import (
 )
 from robotspec.driver.handles import (
     Completion,
+    HomingGenerator,
     RobotJointCommand,
     TrajectoryGenerator,
     TrajectoryTask,
@@ -300,6 +302,15 @@ class RobotDriver(DriverLoop):
             self._wait_completion(completion)
         return completion
 
+    def homing_generator(self) -> HomingGenerator:
+        """A generator whose first ``Next()`` homes the robot (needs ``homing_command``).
+
+        Why: Robot Raconteur's ``home()`` returns a generator; the service hands this one out.
+        """
+        if not self._robot_info.has(RobotCapability.homing_command):
+            raise InvalidOperationError("Robot does not support homing")
+        return HomingGenerator(self)
+
     def _homing_finished(self, success: bool, message: str = "") -> None:
         """Called by the subclass when homing ends."""
         with self._lock:
@@ -468,9 +479,16 @@ class RobotDriver(DriverLoop):
 
     # ------------------------------------------------------------------ streaming
 
-    def set_position_command(self, command: RobotJointCommand) -> None:
-        """Write the position-command wire (used in ``position_command`` mode only)."""
+    def set_position_command(self, command: RobotJointCommand, *, new_client: bool = False) -> None:
+        """Write the position-command wire (used in ``position_command`` mode only).
+
+        ``new_client``: the sample comes from another client than the previous one. Its seqno
+        counter is its own, so the ordering check restarts with it (as the reference does when
+        another endpoint writes the wire); the Robot Raconteur service sets it.
+        """
         with self._lock:
+            if new_client:
+                self._stream_last_seqno = -1
             if self._command_mode is CommandMode.position_command:
                 self._stream_position = command
 
@@ -551,6 +569,15 @@ class RobotDriver(DriverLoop):
             self._current_payload_pose[chain] = None
             self._config_seqno += 1
             self.events.append(("payload_changed", chain, ""))
+
+    # ------------------------------------------------------------------ state listeners
+
+    def remove_state_listener(self, listener: Callable[[RobotState], None]) -> None:
+        """Stop calling ``listener`` after each step (no error if it was not added)."""
+        try:
+            self._listeners.remove(listener)
+        except ValueError:
+            pass
 
     # ------------------------------------------------------------------ parameters and signals
 

@@ -36,6 +36,7 @@ from pydantic import (
     model_validator,
 )
 
+from robotspec.driver.rr_names import rr_name_problem, rr_name_suggestion
 from robotspec.errors import RobotInfoError, RobotSpecErrors, closest_names
 from robotspec.files.yamlio import LocatedYaml, load_yaml, load_yaml_text, validation_errors
 
@@ -540,6 +541,16 @@ def _semantic_checks(
         )
         (warnings if warn else errors).append(e)
 
+    device = info.device_info.device
+    name_problem = rr_name_problem(device.name) if device.name else None
+    if name_problem and device.uuid is None:
+        # Served, the device name becomes the node name and its identifier's lock file.
+        err(
+            f"device_info.device.name '{device.name}' {name_problem}: Robot Raconteur cannot "
+            "use it as a device name (letters, digits, '_', '.' and '-', starting with a "
+            f"letter); did you mean '{rr_name_suggestion(device.name)}'?",
+            ("device_info", "device", "name"),
+        )
     if not info.joint_info:
         err("joint_info must list at least one joint", ("joint_info",))
     if not info.chains:

@@ -17,7 +17,6 @@ limits, instead of following a stale velocity command into a joint limit.
 from __future__ import annotations
 
 import math
-from enum import StrEnum
 from typing import Any
 
 import numpy as np
@@ -25,6 +24,7 @@ import numpy.typing as npt
 
 from robotspec.driver.clock import Clock
 from robotspec.driver.errors import InvalidArgumentError
+from robotspec.driver.faults import Fault, fault_param, fault_param_value
 from robotspec.driver.handles import Completion
 from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
@@ -33,17 +33,6 @@ from robotspec.driver.state import EstopSource
 __all__ = ["Fault", "SimRobot"]
 
 FloatArray = npt.NDArray[np.float64]
-
-
-class Fault(StrEnum):
-    """Faults a test (or a scenario) can inject into the simulated robot."""
-
-    lost_feedback = "lost_feedback"
-    estop = "estop"
-    drive_error = "drive_error"
-    disabled = "disabled"
-    frozen = "frozen"
-    step_exception = "step_exception"
 
 
 class SimRobot(RobotDriver):
@@ -300,3 +289,41 @@ class SimRobot(RobotDriver):
                 self._frozen = False
             elif f is Fault.step_exception:
                 self._raise_in_step = False
+
+    def fault_active(self, fault: Fault | str) -> bool:
+        """Whether ``fault`` is injected now.
+
+        ``reset_errors()`` clears the drive error and the e-stop (the simulated operator does).
+        """
+        f = Fault(fault)
+        if f is Fault.lost_feedback:
+            return self._feedback_lost
+        if f is Fault.estop:
+            return self._sim_estop != EstopSource.none
+        if f is Fault.drive_error:
+            return self._sim_error
+        if f is Fault.disabled:
+            return not self._sim_enabled
+        if f is Fault.frozen:
+            return self._frozen
+        return self._raise_in_step
+
+    # ------------------------------------------------------------------ faults as parameters
+
+    def getf_param(self, param_name: str) -> Any:
+        """``fault.NAME``: whether that fault is injected (see :mod:`robotspec.driver.faults`)."""
+        with self._lock:
+            return self.fault_active(fault_param(param_name))
+
+    def setf_param(self, param_name: str, value: Any) -> None:
+        """``fault.NAME`` = true injects that fault, false clears it (e-stop source: button 1).
+
+        Why: a client connected over Robot Raconteur can test its fault handling this way.
+        """
+        fault = fault_param(param_name)
+        on = fault_param_value(param_name, value)
+        with self._lock:
+            if on:
+                self.inject_fault(fault)
+            else:
+                self.clear_fault(fault)

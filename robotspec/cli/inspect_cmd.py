@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from robotspec.cli.notes import print_notes
 from robotspec.cli.options import JsonFlag, PackagePath, SpecArg, load_robot
 from robotspec.cli.table import render_table
 
@@ -61,6 +62,7 @@ def chains(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
     from robotspec.semantic import ParallelGripper
 
     robot = load_robot(spec, package_path)
+    print_notes(robot)
     items = [_chain_row(robot, c) for c in robot.all_chains]
     for m in robot.manipulators:
         if isinstance(m, ParallelGripper):
@@ -173,6 +175,7 @@ def sensors(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath 
 def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """The robot's moving joints with limits; velocities tightened by the spec end in '*'."""
     robot = load_robot(spec, package_path)
+    print_notes(robot)
     w = robot.world
     tightened = w.loaded_velocity_limits
     items = []
@@ -255,6 +258,7 @@ def _group_text(g: dict[str, Any]) -> str:
 def collisions(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """Disabled collision pairs (by SRDF reason) and disabled bodies."""
     robot = load_robot(spec, package_path)
+    print_notes(robot)
     reasons: dict[str, int] = {}
     if robot.srdf is not None:
         for d in robot.srdf.disabled_collisions:

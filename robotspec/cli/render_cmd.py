@@ -9,7 +9,14 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from robotspec.cli.geometry import check_missing_geometry, report_skipped
-from robotspec.cli.options import PackagePath, SkipMeshes, SpecArg, load_robot
+from robotspec.cli.options import (
+    PackagePath,
+    QOpt,
+    SkipMeshes,
+    SpecArg,
+    joint_values,
+    load_robot,
+)
 
 if TYPE_CHECKING:
     pass
@@ -34,6 +41,7 @@ StateOpt = Annotated[
 def render(
     spec: SpecArg,
     state: StateOpt = None,
+    q: QOpt = None,
     output: Annotated[Path, typer.Option("--output", "-o", help="The PNG file to write.")] = Path(
         "robot.png"
     ),
@@ -63,7 +71,7 @@ def render(
     if view not in VIEWS:
         raise typer.BadParameter(f"'{view}' is not one of {', '.join(VIEWS)}", param_hint="--view")
     robot = load_robot(spec, package_path)
-    q = state_configuration(robot, state or ())
+    config = state_configuration(robot, state or (), joint_values(q))
     reported = check_missing_geometry(
         robot, skip=skip_missing_meshes, collision=False, command="render"
     )
@@ -71,7 +79,7 @@ def render(
     report_skipped(scene.skipped, reported)
     title = robot.name + (f" · {', '.join(state)}" if state else "")
     picture = render_scene(
-        scene, q, RenderOptions(width=width, height=height, view=view, title=title)
+        scene, config, RenderOptions(width=width, height=height, view=view, title=title)
     )
     picture.save(output)
     sys.stdout.write(f"wrote {output} ({width}x{height}, {view} view)\n")

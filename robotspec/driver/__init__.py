@@ -1,8 +1,9 @@
 """A simulated Robot Raconteur-style robot driver.
 
 The subpackage follows the contract of ``robotraconteur_abstract_robot.AbstractRobot`` (the seed
-document) and the behaviour recorded in the reference note, with the reference's defects fixed (see
-:mod:`robotspec.driver.robot_driver` and ``docs/driver.md``). Modules, one job each:
+document; upstream ``abstract_robot.py`` of robotraconteur-abstract-robot 0.2.2), with the
+reference's defects fixed (listed in ``docs/driver.md``).
+Modules, one job each:
 
 * :mod:`~robotspec.driver.robot_info` -- the RobotInfo YAML as validated, located models;
 * :mod:`~robotspec.driver.state` -- command modes, state flags and frozen state snapshots;

@@ -2,7 +2,8 @@
 
 Every joint frame is parallel to the base frame at q = 0; ``H[i]`` is joint i's axis and ``P[i]``
 the offset from joint i-1 to joint i, all in base coordinates at q = 0; ``P[n]`` reaches the chain
-end, then ``flange_pose`` and the tool's TCP transform follow. See the reference note §1(c).
+end, then ``flange_pose`` and the tool's TCP transform follow. This is general-robotics-toolbox's
+``Robot`` convention (``general_robotics_toolbox.fwdkin``, 0.7.3).
 
 Why written here and not taken from the toolbox: it is a small numpy routine, the toolbox is not a
 dependency, and the loop calls it every step (1 kHz), so it works on preallocated arrays and

@@ -5,7 +5,7 @@ from the world model lets ``robotspec drive --spec SPEC --chain NAME`` drive eve
 can load, with kinematics that agree with the world's own forward kinematics (tested to 1e-9).
 
 The conversion follows the general-robotics-toolbox / standard_robdef ``urdf_to_robotinfo.py``
-recipe (reference note §1(c)):
+recipe (robotraconteur_standard_robdef ``tools/urdf_to_robotinfo.py``):
 
 * walk the connections from ``root`` to the flange body, keeping the accumulated rotation ``R``
   (the frame orientation at q = 0) and the current offset ``P[k]``;

@@ -33,7 +33,7 @@ class Fault(StrEnum):
 
 #: Parameter names are ``fault.<name>``.
 FAULT_PARAM_PREFIX = "fault."
-#: Other names a fault answers to: the reference note's conformance script calls the drive
+#: Other names a fault answers to: conformance scenarios (docs/driver.md) call the drive
 #: error ``sim_error``.
 FAULT_ALIASES = {"sim_error": Fault.drive_error}
 

@@ -2,11 +2,11 @@
 
 :class:`DriverLoop`, the base of :class:`~robotspec.driver.robot_driver.RobotDriver`, follows
 ``robotraconteur_abstract_robot.AbstractRobot`` 0.2.2 (the seed document is the contract; the
-reference note records its behaviour). Each timestep runs, in order: feedback
-(``_read_feedback``, the subclass), communication check, robot state check, command fill, the
-command guard, state fill, and ``_send_robot_command`` (the subclass). The state machine is the
-reference's (§1.2 of the note), rule for rule; its deliberate deviations are listed in
-:mod:`robotspec.driver.robot_driver`.
+upstream source is ``abstract_robot.py`` of robotraconteur-abstract-robot). Each timestep runs, in
+order: feedback (``_read_feedback``, the subclass), communication check, robot state check, command
+fill, the command guard, state fill, and ``_send_robot_command`` (the subclass). The state machine
+is the reference's (``AbstractRobot._verify_robot_state`` and its ``command_mode`` setter), rule for
+rule; its deliberate deviations are listed in ``docs/driver.md``.
 
 Time comes from a :class:`~robotspec.driver.clock.Clock`. With a simulated clock and no loop
 thread, blocking calls (a ``wait=True`` jog, a trajectory ``Next()``) step the loop themselves

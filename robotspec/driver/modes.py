@@ -1,7 +1,8 @@
 """The driver's state machine: communication and robot-state checks, and ending interrupted motion.
 
-Steps 2 and 3 of the timestep (note §1.2 of the reference note, rule for rule, first match wins),
-what an interrupted motion is told, and the limits of the current operational mode.
+Steps 2 and 3 of the timestep (the reference's ``_verify_communication`` and
+``_verify_robot_state``, rule for rule, first match wins), what an interrupted motion is told, and
+the limits of the current operational mode.
 """
 
 from __future__ import annotations
@@ -54,7 +55,7 @@ class ModeMachine(LoopState):
         return True
 
     def _verify_robot_state(self, now: float) -> bool:
-        """Step 3: the reference's rules, first match wins (note §1.2)."""
+        """Step 3: the reference's rules, first match wins (``_verify_robot_state``)."""
         error = self._error or bool(self._fault_message)
         # Deviation: an e-stop ends homing too. The reference keeps homing through an e-stop
         # when the drives still report enabled (they do, flags 0x2000c), so the mode said

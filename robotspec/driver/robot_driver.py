@@ -4,49 +4,8 @@
 member checks its arguments and the state machine, then hands work to the timestep pipeline of
 :class:`~robotspec.driver.loop.DriverLoop`, which it extends.
 
-Deliberate deviations from the reference (its defects, §1.11 of the note), each tested:
-
-1. An exception inside a step never kills the loop: the driver enters ``invalid_state`` with the
-   message in ``current_errors`` and the ``error`` flag, keeps publishing, and recovers after
-   ``reset_errors()`` or ``command_mode = halt``.
-2. ``halt()``, ``home()``, and the ``operational_mode``, ``controller_state`` and
-   ``current_errors`` properties work.
-3. Limits: ``jog_joint`` checks ``|velocity|`` (both signs) against the limit of the operational
-   mode; ``jog_freespace`` refuses targets outside the joint limits; jogs and both streams respect
-   the acceleration limits and brake before a joint limit (:mod:`robotspec.driver.profiles`);
-   every command passes :class:`~robotspec.driver.commands.CommandGuard`. NaN and infinity are
-   refused everywhere.
-   A speed ratio above 1 never raises jog speed or acceleration beyond the joint limits.
-4. Trajectories: the final waypoint is commanded exactly; a tracking failure fails the task with
-   OperationFailed, clears ``trajectory_running``, cancels the queue and drops to ``halt``;
-   ``running`` status reports the real trajectory time and waypoint; each outcome is delivered
-   once; a queued task cancelled before it starts raises OperationAborted "Trajectory cancelled
-   by controller before start" from ``Next()``; ``Close()`` on a finished task is a no-op; the
-   100 ms gap rule uses the unscaled times; messages carry the waypoint index; the tracking check
-   compares the measured position with the setpoint sent the step before (not the new one, which
-   tripped at high speed).
-5. Messages: "Robot must be in trajectory mode to execute trajectory"; "Position command must be
-   within 1000 degrees from current position".
-6. Tools: ``tool_detached`` accepts the attached tool's name (or ""); tools and payloads work on
-   every chain; ``robot_info.config_seqno`` follows the attachments.
-7. A waiting jog interrupted by halt, an error, an e-stop or lost communication raises
-   OperationAborted instead of returning success; a waiting jog returns when the arm (not the
-   command) has arrived; ``Abort()`` takes the lock; leaving a motion mode for ``halt`` brakes at
-   the acceleration limits instead of stopping dead.
-8. Capabilities are checked: ``trajectory_command`` for trajectory mode (also on the homing route
-   out of ``invalid_state``), ``software_enable`` for ``enable()``/``disable()``,
-   ``software_reset_errors`` for ``reset_errors()`` (a driver-internal fault can always be reset).
-   ``speed_ratio`` and ``trajectory_queueing`` are *not* enforced: none of the real RobotInfo
-   files declares them, yet every reference driver honours both.
-9. ``velocity_command`` mode works (the reference's loop thread dies on the first command); it
-   scales by the speed ratio and sets ``valid_velocity_command``.
-10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares), and refuses a
-    twist the chain cannot follow at its pose.
-11. The simulated robot (:class:`~robotspec.driver.sim.SimRobot`) has a command watchdog, like a
-    real controller: when the driver sends no command for ``command_timeout`` (default 0.1 s; the
-    driver stops sending once feedback is lost), the arm drops its last command and brakes to
-    rest at its acceleration limits. The reference's simulated robot keeps following its last
-    velocity command until a joint limit.
+The reference's defects are not copied: the deliberate deviations, each tested, are listed once,
+in ``docs/driver.md`` ("Deliberate deviations from the reference").
 """
 
 from __future__ import annotations
@@ -135,7 +94,7 @@ class RobotDriver(DriverLoop):
         self.set_command_mode(value)
 
     def set_command_mode(self, value: CommandMode | int | str) -> None:
-        """Request a command mode; the reference's checks, in its order (note §1.2)."""
+        """Request a command mode: the reference's checks, in the order of its setter."""
         mode = parse_mode(value)
         with self._lock:
             current = self._command_mode

@@ -13,12 +13,13 @@ the loop thread. Calls that block until the robot has done something (``jog_*`` 
 are answered through RR's asynchronous handlers, so a few slow clients can never starve RR's
 pool (which also serves ``halt()``, marked urgent in the robdef).
 
-Where the adapter deliberately differs from the reference service (the reference note, §1.11),
-beyond what the driver already fixes: ``halt()``, ``home()``, ``operational_mode``,
-``controller_state`` and ``current_errors`` work; ``robot_info.config_seqno`` follows tool and
-payload changes; joint units on AdvancedRobotState are meter / newton for prismatic joints; the
-state structures are built without allocation and only for wires and pipes somebody reads, and
-they are packed and sent by a publisher thread of the adapter's own, not by the control loop.
+Where the adapter deliberately differs from the reference service (robotraconteur-abstract-robot
+0.2.2's ``AbstractRobot`` service), beyond what the driver already fixes: ``halt()``, ``home()``,
+``operational_mode``, ``controller_state`` and ``current_errors`` work; ``robot_info.config_seqno``
+follows tool and payload changes; joint units on AdvancedRobotState are meter / newton for prismatic
+joints; the state structures are built without allocation and only for wires and pipes somebody
+reads, and they are packed and sent by a publisher thread of the adapter's own, not by the control
+loop.
 """
 
 from __future__ import annotations

@@ -347,16 +347,16 @@ class CameraSpec(_Model):
     )
     minimal_height: float | None = Field(
         default=None,
-        description="lowest height of the camera above the robot's root "
-        "(default: the preset's, else 0)",
-        examples=[1.27],
+        description="lowest height of the camera's frame above the robot's root over the "
+        "limits of the joints that move it (checked by FK; default: the preset's, else 0)",
+        examples=[1.166],
         json_schema_extra={"unit": "m"},
     )
     maximal_height: float | None = Field(
         default=None,
-        description="highest height of the camera above the robot's root "
-        "(default: the preset's, else 1)",
-        examples=[1.6],
+        description="highest height of the camera's frame above the robot's root over the "
+        "limits of the joints that move it (checked by FK; default: the preset's, else 1)",
+        examples=[1.583],
         json_schema_extra={"unit": "m"},
     )
     default: bool = Field(default=False, description="the robot's default camera", examples=[True])

@@ -141,6 +141,16 @@ def test_nothing_imports_the_cli() -> None:
     assert {u for u in users if _room(u) != "cli"} == set()
 
 
+def test_commands_never_import_commands() -> None:
+    # Shared CLI work lives in plain modules (validation_report, chain_table, driving).
+    calls = {
+        (src, dst)
+        for src, dst, _, room in _edges()
+        if src.endswith("_cmd") and dst.endswith("_cmd") and src != dst
+    }
+    assert calls == set()
+
+
 @pytest.mark.parametrize("room", ["driver", "service"])
 def test_rooms_beside_the_stack_stay_beside_it(room: str) -> None:
     used = {_room(dst) for src, dst, _, r in _edges() if r == room} - {room}

@@ -8,11 +8,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from robotspec.driver.chain_kinematics import quat_to_rot
 from robotspec.driver.commands import RobotJointCommand
 from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError
 from robotspec.driver.robot_info import ToolInfo
 from robotspec.driver.state import CommandMode
+from robotspec.model.rotations import quat_wxyz_to_matrix
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -62,7 +62,7 @@ def tool_transform(tool: ToolInfo | None) -> tuple[FloatArray, FloatArray] | Non
     if tool is None:
         return None
     return (
-        quat_to_rot(tool.tcp.rotation.as_tuple()),
+        quat_wxyz_to_matrix(tool.tcp.rotation.as_tuple()),
         np.array(tool.tcp.translation.as_tuple()),
     )
 

@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robotspec.driver.cartesian import chain_reach
-from robotspec.driver.chain_kinematics import HPChain, quat_to_rot
+from robotspec.driver.chain_kinematics import HPChain
 from robotspec.driver.clock import Clock, RealClock
 from robotspec.driver.commands import (
     CommandGuard,
@@ -52,6 +52,7 @@ from robotspec.driver.state import (
     StateFlags,
     TcpPose,
 )
+from robotspec.model.rotations import quat_wxyz_to_matrix
 
 __all__ = ["LoopState"]
 
@@ -94,7 +95,7 @@ class LoopState:
                     np.array([h.as_tuple() for h in c.H]),
                     np.array([p.as_tuple() for p in c.P]),
                     prismatic=[bool(self._limits.prismatic[j]) for j in c.joint_numbers],
-                    flange_rotation=quat_to_rot(fp.orientation.as_tuple()),
+                    flange_rotation=quat_wxyz_to_matrix(fp.orientation.as_tuple()),
                     flange_position=np.array(fp.position.as_tuple()),
                 )
             )

@@ -16,7 +16,6 @@ from typing import Any
 
 import numpy as np
 
-from robotspec.driver.chain_kinematics import quat_to_rot
 from robotspec.driver.commands import (
     JointLimitArrays,
     RobotJointCommand,
@@ -64,6 +63,7 @@ from robotspec.driver.state import (
 )
 from robotspec.driver.trajectory import JointTrajectory, load_trajectory
 from robotspec.errors import DriverError
+from robotspec.model.rotations import quat_wxyz_to_matrix
 
 __all__ = ["RobotDriver"]
 
@@ -539,7 +539,7 @@ class RobotDriver(DriverLoop):
                 raise InvalidArgumentError(f"Payload already attached to kinematic chain {chain}")
             if pose is not None:
                 p = pose.position
-                tf_p = (quat_to_rot(pose.orientation.as_tuple()), np.array([p.x, p.y, p.z]))
+                tf_p = (quat_wxyz_to_matrix(pose.orientation.as_tuple()), np.array([p.x, p.y, p.z]))
                 _check_frame(f"payload '{payload.name}' pose", pose.orientation, tf_p)
             self._current_payload[chain] = payload
             self._current_payload_pose[chain] = pose or Pose()

@@ -7,7 +7,6 @@ import struct
 import numpy as np
 import numpy.typing as npt
 
-from robotspec.driver.chain_kinematics import rot_to_quat_tuple
 from robotspec.driver.modes import ModeMachine
 from robotspec.driver.state import (
     ESTOP_SOURCE_FLAGS,
@@ -17,6 +16,7 @@ from robotspec.driver.state import (
     robot_state_snapshot,
     tcp_pose_snapshot,
 )
+from robotspec.model.rotations import matrix_to_quat_wxyz_tuple
 
 __all__ = ["StateFill"]
 
@@ -79,7 +79,9 @@ class StateFill(ModeMachine):
             )
             # One read-only array per chain, sliced into position, orientation and twist
             # (views of a read-only buffer stay read-only): one allocation instead of three.
-            tcp = np.frombuffer(_PACK_TCP(*pos, *rot_to_quat_tuple(rot), *twist))  # read-only
+            tcp = np.frombuffer(
+                _PACK_TCP(*pos, *matrix_to_quat_wxyz_tuple(rot), *twist)
+            )  # read-only
             poses.append(tcp_pose_snapshot(tcp[0:3], tcp[3:7]))
             vels.append(tcp[7:13])
         self._endpoint_key = key

@@ -16,6 +16,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+from rows import Row, add_json_flag, print_rows
 
 
 def median_time(fn: Callable[[], object], repeat: int) -> float:
@@ -33,7 +34,9 @@ def main() -> None:
     parser.add_argument("--configs", type=int, default=2000, help="configurations per check run")
     parser.add_argument("--samples", type=int, default=10_000, help="matrix generation samples")
     parser.add_argument("--jobs", type=int, default=None, help="processes for the matrix")
+    add_json_flag(parser)
     args = parser.parse_args()
+    say = (lambda *a, **k: None) if args.json else print
 
     import pinocchio as pin
 
@@ -135,15 +138,11 @@ def main() -> None:
         )
     )
 
-    print(
+    say(
         f"PR2 (example-robot-data): {len(pairs)} checked body pairs "
         f"({len(owner)} geometry pairs), {n} random configurations; answers identical\n"
     )
-    print(
-        f"{'robotspec':42} {'per config':>10}   {'pinocchio':34} {'per config':>10}  {'ratio':>6}"
-    )
-    for name, a, peer, b in rows:
-        print(f"{name:42} {_fmt(a):>10}   {peer:34} {_fmt(b):>10}  {b / a:6.2f}")
+    table = [Row(name, a, f"pinocchio {peer}", b) for name, a, peer, b in rows]
 
     t = time.perf_counter()
     matrix = generate_for_robot(robot, samples=args.samples, seed=0, processes=args.jobs)
@@ -156,9 +155,17 @@ def main() -> None:
     )
     precision, recall = compare_pairs(matrix.disabled_pairs(), reference)
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
-    print(
-        f"\ncollision matrix, {args.samples} samples, {matrix.processes} processes: "
-        f"{wall:.1f} s wall (target < 30 s)\n  {counts}; {len(matrix.checked)} pairs stay checked"
+    table.append(
+        Row(
+            f"collision matrix, {args.samples} samples, {matrix.processes} processes (wall)",
+            wall,
+            "target < 5 s",
+            5.0,
+        )
+    )
+    print_rows(table, args.json)
+    say(
+        f"\ncollision matrix: {counts}; {len(matrix.checked)} pairs stay checked"
         f"\n  against the shipped pr2.srdf ({len(reference)} pairs between bodies with geometry): "
         f"precision {precision:.3f}, recall {recall:.3f}"
     )
@@ -166,14 +173,6 @@ def main() -> None:
 
 def _m(values: list[float]) -> float:
     return statistics.median(values)
-
-
-def _fmt(t: float) -> str:
-    if t < 1e-3:
-        return f"{t * 1e6:.1f} us"
-    if t < 1:
-        return f"{t * 1e3:.2f} ms"
-    return f"{t:.2f} s"
 
 
 if __name__ == "__main__":

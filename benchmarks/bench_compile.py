@@ -26,6 +26,8 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from rows import Row, add_json_flag, print_rows
+
 
 def median_times(fns: Sequence[Callable[[], object]], repeat: int) -> list[float]:
     """Median wall time (seconds) of each function over ``repeat`` rounds, after a warm-up.
@@ -48,7 +50,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--repeat", type=int, default=15)
     parser.add_argument("--profile", action="store_true", help="cProfile robotspec's compile")
+    add_json_flag(parser)
     args = parser.parse_args()
+    say = (lambda *a, **k: None) if args.json else print
 
     import pinocchio as pin
 
@@ -79,20 +83,23 @@ def main() -> None:
 
     robot = ours()
     model, geom = pinocchio()  # type: ignore[misc]
-    print(
+    say(
         f"robotspec: {len(robot.bodies)} bodies, {len(robot.kinematic_chains)} chains, "  # type: ignore[attr-defined]
         f"{len(robot.disabled_collision_pairs)} disabled pairs (with geometry)"  # type: ignore[attr-defined]
     )
-    print(
+    say(
         f"pinocchio: {model.njoints} joints, {geom.ngeoms} collision geometries, "
         f"{len(geom.collisionPairs)} collision pairs after the SRDF"
     )
     t_ours, t_pin = median_times([ours, pinocchio], args.repeat)
-    print(f"{'robotspec compile_robot(pr2)':<40}{t_ours * 1e3:9.1f} ms")
-    print(f"{'pinocchio model+geom+SRDF pairs':<40}{t_pin * 1e3:9.1f} ms")
-    ratio = t_pin / t_ours
-    verdict = "robotspec faster" if ratio >= 1 else "robotspec SLOWER"
-    print(f"ratio pinocchio/robotspec: {ratio:.2f} ({verdict}; median of {args.repeat})")
+    rows = [
+        Row(
+            "compile PR2 spec (URDF + SRDF + spec)",
+            t_ours,
+            "pinocchio model+geom+SRDF pairs",
+            t_pin,
+        )
+    ]
 
     import tempfile
 
@@ -118,11 +125,16 @@ def main() -> None:
         return model, geom
 
     t_comp, t_pin_joined = median_times([composed, pin_joined], args.repeat)
-    print(f"{'robotspec compile_robot(b1_ur5_allegro)':<40}{t_comp * 1e3:9.1f} ms")
-    print(f"{'pinocchio, the exported joined files':<40}{t_pin_joined * 1e3:9.1f} ms")
-    ratio = t_pin_joined / t_comp
-    verdict = "robotspec faster" if ratio >= 1 else "robotspec SLOWER"
-    print(f"ratio pinocchio/robotspec: {ratio:.2f} ({verdict}; median of {args.repeat})")
+    rows.append(
+        Row(
+            "compile composed b1_ur5_allegro (3 parts)",
+            t_comp,
+            "pinocchio, the exported joined files",
+            t_pin_joined,
+        )
+    )
+    print_rows(rows, args.json)
+    say(f"(medians of {args.repeat}, calls interleaved; ratio = pinocchio / robotspec)")
 
     if args.profile:
         prof = cProfile.Profile()

@@ -25,6 +25,7 @@ are redirected to a temporary folder so nothing is written outside it.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import statistics
@@ -39,6 +40,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from rows import Row, add_json_flag, print_rows
 
 SHARED = Path(__file__).resolve().parents[2] / "shared"
 ABB = SHARED / "robotinfo" / "abb_irb1200_5_90.yml"
@@ -406,7 +408,18 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=10.0, help="run length per driver")
     parser.add_argument("--rate", type=float, default=1000.0, help="loop rate in Hz")
     parser.add_argument("--skip-reference", action="store_true")
+    add_json_flag(parser)
     args = parser.parse_args()
+    if args.json:  # the report goes to stderr, stdout gets one JSON object per row
+        with contextlib.redirect_stdout(sys.stderr):
+            rows = run(args)
+        print_rows(rows, True)
+        return
+    run(args)
+
+
+def run(args: argparse.Namespace) -> list[Row]:
+    """Measure, print the report, and return its rows."""
 
     from robotspec.driver.export import dump_robot_info_yaml
     from robotspec.driver.robot_info import load_robot_info, read_robot_info_text
@@ -497,6 +510,22 @@ def main() -> None:
         f"({ours.cpu_mean * 1e6:.1f} us mean)"
     )
     _ = (math, statistics, period)
+    ref_r = results[1] if len(results) > 1 else None
+    ref_name = "reference AbstractRobot driver" if ref_r else f"reference not run: {reason}"
+    return [
+        Row(
+            f"driver loop {args.rate:g} Hz, p99 period error",
+            ours.err_p99,
+            ref_name,
+            ref_r.err_p99 if ref_r else None,
+        ),
+        Row(
+            f"driver loop {args.rate:g} Hz, CPU per step (loop thread)",
+            ours.cpu_mean,
+            ref_name,
+            ref_r.cpu_mean if ref_r else None,
+        ),
+    ]
 
 
 if __name__ == "__main__":

@@ -14,11 +14,13 @@ import tempfile
 import time
 from pathlib import Path
 
+from rows import Row, add_json_flag, print_rows
+
 
 def generated_urdf(n: int, *, bare: bool = False) -> str:
     """A tree of ``n`` links: each link hangs below link ``(i - 1) // 3`` by a revolute joint.
 
-    ``bare``: links without geometry or mass (about 6 MB for 60,000 links, the issue's file).
+    ``bare``: links without geometry or mass (13 MB for 60,000 links, most of it joints).
     """
     parts = ['<robot name="big">']
     for i in range(n):
@@ -43,7 +45,8 @@ def generated_urdf(n: int, *, bare: bool = False) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--links", type=int, default=60_000)
-    parser.add_argument("--bare", action="store_true", help="links without geometry (6 MB)")
+    parser.add_argument("--bare", action="store_true", help="links without geometry (13 MB)")
+    add_json_flag(parser)
     args = parser.parse_args()
 
     import yourdfpy
@@ -61,10 +64,9 @@ def main() -> None:
         peer = yourdfpy.URDF.load(str(path), load_meshes=False, build_scene_graph=False)
         t_ydp = time.perf_counter() - t
     assert len(world.bodies) == len(peer.robot.links) == args.links
-    print(f"{args.links} links, {size / 1e6:.1f} MB URDF, one run")
-    print(f"robotspec load_urdf(meshes='keep')                   {t_ours:8.2f} s")
-    print(f"yourdfpy URDF.load(load_meshes=False, no scene graph) {t_ydp:8.2f} s")
-    print(f"ratio (yourdfpy / robotspec)                         {t_ydp / t_ours:8.2f}")
+    what = f"load_urdf, {args.links} links ({size / 1e6:.1f} MB)"
+    rows = [Row(what, t_ours, "yourdfpy URDF.load, no meshes, no scene graph", t_ydp)]
+    print_rows(rows, args.json)
 
 
 if __name__ == "__main__":

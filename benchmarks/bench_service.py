@@ -20,6 +20,7 @@ and Jacobian in its feedback step, as in the reference note's measurement).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import json
 import os
@@ -33,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from rows import Row, add_json_flag, print_rows
 
 HERE = Path(__file__).resolve()
 SHARED_INFO = HERE.parents[2] / "shared" / "robotinfo" / "abb_irb1200_5_90.yml"
@@ -186,7 +188,7 @@ def bench_robotspec(info_path: Path, rate: float, seconds: float, warmup: float)
     with tempfile.TemporaryDirectory(prefix="rr-bench") as tmp:
         with RobotServer(driver, info, ServeOptions(port=0, state_dir=Path(tmp))) as server:
             assert server.service is not None
-            publisher = server.service.publisher_thread
+            publisher = server.service.publisher.thread
             return measure(timer, server.url, seconds, warmup, publisher)
 
 
@@ -301,10 +303,21 @@ def main() -> None:
     parser.add_argument("--robotinfo", type=Path, default=None)
     parser.add_argument("--only", choices=["robotspec", "reference"], default=None)
     parser.add_argument("--client", help=argparse.SUPPRESS)
+    add_json_flag(parser)
     args = parser.parse_args()
     if args.client:
         client_main(args.client, args.seconds)
         return
+    if args.json:  # the report goes to stderr, stdout gets one JSON object per row
+        with contextlib.redirect_stdout(sys.stderr):
+            rows = run(args)
+        print_rows(rows, True)
+        return
+    run(args)
+
+
+def run(args: argparse.Namespace) -> list[Row]:
+    """Measure, print the report, and return its rows."""
     info_path = args.robotinfo or (SHARED_INFO if SHARED_INFO.exists() else LOCAL_INFO)
     print(f"robot {info_path.name}, {args.rate:g} Hz, {args.seconds:g} s, one robot_state client")
     results: dict[str, Any] = {}
@@ -333,6 +346,28 @@ def main() -> None:
             f"target loop CPU per step < 0.5 ms: {'met' if loop < 0.5 else 'MISSED'} "
             f"({loop:.3f} ms)"
         )
+    rows: list[Row] = []
+    if "robotspec" in results:
+        ours = results["robotspec"]
+        ref = results.get("reference")
+        peer = "reference loop" if ref else "reference not run"
+        rows.append(
+            Row(
+                f"serving one RR client at {args.rate:g} Hz, CPU per step: loop thread",
+                ours["cpu_mean_ms"] / 1e3,
+                peer,
+                ref["cpu_mean_ms"] / 1e3 if ref else None,
+            )
+        )
+        rows.append(
+            Row(
+                f"serving one RR client at {args.rate:g} Hz, CPU per step: whole process",
+                ours["process_cpu_per_step_ms"] / 1e3,
+                peer,
+                ref["process_cpu_per_step_ms"] / 1e3 if ref else None,
+            )
+        )
+    return rows
 
 
 if __name__ == "__main__":

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+from rows import Row, add_json_flag, print_rows
 
 
 def best_of(fn: Callable[[], object], repeat: int, number: int = 1) -> float:
@@ -29,6 +30,7 @@ def best_of(fn: Callable[[], object], repeat: int, number: int = 1) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--samples", type=int, default=10_000)
+    add_json_flag(parser)
     args = parser.parse_args()
 
     import importlib.metadata as md
@@ -108,12 +110,14 @@ def main() -> None:
     t_chain = best_of(lambda: chain.fk(q), 7, 500)
     rows.append(("FK of the 7-joint arm chain", t_chain, "(target: under 50 us)", 50e-6))
     t_jac = best_of(lambda: chain.jacobian(q), 7, 500)
+    wrist = model.getFrameId("r_wrist_roll_link")
+    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
     rows.append(
         (
             "Jacobian of the 7-joint arm chain",
             t_jac,
-            "pinocchio computeFrameJacobian",
-            best_of(lambda: pin.computeFrameJacobian(model, data, qp, frame_ids[0]), 7, 500),
+            "pinocchio computeFrameJacobian (wrist, world-aligned)",
+            best_of(lambda: pin.computeFrameJacobian(model, data, qp, wrist, lwa), 7, 500),
         )
     )
 
@@ -147,18 +151,9 @@ def main() -> None:
         ),
     ]
 
-    print(f"PR2 (example-robot-data): {len(world.bodies)} bodies, {n_dof} DOF\n")
-    print(f"{'robotspec':40} {'time':>10}   {'peer':45} {'time':>10}  {'peer/ours':>9}")
-    for name, ours, peer, theirs in rows:
-        print(f"{name:40} {fmt(ours):>10}   {peer:45} {fmt(theirs):>10}  {theirs / ours:9.2f}")
-
-
-def fmt(t: float) -> str:
-    if t < 1e-3:
-        return f"{t * 1e6:.1f} us"
-    if t < 1:
-        return f"{t * 1e3:.2f} ms"
-    return f"{t:.2f} s"
+    if not args.json:
+        print(f"PR2 (example-robot-data): {len(world.bodies)} bodies, {n_dof} DOF\n")
+    print_rows([Row(*r) for r in rows], args.json)
 
 
 if __name__ == "__main__":

@@ -170,8 +170,9 @@ class Diagnostics:
         problems = self.in_file_order(problems)
         if not problems:
             return
+        warnings = () if strict else self.in_file_order(self.warnings)
         if len(problems) == 1:
-            raise problems[0]
+            raise problems[0].with_warnings(warnings)
         raise RobotSpecErrors(
             problems, summary=f"{self.loaded.file.name}: {len(problems)} problems"
-        )
+        ).with_warnings(warnings)

@@ -199,6 +199,16 @@ class RobotSpecError(Exception):
         # so copies and pickles (worker processes) rebuild from the state, not from ``args``.
         return (_rebuild, (type(self), self.args), self.__dict__)
 
+    #: Warnings found in the same run as this error (the CLI prints and counts them too); an
+    #: error raised after collecting every problem of a spec carries its warnings this way.
+    warnings: tuple[RobotSpecError, ...] = ()
+
+    def with_warnings(self, warnings: Sequence[RobotSpecError]) -> RobotSpecError:
+        """A copy of this error that carries the run's ``warnings``."""
+        new = copy.copy(self)
+        new.warnings = tuple(warnings)
+        return new
+
     def with_severity(self, severity: str) -> RobotSpecError:
         """A copy of this error with another severity (a warning that strict mode may promote)."""
         new = copy.copy(self)

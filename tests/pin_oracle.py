@@ -40,6 +40,7 @@ class PinOracle:
         self.pin.updateFramePlacements(self.model, self.data)
         out = {}
         for b in self.world.bodies:
-            fid = self.model.getFrameId(b.name)
+            # A link's frame (some URDFs name a joint like a link: ANYmal's LF_HAA).
+            fid = self.model.getFrameId(b.name, self.pin.FrameType.BODY)
             out[b.name] = self.data.oMf[fid].homogeneous.copy()
         return out

@@ -193,7 +193,8 @@ def _init(
     code, _, err = run(capsys, "init", *argv, "-o", str(out))
     assert code == 0, err
     text = out.read_text()
-    assert text.startswith(f"# yaml-language-server: $schema={shipped_schema_path().as_uri()}")
+    # A portable schema reference: the file beside the spec, never this machine's path.
+    assert text.startswith("# yaml-language-server: $schema=robotspec.schema.json\n")
     check_spec(out, package_paths=allow)  # the draft validates as written
     data = yaml.safe_load(text)
     assert isinstance(data, dict)
@@ -222,12 +223,20 @@ def test_init_pr2_from_srdf(capsys: pytest.CaptureFixture[str], tmp_path: Path) 
     }
     chains = data["chains"]
     assert isinstance(chains, dict)
-    assert chains["right_arm"] == {"group": "right_arm", "manipulator": "right_eef"}
-    assert chains["left_arm"] == {"group": "left_arm", "manipulator": "left_eef"}
-    assert data["manipulators"]["right_eef"]["tool_frame"] == "r_gripper_tool_frame"  # type: ignore[index]
-    assert data["manipulators"]["right_eef"]["root"] == "r_gripper_palm_link"  # type: ignore[index]
+    assert chains["right_arm"]["group"] == "right_arm"
+    assert chains["right_arm"]["manipulator"] == "right_eef"
+    assert chains["right_arm"]["sensors"] == ["r_forearm_cam"]
+    # The SRDF's group states become the arm's named states.
+    assert set(chains["right_arm"]["states"]) == {"tuck_right_arm"}
+    assert set(chains) == {"left_arm", "right_arm"}  # the head is the neck, 'torso' the torso
+    right = data["manipulators"]["right_eef"]  # type: ignore[index]
+    assert right["type"] == "parallel_gripper"
+    assert right["tool_frame"] == "r_gripper_tool_frame"
+    assert right["root"] == "r_gripper_palm_link"
+    assert data["torso"]["root"] == "base_link"  # type: ignore[index]
+    assert data["neck"]["tip"] == "head_tilt_link"  # type: ignore[index]
+    assert "wide_stereo" in data["neck"]["sensors"]  # type: ignore[index]
     assert "wide_stereo" in data["sensors"]  # type: ignore[operator]
-    assert data["import_srdf_group_states"] is True
     # A second run refuses to overwrite.
     code, _, err = run(
         capsys, "init", str(robots / "pr2_description/urdf/pr2.urdf"), "-o", str(out)
@@ -239,13 +248,14 @@ def test_init_pr2_from_srdf(capsys: pytest.CaptureFixture[str], tmp_path: Path) 
 def test_init_without_srdf_guesses_chains_and_tool(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    # UR5e: nobody wrote a spec for it; the chain and tool0 come from the tree alone.
+    # UR5e: nobody wrote a spec for it; the arm and tool0 come from the tree alone.
     urdf = shared_path("robots", "ur5e", "ur5e.urdf")
     data = _init(capsys, tmp_path / "ur5e.yaml", str(urdf))
     assert data["chains"] == {
-        "chain_1": {"root": "base_link", "tip": "wrist_3_link", "manipulator": "chain_1_tool"}
+        "arm": {"root": "base_link", "tip": "wrist_3_link", "manipulator": "tool"}
     }
-    assert data["manipulators"]["chain_1_tool"]["tool_frame"] == "tool0"  # type: ignore[index]
+    assert data["manipulators"]["tool"]["tool_frame"] == "tool0"  # type: ignore[index]
+    assert data["drive"] == {"type": "fixed"}
 
 
 def test_init_fanuc_writes_package_paths(
@@ -266,9 +276,9 @@ def test_init_fanuc_writes_package_paths(
     assert desc["urdf"] == "package://moveit_resources_fanuc_description/urdf/fanuc.urdf"
     assert len(desc["package_paths"]) == 1
     assert (tmp_path / desc["package_paths"][0]).resolve() == fanuc.resolve()
-    assert data["chains"] == {
-        "manipulator": {"group": "manipulator", "manipulator": "manipulator_tool"}
-    }
+    chains = data["chains"]
+    assert isinstance(chains, dict) and list(chains) == ["manipulator"]
+    assert chains["manipulator"]["group"] == "manipulator"
 
 
 def test_init_talos_humanoid(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -282,9 +292,14 @@ def test_init_talos_humanoid(capsys: pytest.CaptureFixture[str], tmp_path: Path)
     )
     chains = data["chains"]
     assert isinstance(chains, dict)
-    tips = sorted(c["tip"] for c in chains.values())
-    # Arms and legs, guessed from the tree (the SRDF defines no chain groups).
-    assert tips == ["arm_left_7_link", "arm_right_7_link", "leg_left_6_link", "leg_right_6_link"]
+    # The SRDF's groups (joints plus a chain): arms and legs, in the SRDF's names.
+    assert sorted(chains) == ["l_arm", "l_leg", "r_arm", "r_leg"]
+    assert chains["l_leg"]["kind"] == "chain"
+    assert data["torso"]["root"] == "base_link"  # type: ignore[index]
+    assert data["torso"]["states"] == {  # type: ignore[index]
+        "half_sitting": {"torso_1_joint": 0, "torso_2_joint": 0.006761}
+    }
+    assert data["neck"]["root"] == "torso_2_link"  # type: ignore[index]
 
 
 def test_shell_completion_of_commands_and_specs(
@@ -315,7 +330,7 @@ def test_shell_completion_of_commands_and_specs(
 def test_demo_scenario_passes_for_shipped_robots(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, robot: str, chain: str | None
 ) -> None:
-    # The README's demo drives the first arm through a generated scenario; run the same
+    # The README's demo drives the last arm through a generated scenario; run the same
     # scenario on virtual time (Panda's home sits on a joint limit: exact ends matter).
     erd_robots()
     from robotspec.cli.demo_cmd import demo_scenario

@@ -329,7 +329,7 @@ def test_replaced_root_keeps_the_mass_where_it_was(tmp_path: Path) -> None:
     for replace in (False, True):
         spec = _fixture(tmp_path, ARM_AND_HAND.replace("REPLACE", str(replace).lower()))
         urdf = tmp_path / f"joined_{replace}.urdf"
-        urdf.write_text(urdf_text(joined_urdf(load_spec(spec), package_paths=[ur]), comment="test"))
+        urdf.write_text(urdf_text(joined_urdf(load_spec(spec)), comment="test"))
         model = pin.buildModelFromUrdf(str(urdf))
         inertias.append(model.inertias[model.getJointId("wrist")])
     welded, replaced = inertias

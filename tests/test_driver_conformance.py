@@ -19,7 +19,7 @@ from robotspec.driver.errors import (
     OperationAbortedError,
     OperationFailedError,
 )
-from robotspec.driver.loop import RobotJointCommand, TrajectoryGenerator
+from robotspec.driver.loop import JOG_ARRIVAL_TOLERANCE, RobotJointCommand, TrajectoryGenerator
 from robotspec.driver.robot_info import PayloadInfo, Pose, ToolInfo, read_robot_info
 from robotspec.driver.sim import Fault, SimRobot
 from robotspec.driver.state import (
@@ -148,8 +148,12 @@ def test_09_jog_freespace_wait(abb: SimRobot) -> None:
     t0 = elapsed(abb)
     abb.jog_freespace(target, 0.5 * abb.limits.velocity, True)
     took = elapsed(abb) - t0
-    assert 0.27 <= took <= 0.31  # simulated seconds; the reference took 0.286-0.293 s
-    assert np.max(np.abs(q_of(abb) - target)) < 5e-4
+    # Simulated seconds; the reference took 0.286-0.293 s, but returned when its *command*
+    # arrived. [deviate] here the call returns when the arm has arrived (within
+    # JOG_ARRIVAL_TOLERANCE, at rest): a few periods later.
+    assert 0.27 <= took <= 0.34
+    assert np.max(np.abs(q_of(abb) - target)) <= JOG_ARRIVAL_TOLERANCE
+    assert not np.any(abb.robot_state.joint_velocity)
     abb.step()
     np.testing.assert_allclose(q_of(abb), target, atol=1e-12)
 

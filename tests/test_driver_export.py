@@ -10,6 +10,7 @@ import pytest
 import yaml
 
 from robotspec.description.urdf import load_urdf
+from robotspec.driver.chain_kinematics import HPChain
 from robotspec.driver.clock import SimClock
 from robotspec.driver.export import (
     DEFAULT_ACCELERATION_FACTOR,
@@ -17,7 +18,6 @@ from robotspec.driver.export import (
     export_chain,
     robot_info_from_chain,
 )
-from robotspec.driver.hp_kinematics import HPChain, quat_to_rot
 from robotspec.driver.robot_info import (
     JointType,
     RobotInfo,
@@ -28,6 +28,7 @@ from robotspec.driver.sim import SimRobot
 from robotspec.driver.state import CommandMode
 from robotspec.errors import KinematicsError, RobotInfoError
 from robotspec.model.kinematics import ChainKinematics
+from robotspec.model.rotations import quat_wxyz_to_matrix
 from robotspec.model.world import World
 from tests.conftest import erd_robots, shared_path
 
@@ -44,7 +45,7 @@ def hp_of(info: RobotInfo, chain: int = 0) -> HPChain:
         np.array([h.as_tuple() for h in c.H]),
         np.array([p.as_tuple() for p in c.P]),
         prismatic=prismatic,
-        flange_rotation=quat_to_rot(c.flange_pose.orientation.as_tuple()),
+        flange_rotation=quat_wxyz_to_matrix(c.flange_pose.orientation.as_tuple()),
         flange_position=np.array(c.flange_pose.position.as_tuple()),
     )
 

@@ -7,10 +7,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robotspec.driver.chain_kinematics import HPChain
 from robotspec.driver.conversions import tool_transform
-from robotspec.driver.hp_kinematics import HPChain, quat_to_rot, rot_to_quat, rot_to_quat_tuple
 from robotspec.driver.robot_info import Pose, load_robot_info
 from robotspec.driver.sim import SimRobot
+from robotspec.model.rotations import (
+    matrix_to_quat_wxyz,
+    matrix_to_quat_wxyz_tuple,
+    quat_wxyz_to_matrix,
+)
 from tests.driver_support import RRP, robotinfo, shared_robotinfo_files
 
 TABLE = {
@@ -37,7 +42,7 @@ def test_fk_at_zero_matches_reference(name: str) -> None:
 def test_abb_flange_orientation() -> None:
     (hp,) = _chains(robotinfo("abb_irb1200_5_90.yml"))
     r, _ = hp.fk(np.zeros(6))
-    np.testing.assert_allclose(rot_to_quat(r), [0.7071, 0, 0.7071, 0], atol=1e-4)
+    np.testing.assert_allclose(matrix_to_quat_wxyz(r), [0.7071, 0, 0.7071, 0], atol=1e-4)
 
 
 def _random_chain(seed: int, coordinate_axes: bool = False) -> HPChain:
@@ -57,7 +62,7 @@ def _random_chain(seed: int, coordinate_axes: bool = False) -> HPChain:
         h,
         offsets,
         prismatic=list(rng.random(n) < 0.3),
-        flange_rotation=quat_to_rot(rng.normal(size=4)),
+        flange_rotation=quat_wxyz_to_matrix(rng.normal(size=4)),
         flange_position=rng.normal(size=3) * 0.1,
     )
 
@@ -68,7 +73,7 @@ def test_jacobian_matches_finite_differences(seed: int) -> None:
     hp = _random_chain(seed)
     rng = np.random.default_rng(seed + 1)
     q = rng.uniform(-2, 2, hp.n)
-    tool_r, tool_p = quat_to_rot(rng.normal(size=4)), rng.normal(size=3) * 0.1
+    tool_r, tool_p = quat_wxyz_to_matrix(rng.normal(size=4)), rng.normal(size=3) * 0.1
     r0, p0, jac = hp.fk_jacobian(q, tool_r, tool_p)
     eps = 1e-6
     for i in range(hp.n):
@@ -88,7 +93,7 @@ def test_fast_path_equals_numpy_path(seed: int, coordinate_axes: bool) -> None:
     rng = np.random.default_rng(seed + 2)
     q = rng.uniform(-3, 3, hp.n)
     qd = rng.uniform(-1, 1, hp.n)
-    tool_r, tool_p = quat_to_rot(rng.normal(size=4)), rng.normal(size=3) * 0.1
+    tool_r, tool_p = quat_wxyz_to_matrix(rng.normal(size=4)), rng.normal(size=3) * 0.1
     r, p, jac = hp.fk_jacobian(q, tool_r, tool_p)
     rot, pos, twist = hp.tcp_state(
         q.tolist(), qd.tolist(), tool_r.reshape(9).tolist(), tool_p.tolist()
@@ -96,7 +101,7 @@ def test_fast_path_equals_numpy_path(seed: int, coordinate_axes: bool) -> None:
     np.testing.assert_allclose(np.array(rot).reshape(3, 3), r, atol=1e-12)
     np.testing.assert_allclose(pos, p, atol=1e-12)
     np.testing.assert_allclose(twist, jac @ qd, atol=1e-12)
-    np.testing.assert_allclose(rot_to_quat_tuple(rot), rot_to_quat(r), atol=1e-12)
+    np.testing.assert_allclose(matrix_to_quat_wxyz_tuple(rot), matrix_to_quat_wxyz(r), atol=1e-12)
 
 
 @settings(max_examples=60, deadline=None)
@@ -107,7 +112,7 @@ def test_fast_path_equals_numpy_path(seed: int, coordinate_axes: bool) -> None:
 )
 def test_quaternion_round_trip(v: list[float]) -> None:
     q = np.array(v) / np.linalg.norm(v)
-    back = rot_to_quat(quat_to_rot(q))
+    back = matrix_to_quat_wxyz(quat_wxyz_to_matrix(q))
     assert abs(float(np.dot(back, q))) == pytest.approx(1.0, abs=1e-9)  # q and -q are one rotation
     assert back[0] >= 0.0
 

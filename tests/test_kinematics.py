@@ -152,3 +152,30 @@ def test_bad_configuration_is_refused(pr2) -> None:
     q[0] = np.nan
     with pytest.raises(KinematicsError, match="NaN or infinite"):
         k.forward(q)
+    chain = k.chain("torso_lift_link", "r_wrist_roll_link")
+    for call in (chain.fk, chain.jacobian, k.forward):
+        with pytest.raises(KinematicsError, match="NaN or infinite"):
+            call(q)
+        with pytest.raises(KinematicsError, match="shape"):
+            call(np.zeros((2, len(q))))
+        with pytest.raises(KinematicsError, match="shape"):
+            call([1.0, "x"])
+    for batch in (chain.fk_batch, k.forward_batch):
+        with pytest.raises(KinematicsError, match="shape"):
+            batch(np.zeros(len(q)))
+        with pytest.raises(KinematicsError, match="NaN or infinite"):
+            batch(np.stack([w.configuration(), q]))
+
+
+def test_chain_batch_equals_single(pr2) -> None:
+    w, k, _ = pr2
+    qs = np.random.default_rng(7).uniform(-2, 2, (20, len(w.degrees_of_freedom)))
+    chain = k.chain("base_footprint", "l_gripper_tool_frame")
+    batch = chain.fk_batch(qs)
+    assert batch.shape == (20, 4, 4)
+    for q, pose in zip(qs, batch, strict=True):
+        np.testing.assert_allclose(pose, chain.fk(q), atol=1e-12)
+        np.testing.assert_allclose(
+            pose, k.forward(q)[w.get_body_by_name("l_gripper_tool_frame").index], atol=1e-12
+        )
+    assert chain.fk_batch(np.zeros((0, len(w.degrees_of_freedom)))).shape == (0, 4, 4)

@@ -237,7 +237,7 @@ def test_dotdot_after_a_symlink_follows_the_link_like_the_os(tmp_path: Path) -> 
     assert not r.is_allowed(pkg / "late.stl")
 
 
-@pytest.mark.parametrize("scheme", ["http", "https", "ftp", "model"])
+@pytest.mark.parametrize("scheme", ["http", "https", "ftp"])
 def test_other_schemes_are_refused(scheme: str) -> None:
     uri = f"{scheme}://example.com/robot/mesh.stl"
     with pytest.raises(DescriptionError) as info:
@@ -245,8 +245,38 @@ def test_other_schemes_are_refused(scheme: str) -> None:
     assert not isinstance(info.value, PathOutsideRootsError)
     assert info.value.message == (
         f"unsupported URI scheme '{scheme}' in '{uri}'; "
-        "robotspec reads only package://, file:// and paths"
+        "robotspec reads only package://, model://, file:// and paths"
     )
+
+
+def test_empty_package_name_starts_at_a_package_root() -> None:
+    # pinocchio joins what follows 'package://' to each package folder: Talos's
+    # 'package:///example-robot-data/robots/...' is '<folder>/example-robot-data/robots/...'.
+    r = isolated()
+    mesh = BETA / "meshes" / "box.stl"
+    assert r.resolve("package:///beta_dir/meshes/box.stl") == mesh  # a search folder's child
+    assert r.resolve("package:///beta_meshes/meshes/box.stl") == mesh  # else a package name
+    assert r.resolve("model://beta_meshes/meshes/box.stl") == mesh  # pinocchio's model://
+    with pytest.raises(PackageNotFoundError) as info:
+        r.resolve("package:///no_such_pkg/meshes/a.stl", file="robot.urdf", line=9)
+    searched = ", ".join(str(f) for f in r.search_folders)
+    assert info.value.message == (
+        "package 'no_such_pkg' not found (a package:/// path starts at a package root); "
+        f"searched: {searched}"
+    )
+    assert (info.value.file, info.value.line, info.value.name) == ("robot.urdf", 9, "no_such_pkg")
+    # No search folder may be left: '..' is probed nowhere and is no package name.
+    with pytest.raises(PackageNotFoundError, match="package '..' not found"):
+        r.resolve("package:///../../../../../../etc/passwd")
+    with pytest.raises(PathOutsideRootsError):
+        r.resolve("package:///beta_meshes/../../../../../../../../etc/passwd")
+
+
+def test_talos_full_v2_meshes_resolve_from_the_package_root() -> None:
+    robots = erd_robots()
+    r = PackageResolver.create(None, use_environment=False)
+    uri = "package:///example-robot-data/robots/talos_data/meshes/torso/torso_2.STL"
+    assert r.resolve(uri) == robots / "talos_data" / "meshes" / "torso" / "torso_2.STL"
 
 
 def test_bad_package_names_and_empty_refs() -> None:
@@ -269,13 +299,18 @@ def test_allowed_roots_include_the_description_and_its_package() -> None:
 SEGMENT = st.sampled_from(["..", ".", "meshes", "box.stl", "x", "", "..."])
 
 
-@given(st.lists(SEGMENT, min_size=1, max_size=10), st.sampled_from(["package", "file", "plain"]))
+@given(
+    st.lists(SEGMENT, min_size=1, max_size=10),
+    st.sampled_from(["package", "root", "model", "file", "plain"]),
+)
 def test_dotdot_never_escapes(segments: list[str], form: str) -> None:
     r = isolated()
     rel = "/".join(segments)
     base = ALPHA / "urdf"
     uri = {
         "package": f"package://beta_meshes/{rel}",
+        "root": f"package:///{rel}",
+        "model": f"model://beta_meshes/{rel}",
         "file": f"file://{rel}",
         "plain": rel,
     }[form]
@@ -283,7 +318,7 @@ def test_dotdot_never_escapes(segments: list[str], form: str) -> None:
         return
     try:
         path = r.resolve(uri, relative_to=base)
-    except PathOutsideRootsError:
+    except (PathOutsideRootsError, PackageNotFoundError):
         return
     real = Path(os.path.realpath(path))
     assert any(real == root or real.is_relative_to(root) for root in r.allowed_roots)

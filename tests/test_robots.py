@@ -263,7 +263,8 @@ def test_pr2_neck_and_camera(pr2: PR2) -> None:
     assert cam.root.name == "wide_stereo_optical_frame"
     assert cam.forward_facing_axis == (0, 0, 1)
     assert (cam.field_of_view.horizontal_angle, cam.field_of_view.vertical_angle) == KINECT_FOV
-    assert (cam.minimal_height, cam.maximal_height) == (1.27, 1.6)
+    # FIX: FK's exact range over torso_lift_joint and head_tilt_joint (the reference: 1.27-1.60).
+    assert (cam.minimal_height, cam.maximal_height) == (1.166, 1.583)
     assert pr2.default_camera is cam
 
 
@@ -480,12 +481,13 @@ def test_hsrb_arm_and_gripper(hsrb: HSRB) -> None:
 
 HSRB_CAMERAS = {
     # name: (body, preset field of view (h, v), minimal, maximal height)
-    "hand_camera": ("hand_camera_frame", KINECT_FOV, 0.674, 1.364),
-    "head_center_camera": ("head_center_camera_frame", KINECT_FOV, 0.813, 1.158),
-    "head_r_stereo_camera": ("head_r_stereo_camera_link", KINECT_FOV, 0.813, 1.158),
-    "head_l_stereo_camera": ("head_l_stereo_camera_link", KINECT_FOV, 0.813, 1.158),
+    # Heights: FK's over every joint that moves the camera (validate checks them).
+    "hand_camera": ("hand_camera_frame", KINECT_FOV, -0.1, 1.514),
+    "head_center_camera": ("head_center_camera_frame", KINECT_FOV, 0.733, 1.161),
+    "head_r_stereo_camera": ("head_r_stereo_camera_link", KINECT_FOV, 0.732, 1.161),
+    "head_l_stereo_camera": ("head_l_stereo_camera_link", KINECT_FOV, 0.732, 1.161),
     # Our head RGB-D sensor uses the Xtion preset (the reference copied the Kinect values).
-    "head_rgbd_camera": ("head_rgbd_sensor_link", (1.0123, 0.7854), 0.967, 1.312),
+    "head_rgbd_camera": ("head_rgbd_sensor_link", (1.0123, 0.7854), 0.832, 1.326),
 }
 
 
@@ -601,7 +603,7 @@ def test_users_own_spec_extending_pr2(
         f"extends: {shipped_specs()['pr2']}\n"
         "name: my_pr2\n"
         "sensors:\n"
-        "  kinect: {minimal_height: 1.0}\n"
+        "  kinect: {maximal_height: 1.58}\n"
         "velocity_limits: {default: 0.5}\n"
         "chains:\n"
         "  right_arm:\n"
@@ -612,7 +614,7 @@ def test_users_own_spec_extending_pr2(
     assert type(robot) is AbstractRobot  # a user's file is not the shipped class
     assert robot.name == "my_pr2"
     cam = camera(robot, "kinect")
-    assert (cam.minimal_height, cam.maximal_height) == (1.0, 1.6)
+    assert (cam.minimal_height, cam.maximal_height) == (1.166, 1.58)
     assert set(chain_by_name(robot, "right_arm").states) == {"park", "up"}
     assert velocity_of(robot.world, "head_pan_joint") == 0.5
     assert velocity_of(robot.world, "r_shoulder_pan_joint") == 0.15

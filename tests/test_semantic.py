@@ -294,7 +294,13 @@ def test_neck_is_a_sensor_chain(fresh_pr2: PR2) -> None:
     assert robot.neck is neck and robot.sensor_chains == [neck] and robot.sensors == [cam]
     with pytest.raises(AssignmentError, match="already has neck"):
         robot.add_neck(
-            Neck(name="n2", root=body("head_pan_link"), world=w, tip=body("head_tilt_link"))
+            Neck(
+                name="n2",
+                root=body("head_pan_link"),
+                world=w,
+                tip=body("head_tilt_link"),
+                sensors=[cam],
+            )
         )
 
 

@@ -8,15 +8,14 @@ the robot's own state, not timing.
 
 from __future__ import annotations
 
+import math
 import os
-import shutil
 import socket
 import subprocess
 import sys
-import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -38,96 +37,27 @@ from robotspec.driver.robot_info import load_robot_info
 from robotspec.driver.sim import Fault, SimRobot
 from robotspec.driver.state import CommandMode, StateFlags
 from robotspec.errors import ServiceError
-from robotspec.service.node import start_client_node
 from robotspec.service.server import RobotServer, ServeOptions
 
 from .driver_support import RRP
+from .service_support import (
+    PERIOD,
+    WAIT,
+    Served,
+    client_node,
+    rr_exception,
+    serve,
+    short_tmp,
+    wait_until,
+)
 
-PERIOD = 0.004
-WAIT = 5.0  # the longest any condition below is waited for, in seconds
-
-
-def wait_until(cond: Callable[[], bool], timeout: float = WAIT) -> None:
-    end = time.monotonic() + timeout
-    while not cond():
-        if time.monotonic() > end:
-            raise AssertionError("condition not met in time")
-        time.sleep(0.005)
-
-
-@pytest.fixture
-def short_tmp() -> Iterator[Path]:
-    """A temporary folder with a short path: the node's UNIX socket path must fit in 107 bytes,
-    and pytest's ``tmp_path`` can be long on some systems."""
-    path = Path(tempfile.mkdtemp(prefix="rs", dir="/tmp" if os.path.isdir("/tmp") else None))
-    yield path
-    shutil.rmtree(path, ignore_errors=True)
-
-
-@pytest.fixture(scope="module")
-def client_node(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    node = start_client_node(tmp_path_factory.mktemp("rr-client"))
-    yield node
-    node.Shutdown()
-
-
-class Served:
-    """A running server, its driver and a connected client object."""
-
-    def __init__(self, server: RobotServer, driver: SimRobot, node: Any, robot: Any) -> None:
-        self.server = server
-        self.driver = driver
-        self.node = node
-        self.robot = robot
-
-    def state(self) -> Any:
-        value, _ = self.robot.robot_state.PeekInValue()
-        return value
-
-    def q(self) -> np.ndarray:
-        return np.array(self.state().joint_position)
-
-    def struct(self, name: str) -> Any:
-        return self.node.GetStructureType(name, self.robot)()
-
-    def wait_mode(self, mode: CommandMode) -> None:
-        wait_until(lambda: self.state().command_mode == int(mode))
-
-    def trajectory(self, delta: np.ndarray, duration: float) -> Any:
-        q0 = self.q()
-        traj = self.struct("com.robotraconteur.robotics.trajectory.JointTrajectory")
-        traj.joint_names = list(self.driver.joint_names)
-        m = int(round(duration / 0.05)) + 1
-        wps = []
-        for i in range(m):
-            s = i / (m - 1)
-            w = self.struct("com.robotraconteur.robotics.trajectory.JointTrajectoryWaypoint")
-            w.joint_position = q0 + delta * (3 * s * s - 2 * s**3)
-            w.time_from_start = duration * s
-            wps.append(w)
-        traj.waypoints = wps
-        return traj
+__all__ = ["client_node", "short_tmp"]  # fixtures from service_support, used by the tests below
 
 
 @pytest.fixture
 def served(short_tmp: Path, client_node: Any) -> Iterator[Served]:
-    info = load_robot_info(RRP)
-    driver = SimRobot(info, update_period=PERIOD)
-    server = RobotServer(driver, info, ServeOptions(port=0, state_dir=short_tmp / "rr"))
-    with server:
-        robot = client_node.ConnectService(server.url)
-        try:
-            yield Served(server, driver, client_node, robot)
-        finally:
-            client_node.DisconnectService(robot)
-    assert server.service is None
-
-
-def rr_exception(name: str) -> type[BaseException]:
-    import RobotRaconteur as RR
-
-    cls: type[BaseException] = getattr(RR, name)
-    return cls
+    with serve(RRP, short_tmp / "rr", client_node) as served:
+        yield served
 
 
 def test_robot_info_and_state_wires(served: Served) -> None:
@@ -565,12 +495,13 @@ def test_home_through_the_homing_generator(served: Served) -> None:
     np.testing.assert_allclose(served.q(), home, atol=1e-6)
 
 
-def _spatial_velocity(served: Served, linear_x: float) -> Any:
+def _spatial_velocity(served: Served, linear_x: float, linear_y: float = 0.0) -> Any:
     dtype = served.node.GetNamedArrayDType(
         "com.robotraconteur.geometry.SpatialVelocity", served.robot
     )
     v = np.zeros(1, dtype=dtype)
     v[0]["linear"]["x"] = linear_x
+    v[0]["linear"]["y"] = linear_y
     return v
 
 
@@ -579,12 +510,18 @@ def test_jog_cartesian(served: Served) -> None:
     r.command_mode = int(CommandMode.jog)
     x0 = float(served.state().kin_chain_tcp[0]["position"]["x"])
     y0 = float(served.state().kin_chain_tcp[0]["position"]["y"])
-    r.jog_cartesian({0: _spatial_velocity(served, 0.05)}, 0.5, True)  # +x, along the slide
+    # The arm's base is yawed 0.1 rad at home: a pure +x translation needs a rotation this
+    # three-joint arm cannot avoid, so it is refused rather than driven the wrong way.
+    with pytest.raises(rr_exception("InvalidArgumentException"), match="cannot move along"):
+        r.jog_cartesian({0: _spatial_velocity(served, 0.05)}, 0.5, True)
+    # Along the slide (yawed 0.1 rad) it can: the tool goes exactly that way.
+    c, s = 0.05 * math.cos(0.1), 0.05 * math.sin(0.1)
+    r.jog_cartesian({0: _spatial_velocity(served, c, s)}, 0.5, True)
     wait_until(lambda: not np.any(served.state().joint_velocity))
     tcp = served.state().kin_chain_tcp[0]["position"]
     dx, dy = float(tcp["x"]) - x0, float(tcp["y"]) - y0
     assert dx > 0.01
-    assert abs(dy) < 0.1 * dx  # mostly along x (damped least squares, from a yawed pose)
+    assert math.degrees(abs(math.atan2(dy, dx) - 0.1)) < 1.0
     with pytest.raises(rr_exception("InvalidArgumentException"), match="Invalid kinematic chain"):
         r.jog_cartesian({3: _spatial_velocity(served, 0.05)}, 0.5, True)
     with pytest.raises(rr_exception("InvalidArgumentException"), match="exactly one"):
@@ -633,7 +570,7 @@ def test_publisher_thread_sends_every_step_in_order(short_tmp: Path, client_node
     )
     with server:
         service = server.service
-        assert service is not None and service.publisher_thread.is_alive()
+        assert service is not None and service.publisher.thread.is_alive()
         robot = client_node.ConnectService(server.url)
         try:
             wire = robot.robot_state.Connect()
@@ -642,15 +579,58 @@ def test_publisher_thread_sends_every_step_in_order(short_tmp: Path, client_node
             try:
                 for _ in range(20):
                     driver.step()  # stepped here: no loop thread
-                wait_until(lambda: service.published == 20)
+                wait_until(lambda: service.publisher.published == 20)
                 wait_until(lambda: bool(seqnos) and seqnos[-1] == driver.robot_state.seqno)
             finally:
                 wire.Close()
             assert seqnos == sorted(seqnos)
-            assert service.publish_dropped == 0 and service.publish_errors == 0
+            assert service.publisher.dropped == 0 and service.publisher.errors == 0
         finally:
             client_node.DisconnectService(robot)
-    assert not service.publisher_thread.is_alive()  # stopped with the server
+    assert not service.publisher.thread.is_alive()  # stopped with the server
+
+
+def test_publisher_that_fell_behind_keeps_publishing(short_tmp: Path, client_node: Any) -> None:
+    # Regression: a publisher more than PUBLISH_BACKLOG steps behind (a CPU hiccup) dropped the
+    # oldest states and then ended its thread, as if closed: the wires froze for good.
+    from robotspec.service.publisher import PUBLISH_BACKLOG
+
+    info = load_robot_info(RRP)
+    driver = SimRobot(info, update_period=PERIOD)
+    server = RobotServer(
+        driver, info, ServeOptions(port=0, state_dir=short_tmp / "rr"), start_loop=False
+    )
+    with server:
+        service = server.service
+        assert service is not None
+        publisher = service.publisher
+        entered, release = threading.Event(), threading.Event()
+        inner = publisher._publish_step
+
+        def stalled(st: Any, latest: bool) -> None:
+            entered.set()
+            release.wait(WAIT)  # the first state stalls the publisher thread
+            inner(st, latest)
+
+        publisher._publish_step = stalled  # type: ignore[method-assign]
+        driver.step()
+        assert entered.wait(WAIT)
+        for _ in range(PUBLISH_BACKLOG + 12):
+            driver.step()  # queued behind the stalled one
+        publisher._publish_step = inner  # type: ignore[method-assign]
+        release.set()
+        wait_until(lambda: publisher.dropped == 12)
+        driver.step()  # after falling behind, a new step is still sent
+        wait_until(lambda: publisher.published == 1 + PUBLISH_BACKLOG + 1)
+        assert publisher.thread.is_alive()
+        robot = client_node.ConnectService(server.url)
+        try:
+            driver.step()
+            want = driver.robot_state.seqno
+            wait_until(lambda: robot.robot_state.PeekInValue()[0].seqno == want)
+        finally:
+            client_node.DisconnectService(robot)
+    assert not publisher.thread.is_alive()
 
 
 def _own_sockets(kind: str) -> list[tuple[str, int]]:
@@ -716,7 +696,7 @@ def test_loopback_only_without_public_and_discoverable_with_it(
 def test_cli_passes_public_through(
     short_tmp: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from robotspec.service import cli as service_cli
+    from robotspec.service import serve as service_serve
 
     seen: list[ServeOptions] = []
 
@@ -725,7 +705,7 @@ def test_cli_passes_public_through(
             super().__init__(*args, **kw)
             seen.append(self.options)
 
-    monkeypatch.setattr(service_cli, "RobotServer", Recording)
+    monkeypatch.setattr(service_serve, "RobotServer", Recording)
     for extra in ([], ["--public"]):
         code = render.run_app(
             app,

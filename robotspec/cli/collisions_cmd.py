@@ -10,11 +10,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from robotspec.cli.geometry import check_missing_geometry, report_skipped
 from robotspec.cli.options import (
     JsonFlag,
     PackagePath,
+    QOpt,
     SkipMeshes,
     SpecArg,
+    joint_values,
     load_robot,
     write_output,
 )
@@ -43,37 +46,6 @@ StateOpt = Annotated[
         show_default=False,
     ),
 ]
-QOpt = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--q",
-        help="A joint value JOINT=VALUE (rad or m), applied after the states; repeatable.",
-        show_default=False,
-    ),
-]
-
-
-def _values(items: list[str] | None) -> dict[str, float]:
-    out: dict[str, float] = {}
-    for item in items or ():
-        name, sep, text = item.partition("=")
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not sep or not name.strip() or not math.isfinite(value):
-            raise CollisionError(
-                f"--q '{item}': expected JOINT=VALUE with a finite number", kind="option"
-            )
-        out[name.strip()] = value
-    return out
-
-
-def _warn_skipped(skipped: tuple[Any, ...]) -> None:
-    from robotspec.cli.render import print_error
-
-    for err in skipped:
-        print_error(err)
 
 
 @collisions_app.command("check")
@@ -83,6 +55,14 @@ def check(
     q: QOpt = None,
     distances: Annotated[
         bool, typer.Option("--distances", help="Also list every checked pair's distance.")
+    ] = False,
+    ignore_srdf: Annotated[
+        bool,
+        typer.Option(
+            "--ignore-srdf",
+            help="Check the pairs the SRDF disables too (adjacent pairs stay unchecked); shows "
+            "the witnesses of `collisions audit`.",
+        ),
     ] = False,
     as_json: JsonFlag = False,
     skip_missing_meshes: SkipMeshes = False,
@@ -96,12 +76,29 @@ def check(
     from robotspec.collision import SelfCollisionChecker
 
     robot = load_robot(spec, package_path)
+    reported = check_missing_geometry(
+        robot, skip=skip_missing_meshes, collision=True, command="check collisions"
+    )
     checker = SelfCollisionChecker.from_robot(
         robot, on_missing_mesh="skip" if skip_missing_meshes else "error"
     )
-    config = checker.configuration(state or (), _values(q))
+    config = checker.configuration(state or (), joint_values(q))
+    if ignore_srdf:
+        from robotspec.collision import CollisionRules
+
+        rules = checker.rules
+        checker = SelfCollisionChecker(
+            robot.world,
+            CollisionRules(
+                bodies=rules.bodies,
+                adjacent=rules.adjacent,
+                disabled_bodies=rules.disabled_bodies,
+                buffer_distance=rules.buffer_distance,
+            ),
+            on_missing_mesh="skip" if skip_missing_meshes else "error",
+        )
     colliding = checker.colliding_pairs(config)
-    _warn_skipped(checker.skipped)
+    report_skipped(checker.skipped, reported)
     buffer = checker.rules.buffer_distance
     near = [p for p in checker.buffer_violations(config) if p not in colliding] if buffer else []
     pair_d = checker.distances(config) if distances else ()
@@ -167,6 +164,14 @@ def generate(
             "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
         ),
     ] = None,
+    compare: Annotated[
+        Path | None,
+        typer.Option(
+            "--compare",
+            help="An SRDF to compare with: precision, recall and each differing pair with its "
+            "reason (on stderr).",
+        ),
+    ] = None,
     skip_missing_meshes: SkipMeshes = False,
     package_path: PackagePath = None,
 ) -> None:
@@ -174,14 +179,21 @@ def generate(
 
     Without --merge the SRDF holds only the disable_collisions; with it, the robot's SRDF with
     the new pairs added. A summary (and, when the robot has an SRDF, precision and recall against
-    it) goes to stderr.
+    it) and a convergence report (pairs first seen colliding in the last half of the samples)
+    go to stderr.
     """
     from robotspec.collision import Progress, compare_pairs, generate_for_robot
+    from robotspec.collision.convergence import compare_with_srdf, convergence
+    from robotspec.description.srdf import load_srdf
     from robotspec.export.srdf import write_srdf
 
     robot = load_robot(spec, package_path)
+    other = None if compare is None else load_srdf(compare, strict=False)
     if merge and robot.srdf is None:
         raise CollisionError(f"--merge: robot '{robot.name}' has no SRDF to merge into")
+    reported = check_missing_geometry(
+        robot, skip=skip_missing_meshes, collision=True, command="generate the matrix"
+    )
     bar = Progress(0, "collision matrix", enabled=progress)
 
     def report(done: int, total: int) -> None:
@@ -197,7 +209,7 @@ def generate(
             progress=report,
             on_missing_mesh="skip" if skip_missing_meshes else "error",
         )
-    _warn_skipped(matrix.skipped)
+    report_skipped(matrix.skipped, reported)
     text = write_srdf(matrix.to_srdf(robot.srdf if merge else None, merge=True))
     write_output(text, output)
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
@@ -218,6 +230,71 @@ def generate(
             f"against {Path(robot.srdf.file or 'the SRDF').name}: precision {precision:.3f}, "
             f"recall {recall:.3f} ({len(reference)} pairs there)"
         )
+    lines += convergence(matrix).lines()
+    if other is not None and compare is not None:
+        lines += compare_with_srdf(matrix, other, compare.name).lines()
     if output is not None:
         lines.append(f"wrote {output}")
     sys.stderr.write("\n".join(lines) + "\n")
+
+
+@collisions_app.command("audit")
+def audit(
+    spec: SpecArg,
+    samples: Annotated[
+        int,
+        typer.Option(
+            "--samples", "-n", min=0, help="Random configurations for the regenerated matrix."
+        ),
+    ] = 10_000,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the sampler.")] = 0,
+    jobs: Annotated[
+        int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes (default: CPUs).")
+    ] = None,
+    show_ok: Annotated[
+        bool, typer.Option("--all", help="Also list the entries that are right.")
+    ] = False,
+    progress: Annotated[
+        bool | None,
+        typer.Option(
+            "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
+        ),
+    ] = None,
+    as_json: JsonFlag = False,
+    skip_missing_meshes: SkipMeshes = False,
+    package_path: PackagePath = None,
+) -> None:
+    """What each SRDF disable_collisions entry does. Exit code 1 when an entry is wrong.
+
+    Inert entries (unknown links, bodies without collision geometry, a link paired with
+    itself), duplicates, Adjacent entries whose bodies are not adjacent, Never entries whose
+    bodies collide in sampled configurations (each with a witness: joint values to pass to
+    `collisions check --q` or `render --q`), and the pairs a regenerated matrix would disable
+    that the SRDF does not.
+    """
+    from robotspec.cli.audit_report import audit_json, audit_text
+    from robotspec.collision import Progress
+    from robotspec.collision.audit import audit_srdf
+
+    robot = load_robot(spec, package_path)
+    bar = Progress(0, "audit", enabled=progress)
+
+    def report(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done - bar.done)
+
+    with bar:
+        result = audit_srdf(
+            robot,
+            samples=samples,
+            seed=seed,
+            processes=jobs,
+            progress=report,
+            on_missing_mesh="skip" if skip_missing_meshes else "error",
+        )
+    if as_json:
+        sys.stdout.write(json.dumps(audit_json(result), indent=2) + "\n")
+    else:
+        sys.stdout.write(audit_text(result, spec, show_ok))
+    if result.wrong:
+        raise typer.Exit(1)

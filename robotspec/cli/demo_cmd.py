@@ -72,35 +72,44 @@ def demo_scenario(info: RobotInfo) -> str:
 def demo(
     robot: Annotated[str, typer.Argument(help="A shipped robot or a spec file.")] = "pr2",
     chain: Annotated[
-        str | None, typer.Option("--chain", help="The chain to drive (default: the first arm).")
+        str | None,
+        typer.Option(
+            "--chain",
+            help="The chain to drive (default: the last arm the spec lists, the PR2's right arm).",
+        ),
     ] = None,
     package_path: PackagePath = None,
 ) -> None:
     """Validate a robot's spec, show its chains, then drive its arm in simulation."""
-    from robotspec.cli.drive_cmd import drive
-    from robotspec.cli.inspect_cmd import chains
-    from robotspec.cli.validate_cmd import validate
-    from robotspec.compiler import compile_robot
+    from robotspec.cli.chain_table import print_chains
+    from robotspec.cli.driving import run_driver
+    from robotspec.cli.validation_report import report_validation
     from robotspec.export.robotinfo import export_spec_chain
+    from robotspec.robots import load
 
     def head(text: str) -> None:
         sys.stdout.write(f"\n== {text}\n")
         sys.stdout.flush()
 
     head(f"robotspec validate {robot}")
-    validate([robot], package_path=package_path)
+    if report_validation([robot], package_paths=package_path or ()):
+        raise typer.Exit(1)
     head(f"robotspec inspect chains {robot}")
-    chains(robot, package_path=package_path)
+    compiled = load(robot, package_paths=package_path or ())
+    print_chains(compiled)
     if chain is None:
-        compiled = compile_robot(robot, package_paths=package_path or ())
         arms = compiled.arms or compiled.all_chains
         if not arms:
             sys.stdout.write("this robot has no chain to drive\n")
             return
+        # The last arm, as the help says: on the PR2 the right arm, the one the driver guide uses.
         chain = arms[-1].name
-    info = export_spec_chain(robot, chain, package_path).info
+    exported = export_spec_chain(robot, chain, package_path)
+    for note in exported.notes:
+        sys.stderr.write(f"note: {note}\n")
+    info = exported.info
     with tempfile.TemporaryDirectory(prefix="robotspec-demo-") as tmp:
         script = Path(tmp) / "demo.yaml"
         script.write_text(demo_scenario(info), encoding="utf-8")
         head(f"robotspec drive --spec {robot} --chain {chain} --script <generated>")
-        drive(spec=robot, chain=chain, script=script, package_path=package_path)
+        run_driver(info, f"{robot}_{chain}", script=script)

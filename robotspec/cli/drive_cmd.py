@@ -2,18 +2,12 @@
 
 from __future__ import annotations
 
-import sys
-import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import Annotated
 
 import typer
 
 from robotspec.cli.options import PackagePath
-
-if TYPE_CHECKING:
-    from robotspec.driver.state import RobotState
-
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
@@ -88,7 +82,7 @@ def drive(
         raise typer.BadParameter(
             f"unknown log format '{log.suffix}' (use .csv or .jsonl)", param_hint="--log"
         )
-    from robotspec.service.cli import serve_option_problem
+    from robotspec.service.serve import serve_option_problem
 
     problem = serve_option_problem(
         serve=serve,
@@ -102,160 +96,21 @@ def drive(
     if problem:
         raise typer.BadParameter(problem)
 
-    from robotspec.driver.clock import RealClock, SimClock
-    from robotspec.driver.script import load_scenario, mismatch_errors, run_scenario
-    from robotspec.driver.sim import SimRobot
-    from robotspec.driver.statelog import StateLog
-    from robotspec.errors import RobotSpecError, RobotSpecErrors
+    from robotspec.cli.driving import drive_target, run_driver
 
-    if spec is not None:
-        # Export the chain in memory (H/P, limits, flange) and drive that: every robot
-        # robotspec can compile can be driven, not only those that ship a RobotInfo.
-        from robotspec.export.robotinfo import export_spec_chain
-
-        assert chain is not None
-        exported = export_spec_chain(spec, chain, package_path)
-        for note in exported.notes:
-            sys.stderr.write(f"note: {note}\n")
-        info = exported.info
-        fallback_name = f"{spec}_{chain}"
-    else:
-        from robotspec.driver.robot_info import read_robot_info
-
-        assert sim is not None
-        loaded_info = read_robot_info(sim)
-        for w in loaded_info.warnings:
-            sys.stderr.write(w.detail.render() + "\n")
-        info = loaded_info.info
-        fallback_name = sim.stem
-    scenario = load_scenario(script) if script is not None else None
-    clock = SimClock() if virtual_time else RealClock()
-    driver = SimRobot(info, clock=clock, update_period=1.0 / rate)
-    statelog = None
-    if log is not None:
-        statelog = StateLog(log, info.joint_names, len(info.chains))
-        driver.add_state_listener(statelog)
-    tty = sys.stdout.isatty()
-    status = _StatusLine(tty)
-    driver.add_state_listener(status)
-    trace = None
-    if plot is not None:
-        from robotspec.render.deps import require
-        from robotspec.render.plot import JointTrace
-
-        require("matplotlib", "matplotlib", "--plot")
-        trace = JointTrace(info.joint_names)
-        driver.add_state_listener(trace)
-    name = info.device_info.device.name or fallback_name
-    sys.stderr.write(
-        f"driving {name} ({len(info.joint_info)} joints, {len(info.chains)} "
-        f"chain{'s' if len(info.chains) != 1 else ''}) in simulation at {rate:g} Hz"
-        f"{' (virtual time)' if virtual_time else ''}; Ctrl-C stops\n"
+    info, fallback_name = drive_target(sim, spec, chain, package_path)
+    run_driver(
+        info,
+        fallback_name,
+        rate=rate,
+        duration=duration,
+        script=script,
+        log=log,
+        plot=plot,
+        virtual_time=virtual_time,
+        serve=serve,
+        port=port,
+        public=public,
+        node_name=node_name,
+        state_dir=state_dir,
     )
-    results = []
-    interrupted = False
-    wall0 = time.perf_counter()
-    try:
-        driver.step()
-        if serve:
-            from robotspec.service.cli import serve_driver
-
-            serve_driver(
-                driver,
-                info,
-                port=port,
-                public=public,
-                node_name=node_name,
-                state_dir=state_dir,
-                duration=duration,
-                fallback_name=fallback_name,
-            )
-        elif scenario is not None:
-
-            def report(r: object) -> None:
-                from robotspec.driver.script import StepResult
-
-                assert isinstance(r, StepResult)
-                status.clear()
-                mark = "ok  " if r.ok else "FAIL"
-                extra = f": {r.detail}" if r.detail else ""
-                sys.stdout.write(f"{mark} step {r.index} {r.description}{extra}\n")
-
-            results = run_scenario(driver, scenario, on_result=report)
-            if duration is not None:
-                driver.run_for(max(0.0, duration - driver._stopwatch_ellapsed_s()))
-        elif duration is not None:
-            driver.run_for(duration)
-        else:
-            while True:
-                driver.step()
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        status.clear()
-        if statelog is not None:
-            statelog.close()
-    st = driver.robot_state
-    sim_s = driver._stopwatch_ellapsed_s()
-    wall = time.perf_counter() - wall0
-    summary = (
-        f"{'stopped by Ctrl-C after' if interrupted else 'ran'} {st.seqno} steps, "
-        f"{sim_s:.2f} s{' simulated' if virtual_time else ''} in {wall:.2f} s; "
-        f"final mode {st.command_mode.name}, flags 0x{int(st.flags):x}"
-    )
-    sys.stdout.write(summary + "\n")
-    if statelog is not None:
-        sys.stdout.write(f"wrote {statelog.rows} states to {log}\n")
-    if trace is not None and plot is not None:
-        from robotspec.render.plot import plot_joint_trace
-
-        drawn = plot_joint_trace(trace, plot, title=f"{name}: positions (solid), commands (dashed)")
-        sys.stdout.write(f"wrote {plot} ({drawn.lines} lines, {drawn.samples} samples)\n")
-    if scenario is not None:
-        failed = mismatch_errors(scenario, results)
-        n_run = len(results)
-        n_steps = len(scenario.scenario.steps)
-        sys.stdout.write(
-            f"scenario: {n_run - len(failed)} of {n_steps} steps as expected"
-            f"{'' if n_run == n_steps else f' ({n_steps - n_run} not run)'}\n"
-        )
-        if interrupted and n_run < n_steps:
-            failed.append(
-                RobotSpecError(f"scenario interrupted before step {n_run + 1}", file=str(script))
-            )
-        if failed:
-            if len(failed) == 1:
-                raise failed[0]
-            raise RobotSpecErrors(failed, summary=f"{script}: {len(failed)} steps not as expected")
-
-
-class _StatusLine:
-    """A live one-line status on a terminal, about 10 times a second; silent when piped."""
-
-    def __init__(self, enabled: bool) -> None:
-        self.enabled = enabled
-        self._last = 0.0
-        self._shown = False
-
-    def __call__(self, st: RobotState) -> None:
-        if not self.enabled:
-            return
-        now = time.monotonic()
-        if now - self._last < 0.1:
-            return
-        self._last = now
-        q = " ".join(f"{x:+.3f}" for x in st.joint_position[:8])
-        line = (
-            f"t={st.ts:8.2f}s  mode={st.command_mode.name:<16} flags=0x{int(st.flags):07x}  q=[{q}]"
-        )
-        if st.error_message:
-            line += f"  error: {st.error_message}"
-        sys.stdout.write("\r" + line[:160] + "\x1b[K")
-        sys.stdout.flush()
-        self._shown = True
-
-    def clear(self) -> None:
-        if self._shown:
-            sys.stdout.write("\r\x1b[K")
-            sys.stdout.flush()
-            self._shown = False

@@ -9,11 +9,12 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from robotspec.cli.notes import print_notes
 from robotspec.cli.options import JsonFlag, PackagePath, SpecArg, load_robot
-from robotspec.cli.table import render_table
+from robotspec.cli.table import emit_table
 
 if TYPE_CHECKING:
-    from robotspec.semantic import AbstractRobot, KinematicChain
+    pass
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
@@ -23,63 +24,14 @@ inspect_app = typer.Typer(help="Show what a spec compiles to.", no_args_is_help=
 app.add_typer(inspect_app, name="inspect")
 
 
-def _emit(data: Any, headers: list[str], rows: list[list[Any]], as_json: bool) -> None:
-    if as_json:
-        sys.stdout.write(json.dumps(data, indent=2) + "\n")
-    else:
-        sys.stdout.write(render_table(headers, rows) + "\n")
-
-
-def _kind(robot: AbstractRobot, chain: KinematicChain) -> str:
-    if chain is robot.torso:
-        return "torso"
-    if chain is robot.neck:
-        return "neck"
-    from robotspec.semantic import Finger
-
-    if isinstance(chain, Finger):
-        return "finger"
-    return "arm" if chain.manipulator is not None else "chain"
-
-
-def _chain_row(robot: AbstractRobot, c: KinematicChain) -> dict[str, Any]:
-    return {
-        "name": c.name,
-        "kind": _kind(robot, c),
-        "root": c.root.name,
-        "tip": c.tip.name,
-        "joints": len(c.connections),
-        "dof": len(c.degrees_of_freedom),
-        "manipulator": None if c.manipulator is None else c.manipulator.name,
-        "sensors": [s.name for s in c.sensors],
-    }
-
-
 @inspect_app.command("chains")
 def chains(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """The robot's kinematic chains: kind, root, tip, joints, DOF, manipulator, sensors."""
-    from robotspec.semantic import ParallelGripper
+    from robotspec.cli.chain_table import print_chains
 
     robot = load_robot(spec, package_path)
-    items = [_chain_row(robot, c) for c in robot.all_chains]
-    for m in robot.manipulators:
-        if isinstance(m, ParallelGripper):
-            items += [_chain_row(robot, m.thumb), _chain_row(robot, m.finger)]
-    rows = [
-        [
-            i["name"],
-            i["kind"],
-            i["root"],
-            i["tip"],
-            i["joints"],
-            i["dof"],
-            i["manipulator"],
-            ", ".join(i["sensors"]) or None,
-        ]
-        for i in items
-    ]
-    headers = ["chain", "kind", "root", "tip", "joints", "dof", "manipulator", "sensors"]
-    _emit(items, headers, rows, as_json)
+    print_notes(robot)
+    print_chains(robot, as_json=as_json)
 
 
 @inspect_app.command("manipulators")
@@ -125,7 +77,7 @@ def manipulators(
         "front axis",
         "states",
     ]
-    _emit(items, headers, rows, as_json)
+    emit_table(items, headers, rows, as_json)
 
 
 @inspect_app.command("sensors")
@@ -166,17 +118,16 @@ def sensors(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath 
                 f"{i['minimal_height']:g}-{i['maximal_height']:g}" if fov else None,
             ]
         )
-    _emit(items, ["sensor", "type", "body", "axis", "fov (rad)", "height (m)"], rows, as_json)
+    emit_table(items, ["sensor", "type", "body", "axis", "fov (rad)", "height (m)"], rows, as_json)
 
 
 @inspect_app.command("joints")
 def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """The robot's moving joints with limits; velocities tightened by the spec end in '*'."""
     robot = load_robot(spec, package_path)
-    from robotspec.description.urdf import load_urdf  # noqa: F401  (keeps import cost inside the command)
-
+    print_notes(robot)
     w = robot.world
-    original = _urdf_velocities(robot)
+    tightened = w.loaded_velocity_limits
     items = []
     for c in robot.connections:
         if c.is_fixed:
@@ -189,9 +140,7 @@ def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
             "lower": None if dof is None or c.mimic else _num(dof.lower),
             "upper": None if dof is None or c.mimic else _num(dof.upper),
             "velocity": None if dof is None or c.mimic else _num(dof.velocity),
-            "tightened": bool(
-                dof is not None and not c.mimic and dof.velocity < original.get(dof.name, math.inf)
-            ),
+            "tightened": bool(dof is not None and not c.mimic and dof.name in tightened),
             "controlled": c in robot.controlled_connections,
         }
         items.append(item)
@@ -207,12 +156,7 @@ def joints(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
         ]
         for i in items
     ]
-    _emit(items, ["joint", "type", "lower", "upper", "velocity"], rows, as_json)
-
-
-def _urdf_velocities(robot: AbstractRobot) -> dict[str, float]:
-    """Velocity limits before the spec tightened them (from the compiler's record)."""
-    return dict(getattr(robot, "urdf_velocity_limits", {}) or {})
+    emit_table(items, ["joint", "type", "lower", "upper", "velocity"], rows, as_json)
 
 
 @inspect_app.command("groups")
@@ -246,7 +190,7 @@ def groups(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath =
         for e in items["end_effectors"]
     ]
     rows += [["group_state", s["name"], f"group {s['group']}"] for s in items["group_states"]]
-    _emit(items, ["element", "name", "content"], rows, as_json)
+    emit_table(items, ["element", "name", "content"], rows, as_json)
 
 
 def _group_text(g: dict[str, Any]) -> str:
@@ -264,6 +208,7 @@ def _group_text(g: dict[str, Any]) -> str:
 def collisions(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None) -> None:
     """Disabled collision pairs (by SRDF reason) and disabled bodies."""
     robot = load_robot(spec, package_path)
+    print_notes(robot)
     reasons: dict[str, int] = {}
     if robot.srdf is not None:
         for d in robot.srdf.disabled_collisions:
@@ -279,7 +224,7 @@ def collisions(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePa
     rows.append(["disabled pairs (total)", items["disabled_pairs"]])
     rows.append(["disabled bodies", ", ".join(items["disabled_bodies"]) or None])
     rows.append(["buffer distance (m)", items["buffer_distance"]])
-    _emit(items, ["what", "value"], rows, as_json)
+    emit_table(items, ["what", "value"], rows, as_json)
 
 
 @inspect_app.command("tree")
@@ -403,4 +348,4 @@ def parts(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = 
         for d in data
     ]
     headers = ["part", "source", "prefix", "attached to", "weld", "root link", "links", "joints"]
-    _emit(data, headers, rows, as_json)
+    emit_table(data, headers, rows, as_json)

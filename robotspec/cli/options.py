@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
+
+from robotspec.errors import CollisionError
 
 if TYPE_CHECKING:
     from robotspec.semantic import AbstractRobot
@@ -119,3 +122,30 @@ def load_robot(spec: str, package_path: list[Path] | None) -> AbstractRobot:
     from robotspec.robots import load
 
     return load(spec, package_paths=package_path or ())
+
+
+QOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--q",
+        help="A joint value JOINT=VALUE (rad or m), applied after the states; repeatable.",
+        show_default=False,
+    ),
+]
+
+
+def joint_values(items: list[str] | None) -> dict[str, float]:
+    """``--q JOINT=VALUE`` options as a mapping; a malformed or non-finite value is an error."""
+    out: dict[str, float] = {}
+    for item in items or ():
+        name, sep, text = item.partition("=")
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not sep or not name.strip() or not math.isfinite(value):
+            raise CollisionError(
+                f"--q '{item}': expected JOINT=VALUE with a finite number", kind="option"
+            )
+        out[name.strip()] = value
+    return out

@@ -4,11 +4,19 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from robotspec.cli.options import PackagePath, SkipMeshes, SpecArg, load_robot
+from robotspec.cli.geometry import check_missing_geometry, report_skipped
+from robotspec.cli.options import (
+    PackagePath,
+    QOpt,
+    SkipMeshes,
+    SpecArg,
+    joint_values,
+    load_robot,
+)
 
 if TYPE_CHECKING:
     pass
@@ -29,17 +37,11 @@ StateOpt = Annotated[
 ]
 
 
-def _warn(skipped: tuple[Any, ...]) -> None:
-    from robotspec.cli.render import print_error
-
-    for err in skipped:
-        print_error(err)
-
-
 @app.command("render")
 def render(
     spec: SpecArg,
     state: StateOpt = None,
+    q: QOpt = None,
     output: Annotated[Path, typer.Option("--output", "-o", help="The PNG file to write.")] = Path(
         "robot.png"
     ),
@@ -69,12 +71,15 @@ def render(
     if view not in VIEWS:
         raise typer.BadParameter(f"'{view}' is not one of {', '.join(VIEWS)}", param_hint="--view")
     robot = load_robot(spec, package_path)
-    q = state_configuration(robot, state or ())
+    config = state_configuration(robot, state or (), joint_values(q))
+    reported = check_missing_geometry(
+        robot, skip=skip_missing_meshes, collision=False, command="render"
+    )
     scene = build_scene(robot, on_missing_mesh="skip" if skip_missing_meshes else "error")
-    _warn(scene.skipped)
+    report_skipped(scene.skipped, reported)
     title = robot.name + (f" · {', '.join(state)}" if state else "")
     picture = render_scene(
-        scene, q, RenderOptions(width=width, height=height, view=view, title=title)
+        scene, config, RenderOptions(width=width, height=height, view=view, title=title)
     )
     picture.save(output)
     sys.stdout.write(f"wrote {output} ({width}x{height}, {view} view)\n")
@@ -105,6 +110,9 @@ def view(
 
     robot = load_robot(spec, package_path)
     q = state_configuration(robot, state or ())
+    reported = check_missing_geometry(
+        robot, skip=skip_missing_meshes, collision=False, command="view"
+    )
     viewer = RobotViewer(
         robot,
         q,
@@ -112,7 +120,7 @@ def view(
         port=port,
         on_missing_mesh="skip" if skip_missing_meshes else "error",
     )
-    _warn(viewer.skipped)
+    report_skipped(viewer.skipped, reported)
     sys.stdout.write(f"viewing {robot.name} at {viewer.url} ; Ctrl-C stops\n")
     sys.stdout.flush()
     try:

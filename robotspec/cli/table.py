@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import json
+import sys
 from collections.abc import Sequence
+from typing import Any
 
 from robotspec.errors import printable
 
-__all__ = ["render_table"]
+__all__ = ["emit_table", "render_table"]
 
 
 def render_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
@@ -20,3 +23,13 @@ def render_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> st
     for row in cells:
         lines.append("  ".join(c.ljust(widths[i]) for i, c in enumerate(row)).rstrip())
     return "\n".join(lines)
+
+
+def emit_table(
+    data: Any, headers: Sequence[str], rows: Sequence[Sequence[object]], as_json: bool
+) -> None:
+    """Print ``data`` as JSON, or ``rows`` as a table: every ``inspect`` view offers both."""
+    if as_json:
+        sys.stdout.write(json.dumps(data, indent=2) + "\n")
+    else:
+        sys.stdout.write(render_table(headers, rows) + "\n")

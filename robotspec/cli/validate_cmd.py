@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-import json
-import sys
 from enum import StrEnum
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
 from robotspec.cli.options import PackagePath, complete_spec
-from robotspec.cli.render import styled
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
@@ -34,59 +31,13 @@ def validate(
     package_path: PackagePath = None,
 ) -> None:
     """Check specs against their robot files; exit 0 if valid, 1 if not."""
-    from robotspec.compiler import check_spec
-    from robotspec.errors import ErrorDetail, RobotSpecError
+    from robotspec.cli.validation_report import report_validation
 
-    results: list[dict[str, Any]] = []
-    n_err = n_warn = 0
-    for ref in specs:
-        errors: tuple[ErrorDetail, ...] = ()
-        warnings: tuple[ErrorDetail, ...] = ()
-        try:
-            result = check_spec(ref, package_paths=package_path or (), strict=strict)
-            warnings = tuple(d for w in result.warnings for d in w.details)
-        except RobotSpecError as exc:
-            errors = exc.details
-        n_err += len(errors)
-        n_warn += 0 if strict else len(warnings)
-        results.append({"spec": ref, "valid": not errors, "errors": errors, "warnings": warnings})
-    if format is Format.json:
-        out = [
-            {
-                "spec": r["spec"],
-                "valid": r["valid"],
-                "problems": [_as_json(d) for d in (*r["errors"], *r["warnings"])],
-            }
-            for r in results
-        ]
-        sys.stdout.write(json.dumps(out, indent=2) + "\n")
-    else:
-        for r in results:
-            for d in (*r["errors"], *r["warnings"]):
-                sys.stdout.write(styled(d, sys.stdout) + "\n")
-        n_specs = len(results)
-        bad = sum(1 for r in results if not r["valid"])
-        summary = (
-            f"{n_specs - bad} of {_plural(n_specs, 'spec')} valid; "
-            f"{_plural(n_err, 'error')}, {_plural(n_warn, 'warning')}"
-        )
-        sys.stdout.write(summary + "\n")
+    n_err = report_validation(
+        specs,
+        strict=strict,
+        as_json=format is Format.json,
+        package_paths=package_path or (),
+    )
     if n_err:
         raise typer.Exit(1)
-
-
-def _as_json(d: Any) -> dict[str, Any]:
-    return {
-        "severity": d.severity,
-        "file": d.file,
-        "line": d.line,
-        "column": d.column,
-        "message": d.message,
-        "name": d.name,
-        "suggestions": list(d.suggestions),
-        "location": list(d.location),
-    }
-
-
-def _plural(n: int, word: str) -> str:
-    return f"{n} {word}{'' if n == 1 else 's'}"

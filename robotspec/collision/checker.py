@@ -1,10 +1,12 @@
 """Self-collision queries of a robot on one configuration or a batch, with coal.
 
-How a query runs: batched forward kinematics (numpy) gives every body pose; each geometry's
-body-frame bounding box is moved with its body (a broad phase over all samples and all pairs at
-once, in numpy); coal's narrow phase (a precomputed ``ComputeCollision`` per geometry pair, the
-functor pinocchio uses) runs only for pairs whose boxes overlap. Results are per *body* pair: a
-pair collides when any of their geometries do, and its distance is the minimum over them.
+How a query runs: forward kinematics (the C core) gives every body pose; each geometry's
+body-frame bounding box is moved with its body and tested against its partners' (a broad phase
+over all samples and all pairs in one C call: world-aligned bounds, then the oriented boxes'
+separating axes); coal's narrow phase (a precomputed ``ComputeCollision`` per geometry pair, the
+functor pinocchio uses) runs only for pairs whose boxes come within the margin. Results are per
+*body* pair: a pair collides when any of their geometries do, and its distance is the minimum
+over them.
 
 Everything is built on the first query (meshes read once), so constructing a checker is cheap.
 """
@@ -27,6 +29,7 @@ from robotspec.collision.shapes import (
     import_coal,
 )
 from robotspec.errors import CollisionError, RobotSpecError
+from robotspec.model import _kincore
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
 from robotspec.semantic.states import state_configuration
@@ -42,8 +45,6 @@ Bools = NDArray[np.bool_]
 
 #: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).
 _BLOCK = 512
-#: Below this many box-overlapping pairs, the oriented-box test is skipped (see _candidates).
-_SAT_MIN = 48
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,7 @@ class _Compiled:
     pair_of: I64  # (Q,) index of the body pair each geometry pair belongs to
     collide: tuple[Any, ...]  # coal.ComputeCollision per geometry pair
     transforms: tuple[Any, ...]  # one reusable coal.Transform3s per geometry
+    broad: object  # the C core's table of geometries and pairs (_kincore.geoms)
 
     # Python lists for the per-pair loop (indexing a list is several times cheaper).
     pair_geom1_list: list[int] = field(init=False)
@@ -118,6 +120,7 @@ class SelfCollisionChecker:
         self._kin: Kinematics | None = None
         self._compiled: _Compiled | None = None
         self._distance_fns: tuple[Any, ...] | None = None
+        self._request: tuple[float, Any, Any] | None = None
         self._robot: AbstractRobot | None = None
 
     @classmethod
@@ -207,6 +210,15 @@ class SelfCollisionChecker:
                 for i, j in zip(g1, g2, strict=True)
             ),
             transforms=tuple(coal.Transform3s() for _ in geoms),
+            broad=_kincore.geoms(
+                np.array([g.body_index for g in geoms], dtype=np.int64),
+                np.array([g.body_T_geometry for g in geoms], dtype=np.float64).reshape(-1, 4, 4),
+                np.array([g.aabb_center for g in geoms], dtype=np.float64).reshape(-1, 3),
+                np.array([g.aabb_half for g in geoms], dtype=np.float64).reshape(-1, 3),
+                np.array(g1, dtype=np.int64),
+                np.array(g2, dtype=np.int64),
+                len(self.world.bodies),
+            ),
         )
         return self._compiled
 
@@ -220,74 +232,18 @@ class SelfCollisionChecker:
             arr = arr[None, :]
         return arr
 
-    def _poses(self, c: _Compiled, qs: F64) -> tuple[F64, F64]:
-        """Body poses of each geometry's body, and the geometries' poses: (n, G, 4, 4) each."""
-        if qs.shape[0] == 1:
-            bodies = self.kinematics.forward(qs[0])[None]
-        else:
-            bodies = self.kinematics.forward_batch(qs)
-        bp = bodies[:, c.geom_body]
-        return bp, bp @ c.body_T_geom
+    def _broad(
+        self, c: _Compiled, qs: F64, margin: float, mask: NDArray[np.uint8] | None
+    ) -> tuple[list[int], list[int], F64]:
+        """Candidate (sample, geometry pair)s of ``qs`` and every geometry's pose (n, G, 4, 4).
 
-    @staticmethod
-    def _candidates(c: _Compiled, bp: F64, margin: float, cols: I64 | None) -> tuple[I64, I64, F64]:
-        """(sample, geometry pair) whose bounding boxes come within ``margin``: a broad phase.
-
-        First the boxes' world-aligned bounds (all pairs at once), then an exact
-        separating-axis test of the oriented boxes (15 axes) on the survivors. Both are
-        conservative: a pair they drop is farther apart than ``margin``. Also returns the boxes'
-        world centres (3, n, G). Written as elementwise array arithmetic: numpy's batched
-        ``matmul``/``einsum`` on 3x3 blocks is several times slower.
+        A candidate's boxes come within ``margin``; every other pair is farther apart than that,
+        so coal's narrow phase on the candidates gives the exact answer.
         """
-        g1 = c.pair_geom1 if cols is None else c.pair_geom1[cols]
-        g2 = c.pair_geom2 if cols is None else c.pair_geom2[cols]
-        n = bp.shape[0]
-        cx, h = c.aabb_center, c.aabb_half
-        rot = [[bp[..., i, j] for j in range(3)] for i in range(3)]
-        centers = np.empty((3, n, len(cx)))
-        ok = np.ones((n, len(g1)), dtype=np.bool_)
-        for a in range(3):
-            row = rot[a]
-            cen = row[0] * cx[:, 0] + row[1] * cx[:, 1] + row[2] * cx[:, 2] + bp[..., a, 3]
-            half = np.abs(row[0]) * h[:, 0] + np.abs(row[1]) * h[:, 1] + np.abs(row[2]) * h[:, 2]
-            centers[a] = cen
-            lo = cen - half - margin
-            hi = cen + half
-            ok &= lo[:, g1] <= hi[:, g2]
-            ok &= lo[:, g2] <= hi[:, g1]
-        rows, ks = np.nonzero(ok)
-        if len(rows) < _SAT_MIN:
-            # A hundred array operations cost more than coal's own bounding-volume test on a
-            # few pairs (one configuration): leave those to the narrow phase.
-            return rows, ks, centers
-        i, j = g1[ks], g2[ks]
-        # Oriented boxes A (geometry i) and B (geometry j), B expressed in A's frame.
-        ra = [[rot[x][y][rows, i] for y in range(3)] for x in range(3)]
-        rb = [[rot[x][y][rows, j] for y in range(3)] for x in range(3)]
-        ha = [h[i, x] + margin / 2.0 for x in range(3)]
-        hb = [h[j, x] + margin / 2.0 for x in range(3)]
-        d = [centers[x][rows, j] - centers[x][rows, i] for x in range(3)]
-        r = [
-            [ra[0][x] * rb[0][y] + ra[1][x] * rb[1][y] + ra[2][x] * rb[2][y] for y in range(3)]
-            for x in range(3)
-        ]
-        t = [ra[0][x] * d[0] + ra[1][x] * d[1] + ra[2][x] * d[2] for x in range(3)]
-        ar = [[np.abs(r[x][y]) + 1e-9 for y in range(3)] for x in range(3)]
-        sep = np.zeros(len(rows), dtype=np.bool_)
-        for x in range(3):
-            sep |= np.abs(t[x]) > ha[x] + ar[x][0] * hb[0] + ar[x][1] * hb[1] + ar[x][2] * hb[2]
-            tb = t[0] * r[0][x] + t[1] * r[1][x] + t[2] * r[2][x]
-            sep |= np.abs(tb) > ha[0] * ar[0][x] + ha[1] * ar[1][x] + ha[2] * ar[2][x] + hb[x]
-        for x in range(3):
-            x1, x2 = (x + 1) % 3, (x + 2) % 3
-            for y in range(3):
-                y1, y2 = (y + 1) % 3, (y + 2) % 3
-                lhs = np.abs(t[x2] * r[x1][y] - t[x1] * r[x2][y])
-                rhs = ha[x1] * ar[x2][y] + ha[x2] * ar[x1][y] + hb[y1] * ar[x][y2]
-                rhs += hb[y2] * ar[x][y1]
-                sep |= lhs > rhs
-        keep = ~sep
-        return rows[keep], ks[keep], centers
+        kin = self.kinematics
+        bodies = kin.forward(qs[0]) if qs.shape[0] == 1 else kin.forward_batch(qs)
+        rows, ks, poses = _kincore.broad(c.broad, bodies, margin, mask)
+        return rows.tolist(), ks.tolist(), poses
 
     # ------------------------------------------------------------------------- queries
     def _scan(
@@ -308,38 +264,32 @@ class SelfCollisionChecker:
         if not margin >= 0.0:
             raise CollisionError(f"margin must be >= 0, got {margin}", kind="config")
         c = self._build()
-        coal = import_coal()
         n = qs.shape[0]
         hits = np.zeros((n, len(self._pairs)), dtype=np.bool_)
         if not len(c.pair_of):
             return hits
-        cols: I64 | None = None
-        if pair_mask is not None:
-            cols = np.flatnonzero(pair_mask[c.pair_of])
-        if cols is None:
-            owner, q_index = c.pair_of_list, c.pair_index_list
-        else:
-            owner, q_index = c.pair_of[cols].tolist(), cols.tolist()
-        req = coal.CollisionRequest()
-        req.security_margin = margin
-        res = coal.CollisionResult()
+        geom_mask = None if pair_mask is None else pair_mask[c.pair_of].astype(np.uint8)
+        req, res = self._requests(margin)
         clear, is_collision = res.clear, res.isCollision
         found = [False] * len(self._pairs)
         tf = c.transforms
         fns = c.collide
+        owner = c.pair_of_list
         g1s, g2s = c.pair_geom1_list, c.pair_geom2_list
         hit_rows: list[int] = []
         hit_pairs: list[int] = []
         for start in range(0, n, _BLOCK):
-            bp, poses = self._poses(c, qs[start : start + _BLOCK])
-            rows, ks, _ = self._candidates(c, bp, margin, cols)
-            rot = np.ascontiguousarray(poses[..., :3, :3])
-            trans = np.ascontiguousarray(poses[..., :3, 3])
+            block = qs[start : start + _BLOCK]
+            if drop_found and geom_mask is not None and start:
+                geom_mask &= ~np.asarray(found, dtype=np.bool_)[c.pair_of]
+            elif drop_found and start:
+                geom_mask = (~np.asarray(found, dtype=np.bool_)[c.pair_of]).astype(np.uint8)
+            rows, ks, poses = self._broad(c, block, margin, geom_mask)
             stamp = [-1] * len(tf)
             last_row = -1
             skip_row = False
             row_hits: set[int] = set()
-            for r, k in zip(rows.tolist(), ks.tolist(), strict=True):
+            for r, k in zip(rows, ks, strict=True):
                 if r != last_row:
                     last_row, skip_row = r, False
                     row_hits = set()
@@ -348,18 +298,19 @@ class SelfCollisionChecker:
                 p = owner[k]
                 if p in row_hits or (drop_found and found[p]):
                     continue
-                qi = q_index[k]
-                i, j = g1s[qi], g2s[qi]
+                i, j = g1s[k], g2s[k]
                 if stamp[i] != r:
                     stamp[i] = r
-                    tf[i].setRotation(rot[r, i])
-                    tf[i].setTranslation(trans[r, i])
+                    pose = poses[r, i]
+                    tf[i].setRotation(pose[:3, :3])
+                    tf[i].setTranslation(pose[:3, 3])
                 if stamp[j] != r:
                     stamp[j] = r
-                    tf[j].setRotation(rot[r, j])
-                    tf[j].setTranslation(trans[r, j])
+                    pose = poses[r, j]
+                    tf[j].setRotation(pose[:3, :3])
+                    tf[j].setTranslation(pose[:3, 3])
                 clear()
-                fns[qi](tf[i], tf[j], req, res)
+                fns[k](tf[i], tf[j], req, res)
                 if is_collision():
                     row_hits.add(p)
                     hit_rows.append(start + r)
@@ -368,6 +319,16 @@ class SelfCollisionChecker:
                     skip_row = first_only
         hits[hit_rows, hit_pairs] = True
         return hits
+
+    def _requests(self, margin: float) -> tuple[Any, Any]:
+        """A coal collision request for ``margin`` and a result to reuse (kept per checker)."""
+        cached = self._request
+        if cached is None or cached[0] != margin:
+            coal = import_coal()
+            req = coal.CollisionRequest()
+            req.security_margin = margin
+            cached = self._request = (margin, req, coal.CollisionResult())
+        return cached[1], cached[2]
 
     def in_collision(self, q: object, *, margin: float = 0.0) -> bool:
         """Whether any checked pair collides (or comes closer than ``margin``) at ``q``."""
@@ -387,9 +348,14 @@ class SelfCollisionChecker:
         hits = self._scan(self._as_batch(qs), margin=margin, first_only=True)
         return np.asarray(hits.any(axis=1), dtype=np.bool_)
 
-    def collisions_batch(self, qs: object, *, margin: float = 0.0) -> Bools:
-        """Per configuration and checked pair (N, P): whether the pair collides."""
-        return self._scan(self._as_batch(qs), margin=margin)
+    def collisions_batch(
+        self, qs: object, *, margin: float = 0.0, pair_mask: Bools | None = None
+    ) -> Bools:
+        """Per configuration and checked pair (N, P): whether the pair collides.
+
+        ``pair_mask`` (P,) limits the pairs tested; the others read ``False``.
+        """
+        return self._scan(self._as_batch(qs), margin=margin, pair_mask=pair_mask)
 
     def ever_colliding(
         self, qs: object, *, pair_mask: Bools | None = None, margin: float = 0.0
@@ -424,8 +390,9 @@ class SelfCollisionChecker:
         res = coal.DistanceResult()
         tf = c.transforms
         g1s, g2s, owner = c.pair_geom1.tolist(), c.pair_geom2.tolist(), c.pair_of.tolist()
+        none = np.zeros(len(c.pair_of), dtype=np.uint8)  # poses only, no broad phase
         for start in range(0, n, _BLOCK):
-            _, poses = self._poses(c, qs[start : start + _BLOCK])
+            _, _, poses = self._broad(c, qs[start : start + _BLOCK], 0.0, none)
             for r in range(poses.shape[0]):
                 for g in range(len(tf)):
                     tf[g].setRotation(poses[r, g, :3, :3])

@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from robotspec.collision.checker import SelfCollisionChecker
 from robotspec.collision.parallel import default_processes, ever_colliding_parallel
@@ -94,6 +95,9 @@ class CollisionMatrix:
     processes: int
     seconds: float
     skipped: tuple[RobotSpecError, ...] = ()
+    #: Pairs the "Never" pass saw colliding, with the index of the first sample (chunk
+    #: resolution: the chunk's first sample) in which they did; see :mod:`.convergence`.
+    first_collision: tuple[tuple[str, str, int], ...] = ()
 
     def count(self, reason: str) -> int:
         """How many pairs were disabled for ``reason``."""
@@ -199,7 +203,9 @@ def generate_collision_matrix(
             decide(k, ADJACENT)
     undecided = np.array([k not in verdict for k in range(len(pairs))], dtype=np.bool_)
 
-    hits = checker.collisions_batch(default_configuration(world)[None])[0]
+    # Decided pairs are not tested again: adjacent ones are the costliest to test (their meshes
+    # touch or nearly touch in every configuration).
+    hits = checker.collisions_batch(default_configuration(world)[None], pair_mask=undecided)[0]
     for k in np.flatnonzero(hits & undecided).tolist():
         decide(k, DEFAULT, 1, 1)
     undecided &= ~hits
@@ -220,7 +226,7 @@ def generate_collision_matrix(
     for _ in range(_MAX_ALWAYS_ROUNDS):
         qs = random_configurations(world, ALWAYS_ROUND, rng)
         always_drawn += ALWAYS_ROUND
-        counts = checker.collisions_batch(qs).sum(axis=0)
+        counts = checker.collisions_batch(qs, pair_mask=undecided).sum(axis=0)
         tick(ALWAYS_ROUND)
         found = np.flatnonzero(undecided & (counts >= limit))
         for k in found.tolist():
@@ -231,6 +237,12 @@ def generate_collision_matrix(
         total += ALWAYS_ROUND
 
     qs = random_configurations(world, samples, rng)
+    first: dict[int, int] = {}
+
+    def seen(start: int, hits: NDArray[np.bool_]) -> None:
+        for k in np.flatnonzero(hits).tolist():
+            first.setdefault(k, start)
+
     ever = ever_colliding_parallel(
         checker,
         qs,
@@ -239,6 +251,7 @@ def generate_collision_matrix(
         on_missing_mesh=on_missing_mesh,
         start_method=start_method,
         progress=tick,
+        on_chunk=seen,
     )
     for k in np.flatnonzero(undecided & ~ever).tolist():
         decide(k, NEVER, 0, samples)
@@ -255,6 +268,7 @@ def generate_collision_matrix(
         processes=procs,
         seconds=time.perf_counter() - started,
         skipped=tuple(checker.skipped),
+        first_collision=tuple((*pair_key(*pairs[k]), start) for k, start in sorted(first.items())),
     )
 
 

@@ -100,18 +100,24 @@ def ever_colliding_parallel(
     on_missing_mesh: MissingMeshPolicy = "error",
     start_method: str | None = None,
     progress: Callable[[int], None] | None = None,
+    on_chunk: Callable[[int, Bools], None] | None = None,
 ) -> Bools:
     """Per pair: whether it collides in any configuration of ``qs``, among pairs in ``mask``.
 
     Chunks go to ``processes`` workers; each chunk is sent with the pairs not yet seen colliding,
     so the work shrinks as the run goes. The answer is a union over chunks, so it does not depend
-    on the number of processes or on the order chunks finish in.
+    on the number of processes or on the order chunks finish in. ``on_chunk(start, hits)`` sees
+    each chunk's result in sample order (``start`` = its first sample's index), so a caller can
+    tell when each pair was first seen colliding (the matrix's convergence report).
     """
     ever = np.zeros(len(checker.active_pairs), dtype=np.bool_)
     chunks: Sequence[F64] = [qs[i : i + chunk] for i in range(0, len(qs), chunk)]
     if processes <= 1 or len(chunks) <= 1:
-        for block in chunks:
-            ever |= checker.ever_colliding(block, pair_mask=mask & ~ever, margin=margin)
+        for i, block in enumerate(chunks):
+            hits = checker.ever_colliding(block, pair_mask=mask & ~ever, margin=margin)
+            if on_chunk is not None:
+                on_chunk(i * chunk, hits & ~ever)
+            ever |= hits
             if progress is not None:
                 progress(len(block))
         return ever
@@ -120,13 +126,18 @@ def ever_colliding_parallel(
     pending: deque[tuple[int, AsyncResult[Any]]] = deque()
     with ctx.Pool(processes, initializer=_init_worker, initargs=(inputs,)) as pool:
         todo = deque(chunks)
+        done = 0
         while todo or pending:
             while todo and len(pending) < 2 * processes:
                 block = todo.popleft()
                 task = pool.apply_async(_ever_colliding_task, (block, mask & ~ever, margin))
                 pending.append((len(block), task))
             size, task = pending.popleft()
-            ever |= task.get()
+            hits = task.get()
+            if on_chunk is not None:
+                on_chunk(done, hits & ~ever)
+            done += size
+            ever |= hits
             if progress is not None:
                 progress(size)
     return ever

@@ -162,11 +162,14 @@ def _check_dimensions(shape: Shape, body: Body, file: str | None) -> None:
     elif isinstance(g, Sphere):
         values = (g.radius,)
     else:
-        values = g.scale
+        # A negative mesh scale mirrors the mesh (Talos's right arm reuses the left arm's
+        # meshes with scale 1 -1 1), as in every URDF reader; only zero flattens it.
+        values = tuple(abs(v) for v in g.scale)
     if not all(math.isfinite(v) and v > 0 for v in values):
+        shown = g.scale if isinstance(g, Mesh) else values
         raise CollisionError(
             f"link '{body.name}': collision {type(g).__name__.lower()} has a non-positive or "
-            f"non-finite dimension {tuple(values)}",
+            f"non-finite dimension {tuple(shown)}",
             file=file,
             line=shape.line,
             kind="link",

@@ -14,7 +14,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from robotspec.compiler.arm_sides import check_arm_sides
 from robotspec.compiler.build import Build, build_robot
+from robotspec.description.srdf import Srdf
 from robotspec.diagnostics import Diagnostics
 from robotspec.errors import RobotSpecError, SpecError, missing_file
 from robotspec.model.world import ConnectionType, World
@@ -141,6 +143,36 @@ def _prepare_world(
     return world
 
 
+def _check_srdf(
+    srdf: Srdf, world: World, urdf_name: str, diag: Diagnostics, *, own_file: bool
+) -> Srdf:
+    """The SRDF as the compiler uses it: prefixed names read as the URDF's, problems recorded.
+
+    A composed robot's SRDF was renamed part by part already (``own_file`` is false for it).
+    """
+    from robotspec.description.srdf import check_srdf_against, check_srdf_references
+    from robotspec.description.srdf_names import map_prefixed_names, self_pair_warnings
+
+    ambiguous: frozenset[tuple[int | None, str]] = frozenset()
+    if own_file:
+        mapping = map_prefixed_names(srdf, world.body_names, world.connection_names)
+        srdf, ambiguous = mapping.srdf, mapping.ambiguous
+        for err in (*mapping.warnings, *mapping.errors):
+            diag.add(err)
+    for err in [
+        *check_srdf_references(srdf),
+        *check_srdf_against(srdf, world.body_names, world.connection_names, urdf_name=urdf_name),
+    ]:
+        if (err.line, err.name) in ambiguous:
+            continue  # its error already says what to change
+        # An SRDF often outlives its URDF (HSRB's names odom_x/y/t); like MoveIt, warn and
+        # ignore the element. A spec that *uses* a stale name still fails on its own line.
+        diag.add(err.with_severity("warning"))
+    for err in self_pair_warnings(srdf):
+        diag.add(err)
+    return srdf
+
+
 def _compile(
     loaded: LoadedSpec,
     *,
@@ -150,7 +182,6 @@ def _compile(
     strict: bool = False,
 ) -> CompileResult:
     from robotspec.description.load import load_description, resolve_file
-    from robotspec.description.srdf import check_srdf_against, check_srdf_references
     from robotspec.spec.load import check_package_paths
 
     check_package_paths(loaded, package_paths)
@@ -217,23 +248,13 @@ def _compile(
         except RobotSpecError as exc:
             diag.add_all(exc, ("description", "srdf"))
     if srdf is not None:
-        for err in [
-            *check_srdf_references(srdf),
-            *check_srdf_against(
-                srdf,
-                base_world.body_names,
-                base_world.connection_names,
-                urdf_name=urdf_name,
-            ),
-        ]:
-            # An SRDF often outlives its URDF (HSRB's names odom_x/y/t); like MoveIt, warn and
-            # ignore the element. A spec that *uses* a stale name still fails on its own line.
-            diag.add(err.with_severity("warning"))
+        srdf = _check_srdf(srdf, base_world, urdf_name, diag, own_file=composition is None)
     prepared = _prepare_world(loaded, base_world, srdf, diag, add_drive=world is None)
     build = Build(
         loaded=loaded, world=prepared, diag=diag, srdf=srdf, presets=load_camera_presets()
     )
     robot = build_robot(build, robot_class)
+    check_arm_sides(robot, loaded.spec.chains, diag)
     diag.raise_if_failed(strict=strict)
     return CompileResult(
         loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))

@@ -160,15 +160,28 @@ def assemble(b: Build, r: Resolved, robot_class: type[AbstractRobot]) -> Abstrac
         )
     for name, c in spec.chains.items():
         cr, ct = r.chains[name]
-        cls: type[KinematicChain] = Arm if c.manipulator is not None else KinematicChain
+        sensors_of = [sensors[s] for s in c.sensors]
+        if c.manipulator is not None:
+            robot.add_arm(
+                Arm(
+                    name=name,
+                    root=cr,
+                    world=w,
+                    tip=ct,
+                    manipulator=manipulators[c.manipulator],
+                    sensors=sensors_of,
+                    states=_part_states(b, name),
+                    side=c.side,
+                )
+            )
+            continue
         robot.add_kinematic_chain(
-            cls(
+            KinematicChain(
                 name=name,
                 root=cr,
                 world=w,
                 tip=ct,
-                manipulator=None if c.manipulator is None else manipulators[c.manipulator],
-                sensors=[sensors[s] for s in c.sensors],
+                sensors=sensors_of,
                 states=_part_states(b, name),
             ),
             warn=False,

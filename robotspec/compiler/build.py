@@ -9,7 +9,9 @@ from __future__ import annotations
 
 from robotspec.compiler.assemble import Resolved, assemble
 from robotspec.compiler.context import Build, moved_by, subtree_joints
-from robotspec.compiler.joints import check_states, check_velocity
+from robotspec.compiler.joints import check_states, check_velocity, srdf_state_values
+from robotspec.compiler.kinematic_checks import KinematicInputs, check_kinematics
+from robotspec.compiler.part_checks import check_parts
 from robotspec.compiler.parts import (
     CameraValues,
     camera_values,
@@ -171,7 +173,7 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
         for gs in b.srdf.group_states:
             if gs.group is None:
                 continue  # a group-less state (lenient SRDF read) belongs to no part
-            single = {j: v[0] for j, v in gs.joint_values if len(v) == 1}
+            single = srdf_state_values(b, gs)
             b.add_states(
                 gs.group,
                 check_states(
@@ -182,6 +184,20 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
                     None,
                 ),
             )
+    # Checks across parts and with the robot's kinematics, over what resolved.
+    check_parts(b, cameras)
+    if root is not None:
+        check_kinematics(
+            b,
+            KinematicInputs(
+                root=root,
+                torso=torso_ends,
+                neck=neck_ends,
+                chains=chain_ends_by_name,
+                manipulators=manip_ends,
+                cameras=cameras,
+            ),
+        )
     diag.raise_if_failed()
     assert root is not None  # no errors means the root resolved
     resolved = Resolved(

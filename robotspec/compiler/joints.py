@@ -6,11 +6,13 @@ import math
 from collections.abc import Mapping
 
 from robotspec.compiler.context import Build
+from robotspec.description.srdf import GroupState
 from robotspec.diagnostics import Loc
+from robotspec.errors import SrdfError
 from robotspec.model.world import Connection
 from robotspec.semantic import JointState
 
-__all__ = ["check_states", "check_velocity"]
+__all__ = ["check_states", "check_velocity", "srdf_state_values"]
 
 
 def check_states(
@@ -127,3 +129,41 @@ def check_velocity(b: Build, robot_joints: list[Connection]) -> dict[str, float]
             )
         caps[dof.name] = v
     return caps
+
+
+def srdf_state_values(b: Build, gs: GroupState) -> dict[str, float]:
+    """The 1-DOF values of an SRDF group state a spec imports, mimic joints taken out.
+
+    Joints the URDF lacks are left out: the SRDF check warns about each at its own line, so the
+    spec's ``import_srdf_group_states`` line does not collect one error per joint. MoveIt group
+    states list mimic joints beside their leaders (Baxter's fingers); a spec state sets only
+    leaders. A mimic value that agrees with its leader's is dropped silently; one
+    that disagrees (or whose leader is absent) is dropped with a warning at the SRDF's line.
+    """
+    values = {j: v[0] for j, v in gs.joint_values if len(v) == 1}
+    lines = dict(zip((j for j, _ in gs.joint_values), gs.joint_lines, strict=False))
+    out: dict[str, float] = {}
+    for name, value in values.items():
+        if not b.world.has_connection(name):
+            continue  # warned at the SRDF's line already; MoveIt ignores it the same way
+        mimic = b.world.get_connection_by_name(name).mimic
+        if mimic is None:
+            out[name] = value
+            continue
+        leader = values.get(mimic.leader)
+        if leader is not None and abs(mimic.multiplier * leader + mimic.offset - value) <= 1e-6:
+            continue
+        expected = "" if leader is None else f" ({mimic.multiplier * leader + mimic.offset:g})"
+        b.diag.add(
+            SrdfError(
+                f"group_state '{gs.name}' sets joint '{name}' to {value:g}, but it mimics "
+                f"'{mimic.leader}'{expected}; the value is ignored",
+                file=b.srdf.file if b.srdf is not None else None,
+                line=lines.get(name, gs.line),
+                kind="joint",
+                name=name,
+                suggestions=(mimic.leader,),
+                severity="warning",
+            )
+        )
+    return out

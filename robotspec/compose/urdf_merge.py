@@ -18,7 +18,8 @@ from lxml import etree
 
 from robotspec.compose.naming import PartNames
 from robotspec.description.urdf_walk import parse_floats
-from robotspec.model.geometry import Matrix, matrix_to_rpy, pose_from_xyz_rpy
+from robotspec.model.geometry import Matrix, pose_from_xyz_rpy
+from robotspec.model.rotations import matrix_to_rpy
 
 __all__ = [
     "TreeFacts",

@@ -96,9 +96,13 @@ def load_description(
     srdf_data = None
     if srdf is not None:
         from robotspec.description.srdf import load_srdf
+        from robotspec.description.srdf_names import map_prefixed_names, self_pair_warnings
 
         srdf_path = resolve_file(str(srdf), base, resolver)
         srdf_data = load_srdf(srdf_path, strict=False)
+        mapping = map_prefixed_names(srdf_data, world.body_names, world.connection_names)
+        srdf_data = mapping.srdf
+        issues += [*mapping.warnings, *mapping.errors, *self_pair_warnings(srdf_data)]
     return Description(
         world=world,
         urdf_file=urdf_path,

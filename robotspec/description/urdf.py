@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
@@ -29,6 +30,7 @@ from robotspec.model.geometry import (
 
 if TYPE_CHECKING:
     from robotspec.files.packages import PackageResolver
+from robotspec.description.mesh_report import MissingMesh, summarize_missing_meshes
 from robotspec.description.urdf_walk import JointRecord, ShapeRecord, walk_urdf
 from robotspec.files.limits import limits
 from robotspec.files.reading import read_bounded
@@ -104,7 +106,8 @@ def world_from_urdf_xml(
 ) -> World:
     """Interpret a URDF element tree as a world; all problems are raised together.
 
-    With ``meshes="report"``, unresolvable meshes are appended to ``issues`` as warnings.
+    With ``meshes="report"``, meshes that do not resolve are kept as ``Mesh(path=None)`` and
+    summarized into ``issues`` as warnings, one per missing package (never raised).
     ``checked=True`` marks a tree whose pieces were checked in their own files already (a
     composed robot's parts): its problems are still found, but reported without lines, which
     would point into the joined tree rather than a file.
@@ -116,12 +119,14 @@ def world_from_urdf_xml(
             raise exc.located(file=file, line=None) from None
         raise
     problems: list[RobotSpecError] = []
+    missing: list[MissingMesh] = []
     bodies: list[Body] = []
     body_index: dict[str, int] = {}
     base = Path(file).parent
     for link in records.links:
-        visuals = _shapes(link.visuals, file, base, resolver, meshes, problems)
-        collisions = _shapes(link.collisions, file, base, resolver, meshes, problems)
+        where = _Where(file, base, resolver, meshes, problems, missing, link.name)
+        visuals = _shapes(link.visuals, where)
+        collisions = _shapes(link.collisions, where)
         body_index[link.name] = len(bodies)
         bodies.append(
             Body(
@@ -134,6 +139,8 @@ def world_from_urdf_xml(
             )
         )
     raise_collected(problems)
+    if missing and issues is not None:
+        issues.extend(summarize_missing_meshes(missing))
     joints = {j.name: j for j in records.joints}
     leaders = _resolve_mimics(joints, file)
     dofs: list[DegreeOfFreedom] = []
@@ -255,17 +262,27 @@ def _resolve_mimics(
     return out
 
 
-def _shapes(
-    records: tuple[ShapeRecord, ...],
-    file: str,
-    base: Path,
-    resolver: PackageResolver | None,
-    meshes: MeshPolicy,
-    problems: list[RobotSpecError],
-) -> tuple[Shape, ...]:
+@dataclass(frozen=True)
+class _Where:
+    """What resolving one link's meshes needs, and where its problems go.
+
+    ``problems`` are errors (raised together); ``missing`` are meshes that did not resolve under
+    the ``report`` policy, summarized into one warning per package once every link is read.
+    """
+
+    file: str
+    base: Path
+    resolver: PackageResolver | None
+    meshes: MeshPolicy
+    problems: list[RobotSpecError]
+    missing: list[MissingMesh]
+    body: str
+
+
+def _shapes(records: tuple[ShapeRecord, ...], where: _Where) -> tuple[Shape, ...]:
     out: list[Shape] = []
     for rec in records:
-        geometry = _geometry(rec, file, base, resolver, meshes, problems)
+        geometry = _geometry(rec, where)
         if geometry is None:
             continue
         out.append(
@@ -280,14 +297,7 @@ def _shapes(
     return tuple(out)
 
 
-def _geometry(
-    rec: ShapeRecord,
-    file: str,
-    base: Path,
-    resolver: PackageResolver | None,
-    meshes: MeshPolicy,
-    problems: list[RobotSpecError],
-) -> GeometryShape | None:
+def _geometry(rec: ShapeRecord, where: _Where) -> GeometryShape | None:
     el, v = rec.shape, rec.values
     if el.tag == "capsule":
         return Capsule(radius=v[0], length=v[1])
@@ -297,6 +307,7 @@ def _geometry(
         return Cylinder(radius=v[0], length=v[1])
     if el.tag == "sphere":
         return Sphere(radius=v[0])
+    file, resolver, meshes = where.file, where.resolver, where.meshes
     uri = el.get("filename") or ""
     scale = (v[0], v[1], v[2])
     path: str | None = None
@@ -305,21 +316,25 @@ def _geometry(
             raise ValueError("resolving meshes needs a PackageResolver")
         report = meshes == "report"
         try:
-            resolved = resolver.resolve(uri, relative_to=base, file=file, line=line_of(el))
+            resolved = resolver.resolve(uri, relative_to=where.base, file=file, line=line_of(el))
         except RobotSpecError as exc:
-            problems.append(exc.with_severity("warning") if report else exc)
-            return Mesh(uri=uri, path=None, scale=scale) if report else None
+            if not report:
+                where.problems.append(exc)
+                return None
+            where.missing.append(MissingMesh(uri=uri, body=where.body, error=exc))
+            return Mesh(uri=uri, path=None, scale=scale)
         if not resolved.is_file():
-            problems.append(
-                DescriptionError(
-                    f"mesh '{uri}' resolves to '{resolved}', which does not exist",
-                    file=file,
-                    line=line_of(el),
-                    kind="mesh",
-                    name=uri,
-                    severity="warning" if report else "error",
-                )
+            err = DescriptionError(
+                f"mesh '{uri}' resolves to '{resolved}', which does not exist",
+                file=file,
+                line=line_of(el),
+                kind="mesh",
+                name=uri,
             )
-            return Mesh(uri=uri, path=None, scale=scale) if report else None
+            if not report:
+                where.problems.append(err)
+                return None
+            where.missing.append(MissingMesh(uri=uri, body=where.body, error=err))
+            return Mesh(uri=uri, path=None, scale=scale)
         path = str(resolved)
     return Mesh(uri=uri, path=path, scale=scale)

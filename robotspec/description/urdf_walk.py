@@ -27,7 +27,8 @@ from robotspec.errors import (
     raise_collected,
 )
 from robotspec.files.xmlsafe import line_of
-from robotspec.model.geometry import Matrix, rpy_to_matrix
+from robotspec.model.geometry import Matrix
+from robotspec.model.rotations import rpy_to_matrix
 
 __all__ = [
     "JOINT_TYPES",

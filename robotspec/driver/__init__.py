@@ -1,17 +1,26 @@
 """A simulated Robot Raconteur-style robot driver.
 
 The subpackage follows the contract of ``robotraconteur_abstract_robot.AbstractRobot`` (the seed
-document) and the behaviour recorded in the reference note, with the reference's defects fixed (see
-:mod:`robotspec.driver.robot_driver` and ``docs/driver.md``). Modules, one job each:
+document; upstream ``abstract_robot.py`` of robotraconteur-abstract-robot 0.2.2), with the
+reference's defects fixed (listed in ``docs/driver.md``).
+Modules, one job each:
 
 * :mod:`~robotspec.driver.robot_info` -- the RobotInfo YAML as validated, located models;
 * :mod:`~robotspec.driver.state` -- command modes, state flags and frozen state snapshots;
 * :mod:`~robotspec.driver.commands` -- validation of client commands and the send-path guard;
-* :mod:`~robotspec.driver.profiles` -- online jog profiles (time-optimal, limit-aware);
+* :mod:`~robotspec.driver.profiles` -- online motion profiles: jogs and stream limiting, with
+  acceleration limits and braking before joint limits, on the real step duration;
+* :mod:`~robotspec.driver.cartesian` -- joint rates for a twist (damped least squares) and
+  whether the tool can follow it;
 * :mod:`~robotspec.driver.trajectory` -- joint trajectory checks and interpolation;
-* :mod:`~robotspec.driver.hp_kinematics` -- forward kinematics and Jacobians of H/P chains;
+* :mod:`~robotspec.driver.chain_kinematics` -- forward kinematics and Jacobians of H/P chains;
 * :mod:`~robotspec.driver.clock` -- real and simulated clocks;
-* :mod:`~robotspec.driver.loop` -- the timestep pipeline and state machine;
+* :mod:`~robotspec.driver.loop_state` -- every field of the loop, set up from the RobotInfo;
+* :mod:`~robotspec.driver.modes` -- the state machine (communication and robot-state checks);
+* :mod:`~robotspec.driver.fill` -- the command of each step (jogs, trajectories, streams, guard);
+* :mod:`~robotspec.driver.cartesian_jog` -- Cartesian jogs in the loop, and when they stop;
+* :mod:`~robotspec.driver.state_fill` -- flags, TCP poses and the published snapshot;
+* :mod:`~robotspec.driver.loop` -- the loop, its timing and the timestep pipeline;
 * :mod:`~robotspec.driver.robot_driver` -- the driver base class: the seed's client API;
 * :mod:`~robotspec.driver.sim` -- the simulated robot with injectable faults;
 * :mod:`~robotspec.driver.script` -- YAML scenarios of client calls with expected outcomes.

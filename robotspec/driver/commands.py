@@ -10,6 +10,7 @@ non-finite values outright.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,11 +23,38 @@ from robotspec.driver.robot_info import RobotInfo
 __all__ = [
     "CommandGuard",
     "JointLimitArrays",
+    "RobotJointCommand",
     "check_speed_ratio",
     "joint_array",
 ]
 
 FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class RobotJointCommand:
+    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire.
+
+    ``command`` is kept as a float64 array, taken as is when it already is one (the service
+    hands over the array Robot Raconteur decoded: no copy, no list on the way); anything else
+    (a list, a tuple) is converted once here. Values are checked by the loop, which ignores a
+    sample of the wrong length or with NaN, as every invalid stream sample is ignored.
+    """
+
+    seqno: int
+    state_seqno: int
+    command: FloatArray
+    units: Sequence[str] = ()
+
+    def __post_init__(self) -> None:
+        cmd = self.command
+        if not (isinstance(cmd, np.ndarray) and cmd.dtype == np.float64 and cmd.ndim == 1):
+            try:
+                arr = np.asarray(cmd, dtype=np.float64).reshape(-1)
+            except (TypeError, ValueError):
+                arr = np.zeros(0)  # never accepted: no joint count is 0
+            object.__setattr__(self, "command", arr)
+
 
 #: Speed ratio range, inclusive (reference: InvalidArgument "Invalid speed_ratio" outside).
 SPEED_RATIO_MIN = 0.1
@@ -129,6 +157,7 @@ class CommandGuard:
         self._max_step = limits.velocity * period
         self._neg_max_step = -self._max_step
         self._max_step_l: list[float] = self._max_step.tolist()
+        self._velocity_l: list[float] = limits.velocity.tolist()
         self._lower_l: list[float] = limits.lower.tolist()
         self._upper_l: list[float] = limits.upper.tolist()
         self._neg_velocity = -limits.velocity
@@ -137,21 +166,26 @@ class CommandGuard:
         self.clamped = 0
         self.refused = 0
 
-    def position(self, cmd: FloatArray, reference: FloatArray) -> FloatArray | None:
+    def position(
+        self, cmd: FloatArray, reference: FloatArray, dt: float | None = None
+    ) -> FloatArray | None:
         """The safe position command for ``cmd``, given the previous command or measured q.
 
-        Per joint in plain floats (the loop calls this every step; on a few joints that is
-        several times faster than numpy calls); the clamps propagate NaN as numpy's do.
+        ``dt`` is the time the step covers (default: the period): the velocity limit allows
+        ``velocity * dt`` of motion. Per joint in plain floats (the loop calls this every step;
+        on a few joints that is several times faster than numpy calls); the clamps propagate NaN
+        as numpy's do.
         """
         c = cmd.tolist()
         if not all(map(math.isfinite, c)):
             self.refused += 1
             return None
         r = reference.tolist()
+        steps = self._max_step_l
+        if dt is not None and dt != self.period:
+            steps = [v * dt for v in self._velocity_l]
         out = []
-        for x, ref, step, lo, hi in zip(
-            c, r, self._max_step_l, self._lower_l, self._upper_l, strict=True
-        ):
+        for x, ref, step, lo, hi in zip(c, r, steps, self._lower_l, self._upper_l, strict=True):
             d = x - ref
             d = -step if d < -step else d
             d = step if d > step else d

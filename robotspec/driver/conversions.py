@@ -8,11 +8,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robotspec.driver.commands import RobotJointCommand
 from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError
-from robotspec.driver.handles import RobotJointCommand
-from robotspec.driver.hp_kinematics import quat_to_rot
 from robotspec.driver.robot_info import ToolInfo
 from robotspec.driver.state import CommandMode
+from robotspec.model.rotations import quat_wxyz_to_matrix
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -24,6 +24,13 @@ POSITION_UNITS = {
     "ticks_rot": 2.0 * math.pi / 2**20,
     "nanoticks_rot": 2.0 * math.pi / (2**20 * 1e9),
 }
+#: ``RobotJointCommand.seqno`` is a ``uint64``: counters wrap around at this modulus.
+SEQNO_MODULUS = 1 << 64
+#: A position-stream sample at most this many seqnos behind the last accepted one is out of
+#: order and ignored (the reference ignores every lower seqno); one further behind means the
+#: client restarted its counter, and is accepted.
+STREAM_REORDER_WINDOW = 1000
+
 VELOCITY_UNITS = {
     "implicit": 1.0,
     "radian_second": 1.0,
@@ -55,7 +62,7 @@ def tool_transform(tool: ToolInfo | None) -> tuple[FloatArray, FloatArray] | Non
     if tool is None:
         return None
     return (
-        quat_to_rot(tool.tcp.rotation.as_tuple()),
+        quat_wxyz_to_matrix(tool.tcp.rotation.as_tuple()),
         np.array(tool.tcp.translation.as_tuple()),
     )
 
@@ -67,12 +74,6 @@ def as_lists(
     if tf is None:
         return None
     return [float(x) for x in tf[0].reshape(9)], [float(x) for x in tf[1]]
-
-
-def read_only(a: FloatArray) -> FloatArray:
-    """Mark an array read-only: published state is shared with every listener."""
-    a.flags.writeable = False
-    return a
 
 
 def twist_vector(velocity: Any) -> Any:
@@ -90,10 +91,7 @@ def twist_vector(velocity: Any) -> Any:
 
 def convert_command(cmd: RobotJointCommand, n: int, units: dict[str, float]) -> FloatArray | None:
     """A streamed command in SI units, or None when it must be ignored."""
-    try:
-        values = np.array(cmd.command, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        return None
+    values = cmd.command  # a float64 vector (RobotJointCommand converts anything else)
     if values.shape[0] != n or not np.all(np.isfinite(values)):
         return None
     if len(cmd.units) not in (0, n):
@@ -105,3 +103,19 @@ def convert_command(cmd: RobotJointCommand, n: int, units: dict[str, float]) -> 
             return None
         values = values * scale
     return values
+
+
+def seqno_out_of_order(seqno: int, last: int) -> bool:
+    """Whether a stream sample numbered ``seqno`` is older than ``last``, the last accepted.
+
+    The reference ignores any seqno below the last accepted one, so a single sample with a huge
+    seqno (a client bug, or a counter near the top of ``uint64``) locks the stream for good:
+    every later sample is "older". Here seqnos are compared modulo 2**64, so a counter that wraps
+    from 2**64 - 1 to 0 goes on, and a sample counts as out of order only when it is at most
+    :data:`STREAM_REORDER_WINDOW` behind; a larger step back is a restarted counter and is
+    accepted. Equal seqnos are accepted (the same sample, re-read). ``last`` < 0: none yet.
+    """
+    if last < 0:
+        return False
+    behind = (last - seqno) % SEQNO_MODULUS
+    return 0 < behind <= STREAM_REORDER_WINDOW

@@ -5,7 +5,7 @@ from the world model lets ``robotspec drive --spec SPEC --chain NAME`` drive eve
 can load, with kinematics that agree with the world's own forward kinematics (tested to 1e-9).
 
 The conversion follows the general-robotics-toolbox / standard_robdef ``urdf_to_robotinfo.py``
-recipe (reference note §1(c)):
+recipe (robotraconteur_standard_robdef ``tools/urdf_to_robotinfo.py``):
 
 * walk the connections from ``root`` to the flange body, keeping the accumulated rotation ``R``
   (the frame orientation at q = 0) and the current offset ``P[k]``;
@@ -38,7 +38,6 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
-from robotspec.driver.hp_kinematics import rot_to_quat
 from robotspec.driver.robot_info import (
     DeviceClass,
     DeviceInfo,
@@ -57,6 +56,7 @@ from robotspec.driver.robot_info import (
     Vector3,
 )
 from robotspec.errors import RobotInfoError
+from robotspec.model.rotations import matrix_to_quat_wxyz
 from robotspec.model.world import Body, Connection, ConnectionType, World
 
 __all__ = [
@@ -299,7 +299,7 @@ def export_chain(
             f"the velocity limit used for {', '.join(defaulted_accel)}"
         )
 
-    q = rot_to_quat(_clean(r_acc))
+    q = matrix_to_quat_wxyz(_clean(r_acc))
     flange_pose = Pose(
         orientation=Quaternion(w=float(q[0]), x=float(q[1]), y=float(q[2]), z=float(q[3])),
         position=Vector3(x=0.0, y=0.0, z=0.0),

@@ -7,7 +7,7 @@ internals; the generator's methods step or wait on the driver that made it.
 from __future__ import annotations
 
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -24,22 +24,17 @@ from robotspec.errors import DriverError
 if TYPE_CHECKING:
     from robotspec.driver.robot_driver import RobotDriver
 
-__all__ = ["Completion", "RobotJointCommand", "TrajectoryGenerator", "TrajectoryStatus"]
+__all__ = [
+    "Completion",
+    "HomingGenerator",
+    "TrajectoryGenerator",
+    "TrajectoryStatus",
+]
 
 FloatArray = npt.NDArray[np.float64]
 
 #: ``Next()`` returns ``running`` after this long without an outcome (reference: 5 s).
 NEXT_TIMEOUT_S = 5.0
-
-
-@dataclass(frozen=True)
-class RobotJointCommand:
-    """A streamed ``RobotJointCommand``: what a client writes to the position/velocity wire."""
-
-    seqno: int
-    state_seqno: int
-    command: Sequence[float]
-    units: Sequence[str] = ()
 
 
 @dataclass(frozen=True)
@@ -74,10 +69,6 @@ class Completion:
         if not self._event.is_set():
             self.error = error
             self._event.set()
-
-    def wait_event(self, timeout: float | None) -> bool:
-        """Block on the event (loop-thread mode)."""
-        return self._event.wait(timeout)
 
 
 class TrajectoryTask:
@@ -147,6 +138,10 @@ class TrajectoryGenerator:
 
         d._wait_for(outcome, NEXT_TIMEOUT_S)
         with d._lock:
+            if task.outcome_reported:
+                # Another Next() waiting beside this one delivered the outcome: one completion
+                # per generator, so this caller gets the end of the iteration.
+                raise StopIteration
             if task.error is not None:
                 task.outcome_reported = True
                 raise task.error
@@ -185,3 +180,49 @@ class TrajectoryGenerator:
 
     def __next__(self) -> TrajectoryStatus:
         return self.Next()
+
+
+class HomingGenerator:
+    """The generator ``home()`` returns over Robot Raconteur (``ActionStatusCode{generator}``).
+
+    The first ``Next()`` starts homing (the robot must be in ``homing`` mode); each ``Next()``
+    answers ``complete`` once homed, or ``running`` every 5 s until then; the outcome (complete
+    or the error) is delivered to exactly one caller, however many wait concurrently, and every
+    later ``Next()`` raises StopIteration. ``Abort()`` and ``Close()`` stop homing (mode
+    ``halt``): a waiting ``Next()`` then fails with OperationAborted.
+    """
+
+    def __init__(self, driver: RobotDriver) -> None:
+        self._driver = driver
+        self._completion: Completion | None = None
+        self._reported = False
+        self._lock = threading.Lock()
+
+    def Next(self) -> ActionStatus:  # noqa: N802 - the Robot Raconteur generator API
+        """Start homing (first call), then wait up to 5 s for it to end."""
+        d = self._driver
+        with self._lock:
+            if self._reported:
+                raise StopIteration
+            if self._completion is None:
+                self._completion = d.home(wait=False)
+            completion = self._completion
+        d._wait_for(lambda: completion.done, NEXT_TIMEOUT_S)
+        if not completion.done:
+            return ActionStatus.running
+        with self._lock:
+            if self._reported:
+                raise StopIteration
+            self._reported = True
+        if completion.error is not None:
+            raise completion.error
+        return ActionStatus.complete
+
+    def Abort(self) -> None:  # noqa: N802
+        """Stop homing: mode ``halt``."""
+        self._driver.halt()
+
+    def Close(self) -> None:  # noqa: N802
+        """Stop homing if it is still going, as :meth:`Abort`."""
+        if self._completion is not None and not self._completion.done:
+            self._driver.halt()

@@ -1,10 +1,22 @@
-"""Online jog profiles: each step moves toward a target position or velocity, time-optimally.
+"""Online motion profiles: each step moves toward a target position or velocity, time-optimally.
 
 Why online rather than a precomputed trapezoid: a jog may be re-targeted at any step (a new
 ``jog_freespace`` while moving, a joystick's ``jog_joint`` stream, a Cartesian velocity mapped
-through a changing Jacobian). Planning one step at a time from the current position and velocity,
-with the velocity and acceleration limits and a braking velocity that stops exactly at the target
-(and before a joint limit), handles every case with one rule and never needs a replan.
+through a changing Jacobian, a streamed position). Planning one step at a time from the current
+position and velocity, with the velocity and acceleration limits and a braking velocity that stops
+exactly at the target and before a joint limit, handles every case with one rule and never needs a
+replan.
+
+Why every step takes its real duration ``dt``: the loop's periods jitter, and the simulated (or
+real) arm integrates the time that really elapsed. A profile that advanced by the nominal period
+would drift from the arm and end somewhere else; one that integrates the same ``dt`` only changes
+*when* the arm arrives, never *where*.
+
+The braking rule (:func:`braking_speed`): after a step of duration ``dt`` at speed ``v`` toward a
+stop point ``d`` away, the remaining distance is ``d - v dt``; the step is allowed only if the joint
+can still stop there at ``a``: ``v**2 <= 2 a (d - v dt)``. That set of states is invariant for *any*
+sequence of step durations (braking at ``a`` keeps a state inside it), so no jitter can make a joint
+cross a limit or exceed its acceleration limit, and it never allows more than ``sqrt(2 a d)``.
 """
 
 from __future__ import annotations
@@ -14,14 +26,36 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["JogMotion", "rest_to_rest_time"]
+__all__ = [
+    "BRAKING_MARGIN",
+    "JogMotion",
+    "StreamLimiter",
+    "braking_speed",
+    "rest_to_rest_time",
+]
 
-#: Braking is planned at this fraction of the acceleration limit. Why: the discrete braking curve
-#: is exact only on its own grid; the spare 10 % lets the last step land exactly on the target
-#: without ever exceeding the acceleration limit.
-BRAKING_MARGIN = 0.9
+#: Braking onto a *target* is planned at this fraction of the acceleration limit. Why: the final
+#: snap onto the target (see :data:`SNAP_FRACTION`) and a shorter next period must never need more
+#: than the limit; braking onto a joint *limit* uses the full acceleration.
+BRAKING_MARGIN = 0.95
+#: A joint snaps exactly onto its target when the remaining distance is below this fraction of
+#: ``a dt**2``: the extra velocity change is then at most 5 % of what one step allows.
+SNAP_FRACTION = 0.05
 
 FloatArray = npt.NDArray[np.float64]
+
+
+def braking_speed(distance: float, amax: float, dt: float) -> float:
+    """The highest speed toward a stop point ``distance`` away for a step of ``dt`` seconds.
+
+    The positive root of ``v**2 + 2 a dt v - 2 a d = 0`` (so ``v**2 <= 2 a (d - v dt)``), written
+    without cancellation for tiny distances. Zero when the stop point is behind.
+    """
+    if not distance > 0.0:
+        return 0.0
+    adt = amax * dt
+    two_ad = 2.0 * amax * distance
+    return two_ad / (math.sqrt(adt * adt + two_ad) + adt)
 
 
 def rest_to_rest_time(distance: FloatArray, vmax: FloatArray, amax: FloatArray) -> FloatArray:
@@ -44,7 +78,7 @@ class JogMotion:
         amax: per-joint acceleration limit for this jog.
         lower: position limits the jog must stop before.
         upper: position limits the jog must stop before.
-        dt: the loop period.
+        dt: the nominal loop period (used when :meth:`step` is given no duration).
     """
 
     def __init__(
@@ -66,6 +100,11 @@ class JogMotion:
         self.dt = dt
         self.target_position: FloatArray | None = None
         self.target_velocity: FloatArray | None = None
+        #: Scale velocity changes of all joints together (a Cartesian jog keeps its direction
+        #: while it speeds up and brakes) instead of joint by joint.
+        self.coordinated = False
+        #: Set by :meth:`step` when a joint had to brake for its position limit this step.
+        self.limit_braking = False
         self.velocity_until = 0.0
         self.t = 0.0
         self.done = False
@@ -82,6 +121,7 @@ class JogMotion:
         """
         self.target_position = np.clip(np.array(target, dtype=np.float64), self.lower, self.upper)
         self.target_velocity = None
+        self.coordinated = False
         self.done = False
         if synchronize and not np.any(self.v):
             dist = self.target_position - self.q
@@ -109,15 +149,17 @@ class JogMotion:
             self._lists = tuple(a.tolist() for a in key)
         return self._lists
 
-    def step(self) -> FloatArray:
-        """Advance one period; return the new position command.
+    def step(self, dt: float | None = None) -> FloatArray:
+        """Advance by ``dt`` seconds (default: the nominal period); return the new position.
 
         Per joint in plain floats: on the handful of joints of an arm this is several times
         faster than numpy's per-call overhead (and touches far less memory, which is what a
-        1 kHz loop waking from sleep pays for). Same IEEE operations in the same order as the
-        vectorised form, so the same results; clamps propagate NaN as ``np.minimum`` does.
+        1 kHz loop waking from sleep pays for). The clamps propagate NaN as ``np.minimum`` does.
         """
-        dt = self.dt
+        if dt is None:
+            dt = self.dt
+        if not dt > 0.0:
+            return self.q.copy()
         amax_l, vmax_l, lower_l, upper_l = self._limit_lists()
         q_l = self.q.tolist()
         v_l = self.v.tolist()
@@ -126,85 +168,181 @@ class JogMotion:
         tv = self.target_velocity
         tv_l = tv.tolist() if tv is not None and self.t < self.velocity_until else None
         n = len(q_l)
+        # 1. The velocity each joint wants.
+        want = [0.0] * n
+        for i in range(n):
+            if tgt_l is not None:
+                dist = tgt_l[i] - q_l[i]
+                b = braking_speed(abs(dist), amax_l[i] * BRAKING_MARGIN, dt)
+                vm = vmax_l[i]
+                b = vm if b > vm else b
+                want[i] = b if dist > 0.0 else (-b if dist < 0.0 else dist * 0.0)
+            elif tv_l is not None:
+                want[i] = tv_l[i]
+        # 2. Within the acceleration limits: joint by joint, or all joints scaled together.
+        if self.coordinated:
+            k = 1.0
+            for i in range(n):
+                dv = abs(want[i] - v_l[i])
+                adt = amax_l[i] * dt
+                if dv > adt:
+                    k = min(k, adt / dv)
+            v_new = [v_l[i] + k * (want[i] - v_l[i]) for i in range(n)]
+        else:
+            v_new = [0.0] * n
+            for i in range(n):
+                adt = amax_l[i] * dt
+                v = v_l[i]
+                x = want[i]
+                x = v - adt if x < v - adt else x
+                v_new[i] = v + adt if x > v + adt else x
+        # 3. Never faster than the speed from which the joint can stop at its limit.
         q_out = [0.0] * n
-        v_out = [0.0] * n
-        landing = False  # a joint crossed or reached its target slowly: check for arrival
         all_landed = tgt_l is not None
         moving = False
-        sqrt = math.sqrt
+        braking = False
         for i in range(n):
-            q, v, amax = q_l[i], v_l[i], amax_l[i]
-            adt = amax * dt
-            half = 0.5 * amax * dt
+            q, a = q_l[i], amax_l[i]
+            lo, hi = lower_l[i], upper_l[i]
+            x = v_new[i]
+            cap_hi = braking_speed(hi - q, a, dt)
+            if x > cap_hi:
+                x = cap_hi
+                braking = True
+            cap_lo = -braking_speed(q - lo, a, dt)
+            if x < cap_lo:
+                x = cap_lo
+                braking = True
+            q_new = q + x * dt
             if tgt_l is not None:
-                dist = tgt_l[i] - q
-                a9 = amax * BRAKING_MARGIN
-                h9 = 0.5 * a9 * dt
-                b = (sqrt(h9 * h9 + 2.0 * a9 * abs(dist)) - h9) * _sign(dist)
-                vm = vmax_l[i]
-                b = -vm if b < -vm else b
-                v_des = vm if b > vm else b
-            elif tv_l is not None:
-                v_des = tv_l[i]
-            else:
-                v_des = 0.0
-            # Never plan past a joint limit: brake so as to stop on it.
-            # (At the full deceleration: a target on the limit is then governed by its own
-            # braking.)
-            d_hi = upper_l[i] - q
-            v_hi = (sqrt(half * half + 2.0 * amax * abs(d_hi)) - half) * _sign(d_hi)
-            v_hi = 0.0 if v_hi < 0.0 else v_hi
-            d_lo = lower_l[i] - q
-            v_lo = (sqrt(half * half + 2.0 * amax * abs(d_lo)) - half) * _sign(d_lo)
-            v_lo = 0.0 if v_lo > 0.0 else v_lo
-            v_des = v_lo if v_des < v_lo else v_des
-            v_des = v_hi if v_des > v_hi else v_des
-            dv = v_des - v
-            dv = -adt if dv < -adt else dv
-            dv = adt if dv > adt else dv
-            v_new = v + dv
-            q_new = q + v_new * dt
-            if tgt_l is not None:
-                # Land exactly on the target instead of oscillating around it.
                 t_i = tgt_l[i]
-                crossed = dist * (t_i - q_new) <= 0.0
-                slow = abs(v_new) <= adt * 1.0001
-                near = abs(t_i - q_new) < 1e-12
-                if (crossed or near) and slow:
-                    landing = True
-                    # Landing implies the velocity (tgt - q) / dt: land only when reachable.
-                    feasible = abs(dist / dt - v) <= adt * (1 + 1e-9)
-                    if crossed and not feasible:
-                        # Crossing but unable to land this step: brake as hard as allowed;
-                        # the overshoot is below a_max * dt^2 and is taken back next step.
-                        v_new = v - _sign(v) * adt
-                        q_new = q + v_new * dt
-                    if (crossed and feasible) or near:
-                        q_new = t_i
-                        v_new = 0.0
+                # Snap onto the target when it is that close and the snap keeps the joint
+                # able to stop at its limits (a target on a limit is approached, not snapped).
+                if abs(t_i - q_new) <= SNAP_FRACTION * a * dt * dt and (
+                    cap_lo <= (t_i - q) / dt <= cap_hi
+                ):
+                    q_new = t_i
                 if q_new != t_i:
                     all_landed = False
-            if v_new != 0.0:
-                moving = True
-            lo, hi = lower_l[i], upper_l[i]
             q_new = lo if q_new < lo else q_new
-            q_out[i] = hi if q_new > hi else q_new
-            v_out[i] = v_new
+            q_new = hi if q_new > hi else q_new
+            # The velocity actually realised (a snap or a clamp changes it by a hair).
+            x = (q_new - q) / dt
+            if x != 0.0:
+                moving = True
+            q_out[i] = q_new
+            v_new[i] = x
+        self.limit_braking = braking
         if tgt_l is not None:
-            self.done = landing and all_landed and not moving
+            self.done = all_landed and not moving
         else:
             self.done = self.t >= self.velocity_until and not moving
         q_arr = np.array(q_out)
         self.q = q_arr
-        self.v = np.array(v_out)
+        self.v = np.array(v_new)
         self.t += dt
         return q_arr
 
 
-def _sign(x: float) -> float:
-    """``np.sign`` of one float (0 for 0, NaN for NaN)."""
-    if x > 0.0:
-        return 1.0
-    if x < 0.0:
-        return -1.0
-    return x * 0.0 if x != x else 0.0
+class StreamLimiter:
+    """Acceleration and limit braking for streamed commands (position and velocity streams).
+
+    A client's stream may jump (a new target far away, 3 rad/s to 0 in one sample, a velocity
+    into a joint limit); what reaches the arm never changes speed faster than the acceleration
+    limit and never approaches a joint limit faster than it can stop there.
+
+    Args:
+        q: the start position (last command sent, or the measured position).
+        v: the start velocity.
+        vmax, amax, lower, upper: the joint limits.
+    """
+
+    def __init__(
+        self,
+        q: FloatArray,
+        v: FloatArray,
+        vmax: FloatArray,
+        amax: FloatArray,
+        lower: FloatArray,
+        upper: FloatArray,
+    ) -> None:
+        self.q: list[float] = [float(x) for x in q]
+        self.v: list[float] = [float(x) for x in v]
+        self._vmax = vmax.tolist()
+        self._amax = amax.tolist()
+        self._lower = lower.tolist()
+        self._upper = upper.tolist()
+
+    def position(
+        self, target: list[float], target_velocity: list[float] | None, dt: float
+    ) -> FloatArray:
+        """The next position command toward the streamed ``target`` after ``dt`` seconds.
+
+        Why ``target_velocity``: a stream that moves steadily must be followed without lag, so the
+        braking speed toward the target is raised by the speed at which the target itself moves
+        that way (when the stream holds still, the arm brakes onto it without overshoot).
+        """
+        if not dt > 0.0:
+            return np.array(self.q)
+        q_l, v_l = self.q, self.v
+        out = [0.0] * len(q_l)
+        for i in range(len(q_l)):
+            q, v, a, vm = q_l[i], v_l[i], self._amax[i], self._vmax[i]
+            lo, hi = self._lower[i], self._upper[i]
+            tgt = target[i]
+            tgt = lo if tgt < lo else (hi if tgt > hi else tgt)
+            dist = tgt - q
+            cap = braking_speed(abs(dist), a * BRAKING_MARGIN, dt)
+            if target_velocity is not None:
+                tv = target_velocity[i] if dist > 0.0 else -target_velocity[i]
+                cap += tv if tv > 0.0 else 0.0
+            cap = vm if cap > vm else cap
+            x = dist / dt
+            x = -cap if x < -cap else (cap if x > cap else x)
+            adt = a * dt
+            x = v - adt if x < v - adt else (v + adt if x > v + adt else x)
+            x = _limit_cap(x, q, lo, hi, a, dt)
+            q_new = q + x * dt
+            if (
+                abs(tgt - q_new) <= SNAP_FRACTION * a * dt * dt
+                and _limit_cap((tgt - q) / dt, q, lo, hi, a, dt) == (tgt - q) / dt
+            ):
+                q_new = tgt
+            q_new = lo if q_new < lo else (hi if q_new > hi else q_new)
+            v_l[i] = (q_new - q) / dt
+            q_l[i] = q_new
+            out[i] = q_new
+        return np.array(out)
+
+    def velocity(
+        self, command: list[float], measured: list[float], dt: float, horizon: float
+    ) -> FloatArray:
+        """The next velocity command for the streamed ``command`` at position ``measured``.
+
+        ``dt`` is the time since the last command (the acceleration budget); ``horizon`` the time
+        the command may stay applied before the next one, over which the joint must still be
+        able to stop at its limit. Keep ``horizon`` fixed: the set of states braked this way is
+        invariant for every step up to ``2 * horizon`` long (a varying horizon breaks that).
+        """
+        v_l = self.v
+        out = [0.0] * len(v_l)
+        for i in range(len(v_l)):
+            v, a, vm = v_l[i], self._amax[i], self._vmax[i]
+            x = command[i]
+            x = -vm if x < -vm else (vm if x > vm else x)
+            adt = a * dt
+            x = v - adt if x < v - adt else (v + adt if x > v + adt else x)
+            x = _limit_cap(x, measured[i], self._lower[i], self._upper[i], a, horizon)
+            v_l[i] = x
+            out[i] = x
+        self.q = [float(m) for m in measured]
+        return np.array(out)
+
+
+def _limit_cap(x: float, q: float, lo: float, hi: float, a: float, dt: float) -> float:
+    """``x`` capped so that joint at ``q`` can still stop at ``lo`` and ``hi`` (see module)."""
+    cap_hi = braking_speed(hi - q, a, dt)
+    if x > cap_hi:
+        x = cap_hi
+    cap_lo = -braking_speed(q - lo, a, dt)
+    return cap_lo if x < cap_lo else x

@@ -4,57 +4,21 @@
 member checks its arguments and the state machine, then hands work to the timestep pipeline of
 :class:`~robotspec.driver.loop.DriverLoop`, which it extends.
 
-Deliberate deviations from the reference (its defects, §1.11 of the note), each tested:
-
-1. An exception inside a step never kills the loop: the driver enters ``invalid_state`` with the
-   message in ``current_errors`` and the ``error`` flag, keeps publishing, and recovers after
-   ``reset_errors()`` or ``command_mode = halt``.
-2. ``halt()``, ``home()``, and the ``operational_mode``, ``controller_state`` and
-   ``current_errors`` properties work.
-3. Limits: ``jog_joint`` checks ``|velocity|`` (both signs) against the limit of the operational
-   mode; ``jog_freespace`` refuses targets outside the joint limits; jogs brake before a joint
-   limit; the position stream is clamped to the limits; every command passes
-   :class:`~robotspec.driver.commands.CommandGuard`. NaN and infinity are refused everywhere.
-   A speed ratio above 1 never raises jog speed or acceleration beyond the joint limits.
-4. Trajectories: the final waypoint is commanded exactly; a tracking failure fails the task with
-   OperationFailed, clears ``trajectory_running``, cancels the queue and drops to ``halt``;
-   ``running`` status reports the real trajectory time and waypoint; each outcome is delivered
-   once; a queued task cancelled before it starts raises OperationAborted "Trajectory cancelled
-   by controller before start" from ``Next()``; ``Close()`` on a finished task is a no-op; the
-   100 ms gap rule uses the unscaled times; messages carry the waypoint index; the tracking check
-   compares the measured position with the setpoint sent the step before (not the new one, which
-   tripped at high speed).
-5. Messages: "Robot must be in trajectory mode to execute trajectory"; "Position command must be
-   within 1000 degrees from current position".
-6. Tools: ``tool_detached`` accepts the attached tool's name (or ""); tools and payloads work on
-   every chain; ``robot_info.config_seqno`` follows the attachments.
-7. A waiting jog interrupted by halt, an error, an e-stop or lost communication raises
-   OperationAborted instead of returning success; ``Abort()`` takes the lock; leaving a motion
-   mode for ``halt`` brakes at the acceleration limits instead of stopping dead.
-8. Capabilities are checked: ``trajectory_command`` for trajectory mode (also on the homing route
-   out of ``invalid_state``), ``software_enable`` for ``enable()``/``disable()``,
-   ``software_reset_errors`` for ``reset_errors()`` (a driver-internal fault can always be reset).
-   ``speed_ratio`` and ``trajectory_queueing`` are *not* enforced: none of the real RobotInfo
-   files declares them, yet every reference driver honours both.
-9. ``velocity_command`` mode works (the reference's loop thread dies on the first command); it
-   scales by the speed ratio and sets ``valid_velocity_command``.
-10. ``jog_cartesian`` works, through the chain's Jacobian (damped least squares).
-11. The simulated robot (:class:`~robotspec.driver.sim.SimRobot`) has a command watchdog, like a
-    real controller: when the driver sends no command for ``command_timeout`` (default 0.1 s; the
-    driver stops sending once feedback is lost), the arm drops its last command and brakes to
-    rest at its acceleration limits. The reference's simulated robot keeps following its last
-    velocity command until a joint limit.
+The reference's defects are not copied: the deliberate deviations, each tested, are listed once,
+in ``docs/driver.md`` ("Deliberate deviations from the reference").
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from robotspec.driver.commands import (
     JointLimitArrays,
+    RobotJointCommand,
     check_speed_ratio,
     finite_scalar,
     joint_array,
@@ -74,16 +38,19 @@ from robotspec.driver.errors import (
 )
 from robotspec.driver.handles import (
     Completion,
-    RobotJointCommand,
+    HomingGenerator,
     TrajectoryGenerator,
     TrajectoryTask,
 )
 from robotspec.driver.loop import DriverLoop, FloatArray
 from robotspec.driver.profiles import JogMotion
 from robotspec.driver.robot_info import (
+    MAX_OFFSET_M,
+    QUAT_TOL,
     DeviceInfo,
     PayloadInfo,
     Pose,
+    Quaternion,
     RobotCapability,
     RobotInfo,
     ToolInfo,
@@ -96,6 +63,7 @@ from robotspec.driver.state import (
 )
 from robotspec.driver.trajectory import JointTrajectory, load_trajectory
 from robotspec.errors import DriverError
+from robotspec.model.rotations import quat_wxyz_to_matrix
 
 __all__ = ["RobotDriver"]
 
@@ -126,7 +94,7 @@ class RobotDriver(DriverLoop):
         self.set_command_mode(value)
 
     def set_command_mode(self, value: CommandMode | int | str) -> None:
-        """Request a command mode; the reference's checks, in its order (note §1.2)."""
+        """Request a command mode: the reference's checks, in the order of its setter."""
         mode = parse_mode(value)
         with self._lock:
             current = self._command_mode
@@ -300,6 +268,15 @@ class RobotDriver(DriverLoop):
             self._wait_completion(completion)
         return completion
 
+    def homing_generator(self) -> HomingGenerator:
+        """A generator whose first ``Next()`` homes the robot (needs ``homing_command``).
+
+        Why: Robot Raconteur's ``home()`` returns a generator; the service hands this one out.
+        """
+        if not self._robot_info.has(RobotCapability.homing_command):
+            raise InvalidOperationError("Robot does not support homing")
+        return HomingGenerator(self)
+
     def _homing_finished(self, success: bool, message: str = "") -> None:
         """Called by the subclass when homing ends."""
         with self._lock:
@@ -323,6 +300,7 @@ class RobotDriver(DriverLoop):
         if self._jog_waiter is not None:
             self._jog_waiter.fail(OperationAbortedError("Operation interrupted by new jog command"))
         self._jog = motion
+        self._jog_settle_deadline = None
         waiter = Completion() if wait else None
         self._jog_waiter = waiter
         return waiter
@@ -398,6 +376,7 @@ class RobotDriver(DriverLoop):
         motion.vmax = vlim.copy()
         motion.amax = np.minimum(alim * self._speed_ratio, alim)
         motion.t = 0.0
+        motion.coordinated = False
         motion.at_velocity(qd, timeout)
         return self._install_jog(motion, wait)
 
@@ -406,8 +385,12 @@ class RobotDriver(DriverLoop):
     ) -> None:
         """Jog a chain's TCP at spatial ``velocity`` ``[wx, wy, wz, vx, vy, vz]`` (base frame).
 
-        The joint velocities come from the chain's Jacobian (damped least squares), scaled down
-        together when one would exceed its limit, recomputed every step.
+        The joint velocities come from the chain's Jacobian (damped least squares, see
+        :mod:`robotspec.driver.cartesian`), scaled down together when one would exceed its limit,
+        recomputed every step; all joints speed up and brake together, so the tool keeps its
+        direction. Refused (InvalidArgument) when the chain cannot move along ``velocity`` at this
+        pose (near a singularity, too few joints, a joint at its limit); a jog that reaches such
+        a pose on its way brakes to a stop, and a waiting caller gets OperationFailed.
         """
         with self._lock:
             self._jog_preamble(OperationAbortedError)
@@ -416,8 +399,15 @@ class RobotDriver(DriverLoop):
             if t <= 0.0:
                 raise InvalidArgumentError("Invalid jog timeout specified")
             self._check_chain(chain, "jog")
+            q_start = self._jog.q if self._jog is not None else self._start_point()[0]
+            rates = self._cartesian_rates(chain, q_start, twist)
+            if isinstance(rates, str):
+                raise InvalidArgumentError(f"jog_cartesian refused: {rates}")
             vlim, alim = self._jog_limits()
             waiter = self._velocity_jog(np.zeros(self._joint_count), t, wait, vlim, alim)
+            assert self._jog is not None
+            self._jog.coordinated = True
+            self._jog.target_velocity = rates
             self._jog_cartesian = (chain, twist)
         if waiter is not None:
             self._wait_completion(waiter)
@@ -425,9 +415,16 @@ class RobotDriver(DriverLoop):
     # ------------------------------------------------------------------ trajectories
 
     def execute_trajectory(self, trajectory: JointTrajectory) -> TrajectoryGenerator:
-        """Check and queue a trajectory; drive it by calling ``Next()`` on the generator."""
+        """Check and queue a trajectory; drive it by calling ``Next()`` on the generator.
+
+        The waypoint checks and the interpolation setup run *outside* the loop's lock (they only
+        read the immutable limits and the speed ratio, sampled once): a client uploading 50,000
+        waypoints must not make the loop miss its periods. Only the start-point and mode checks
+        and the queueing take the lock.
+        """
+        ratio = self._speed_ratio
+        interp = load_trajectory(trajectory, self._joint_names, self._limits, ratio)
         with self._lock:
-            interp = load_trajectory(trajectory, self._joint_names, self._limits, self._speed_ratio)
             measured = self._joint_position
             if measured.shape[0] != self._joint_count or np.any(
                 np.abs(measured - interp.positions[0]) > self._trajectory_error_tol
@@ -468,9 +465,16 @@ class RobotDriver(DriverLoop):
 
     # ------------------------------------------------------------------ streaming
 
-    def set_position_command(self, command: RobotJointCommand) -> None:
-        """Write the position-command wire (used in ``position_command`` mode only)."""
+    def set_position_command(self, command: RobotJointCommand, *, new_client: bool = False) -> None:
+        """Write the position-command wire (used in ``position_command`` mode only).
+
+        ``new_client``: the sample comes from another client than the previous one. Its seqno
+        counter is its own, so the ordering check restarts with it (as the reference does when
+        another endpoint writes the wire); the Robot Raconteur service sets it.
+        """
         with self._lock:
+            if new_client:
+                self._stream_last_seqno = -1
             if self._command_mode is CommandMode.position_command:
                 self._stream_position = command
 
@@ -494,8 +498,10 @@ class RobotDriver(DriverLoop):
             self._check_chain(chain, "tool")
             if self._current_tool[chain] is not None:
                 raise InvalidArgumentError(f"Tool already attached to kinematic chain {chain}")
+            tf = tool_transform(tool)
+            _check_frame(f"tool '{tool.name}' tcp", tool.tcp.rotation, tf)
             self._current_tool[chain] = tool
-            self._tool_tf[chain] = tool_transform(tool)
+            self._tool_tf[chain] = tf
             self._tool_tf_lists[chain] = as_lists(self._tool_tf[chain])
             self._config_seqno += 1
             self.events.append(("tool_changed", chain, tool.name))
@@ -531,6 +537,10 @@ class RobotDriver(DriverLoop):
                 )
             if self._current_payload[chain] is not None:
                 raise InvalidArgumentError(f"Payload already attached to kinematic chain {chain}")
+            if pose is not None:
+                p = pose.position
+                tf_p = (quat_wxyz_to_matrix(pose.orientation.as_tuple()), np.array([p.x, p.y, p.z]))
+                _check_frame(f"payload '{payload.name}' pose", pose.orientation, tf_p)
             self._current_payload[chain] = payload
             self._current_payload_pose[chain] = pose or Pose()
             self._config_seqno += 1
@@ -552,6 +562,15 @@ class RobotDriver(DriverLoop):
             self._config_seqno += 1
             self.events.append(("payload_changed", chain, ""))
 
+    # ------------------------------------------------------------------ state listeners
+
+    def remove_state_listener(self, listener: Callable[[RobotState], None]) -> None:
+        """Stop calling ``listener`` after each step (no error if it was not added)."""
+        try:
+            self._listeners.remove(listener)
+        except ValueError:
+            pass
+
     # ------------------------------------------------------------------ parameters and signals
 
     def getf_param(self, param_name: str) -> Any:
@@ -569,3 +588,23 @@ class RobotDriver(DriverLoop):
     def setf_signal(self, signal_name: str, value: Any) -> None:
         """Signals are not implemented by the base driver."""
         raise NotImplementedDriverError("Not implemented")
+
+
+def _check_frame(
+    what: str, rotation: Quaternion, frame: tuple[FloatArray, FloatArray] | None
+) -> None:
+    """Refuse a tool TCP or payload pose with NaN, infinity, bad rotation or absurd offset.
+
+    Why here as well as in the models: a ``ToolInfo`` built with ``model_construct`` (or by
+    another front end) skips validation, and a NaN TCP would be published as a NaN pose.
+    """
+    q = rotation.as_tuple()
+    if frame is None:
+        return
+    values = [*q, *frame[1].tolist()]
+    if not all(math.isfinite(v) for v in values):
+        raise InvalidArgumentError(f"{what} must not contain NaN or infinite values")
+    if abs(math.hypot(*q) - 1.0) > QUAT_TOL:
+        raise InvalidArgumentError(f"{what}: rotation must be a unit quaternion")
+    if max(abs(v) for v in frame[1].tolist()) > MAX_OFFSET_M:
+        raise InvalidArgumentError(f"{what}: offset beyond {MAX_OFFSET_M:g} m")

@@ -19,7 +19,6 @@ without ``flange_pose`` (identity is used, as the reference does silently) and `
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -36,6 +35,7 @@ from pydantic import (
     model_validator,
 )
 
+from robotspec.driver.rr_names import rr_name_problem, rr_name_suggestion
 from robotspec.errors import RobotInfoError, RobotSpecErrors, closest_names
 from robotspec.files.yamlio import LocatedYaml, load_yaml, load_yaml_text, validation_errors
 
@@ -68,12 +68,22 @@ __all__ = [
 UNIT_TOL = 1e-6
 #: Quaternions must be unit length to this tolerance (real files carry 6-digit rounding).
 QUAT_TOL = 1e-4
+#: Largest magnitude of a link offset or flange position, metres. Why a bound: finite but absurd
+#: values (1e200) make the pose and twist arithmetic overflow to infinity in the loop.
+MAX_OFFSET_M = 1e3
+#: Largest magnitude of a joint limit value (position, velocity, acceleration, ...), for the same
+#: reason: the braking arithmetic squares ``acceleration * period``.
+MAX_LIMIT = 1e9
 
 
 class _Model(BaseModel):
-    """Base of every RobotInfo model: unknown keys are errors, instances are immutable."""
+    """Base of every RobotInfo model: unknown keys are errors, instances are immutable.
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    NaN and infinity are refused in every float field (``allow_inf_nan=False``): a NaN in an axis,
+    an offset or a flange quaternion would otherwise load and be published as NaN poses.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class RobotTypeCode(StrEnum):
@@ -260,7 +270,8 @@ class Quaternion(_Model):
 
     @model_validator(mode="after")
     def _unit(self) -> Quaternion:
-        norm = math.sqrt(self.w**2 + self.x**2 + self.y**2 + self.z**2)
+        # hypot: a component of 1e200 gives a norm of 1e200, not an OverflowError from ``**``.
+        norm = math.hypot(self.w, self.x, self.y, self.z)
         if abs(norm - 1.0) > QUAT_TOL:
             raise ValueError(f"quaternion must have unit norm (norm is {norm:.6g})")
         return self
@@ -367,6 +378,8 @@ class JointLimits(_Model):
     def _finite(cls, value: float) -> float:
         if not math.isfinite(value):
             raise ValueError("must be a finite number")
+        if abs(value) > MAX_LIMIT:
+            raise ValueError(f"must be within +-{MAX_LIMIT:g}")
         return value
 
     @model_validator(mode="after")
@@ -451,15 +464,6 @@ class KinChainInfo(_Model):
     description: str = ""
     extended: dict[str, Any] = Field(default_factory=dict)
 
-    @field_validator("H")
-    @classmethod
-    def _unit_axes(cls, value: tuple[Vector3, ...]) -> tuple[Vector3, ...]:
-        for i, h in enumerate(value):
-            norm = math.sqrt(h.x**2 + h.y**2 + h.z**2)
-            if abs(norm - 1.0) > UNIT_TOL:
-                raise ValueError(f"H[{i}] must be a unit vector (norm is {norm:.6g})")
-        return value
-
     @field_validator("joint_numbers")
     @classmethod
     def _increasing(cls, value: tuple[int, ...]) -> tuple[int, ...]:
@@ -540,6 +544,16 @@ def _semantic_checks(
         )
         (warnings if warn else errors).append(e)
 
+    device = info.device_info.device
+    name_problem = rr_name_problem(device.name) if device.name else None
+    if name_problem and device.uuid is None:
+        # Served, the device name becomes the node name and its identifier's lock file.
+        err(
+            f"device_info.device.name '{device.name}' {name_problem}: Robot Raconteur cannot "
+            "use it as a device name (letters, digits, '_', '.' and '-', starting with a "
+            f"letter); did you mean '{rr_name_suggestion(device.name)}'?",
+            ("device_info", "device", "name"),
+        )
     if not info.joint_info:
         err("joint_info must list at least one joint", ("joint_info",))
     if not info.chains:
@@ -571,6 +585,23 @@ def _semantic_checks(
     for c, chain in enumerate(info.chains):
         n = len(chain.joint_numbers)
         where = f"chains[{c}]"
+        for i, h in enumerate(chain.H):
+            norm = math.hypot(h.x, h.y, h.z)  # no OverflowError for 1e200
+            if abs(norm - 1.0) > UNIT_TOL:
+                err(
+                    f"{where}.H[{i}] must be a unit vector (norm is {norm:.6g})",
+                    ("chains", c, "H", i),
+                )
+        offsets: list[tuple[str, tuple[str | int, ...], Vector3]] = [
+            (f"P[{i}]", ("chains", c, "P", i), p) for i, p in enumerate(chain.P)
+        ]
+        if chain.flange_pose is not None:
+            loc_f: tuple[str | int, ...] = ("chains", c, "flange_pose", "position")
+            offsets.append(("flange_pose.position", loc_f, chain.flange_pose.position))
+        for label, loc_p, p in offsets:
+            big = max(abs(p.x), abs(p.y), abs(p.z))
+            if big > MAX_OFFSET_M:
+                err(f"{where}.{label} is {big:g} m from its frame (max {MAX_OFFSET_M:g})", loc_p)
         if len(chain.H) != n:
             err(
                 f"{where}.H has {len(chain.H)} axes but the chain has {n} joints (joint_numbers)",
@@ -652,8 +683,3 @@ def read_robot_info_text(text: str, file: str = "<string>") -> LoadedRobotInfo:
 def load_robot_info(path: str | Path) -> RobotInfo:
     """Load and validate a RobotInfo YAML file; warnings are dropped (see ``read_robot_info``)."""
     return read_robot_info(path).info
-
-
-def chain_joint_indices(info: RobotInfo) -> Sequence[tuple[int, ...]]:
-    """The global joint indices of each chain, in chain order."""
-    return [tuple(c.joint_numbers) for c in info.chains]

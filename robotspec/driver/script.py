@@ -33,7 +33,7 @@ from robotspec.driver.errors import error_kind
 from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import PayloadInfo, Pose, ToolInfo
 from robotspec.driver.sim import Fault, SimRobot
-from robotspec.driver.state import CommandMode, StateFlags
+from robotspec.driver.state import StateFlags
 from robotspec.driver.trajectory import JointTrajectory, Waypoint
 from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names
 from robotspec.files.yamlio import LocatedYaml, load_yaml, validation_errors
@@ -61,14 +61,6 @@ CALLS: dict[str, tuple[frozenset[str], frozenset[str]]] = {
     "payload_attached": (frozenset({"payload"}), frozenset({"chain", "pose"})),
     "payload_detached": (frozenset(), frozenset({"chain", "name"})),
 }
-
-ERROR_KINDS = (
-    "InvalidArgument",
-    "InvalidOperation",
-    "OperationAborted",
-    "OperationFailed",
-    "NotImplemented",
-)
 
 
 class _Model(BaseModel):
@@ -399,8 +391,3 @@ def mismatch_errors(loaded: LoadedScenario, results: list[StepResult]) -> list[R
         for r in results
         if not r.ok
     ]
-
-
-def parse_mode_name(name: str) -> CommandMode:
-    """A command mode by name (scenario convenience)."""
-    return CommandMode[name]

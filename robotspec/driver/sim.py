@@ -6,7 +6,16 @@ instant stop on e-stop -- and must be testable against faults (lost feedback, e-
 error, disabled drives) without a robot.
 
 The command sent in one step is applied over the following period, and feedback read at the next
-step reports the result (``_read_feedback`` integrates, then reports).
+step reports the result (``_read_feedback`` integrates, then reports). Like a servo drive that
+interpolates its setpoints, the arm treats the position commands as a path in time, one period
+late: at time ``t`` it heads for the commanded path at ``t - period`` (interpolated between the
+last two commands, extrapolated along them when a step comes late). On time, that is exactly the
+last command; under jitter, the arm keeps the commanded velocity instead of lurching, which is
+what a real arm does and what lets a jittery loop still end where it was asked.
+
+Like a real controller's soft limits, the arm never approaches a joint limit faster than it can
+stop there at its acceleration limit (:func:`~robotspec.driver.profiles.braking_speed`), whatever
+it is commanded; the hard stop at the limit is the last resort.
 
 Like a real controller's command interface, the simulated arm has a command watchdog: when no
 command arrives from the driver for ``command_timeout`` seconds (the driver stopped sending, e.g.
@@ -17,15 +26,16 @@ limits, instead of following a stale velocity command into a joint limit.
 from __future__ import annotations
 
 import math
-from enum import StrEnum
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from robotspec.driver.clock import Clock
+from robotspec.driver.clock import Clock, step_duration
 from robotspec.driver.errors import InvalidArgumentError
+from robotspec.driver.faults import Fault, fault_param, fault_param_value
 from robotspec.driver.handles import Completion
+from robotspec.driver.profiles import braking_speed
 from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
 from robotspec.driver.state import EstopSource
@@ -33,17 +43,6 @@ from robotspec.driver.state import EstopSource
 __all__ = ["Fault", "SimRobot"]
 
 FloatArray = npt.NDArray[np.float64]
-
-
-class Fault(StrEnum):
-    """Faults a test (or a scenario) can inject into the simulated robot."""
-
-    lost_feedback = "lost_feedback"
-    estop = "estop"
-    drive_error = "drive_error"
-    disabled = "disabled"
-    frozen = "frozen"
-    step_exception = "step_exception"
 
 
 class SimRobot(RobotDriver):
@@ -85,6 +84,10 @@ class SimRobot(RobotDriver):
         self._lower_l: list[float] = lim.lower.tolist()
         self._upper_l: list[float] = lim.upper.tolist()
         self._pending_pos: FloatArray | None = None
+        self._pending_t = 0.0
+        #: The position command before ``_pending_pos`` and when it was sent (consecutive only).
+        self._prior_pos: list[float] | None = None
+        self._prior_t = 0.0
         self._settle_on: list[float] | None = None
         self._pending_vel: FloatArray | None = None
         self._sim_enabled = True
@@ -129,7 +132,7 @@ class SimRobot(RobotDriver):
         self._sim_last_t = now
         if last is None:
             return
-        dt = min(max(now - last, 0.0), 10.0 * self._update_period)
+        dt = step_duration(now, last, self._update_period)
         if dt <= 0.0:
             return
         lim = self._limits
@@ -162,14 +165,14 @@ class SimRobot(RobotDriver):
             v_des_l = v_des.tolist()
         elif self._pending_pos is not None:
             pending = self._pending_pos.tolist()
-            v_des_l = [(pending[i] - q_l[i]) / dt for i in range(n)]
+            aim = self._aim(pending, now)
+            v_des_l = [(aim[i] - q_l[i]) / dt for i in range(n)]
             if pending == self._settle_on:
-                # A command held still: brake so as to land on it (discrete-time braking
-                # curve). Without this, short steps make the servo ring around the target.
+                # A command held still: brake so as to land on it (the braking curve). Without
+                # this, short steps make the servo ring around the target.
                 for i in range(n):
-                    a_dt = self._acc_l[i] * dt
                     err = pending[i] - q_l[i]
-                    v_cap = a_dt * (math.sqrt(0.25 + 2.0 * abs(err) / (a_dt * dt)) - 0.5)
+                    v_cap = braking_speed(abs(err), self._acc_l[i], dt)
                     x = v_des_l[i]
                     x = -v_cap if x < -v_cap else x
                     v_des_l[i] = v_cap if x > v_cap else x
@@ -192,6 +195,12 @@ class SimRobot(RobotDriver):
             dv = -amax_dt if dv < -amax_dt else dv
             dv = amax_dt if dv > amax_dt else dv
             v = v_l[i] + dv
+            # Soft limits: never faster toward a limit than the arm can stop at it.
+            acc = acc_l[i]
+            brake = braking_speed(upper_l[i] - q_l[i], acc, dt)
+            v = brake if v > brake else v
+            brake = -braking_speed(q_l[i] - lower_l[i], acc, dt)
+            v = brake if v < brake else v
             q = q_l[i] + v * dt
             if q < lower_l[i]:
                 q, v = lower_l[i], 0.0
@@ -207,6 +216,27 @@ class SimRobot(RobotDriver):
             self._homing_target = None
             self._sim_homed = True
             self._homing_finished(True)
+
+    def _aim(self, pending: list[float], now: float) -> list[float]:
+        """Where the commanded path was one period ago: the point the arm heads for now.
+
+        On time that is the last command. Early, it lies between the last two commands; late,
+        beyond the last one along their velocity (within the joint limits).
+        """
+        prior = self._prior_pos
+        span = self._pending_t - self._prior_t
+        if prior is None or not span > 0.0:
+            return pending
+        tau = now - self._update_period
+        frac = (tau - self._prior_t) / span
+        if abs(frac - 1.0) < 1e-9:
+            return pending
+        frac = 0.0 if frac < 0.0 else frac
+        out = [p0 + frac * (p1 - p0) for p0, p1 in zip(prior, pending, strict=True)]
+        if frac > 1.0:
+            lo, hi = self._lower_l, self._upper_l
+            out = [lo[i] if x < lo[i] else (hi[i] if x > hi[i] else x) for i, x in enumerate(out)]
+        return out
 
     def _read_feedback(self, now: float) -> None:
         """Integrate the arm over the last period, then report it (unless feedback is lost)."""
@@ -236,7 +266,14 @@ class SimRobot(RobotDriver):
     def _send_robot_command(
         self, now: float, joint_pos_cmd: FloatArray | None, joint_vel_cmd: FloatArray | None
     ) -> None:
+        previous = self._pending_pos
+        if joint_pos_cmd is not None and previous is not None:
+            self._prior_pos = previous.tolist()
+            self._prior_t = self._pending_t
+        else:
+            self._prior_pos = None
         self._pending_pos = joint_pos_cmd
+        self._pending_t = now
         self._pending_vel = joint_vel_cmd
         self._last_command_t = now
         if joint_pos_cmd is not None:
@@ -300,3 +337,41 @@ class SimRobot(RobotDriver):
                 self._frozen = False
             elif f is Fault.step_exception:
                 self._raise_in_step = False
+
+    def fault_active(self, fault: Fault | str) -> bool:
+        """Whether ``fault`` is injected now.
+
+        ``reset_errors()`` clears the drive error and the e-stop (the simulated operator does).
+        """
+        f = Fault(fault)
+        if f is Fault.lost_feedback:
+            return self._feedback_lost
+        if f is Fault.estop:
+            return self._sim_estop != EstopSource.none
+        if f is Fault.drive_error:
+            return self._sim_error
+        if f is Fault.disabled:
+            return not self._sim_enabled
+        if f is Fault.frozen:
+            return self._frozen
+        return self._raise_in_step
+
+    # ------------------------------------------------------------------ faults as parameters
+
+    def getf_param(self, param_name: str) -> Any:
+        """``fault.NAME``: whether that fault is injected (see :mod:`robotspec.driver.faults`)."""
+        with self._lock:
+            return self.fault_active(fault_param(param_name))
+
+    def setf_param(self, param_name: str, value: Any) -> None:
+        """``fault.NAME`` = true injects that fault, false clears it (e-stop source: button 1).
+
+        Why: a client connected over Robot Raconteur can test its fault handling this way.
+        """
+        fault = fault_param(param_name)
+        on = fault_param_value(param_name, value)
+        with self._lock:
+            if on:
+                self.inject_fault(fault)
+            else:
+                self.clear_fault(fault)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import bisect
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -42,6 +43,34 @@ FloatArray = npt.NDArray[np.float64]
 MIN_WAYPOINTS = 5
 MAX_WAYPOINT_GAP = 0.1
 _TIME_EPS = 1e-9
+#: Large conversions run in chunks of this many waypoints, yielding the interpreter between them.
+#: Why: one ``np.array`` or ``tolist`` over 50,000 waypoints holds the GIL for 50-90 ms, and the
+#: loop thread (which needs it every period) waits for all of it.
+CHUNK = 256
+
+
+def _yield() -> None:
+    """Let another thread (the loop) take the interpreter now, if it is waiting."""
+    time.sleep(0)
+
+
+def _to_lists(a: FloatArray) -> list[Any]:
+    """``a.tolist()`` in chunks (see :data:`CHUNK`)."""
+    out: list[Any] = []
+    for start in range(0, a.shape[0], CHUNK):
+        out.extend(a[start : start + CHUNK].tolist())
+        _yield()
+    return out
+
+
+def _rows(rows: Sequence[Sequence[float]], n: int) -> FloatArray:
+    """``np.array(rows)`` as an ``(m, n)`` float array, in chunks (see :data:`CHUNK`)."""
+    m = len(rows)
+    out = np.empty((m, n))
+    for start in range(0, m, CHUNK):
+        out[start : start + CHUNK] = np.array(rows[start : start + CHUNK], dtype=np.float64)
+        _yield()
+    return out
 
 
 @dataclass(frozen=True)
@@ -104,6 +133,7 @@ class TrajectoryInterpolator:
         self.n_waypoints = int(times.shape[0])
         h = np.diff(times)
         delta = np.diff(positions, axis=0) / h[:, None]
+        _yield()  # a large trajectory: let the loop thread in between whole-array steps
         d = np.zeros_like(positions)
         if positions.shape[0] > 2:
             h0 = h[:-1, None]
@@ -112,16 +142,21 @@ class TrajectoryInterpolator:
             w2 = h1 + 2.0 * h0
             d0, d1 = delta[:-1], delta[1:]
             same = d0 * d1 > 0.0
+            _yield()
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 hm = (w1 + w2) / (w1 / d0 + w2 / d1)
+            _yield()
             d[1:-1] = np.where(same & np.isfinite(hm), hm, 0.0)
         self._h = h
         self._slopes = d
         # Plain-float copies for evaluate(), which the loop calls every step.
-        self._times_l: list[float] = times.tolist()
-        self._h_l: list[float] = h.tolist()
-        self._pos_l: list[list[float]] = positions.tolist()
-        self._slopes_l: list[list[float]] = d.tolist()
+        self._times_l: list[float] = _to_lists(times)
+        self._h_l: list[float] = _to_lists(h)
+        # Rows as plain floats only for the segment being sampled: converting all 50,000 rows
+        # up front made 100,000 small lists, and the garbage collector's pass over them froze
+        # the loop thread for 170 ms.
+        self._segment = -1
+        self._rows: tuple[list[float], list[float], list[float], list[float]] = ([], [], [], [])
 
     def evaluate(self, t: float) -> tuple[FloatArray, int]:
         """Position at time ``t`` (clamped to the ends; a new array) and the segment's start.
@@ -144,8 +179,15 @@ class TrajectoryInterpolator:
         h11 = s3 - s2
         hh10 = h10 * h
         hh11 = h11 * h
-        p0, p1 = self._pos_l[k], self._pos_l[k + 1]
-        m0, m1 = self._slopes_l[k], self._slopes_l[k + 1]
+        if k != self._segment:
+            self._segment = k
+            self._rows = (
+                self.positions[k].tolist(),
+                self.positions[k + 1].tolist(),
+                self._slopes[k].tolist(),
+                self._slopes[k + 1].tolist(),
+            )
+        p0, p1, m0, m1 = self._rows
         out = [p0[i] * h00 + (hh10 * m0[i] + h01 * p1[i] + hh11 * m1[i]) for i in range(len(p0))]
         return np.array(out), k
 
@@ -174,40 +216,71 @@ def load_trajectory(
     if wps[0].time_from_start != 0.0:
         raise InvalidArgumentError("Trajectory time_from_start must equal zero for first waypoint")
     m = len(wps)
-    times = np.zeros(m)
-    pos = np.zeros((m, n))
-    for i, w in enumerate(wps):
-        if len(w.joint_position) != n:
-            raise InvalidArgumentError(f"Waypoint {i} invalid joint array length")
-        for what, arr in (
-            ("joint_velocity", w.joint_velocity),
-            ("position_tolerance", w.position_tolerance),
-            ("velocity_tolerance", w.velocity_tolerance),
-        ):
-            if len(arr) not in (0, n):
-                raise InvalidArgumentError(f"Waypoint {i} invalid {what} array length")
-        q = np.array(w.joint_position, dtype=np.float64)
-        if not (np.all(np.isfinite(q)) and math.isfinite(w.time_from_start)) or not all(
-            math.isfinite(v) for v in w.joint_velocity
-        ):
-            raise InvalidArgumentError(f"Waypoint {i} contains NaN or infinite values")
-        t = w.time_from_start / speed_ratio
-        if i > 0:
-            prev_raw = wps[i - 1].time_from_start
-            if t <= times[i - 1]:
-                raise InvalidArgumentError(f"Waypoint {i} time_from_start must be increasing")
-            if w.time_from_start - prev_raw > MAX_WAYPOINT_GAP + _TIME_EPS:
-                raise InvalidArgumentError(f"Waypoint {i} more than 100 ms from previous waypoint")
-        if np.any(q < limits.lower) or np.any(q > limits.upper):
-            raise InvalidArgumentError(f"Waypoint {i} exceeds joint limits")
-        if w.joint_velocity and np.any(
-            np.abs(np.array(w.joint_velocity) * speed_ratio) > limits.velocity
-        ):
-            raise InvalidArgumentError(f"Waypoint {i} exceeds joint velocity limits")
-        if i > 0:
-            fd = np.abs(q - pos[i - 1]) / (t - times[i - 1])
-            if np.any(fd > limits.velocity):
-                raise InvalidArgumentError(f"Waypoint {i} exceeds joint velocity limits")
-        times[i] = t
-        pos[i] = q
+    # Vectorised checks (a 50,000-waypoint upload must not hold the interpreter for a second),
+    # then the first failure in the reference's order: by waypoint, then by check.
+    failures: list[tuple[int, int, str]] = []
+
+    def first(rank: int, bad: npt.NDArray[np.bool_], message: str) -> None:
+        hits = np.flatnonzero(bad)
+        if hits.size:
+            i = int(hits[0])
+            failures.append((i, rank, message.format(i=i)))
+
+    # One pass over the waypoint objects, in chunks that yield the interpreter to the loop.
+    lengths = np.empty(m, dtype=np.intp)
+    opt_sizes = np.empty((m, 3), dtype=np.intp)
+    raw = np.empty(m)
+    vel_finite = np.ones(m, dtype=bool)
+    wp_fast = np.zeros(m, dtype=bool)
+    rows: list[Sequence[float]] = []
+    vmax = limits.velocity.tolist()
+    try:
+        for start in range(0, m, CHUNK):
+            for i in range(start, min(m, start + CHUNK)):
+                w = wps[i]
+                jp, jv = w.joint_position, w.joint_velocity
+                lengths[i] = len(jp)
+                opt_sizes[i] = (len(jv), len(w.position_tolerance), len(w.velocity_tolerance))
+                raw[i] = w.time_from_start
+                rows.append(jp)
+                if jv:
+                    vs = [float(v) for v in jv]
+                    vel_finite[i] = all(map(math.isfinite, vs))
+                    wp_fast[i] = len(vs) == n and any(
+                        abs(v * speed_ratio) > lim for v, lim in zip(vs, vmax, strict=True)
+                    )
+            _yield()
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidArgumentError("Waypoint values must be numbers") from None
+    first(0, lengths != n, "Waypoint {i} invalid joint array length")
+    for rank, what in enumerate(("joint_velocity", "position_tolerance", "velocity_tolerance"), 1):
+        sizes = opt_sizes[:, rank - 1]
+        first(rank, (sizes != 0) & (sizes != n), f"Waypoint {{i}} invalid {what} array length")
+    if failures:
+        raise InvalidArgumentError(min(failures)[2])
+    try:
+        pos = _rows(rows, n)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidArgumentError("Waypoint values must be numbers") from None
+    finite = np.all(np.isfinite(pos), axis=1) & np.isfinite(raw) & vel_finite
+    first(4, ~finite, "Waypoint {i} contains NaN or infinite values")
+    _yield()  # each whole-array step below takes a millisecond or two: yield between them
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        times = raw / speed_ratio
+        dt = np.diff(times)
+        gap = np.diff(raw)
+        inc = np.concatenate([[False], ~(dt > 0.0)])
+        first(5, inc & finite, "Waypoint {i} time_from_start must be increasing")
+        far = np.concatenate([[False], gap > MAX_WAYPOINT_GAP + _TIME_EPS])
+        first(6, far & finite, "Waypoint {i} more than 100 ms from previous waypoint")
+        _yield()
+        outside = np.any(pos < limits.lower, axis=1) | np.any(pos > limits.upper, axis=1)
+        first(7, outside & finite, "Waypoint {i} exceeds joint limits")
+        _yield()
+        fd = np.abs(np.diff(pos, axis=0)) / dt[:, None]
+        fd_fast = np.concatenate([[False], np.any(fd > limits.velocity, axis=1)])
+        first(8, (wp_fast | fd_fast) & finite, "Waypoint {i} exceeds joint velocity limits")
+    if failures:
+        # A non-finite waypoint poisons its neighbours' differences: report it first.
+        raise InvalidArgumentError(min(failures)[2])
     return TrajectoryInterpolator(times, pos)

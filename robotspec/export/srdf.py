@@ -98,6 +98,8 @@ def srdf_from_robot(robot: AbstractRobot) -> Srdf:
     order = {b.name: i for i, b in enumerate(w.bodies)}
     disabled = []
     for pair in robot.disabled_collision_pairs:
+        if len(pair) != 2:
+            continue  # a body "against itself" (added by hand): MoveIt has no such pair
         a, b = sorted(pair, key=lambda n: order.get(n, len(order)))
         disabled.append(DisabledCollision(a, b, reasons.get(pair, "User")))
     disabled.sort(key=lambda d: (order.get(d.link1, 0), order.get(d.link2, 0)))

@@ -505,11 +505,14 @@ class PackageResolver:
         else:
             scheme = match.group(1).lower()
             rest = text[match.end() :]
-            if scheme == "package":
+            if scheme in ("package", "model"):
                 name, _, inner = rest.partition("/")
-                root = self.find_package(name, file=file, line=line)
-                # Joined as text: an absolute-looking rest must not replace the package root.
-                candidate = Path(f"{root}/{inner}") if inner else root
+                if not name and inner.strip("/"):
+                    candidate = self._from_package_root(inner, uri, file, line)
+                else:
+                    root = self.find_package(name, file=file, line=line)
+                    # Joined as text: an absolute-looking rest must not replace the package root.
+                    candidate = Path(f"{root}/{inner}") if inner else root
             elif scheme == "file":
                 path = unquote(rest)
                 if path.startswith("localhost/"):
@@ -518,10 +521,40 @@ class PackageResolver:
             else:
                 raise DescriptionError(
                     f"unsupported URI scheme '{match.group(1)}' in '{uri}'; "
-                    "robotspec reads only package://, file:// and paths",
+                    "robotspec reads only package://, model://, file:// and paths",
                     file=file,
                     line=line,
                     kind="uri",
                     name=uri,
                 )
         return self.check_allowed(candidate, uri=uri, file=file, line=line)
+
+    def _from_package_root(self, inner: str, uri: str, file: str | None, line: int | None) -> Path:
+        """``package:///PKG/path`` (an empty package name): a path that starts at a package root.
+
+        Why: pinocchio joins everything after ``package://`` to each of its package folders, so
+        Talos's ``package:///example-robot-data/robots/...`` names ``<folder>/example-robot-data
+        /robots/...``. robotspec tries its search folders the same way (first existing file
+        wins), then reads the first segment as a package name, as ROS tools would; when neither
+        finds the file, the error names that first segment as the missing package.
+        """
+        rel = inner.lstrip("/")
+        for folder in self.search_folders:
+            candidate = Path(f"{folder}/{rel}")
+            # Fenced before it is probed: nothing outside the roots is even looked at.
+            if self.is_allowed(candidate) and candidate.exists():
+                return candidate
+        first, _, below = rel.partition("/")
+        try:
+            root = self.find_package(first, file=file, line=line)
+        except PackageNotFoundError as exc:
+            raise PackageNotFoundError(
+                f"package '{first}' not found (a package:/// path starts at a package root); "
+                f"{exc.message.partition('; ')[2]}",
+                file=file,
+                line=line,
+                kind="package",
+                name=first,
+                suggestions=exc.suggestions,
+            ) from None
+        return Path(f"{root}/{below}") if below else root

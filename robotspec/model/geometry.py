@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from robotspec.model.rotations import quaternion_to_matrix, rpy_to_matrix
+
 __all__ = [
     "Box",
     "Capsule",
@@ -24,9 +26,6 @@ __all__ = [
     "frozen_array",
     "pose_from_xyz_quaternion",
     "pose_from_xyz_rpy",
-    "matrix_to_rpy",
-    "quaternion_to_matrix",
-    "rpy_to_matrix",
     "UNIT_TOL",
     "unit_norm",
 ]
@@ -41,52 +40,6 @@ def frozen_array(values: object, shape: tuple[int, ...] | None = None) -> Matrix
         arr = arr.reshape(shape)
     arr.setflags(write=False)
     return arr
-
-
-def rpy_to_matrix(roll: float, pitch: float, yaw: float) -> Matrix:
-    """URDF's fixed-axis roll/pitch/yaw: R = Rz(yaw) @ Ry(pitch) @ Rx(roll)."""
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def matrix_to_rpy(r: Matrix) -> tuple[float, float, float]:
-    """URDF roll/pitch/yaw of a rotation matrix (the inverse of :func:`rpy_to_matrix`).
-
-    At pitch +-90 degrees roll and yaw are not separable; roll is set to 0 there and yaw takes
-    the whole rotation about z, which gives the same matrix back.
-    """
-    cp = math.hypot(float(r[0, 0]), float(r[1, 0]))
-    pitch = math.atan2(-float(r[2, 0]), cp)  # atan2, not asin: exact near +-90 degrees too
-    if cp > 1e-12:
-        roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
-        yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
-    else:
-        roll = 0.0
-        yaw = math.atan2(-float(r[0, 1]), float(r[1, 1]))
-    return roll, pitch, yaw
-
-
-def quaternion_to_matrix(x: float, y: float, z: float, w: float) -> Matrix:
-    """Rotation matrix of a unit quaternion given as (x, y, z, w), the ROS order."""
-    n = math.sqrt(x * x + y * y + z * z + w * w)
-    if n == 0.0:
-        raise ValueError("zero quaternion")
-    x, y, z, w = x / n, y / n, z / n, w / n
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
 
 
 def pose_from_xyz_rpy(xyz: tuple[float, float, float], rpy: tuple[float, float, float]) -> Matrix:

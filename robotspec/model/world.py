@@ -60,6 +60,8 @@ class World:
     ) -> None:
         self.name = name
         self.source = source
+        #: Velocity limits as loaded, of the DOFs whose limit was tightened since (by name).
+        self.loaded_velocity_limits: dict[str, float] = {}
         _check_indices(bodies, connections, dofs, source)
         parent_conn = [-1] * len(bodies)
         problems: list[DescriptionError] = []
@@ -449,6 +451,8 @@ class World:
                     f"velocity limit for '{name}' must be positive and finite, got {value}",
                     name=name,
                 )
+            if float(value) < d.velocity:
+                self.loaded_velocity_limits.setdefault(d.name, d.velocity)
             dofs[d.index] = replace(d, velocity=min(d.velocity, float(value)))
         self._dofs = tuple(dofs)
 

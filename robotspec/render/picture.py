@@ -95,7 +95,9 @@ def render_scene(scene: RobotScene, q: F64, options: RenderOptions | None = None
     img[:] = BACKGROUND
     hit = ids >= 0
     img[hit] = rgb[ids[hit]]
-    _outline(img, np.where(hit, bodies[np.maximum(ids, 0)], -1))
+    body_ids = np.full(ids.shape, -1, dtype=np.int64)
+    body_ids[hit] = bodies[ids[hit]]  # (a robot whose meshes are all missing draws nothing)
+    _outline(img, body_ids)
     big_img = np.clip(img, 0, 255).astype(np.uint8)
     image = _finish(big_img, big, segments, s, scene.legend, opts)
     return Picture(image=image, camera=camera, legend=scene.legend, options=opts)

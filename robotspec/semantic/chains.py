@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 from robotspec.model.world import Body, Connection, DegreeOfFreedom
 from robotspec.semantic.base import JointState, SemanticRobotAnnotation
@@ -76,7 +76,9 @@ class KinematicChain(SemanticRobotAnnotation):
 
 @dataclass(eq=False, repr=False)
 class Arm(KinematicChain):
-    """A chain that carries a manipulator."""
+    """A chain that carries a manipulator; ``side`` when the spec names it (left or right)."""
+
+    side: Literal["left", "right"] | None = field(default=None, kw_only=True)
 
 
 @dataclass(eq=False, repr=False)

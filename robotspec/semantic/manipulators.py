@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from robotspec.model.geometry import quaternion_to_matrix
+from robotspec.model.rotations import quaternion_to_matrix
 from robotspec.model.world import Body
 from robotspec.semantic.base import JointState, SemanticRobotAnnotation
 from robotspec.semantic.chains import Finger

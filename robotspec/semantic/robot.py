@@ -23,6 +23,8 @@ from robotspec.semantic.sensors import Camera, Sensor
 
 if TYPE_CHECKING:
     from robotspec.description.srdf import Srdf
+    from robotspec.model.kinematics import ChainKinematics, Kinematics
+    from robotspec.model.pinocchio import PinocchioRobot
 
 __all__ = ["AbstractRobot", "CollisionCheckingConfig", "EmptyChainWarning"]
 
@@ -64,6 +66,10 @@ class AbstractRobot:
     srdf: Srdf | None = field(default=None, kw_only=True, repr=False)
     drive_type: str = field(default="fixed", kw_only=True)
     controlled_joint_names: tuple[str, ...] | None = field(default=None, kw_only=True)
+    _sides: tuple[tuple[int, ...], tuple[KinematicChain, KinematicChain]] | None = field(
+        default=None, init=False, repr=False
+    )
+    _kinematics: Kinematics | None = field(default=None, init=False, repr=False, compare=False)
 
     # ----------------------------------------------------------------------- structure
     @property
@@ -123,6 +129,30 @@ class AbstractRobot:
         return list(self.manipulator_chains)
 
     @property
+    def left_arm(self) -> KinematicChain:
+        """The left one of exactly two arms (the seed's ``SpecifiesLeftRightArm``).
+
+        The spec's ``side`` when it names one, else the arm lying on the root's +y side in the
+        default pose; a KinematicsError when the robot does not have exactly two arms.
+        """
+        return self._left_right()[0]
+
+    @property
+    def right_arm(self) -> KinematicChain:
+        """The right one of exactly two arms (see :attr:`left_arm`)."""
+        return self._left_right()[1]
+
+    def _left_right(self) -> tuple[KinematicChain, KinematicChain]:
+        from robotspec.semantic.sides import arm_sides
+
+        arms = self.arms
+        key = tuple(id(a) for a in arms)
+        if self._sides is None or self._sides[0] != key:
+            declared = [getattr(a, "side", None) for a in arms]
+            self._sides = (key, arm_sides(self.world, self.root, arms, declared))
+        return self._sides[1]
+
+    @property
     def cameras(self) -> list[Camera]:
         """The robot's cameras."""
         return [s for s in self.sensors if isinstance(s, Camera)]
@@ -177,8 +207,23 @@ class AbstractRobot:
         self.torso = torso
         self._register(torso)
 
+    def add_arm(self, arm: KinematicChain) -> None:
+        """Add an arm: a chain that carries a manipulator (the seed's ``HasArms.add_arm``)."""
+        if arm.manipulator is None:
+            raise AssignmentError(
+                f"arm '{arm.name}' carries no manipulator; add it with add_kinematic_chain",
+                name=arm.name,
+            )
+        self.add_kinematic_chain(arm)
+
     def add_neck(self, neck: Neck) -> None:
         """Set the neck (it must carry a sensor) and add it as a chain."""
+        if not neck.sensors:
+            raise AssignmentError(
+                f"neck '{neck.name}' carries no sensor; a neck is the chain that moves the "
+                "head's sensors",
+                name=neck.name,
+            )
         if self.neck is not None and self.neck is not neck:
             raise AssignmentError(
                 f"robot '{self.name}' already has neck '{self.neck.name}'", name=neck.name
@@ -239,11 +284,41 @@ class AbstractRobot:
             return
         with_geometry = {b.name for b in self.bodies_with_collisions}
         for pair in srdf.disabled_collisions:
+            if pair.link1 == pair.link2:
+                continue  # a link against itself (validation warns); no pair to disable
             if pair.link1 in with_geometry and pair.link2 in with_geometry:
                 self.disabled_collision_pairs.add(frozenset((pair.link1, pair.link2)))
         for item in srdf.disable_default_collisions:
             if self.world.has_body(item.link):
                 self.disabled_collision_bodies.add(item.link)
+
+    # ------------------------------------------------------------------------- queries
+    @property
+    def kinematics(self) -> Kinematics:
+        """Forward kinematics of the robot's world, built once (see :class:`Kinematics`).
+
+        ``robot.kinematics.forward(q)`` gives every body's pose, ``.pose(q, name)`` one frame's.
+        """
+        if self._kinematics is None:
+            from robotspec.model.kinematics import Kinematics
+
+            self._kinematics = Kinematics(self.world)
+        return self._kinematics
+
+    def chain_kinematics(self, name: str) -> ChainKinematics:
+        """The tip pose (``.fk(q)``) and Jacobian (``.jacobian(q)``) of a chain, by chain name."""
+        chain = self.get_chain(name)
+        return self.kinematics.chain(chain.root, chain.tip)
+
+    def to_pinocchio(self) -> PinocchioRobot:
+        """The robot as a pinocchio model and collision model, with its semantic frames' ids.
+
+        Needs pinocchio (``pip install 'robotspec[pinocchio]'``); see
+        :mod:`robotspec.interop.pinocchio` for how the world maps onto it.
+        """
+        from robotspec.interop.pinocchio import robot_to_pinocchio
+
+        return robot_to_pinocchio(self)
 
     @classmethod
     def from_world(cls, world: World) -> AbstractRobot:

@@ -37,14 +37,17 @@ from robotspec.driver.robot_info import (
 )
 from robotspec.driver.state import RobotState
 from robotspec.driver.trajectory import JointTrajectory, Waypoint
+from robotspec.service.node import rr
 
 __all__ = [
     "ROBOT_INFO_TYPE",
     "StateStructs",
+    "from_varvalue",
     "payload_from_rr",
     "pose_from_rr",
     "robot_info_dict",
     "joint_command_from_rr",
+    "to_varvalue",
     "tool_from_rr",
     "trajectory_from_rr",
 ]
@@ -126,7 +129,7 @@ def joint_command_from_rr(cmd: Any, unit_names: dict[int, str]) -> RobotJointCom
     return RobotJointCommand(
         seqno=int(cmd.seqno),
         state_seqno=int(cmd.state_seqno),
-        command=np.asarray(cmd.command, dtype=np.float64).reshape(-1).tolist(),
+        command=np.asarray(cmd.command, dtype=np.float64).reshape(-1),  # RR's array, no copy
         units=units,
     )
 
@@ -210,7 +213,32 @@ def spatial_velocity_from_rr(value: Any) -> list[float]:
     ]
 
 
+def from_varvalue(value: Any) -> Any:
+    """The data of a ``varvalue`` (RR hands the server a VarValue; its data may be an array)."""
+    return getattr(value, "data", value)
+
+
 # ---------------------------------------------------------------------------- driver -> client
+
+
+def to_varvalue(value: Any) -> Any:
+    """A driver value (bool, int, float, str, or a float array) as a ``varvalue``.
+
+    Raises:
+        TypeError: a value of another type (a driver bug, reported to the client as such).
+    """
+    rrmod = rr()
+    if isinstance(value, bool | np.bool_):
+        return rrmod.VarValue(bool(value), "bool")
+    if isinstance(value, int | np.integer):
+        return rrmod.VarValue(int(value), "int64")
+    if isinstance(value, float | np.floating):
+        return rrmod.VarValue(float(value), "double")
+    if isinstance(value, str):
+        return rrmod.VarValue(value, "string")
+    if isinstance(value, np.ndarray):
+        return rrmod.VarValue(np.asarray(value, dtype=np.float64).reshape(-1), "double[]")
+    raise TypeError(f"no varvalue for a {type(value).__name__}")
 
 
 class StateStructs:

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from robotspec.driver.rr_names import valid_rr_name
 from robotspec.errors import ServiceError
 
 __all__ = [
@@ -36,6 +37,7 @@ __all__ = [
     "default_state_dir",
     "missing_packages",
     "new_node",
+    "remove_own_run_files",
     "rr",
     "start_server_node",
 ]
@@ -57,9 +59,6 @@ NODE_DIRECTORY_FIELDS = (
 #: The local transport's socket is ``<state>/run/socket/<16 chars>.sock``; UNIX socket paths are
 #: limited to 107 bytes, so the state folder path must stay within this many.
 MAX_STATE_DIR_CHARS = 107 - len("/run/socket/0123456789abcdef.sock")
-
-#: Names Robot Raconteur accepts for nodes and device identifiers.
-_NAME_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-")
 
 
 def missing_packages() -> list[str]:
@@ -106,7 +105,7 @@ def default_state_dir() -> Path:
 
 def valid_name(name: str) -> bool:
     """Whether ``name`` is a valid RR node or identifier name (``^[a-zA-Z][a-zA-Z0-9_.-]*$``)."""
-    return bool(name) and name[0].isascii() and name[0].isalpha() and set(name) <= _NAME_CHARS
+    return valid_rr_name(name)
 
 
 def _node_directories(rrmod: Any, state_dir: Path) -> Any:
@@ -157,12 +156,58 @@ class ServerNode:
         """The connection URL of ``service`` on this node (loopback address)."""
         return f"rr+tcp://{self.host}:{self.port}?service={service}"
 
+    def run_files(self) -> list[Path]:
+        """The lock and discovery files this node keeps in the run folder while it runs."""
+        run = self.state_dir / "run"
+        local = run / "transport" / "local"
+        node_id = str(self.node.NodeID).strip("{}")
+        return [
+            run / "nodeids" / f"{self.node_name}.pid",
+            local / "by-nodename" / f"{self.node_name}.pid",
+            local / "by-nodename" / f"{self.node_name}.info",
+            local / "by-nodeid" / f"{node_id}.pid",
+            local / "by-nodeid" / f"{node_id}.info",
+        ]
+
     def shutdown(self) -> None:
-        """Stop the node: close the transports and connections, release the locks."""
+        """Stop the node: close the transports and connections, release the locks.
+
+        Robot Raconteur leaves its ``.pid`` and ``.info`` files in the run folder when a node
+        shuts down; they are removed here (those that still name this process), while the
+        node still holds their locks, so a later start finds no stale ones.
+        """
         try:
+            remove_own_run_files(self.run_files())
             self.node.Shutdown()
         finally:
             self.locks.clear()
+
+
+def remove_own_run_files(paths: list[Path]) -> list[Path]:
+    """Delete those of ``paths`` that name this process; return the ones deleted.
+
+    A ``.pid`` file must hold this process's PID, an ``.info`` file its ``pid:`` line. Others
+    are left alone: another process may have taken the name since.
+    """
+    pid = str(os.getpid())
+    removed = []
+    for path in paths:
+        try:
+            with path.open("r", encoding="utf-8", errors="replace") as f:
+                text = f.read(4096)
+        except OSError:
+            continue
+        if path.suffix == ".pid":
+            mine = text.strip() == pid
+        else:
+            mine = any(line.strip() == f"pid: {pid}" for line in text.splitlines())
+        if mine:
+            try:
+                path.unlink()
+            except OSError:
+                continue
+            removed.append(path)
+    return removed
 
 
 def _start_error(exc: BaseException, what: str, hint: str) -> ServiceError:

@@ -3,7 +3,9 @@
 Every member delegates to the :class:`~robotspec.driver.robot_driver.RobotDriver` that
 ``drive --sim`` runs; nothing about the robot's behaviour is implemented here. The adapter only
 converts values (:mod:`robotspec.service.convert`), maps the driver's errors to the Robot
-Raconteur exceptions of the same name, and publishes each step's state on the wires and the pipe.
+Raconteur exceptions of the same name (:mod:`robotspec.service.calls`), and hands each step's
+state to its publisher thread (:mod:`robotspec.service.publisher`), which sends it on the wires
+and the pipe.
 
 Threading: RR calls members from its thread pool; the driver's own lock serialises them against
 the loop thread. Calls that block until the robot has done something (``jog_*`` with
@@ -11,199 +13,39 @@ the loop thread. Calls that block until the robot has done something (``jog_*`` 
 are answered through RR's asynchronous handlers, so a few slow clients can never starve RR's
 pool (which also serves ``halt()``, marked urgent in the robdef).
 
-Where the adapter deliberately differs from the reference service (the reference note, §1.11),
-beyond what the driver already fixes: ``halt()``, ``home()``, ``operational_mode``,
-``controller_state`` and ``current_errors`` work; ``robot_info.config_seqno`` follows tool and
-payload changes; joint units on AdvancedRobotState are meter / newton for prismatic joints; the
-state structures are built without allocation and only for wires and pipes somebody reads, and
-they are packed and sent by a publisher thread of the adapter's own, not by the control loop.
+Where the adapter deliberately differs from the reference service (robotraconteur-abstract-robot
+0.2.2's ``AbstractRobot`` service), beyond what the driver already fixes: ``halt()``, ``home()``,
+``operational_mode``, ``controller_state`` and ``current_errors`` work; ``robot_info.config_seqno``
+follows tool and payload changes; joint units on AdvancedRobotState are meter / newton for prismatic
+joints; the state structures are built without allocation and only for wires and pipes somebody
+reads, and they are packed and sent by a publisher thread of the adapter's own, not by the control
+loop.
 """
 
 from __future__ import annotations
 
-import queue
 import threading
-from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager
 from typing import Any
 
-from pydantic import ValidationError
-
-from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError, error_kind
-from robotspec.driver.handles import NEXT_TIMEOUT_S, Completion, TrajectoryGenerator
+from robotspec.driver.errors import InvalidArgumentError
 from robotspec.driver.robot_driver import RobotDriver
-from robotspec.driver.robot_info import RobotCapability, RobotInfo
-from robotspec.driver.state import ActionStatus, RobotState
-from robotspec.errors import RobotSpecError
+from robotspec.driver.robot_info import RobotInfo
 from robotspec.service import convert
+from robotspec.service.calls import (
+    AsyncCalls,
+    Handler,
+    HomingGeneratorService,
+    TrajectoryGeneratorService,
+    rr_errors,
+    to_rr_error,
+)
 from robotspec.service.node import companion, rr
+from robotspec.service.publisher import StatePublisher
 
 __all__ = ["ROBOT_SERVICE_TYPE", "RobotService", "to_rr_error"]
 
 ROBOT_SERVICE_TYPE = "com.robotraconteur.robotics.robot.Robot"
-
-#: Robot Raconteur exception class names by the driver error's ``rr_name``.
-_RR_EXCEPTIONS = {
-    "InvalidArgument": "InvalidArgumentException",
-    "InvalidOperation": "InvalidOperationException",
-    "OperationAborted": "OperationAbortedException",
-    "OperationFailed": "OperationFailedException",
-    "NotImplemented": "NotImplementedException",
-}
-
-Handler = Callable[..., None]
-
-#: How often (loop steps) the adapter asks RR which streams have clients connected.
-CONNECTION_CHECK_STEPS = 8
-#: Streams nobody is connected to are still refreshed this often (s), for ``PeekInValue()``.
-IDLE_REFRESH_S = 0.1
-#: Steps the publisher thread may fall behind before the oldest are dropped (wires only ever
-#: carry the latest value; the sensor-data pipe loses those samples, counted).
-PUBLISH_BACKLOG = 8
-
-
-def to_rr_error(exc: BaseException) -> BaseException:
-    """The Robot Raconteur exception a client should see for ``exc``.
-
-    Driver errors keep their kind (InvalidArgument, OperationAborted, ...) and message; other
-    robotspec errors become OperationFailed; anything else (a bug) becomes OperationFailed naming
-    the exception type, rather than RR's opaque UnknownException.
-    """
-    rrmod = rr()
-    rr_base: type[BaseException] = rrmod.RobotRaconteurException
-    if isinstance(exc, rr_base):
-        return exc
-    err: BaseException
-    if isinstance(exc, StopIteration):
-        err = rrmod.StopIterationException("")
-    elif isinstance(exc, RobotSpecError):
-        cls_name = _RR_EXCEPTIONS.get(error_kind(exc), "OperationFailedException")
-        err = getattr(rrmod, cls_name)(exc.message)
-    else:
-        err = rrmod.OperationFailedException(f"{type(exc).__name__}: {exc}")
-    return err
-
-
-@contextmanager
-def _rr_errors() -> Iterator[None]:
-    """Re-raise driver errors as the Robot Raconteur exceptions clients expect."""
-    try:
-        yield
-    except StopIteration:
-        raise to_rr_error(StopIteration()) from None
-    except ValidationError as exc:
-        raise to_rr_error(InvalidArgumentError(str(exc.errors()[0]["msg"]))) from None
-    except Exception as exc:  # noqa: BLE001 - every error must reach the client typed
-        raise to_rr_error(exc) from None
-
-
-class _Async:
-    """Runs blocking driver calls on the adapter's executor and answers RR's handlers."""
-
-    def __init__(self, executor: ThreadPoolExecutor) -> None:
-        self._executor = executor
-
-    def void(self, fn: Callable[[], None], handler: Handler, blocking: bool) -> None:
-        def run() -> None:
-            try:
-                fn()
-            except BaseException as exc:  # noqa: BLE001 - delivered to the client
-                handler(to_rr_error(_unwrap(exc)))
-                return
-            handler(None)
-
-        if blocking:
-            self._executor.submit(run)
-        else:
-            run()
-
-    def value(self, fn: Callable[[], Any], handler: Handler) -> None:
-        def run() -> None:
-            try:
-                ret = fn()
-            except BaseException as exc:  # noqa: BLE001 - delivered to the client
-                handler(None, to_rr_error(_unwrap(exc)))
-                return
-            handler(ret, None)
-
-        self._executor.submit(run)
-
-
-def _unwrap(exc: BaseException) -> BaseException:
-    if isinstance(exc, ValidationError):
-        return InvalidArgumentError(str(exc.errors()[0]["msg"]))
-    return exc
-
-
-class TrajectoryGeneratorService:
-    """The ``TrajectoryStatus{generator}`` a client drives with Next / Abort / Close."""
-
-    def __init__(self, service: RobotService, gen: TrajectoryGenerator) -> None:
-        self._service = service
-        self._gen = gen
-
-    def AsyncNext(self, handler: Handler) -> None:  # noqa: N802 - RR generator API
-        """Start or continue the trajectory; answers when it ends, fails, or after 5 s."""
-        node = self._service.node
-        gen = self._gen
-        self._service.run_async.value(lambda: convert.trajectory_status(node, gen.Next()), handler)
-
-    def Abort(self) -> None:  # noqa: N802
-        """Stop the robot (mode ``halt``); ``Next()`` then fails with OperationAborted."""
-        with _rr_errors():
-            self._gen.Abort()
-
-    def Close(self) -> None:  # noqa: N802
-        """Cancel this trajectory; the mode stays ``trajectory``."""
-        with _rr_errors():
-            self._gen.Close()
-
-
-class HomingGeneratorService:
-    """The ``ActionStatusCode{generator}`` returned by ``home()``.
-
-    The first ``Next()`` starts homing (the robot must be in ``homing`` mode); each ``Next()``
-    answers ``complete`` once homed, or ``running`` every 5 s until then; StopIteration after.
-    """
-
-    def __init__(self, service: RobotService) -> None:
-        self._service = service
-        self._completion: Completion | None = None
-        self._reported = False
-        self._lock = threading.Lock()
-
-    def _next(self) -> int:
-        driver = self._service.driver
-        with self._lock:
-            if self._reported:
-                raise StopIteration
-            if self._completion is None:
-                self._completion = driver.home(wait=False)
-            completion = self._completion
-        driver._wait_for(lambda: completion.done, NEXT_TIMEOUT_S)
-        if not completion.done:
-            return int(ActionStatus.running)
-        with self._lock:
-            self._reported = True
-        if completion.error is not None:
-            raise completion.error
-        return int(ActionStatus.complete)
-
-    def AsyncNext(self, handler: Handler) -> None:  # noqa: N802 - RR generator API
-        """Start homing (first call), then wait for it."""
-        self._service.run_async.value(self._next, handler)
-
-    def Abort(self) -> None:  # noqa: N802
-        """Stop homing: mode ``halt`` (a waiting ``Next()`` fails with OperationAborted)."""
-        with _rr_errors():
-            self._service.driver.halt()
-
-    def Close(self) -> None:  # noqa: N802
-        """Stop homing, as :meth:`Abort`."""
-        with _rr_errors():
-            if self._completion is not None and not self._completion.done:
-                self._service.driver.halt()
 
 
 class RobotService:
@@ -244,15 +86,9 @@ class RobotService:
         self._rr_info = rr_info
         self._device_info = rr_info.device_info
         self._executor = ThreadPoolExecutor(max_blocking_calls, thread_name_prefix="robotspec-rr")
-        self.run_async = _Async(self._executor)
-        self._structs = convert.StateStructs(node, info, wall_epoch)
+        self.run_async = AsyncCalls(self._executor)
         dt_util = companion("Util.DateTimeUtil").DateTimeUtil(node)
-        sd_util = companion("Util.SensorDataUtil").SensorDataUtil(node)
         self._datetime_util = dt_util
-        self._sensor_data_util = sd_util
-        self._sensor_data_type = node.GetStructureType(
-            "com.robotraconteur.robotics.robot.RobotStateSensorData"
-        )
         self._isoch_info_type = node.GetStructureType("com.robotraconteur.device.isoch.IsochInfo")
         self._isoch_epoch = dt_util.TimeSpec2Now(self._device_info)
         joints = node.GetConstants("com.robotraconteur.robotics.joints")
@@ -262,24 +98,10 @@ class RobotService:
         self._rr_tools: list[Any] = [c.current_tool for c in rr_info.chains]
         self._rr_payloads: list[Any] = [c.current_payload for c in rr_info.chains]
         self._info_seqno = -1
-        self._downsampler: Any = None
-        self._context: Any = None
-        self._wires_ready = False
-        self._steps_since_check = CONNECTION_CHECK_STEPS
-        self._ars_connected = self._pipe_connected = self._clock_connected = False
-        self._last_idle_refresh = -float("inf")
         self._stream_ep = {"position": -1, "velocity": -1}
-        self.publish_errors = 0
-        self.last_publish_error = ""
-        #: States handed to the publisher thread, and those it dropped because it fell behind.
-        self.published = 0
-        self.publish_dropped = 0
-        self._queue: queue.SimpleQueue[RobotState | None] = queue.SimpleQueue()
-        #: The thread that packs and sends the states (its CPU time is the publishing cost).
-        self.publisher_thread = threading.Thread(
-            target=self._publisher_loop, name="robotspec-rr-publisher", daemon=True
-        )
-        self.publisher_thread.start()
+        self._stream_lock = threading.Lock()
+        #: Packs and sends each step's state on the wires and the pipe, from its own thread.
+        self.publisher = StatePublisher(self, node, info, self._device_info, wall_epoch)
         self.tool_changed = rrmod.EventHook()
         self.payload_changed = rrmod.EventHook()
         self.param_changed = rrmod.EventHook()
@@ -287,128 +109,16 @@ class RobotService:
     # ------------------------------------------------------------------ RR lifecycle
 
     def RRServiceObjectInit(self, context: Any, service_path: str) -> None:  # noqa: N802
-        """Called by RR once the wires exist: stream receivers, backlog."""
+        """Called by RR once the wires exist: stream receivers, backlog, publishing."""
         self.robot_state_sensor_data.MaxBacklog = 3
-        self._context = context
         self.position_command.InValueChanged += self._on_position_command
         self.velocity_command.InValueChanged += self._on_velocity_command
-        self._wires_ready = True
-
-    def _get_downsampler(self) -> Any:
-        """The broadcast downsampler, created when a client first asks for downsampling.
-
-        Why lazily: stepping it costs every loop step, and until somebody sets
-        ``isoch_downsample`` every client receives every step anyway.
-        """
-        with self._info_lock:
-            if self._downsampler is None:
-                ds = rr().BroadcastDownsampler(self._context, 0)
-                ds.AddWireBroadcaster(self.robot_state)
-                ds.AddWireBroadcaster(self.advanced_robot_state)
-                ds.AddPipeBroadcaster(self.robot_state_sensor_data)
-                ds.AddWireBroadcaster(self.device_clock_now)
-                self._downsampler = ds
-            return self._downsampler
+        self.publisher.attach(context)
 
     def close(self) -> None:
         """Stop publishing and accepting blocking calls (pending ones end with the driver)."""
-        self._wires_ready = False
-        self._queue.put(None)
-        if self.publisher_thread is not threading.current_thread():
-            self.publisher_thread.join(timeout=2.0)
+        self.publisher.close()
         self._executor.shutdown(wait=False, cancel_futures=True)
-
-    # ------------------------------------------------------------------ publishing
-
-    def publish(self, st: RobotState) -> None:
-        """Hand one step's state to the publisher thread (a driver state listener).
-
-        Why a thread of its own: Robot Raconteur packs a structure the moment it is assigned to
-        a wire, about 0.15 ms or more per structure on a small VM, most of a step's cost. The
-        control loop only queues the (immutable) snapshot; it never waits for serialisation or
-        for the network, and its timing does not depend on how many clients read.
-        """
-        if self._wires_ready:
-            self._queue.put(st)
-
-    def _publisher_loop(self) -> None:
-        """Publisher thread: send every queued state in order; wires get only the latest."""
-        q = self._queue
-        while True:
-            batch = [q.get()]
-            while True:
-                try:
-                    batch.append(q.get_nowait())
-                except queue.Empty:
-                    break
-            states = [st for st in batch if st is not None]
-            if len(states) > PUBLISH_BACKLOG:
-                self.publish_dropped += len(states) - PUBLISH_BACKLOG
-                states = states[-PUBLISH_BACKLOG:]
-            for i, st in enumerate(states):
-                self._publish_step(st, latest=i == len(states) - 1)
-            self.published += len(states)
-            if len(states) != len(batch):  # the close() sentinel
-                return
-
-    def _publish_step(self, st: RobotState, latest: bool) -> None:
-        """Send one step's state to the clients (never raises).
-
-        ``robot_state`` is set every step. ``advanced_robot_state`` and ``device_clock_now`` are
-        set every step while a client is connected to them, and otherwise refreshed at
-        :data:`IDLE_REFRESH_S` intervals so that ``PeekInValue()`` still answers; the sensor
-        data pipe is fed only while connected. Who is connected is asked every
-        :data:`CONNECTION_CHECK_STEPS` steps. Why: packing a structure is most of the cost, so
-        only what somebody reads is packed. When the publisher has fallen behind, wires are set
-        for the ``latest`` state only (a wire carries the latest value anyway), unless a client
-        asked for downsampling.
-        """
-        if not self._wires_ready:
-            return
-        try:
-            ds = self._downsampler
-            if ds is not None:
-                ds.BeginStep()
-            try:
-                # With a downsampler every step counts (each client gets every n-th): none of
-                # the wires may be skipped then.
-                self._publish(st, latest or ds is not None)
-            finally:
-                if ds is not None:
-                    ds.EndStep()
-        except Exception as exc:  # noqa: BLE001 - the publisher must keep going
-            # Counted and kept for diagnosis; the next step tries again.
-            self.publish_errors += 1
-            self.last_publish_error = f"{type(exc).__name__}: {exc}"
-
-    def _publish(self, st: RobotState, latest: bool = True) -> None:
-        if latest:
-            self.robot_state.OutValue = self._structs.robot_state(st)
-        self._steps_since_check += 1
-        if self._steps_since_check >= CONNECTION_CHECK_STEPS:
-            self._steps_since_check = 0
-            self._ars_connected = self.advanced_robot_state.ActiveWireConnectionCount > 0
-            self._pipe_connected = self.robot_state_sensor_data.ActivePipeEndpointCount > 0
-            self._clock_connected = self.device_clock_now.ActiveWireConnectionCount > 0
-        idle_refresh = latest and st.ts - self._last_idle_refresh >= IDLE_REFRESH_S
-        if idle_refresh:
-            self._last_idle_refresh = st.ts
-        ars_wire = (self._ars_connected or idle_refresh) and latest
-        if ars_wire or self._pipe_connected:
-            ars = self._structs.advanced_robot_state(st)
-            if ars_wire:
-                self.advanced_robot_state.OutValue = ars
-            if self._pipe_connected:
-                data = self._sensor_data_type()
-                data.data_header = self._sensor_data_util.FillSensorDataHeader(
-                    self._device_info, st.seqno
-                )
-                data.robot_state = ars
-                self.robot_state_sensor_data.AsyncSendPacket(data, _ignore)
-        if (self._clock_connected or idle_refresh) and latest:
-            self.device_clock_now.OutValue = self._datetime_util.FillDeviceTime(
-                self._device_info, st.seqno
-            )
 
     # ------------------------------------------------------------------ info and modes
 
@@ -438,7 +148,7 @@ class RobotService:
 
     @command_mode.setter
     def command_mode(self, value: int) -> None:
-        with _rr_errors():
+        with rr_errors():
             self.driver.set_command_mode(int(value))
 
     @property
@@ -468,7 +178,7 @@ class RobotService:
 
     @speed_ratio.setter
     def speed_ratio(self, value: float) -> None:
-        with _rr_errors():
+        with rr_errors():
             self.driver.speed_ratio = float(value)
 
     @property
@@ -484,7 +194,7 @@ class RobotService:
     def isoch_downsample(self) -> int:
         """This client's downsample: it receives every (n+1)-th state."""
         rrmod = rr()
-        ds = self._downsampler
+        ds = self.publisher.current_downsampler
         if ds is None:
             return 0
         return int(ds.GetClientDownsample(rrmod.ServerEndpoint.GetCurrentEndpoint()))
@@ -494,29 +204,29 @@ class RobotService:
         rrmod = rr()
         if not 0 <= int(value) <= 1000:
             raise rrmod.InvalidArgumentException("isoch_downsample must be within 0-1000")
-        ds = self._get_downsampler()
+        ds = self.publisher.downsampler()
         ds.SetClientDownsample(rrmod.ServerEndpoint.GetCurrentEndpoint(), int(value))
 
     # ------------------------------------------------------------------ simple functions
 
     def halt(self) -> None:
         """Stop motion: mode ``halt`` (brakes at the acceleration limits)."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.halt()
 
     def enable(self) -> None:
         """Enable the drives."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.enable()
 
     def disable(self) -> None:
         """Disable the drives."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.disable()
 
     def reset_errors(self) -> None:
         """Clear driver faults and the robot's errors."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.reset_errors()
 
     # ------------------------------------------------------------------ motion
@@ -559,36 +269,32 @@ class RobotService:
 
     def execute_trajectory(self, trajectory: Any) -> TrajectoryGeneratorService:
         """Check and queue a trajectory; the client drives it with ``Next()``."""
-        with _rr_errors():
+        with rr_errors():
             gen = self.driver.execute_trajectory(convert.trajectory_from_rr(trajectory))
-        return TrajectoryGeneratorService(self, gen)
+        return TrajectoryGeneratorService(self.run_async, self.node, gen)
 
     def home(self) -> HomingGeneratorService:
         """Home the robot (needs ``homing`` mode); the client drives it with ``Next()``."""
-        with _rr_errors():
-            if not self.driver.robot_info.has(RobotCapability.homing_command):
-                raise InvalidOperationError("Robot does not support homing")
-        return HomingGeneratorService(self)
+        with rr_errors():
+            gen = self.driver.homing_generator()
+        return HomingGeneratorService(self.run_async, gen)
 
     # ------------------------------------------------------------------ streaming
 
     def _on_stream(self, which: str, value: Any, ep: int) -> None:
-        driver = self.driver
         names = self._pos_unit_names if which == "position" else self._vel_unit_names
         try:
             cmd = convert.joint_command_from_rr(value, names)
         except (TypeError, ValueError, AttributeError):
             return  # a malformed command is ignored, as every invalid stream sample is
-        with driver._lock:
-            if ep != self._stream_ep[which]:
-                # A new client restarts its seqno: accept it (the reference does the same).
-                self._stream_ep[which] = ep
-                if which == "position":
-                    driver._stream_last_seqno = -1
+        with self._stream_lock:
+            # A new client restarts its seqno: the driver accepts it (the reference does too).
+            new_client = ep != self._stream_ep[which]
+            self._stream_ep[which] = ep
             if which == "position":
-                driver.set_position_command(cmd)
+                self.driver.set_position_command(cmd, new_client=new_client)
             else:
-                driver.set_velocity_command(cmd)
+                self.driver.set_velocity_command(cmd)
 
     def _on_position_command(self, value: Any, ts: Any, ep: int) -> None:
         self._on_stream("position", value, ep)
@@ -600,7 +306,7 @@ class RobotService:
 
     def tool_attached(self, chain: int, tool: Any) -> None:
         """A tool was attached to ``chain``; its TCP now defines the chain's endpoint."""
-        with _rr_errors():
+        with rr_errors():
             model = convert.tool_from_rr(tool)
             self.driver.tool_attached(int(chain), model)
             assert model is not None
@@ -611,7 +317,7 @@ class RobotService:
 
     def tool_detached(self, chain: int, tool_name: str) -> None:
         """The tool ``tool_name`` (or "" for whichever) was detached from ``chain``."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.tool_detached(int(chain), str(tool_name))
             with self._info_lock:
                 self._rr_tools[int(chain)] = None
@@ -620,7 +326,7 @@ class RobotService:
 
     def payload_attached(self, chain: int, payload: Any, pose: Any) -> None:
         """A payload was attached to the tool of ``chain`` at ``pose`` relative to the TCP."""
-        with _rr_errors():
+        with rr_errors():
             model = convert.payload_from_rr(payload)
             self.driver.payload_attached(int(chain), model, convert.pose_from_rr(pose))
             assert model is not None
@@ -631,7 +337,7 @@ class RobotService:
 
     def payload_detached(self, chain: int, payload_name: str) -> None:
         """The payload ``payload_name`` (or "") was detached from ``chain``."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.payload_detached(int(chain), str(payload_name))
             with self._info_lock:
                 self._rr_payloads[int(chain)] = None
@@ -641,25 +347,23 @@ class RobotService:
     # ------------------------------------------------------------------ parameters and signals
 
     def getf_param(self, param_name: str) -> Any:
-        """A driver parameter (the simulated robot has none)."""
-        with _rr_errors():
-            return self.driver.getf_param(str(param_name))
+        """A driver parameter as a ``varvalue`` (the simulator's: ``fault.NAME``, a bool)."""
+        with rr_errors():
+            return convert.to_varvalue(self.driver.getf_param(str(param_name)))
 
     def setf_param(self, param_name: str, value: Any) -> None:
-        """Set a driver parameter (the simulated robot has none)."""
-        with _rr_errors():
-            self.driver.setf_param(str(param_name), value)
+        """Set a driver parameter (the simulator's: ``fault.NAME`` to true or false)."""
+        name = str(param_name)
+        with rr_errors():
+            self.driver.setf_param(name, convert.from_varvalue(value))
+        self.param_changed.fire(name)
 
     def getf_signal(self, signal_name: str) -> Any:
         """A signal value (not implemented by the simulated robot)."""
-        with _rr_errors():
+        with rr_errors():
             return self.driver.getf_signal(str(signal_name))
 
     def setf_signal(self, signal_name: str, value: Any) -> None:
         """Set a signal (not implemented by the simulated robot)."""
-        with _rr_errors():
+        with rr_errors():
             self.driver.setf_signal(str(signal_name), value)
-
-
-def _ignore(*_: Any) -> None:
-    """Completion handler for fire-and-forget pipe packets."""

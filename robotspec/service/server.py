@@ -9,7 +9,6 @@ loop thread. The driver is the one ``drive --sim`` builds; the server only adapt
 
 from __future__ import annotations
 
-import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,9 +17,16 @@ from typing import Any
 
 from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
+from robotspec.driver.rr_names import rr_name_suggestion, valid_rr_name
 from robotspec.errors import ServiceError
 from robotspec.service import convert
-from robotspec.service.node import ServerNode, companion, start_server_node, valid_name
+from robotspec.service.node import (
+    ServerNode,
+    companion,
+    remove_own_run_files,
+    start_server_node,
+    valid_name,
+)
 from robotspec.service.robot_service import ROBOT_SERVICE_TYPE, RobotService
 
 __all__ = ["DEFAULT_PORT", "RobotServer", "ServeOptions", "default_node_name"]
@@ -46,10 +52,7 @@ def default_node_name(info: RobotInfo, fallback: str) -> str:
     Why the device name: the node-name lock then stops a second driver for the same robot.
     """
     name = info.device_info.device.name or fallback
-    name = re.sub(r"[^a-zA-Z0-9_.-]", "_", name)
-    if not name or not name[0].isalpha():
-        name = "robot_" + name
-    return name
+    return name if valid_rr_name(name) else rr_name_suggestion(name)
 
 
 class RobotServer:
@@ -152,7 +155,8 @@ class RobotServer:
             service = RobotService(self.driver, node, self.info, rr_info, wall_epoch)
             node.RegisterService(opts.service_name, ROBOT_SERVICE_TYPE, service)
             self.service = service
-            self.driver.add_state_listener(service.publish)
+            # The loop calls the publisher directly: one queue put per step, nothing more.
+            self.driver.add_state_listener(service.publisher.publish)
             if self._start_loop:
                 self.driver._start_robot()
         except BaseException:
@@ -167,12 +171,15 @@ class RobotServer:
             self.driver._stop_robot()
         if service is not None:
             service.close()
-            try:
-                self.driver._listeners.remove(service.publish)
-            except ValueError:
-                pass
+            self.driver.remove_state_listener(service.publisher.publish)
         server, self._server = self._server, None
         if server is not None:
+            name = self.info.device_info.device.name
+            if self._locks and name:
+                # The device identifier's lock file (RR leaves it behind), while still locked.
+                remove_own_run_files(
+                    [server.state_dir / "run" / "identifiers" / "device" / f"{name}.pid"]
+                )
             server.shutdown()
         self._locks.clear()
 

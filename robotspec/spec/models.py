@@ -361,16 +361,16 @@ class CameraSpec(_Model):
     )
     minimal_height: float | None = Field(
         default=None,
-        description="lowest height of the camera above the robot's root "
-        "(default: the preset's, else 0)",
-        examples=[1.27],
+        description="lowest height of the camera's frame above the robot's root over the "
+        "limits of the joints that move it (checked by FK; default: the preset's, else 0)",
+        examples=[1.166],
         json_schema_extra={"unit": "m"},
     )
     maximal_height: float | None = Field(
         default=None,
-        description="highest height of the camera above the robot's root "
-        "(default: the preset's, else 1)",
-        examples=[1.6],
+        description="highest height of the camera's frame above the robot's root over the "
+        "limits of the joints that move it (checked by FK; default: the preset's, else 1)",
+        examples=[1.583],
         json_schema_extra={"unit": "m"},
     )
     default: bool = Field(default=False, description="the robot's default camera", examples=[True])
@@ -410,6 +410,12 @@ class ChainSpec(_Model):
         default=None,
         description="name of the manipulator (from `manipulators`) at its tip",
         examples=["left_gripper"],
+    )
+    side: Literal["left", "right"] | None = Field(
+        default=None,
+        description="which arm of a two-arm robot this is, for `left_arm` / `right_arm`; "
+        "default: the arm lying on the root's +y side in the default pose",
+        examples=["left"],
     )
     sensors: list[Name] = Field(
         default_factory=list,

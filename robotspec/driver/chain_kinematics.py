@@ -2,7 +2,8 @@
 
 Every joint frame is parallel to the base frame at q = 0; ``H[i]`` is joint i's axis and ``P[i]``
 the offset from joint i-1 to joint i, all in base coordinates at q = 0; ``P[n]`` reaches the chain
-end, then ``flange_pose`` and the tool's TCP transform follow. See the reference note §1(c).
+end, then ``flange_pose`` and the tool's TCP transform follow. This is general-robotics-toolbox's
+``Robot`` convention (``general_robotics_toolbox.fwdkin``, 0.7.3).
 
 Why written here and not taken from the toolbox: it is a small numpy routine, the toolbox is not a
 dependency, and the loop calls it every step (1 kHz), so it works on preallocated arrays and
@@ -19,76 +20,9 @@ import numpy.typing as npt
 
 __all__ = [
     "HPChain",
-    "quat_to_rot",
-    "rot_to_quat",
 ]
 
 FloatArray = npt.NDArray[np.float64]
-
-
-def quat_to_rot(q: Sequence[float] | FloatArray) -> FloatArray:
-    """Rotation matrix of a unit quaternion ``(w, x, y, z)`` (normalised first)."""
-    w, x, y, z = (float(v) for v in q)
-    n = math.sqrt(w * w + x * x + y * y + z * z)
-    if n == 0.0:
-        return np.eye(3)
-    w, x, y, z = w / n, x / n, y / n, z / n
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def rot_to_quat(r: FloatArray) -> FloatArray:
-    """Unit quaternion ``(w, x, y, z)`` of a rotation matrix, with w >= 0."""
-    m00, m01, m02 = float(r[0, 0]), float(r[0, 1]), float(r[0, 2])
-    m10, m11, m12 = float(r[1, 0]), float(r[1, 1]), float(r[1, 2])
-    m20, m21, m22 = float(r[2, 0]), float(r[2, 1]), float(r[2, 2])
-    tr = m00 + m11 + m22
-    if tr > 0.0:
-        s = math.sqrt(tr + 1.0) * 2.0
-        q = (0.25 * s, (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s)
-    elif m00 > m11 and m00 > m22:
-        s = math.sqrt(1.0 + m00 - m11 - m22) * 2.0
-        q = ((m21 - m12) / s, 0.25 * s, (m01 + m10) / s, (m02 + m20) / s)
-    elif m11 > m22:
-        s = math.sqrt(1.0 + m11 - m00 - m22) * 2.0
-        q = ((m02 - m20) / s, (m01 + m10) / s, 0.25 * s, (m12 + m21) / s)
-    else:
-        s = math.sqrt(1.0 + m22 - m00 - m11) * 2.0
-        q = ((m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s)
-    out = np.array(q)
-    if out[0] < 0.0:
-        out = -out
-    return np.asarray(out / np.linalg.norm(out), dtype=np.float64)
-
-
-Pose3 = tuple[tuple[float, ...], tuple[float, float, float]]
-
-
-def rot_to_quat_tuple(r: Sequence[float]) -> tuple[float, float, float, float]:
-    """Unit quaternion ``(w, x, y, z)``, w >= 0, of a row-major 9-tuple rotation (no numpy)."""
-    m00, m01, m02, m10, m11, m12, m20, m21, m22 = r
-    tr = m00 + m11 + m22
-    if tr > 0.0:
-        s = math.sqrt(tr + 1.0) * 2.0
-        w, x, y, z = 0.25 * s, (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s
-    elif m00 > m11 and m00 > m22:
-        s = math.sqrt(1.0 + m00 - m11 - m22) * 2.0
-        w, x, y, z = (m21 - m12) / s, 0.25 * s, (m01 + m10) / s, (m02 + m20) / s
-    elif m11 > m22:
-        s = math.sqrt(1.0 + m11 - m00 - m22) * 2.0
-        w, x, y, z = (m02 - m20) / s, (m01 + m10) / s, 0.25 * s, (m12 + m21) / s
-    else:
-        s = math.sqrt(1.0 + m22 - m00 - m11) * 2.0
-        w, x, y, z = (m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s
-    n = math.sqrt(w * w + x * x + y * y + z * z)
-    if w < 0.0:
-        n = -n
-    return (w / n, x / n, y / n, z / n)
 
 
 def _axis_kind(h: tuple[float, ...]) -> tuple[int, float]:

@@ -1,0 +1,68 @@
+"""What the geometry commands (render, view, collisions) say about meshes that were not found.
+
+Why: loading a robot treats a missing mesh package as a warning (kinematics need no mesh), so
+the commands that do need the files are the ones that must say which bodies lose their geometry,
+all at once, and either stop (telling the user how to go on) or, with
+``--skip-missing-meshes``, carry on without them.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
+from robotspec.errors import ErrorDetail, RobotSpecError
+
+if TYPE_CHECKING:
+    from robotspec.semantic import AbstractRobot
+
+__all__ = ["check_missing_geometry", "report_skipped"]
+
+
+def check_missing_geometry(
+    robot: AbstractRobot, *, skip: bool, collision: bool, command: str
+) -> frozenset[str]:
+    """Refuse (or, with ``skip``, warn once) when robot bodies have meshes that did not resolve.
+
+    Returns the URIs already reported, so the per-element skips of the geometry builders are
+    not printed again.
+    """
+    from robotspec.description.mesh_report import missing_geometry_message, unresolved_mesh_bodies
+
+    missing = unresolved_mesh_bodies(
+        robot.world, collision=collision, bodies=[b.name for b in robot.bodies]
+    )
+    if not missing:
+        return frozenset()
+    if not skip:
+        raise RobotSpecError(
+            missing_geometry_message(
+                missing,
+                what=f"pass --skip-missing-meshes to {command} without them, or make the package "
+                "findable: -P FOLDER, ROS_PACKAGE_PATH, or description.package_paths in the spec",
+            ),
+            kind="mesh",
+        )
+    _print(
+        ErrorDetail(
+            missing_geometry_message(missing, what=f"{command} goes on without them"),
+            severity="warning",
+        )
+    )
+    return frozenset(u for uris in missing.values() for u in uris)
+
+
+def report_skipped(skipped: Iterable[RobotSpecError], reported: frozenset[str]) -> None:
+    """Print the elements a geometry builder left out, except meshes already reported."""
+    for err in skipped:
+        if err.file in reported:
+            continue
+        for detail in err.details:
+            _print(detail)
+
+
+def _print(detail: ErrorDetail) -> None:
+    from robotspec.cli.render import styled
+
+    sys.stderr.write(styled(detail, sys.stderr) + "\n")

@@ -1,0 +1,149 @@
+"""Meshes that cannot be found: one warning per missing package, and the bodies they leave bare.
+
+Why a module of its own: a robot whose mesh package is not on the search path names that package
+in dozens of meshes (93 on Talos). Reported once per mesh, the one fact that matters (which
+package, and how to make it findable) drowns in repeats. Kinematics, semantics and validation
+never need a mesh, so a missing one is a warning while loading; only the commands that draw or
+collide geometry (render, view, collisions) need the files, and they say which bodies lose it.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+from robotspec.errors import DescriptionError, PackageNotFoundError, RobotSpecError
+from robotspec.model.geometry import Mesh
+from robotspec.model.world import World
+
+__all__ = [
+    "FIX_HINT",
+    "MissingMesh",
+    "mesh_group",
+    "missing_geometry_message",
+    "summarize_missing_meshes",
+    "unresolved_mesh_bodies",
+]
+
+#: What makes a package findable, in the words of each place a user can say it.
+FIX_HINT = (
+    "to fix, add the folder that holds it with -P FOLDER, to ROS_PACKAGE_PATH, "
+    "or to description.package_paths in the spec"
+)
+
+#: How many body names a message lists before it says "and N more".
+SHOWN_BODIES = 6
+
+_PACKAGE_URI = re.compile(r"^(?:package|model)://([^/]*)/*([^/]*)", re.IGNORECASE)
+
+
+@dataclass(frozen=True)
+class MissingMesh:
+    """One mesh element of a body that did not resolve to a file, and why."""
+
+    uri: str
+    body: str
+    error: RobotSpecError
+
+
+def mesh_group(uri: str) -> str:
+    """The package a mesh URI names (the first segment of ``package:///a/...``), else its folder.
+
+    Why: meshes are missing together, because their package is; one warning per group.
+    """
+    match = _PACKAGE_URI.match(uri.strip())
+    if match is not None:
+        return match.group(1) or match.group(2)
+    folder, _, _ = uri.rpartition("/")
+    return folder or uri
+
+
+def _names(bodies: Sequence[str]) -> str:
+    shown = ", ".join(bodies[:SHOWN_BODIES])
+    more = len(bodies) - SHOWN_BODIES
+    return shown + (f" and {more} more" if more > 0 else "")
+
+
+_PLURALS = {"mesh": "meshes", "body": "bodies"}
+
+
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word if n == 1 else _PLURALS.get(word, word + 's')}"
+
+
+def summarize_missing_meshes(missing: Iterable[MissingMesh]) -> list[RobotSpecError]:
+    """One warning per missing package (or folder): how many meshes, which bodies, the fix.
+
+    The warning keeps the position of the first mesh of the group. A mesh outside the allowed
+    folders is not a "not found": it keeps its own message (and count), never merged with others.
+    """
+    groups: dict[tuple[str, bool], list[MissingMesh]] = {}
+    for m in missing:
+        kind = isinstance(m.error, PackageNotFoundError)
+        groups.setdefault((mesh_group(m.uri), kind), []).append(m)
+    out: list[RobotSpecError] = []
+    for (group, package_missing), items in groups.items():
+        first = items[0].error
+        bodies = list(dict.fromkeys(m.body for m in items))
+        extent = (
+            f"{_plural(len(items), 'mesh')} of {_plural(len(bodies), 'body')} "
+            f"({_names(bodies)}) have no geometry"
+        )
+        if len(items) == 1:
+            extent = f"body '{bodies[0]}' has no mesh geometry"
+        if package_missing:
+            message = f"{first.message}; {extent}; {FIX_HINT}"
+        elif first.detail.kind == "mesh":
+            message = (
+                f"{_plural(len(items), 'mesh')} of '{group}' not found "
+                f"(first: {first.message}); {extent}"
+            )
+            if len(items) == 1:
+                message = f"{first.message}; {extent}"
+        else:
+            message = f"{first.message}; {extent}"
+        out.append(
+            DescriptionError(
+                message,
+                file=first.file,
+                line=first.line,
+                kind="package" if package_missing else first.detail.kind,
+                name=group if package_missing else first.name,
+                suggestions=first.suggestions,
+                severity="warning",
+            )
+        )
+    return out
+
+
+def unresolved_mesh_bodies(
+    world: World, *, collision: bool, bodies: Iterable[str] | None = None
+) -> dict[str, list[str]]:
+    """Body name -> the URIs of its meshes that did not resolve to a file (visual or collision).
+
+    The commands that need geometry ask this before building it, so that they can name every
+    body that loses geometry at once instead of failing on the first mesh.
+    """
+    wanted = None if bodies is None else set(bodies)
+    out: dict[str, list[str]] = {}
+    for body in world.bodies:
+        if wanted is not None and body.name not in wanted:
+            continue
+        for shape in body.collisions if collision else body.visuals:
+            g = shape.geometry
+            if isinstance(g, Mesh) and g.path is None:
+                out.setdefault(body.name, []).append(g.uri)
+    return out
+
+
+def missing_geometry_message(missing: dict[str, list[str]], *, what: str) -> str:
+    """'N bodies lose their geometry (a, b, ...; meshes of 'x')' for the geometry commands."""
+    groups = list(dict.fromkeys(mesh_group(u) for uris in missing.values() for u in uris))
+    named = ", ".join(f"'{g}'" for g in groups)
+    bodies = list(missing)
+    verb = "loses its" if len(bodies) == 1 else "lose their"
+    return (
+        f"{_plural(len(bodies), 'body')} {verb} geometry, mesh files not found "
+        f"({_names(bodies)}; meshes of {named}); {what}"
+    )

@@ -1,0 +1,271 @@
+"""SRDF names as robots ship them: a robot prefix the URDF lacks, a link disabled against itself.
+
+Why: SRDFs are often written for a namespaced robot (Baxter's in example-robot-data says
+``baxter/head_pan`` for the URDF's ``head_pan``, as a ``tf_prefix`` or a multi-robot launch
+writes it), and collision SRDFs from several public packages disable a link against itself.
+MoveIt would reject or silently drop both; a user bringing such a robot needs to be told once, in
+the SRDF's own terms, what robotspec did. A prefix that maps each name to exactly one URDF name is
+read through (one warning per group); a name that could map to two URDF names, or two SRDF names
+that would map to one, is a located error saying what to change in the SRDF.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Collection
+from dataclasses import dataclass, field, replace
+
+from robotspec.description.srdf import (
+    DisabledCollision,
+    DisableDefaultCollisions,
+    EnabledCollision,
+    EndEffector,
+    GroupChain,
+    PassiveJoint,
+    Srdf,
+    VirtualJoint,
+)
+from robotspec.errors import RobotSpecError, SrdfError
+
+__all__ = ["PrefixMapping", "map_prefixed_names", "self_pair_warnings"]
+
+#: How many renamings a warning shows before it says "and N more".
+SHOWN = 3
+
+
+@dataclass
+class _Scope:
+    """The renamings of one group (its states included) or of one kind of element."""
+
+    what: str
+    line: int | None
+    renamed: dict[str, str] = field(default_factory=dict)
+    kinds: set[str] = field(default_factory=set)
+
+
+@dataclass(frozen=True)
+class PrefixMapping:
+    """The SRDF with prefixed names read as the URDF's, and what to tell the user about it."""
+
+    srdf: Srdf
+    warnings: tuple[RobotSpecError, ...]
+    errors: tuple[RobotSpecError, ...]
+    #: (line, name) of every SRDF name that was left as written because it was ambiguous.
+    ambiguous: frozenset[tuple[int | None, str]]
+
+
+def _candidates(name: str, known: Collection[str]) -> list[str]:
+    """URDF names ``name`` becomes once a ``prefix/`` is cut, longest remaining name first."""
+    out: list[str] = []
+    start = 0
+    while True:
+        cut = name.find("/", start)
+        if cut < 0:
+            return out
+        rest = name[cut + 1 :]
+        if rest and rest in known:
+            out.append(rest)
+        start = cut + 1
+
+
+def map_prefixed_names(
+    srdf: Srdf, links: Collection[str], joints: Collection[str]
+) -> PrefixMapping:
+    """Read SRDF names that carry a prefix the URDF's names lack as the URDF's names.
+
+    A name the URDF has is never touched. Only a prefix ending in ``/`` is cut (a ROS namespace
+    or ``tf_prefix``): cutting other text would guess.
+    """
+    link_set = set(links)
+    joint_set = set(joints) | {v.name for v in srdf.virtual_joints}
+    file = srdf.file
+    where = _short(file)
+    scopes: dict[str, _Scope] = {}
+    errors: list[RobotSpecError] = []
+    ambiguous: set[tuple[int | None, str]] = set()
+
+    def mapper(scope_key: str, what: str, scope_line: int | None) -> Callable[..., str]:
+        scope = scopes.setdefault(scope_key, _Scope(what, scope_line))
+
+        def rename(kind: str, name: str, line: int | None) -> str:
+            known = link_set if kind == "link" else joint_set
+            if name in known:
+                return name
+            found = _candidates(name, known)
+            if not found:
+                return name
+            if len(found) > 1:
+                ambiguous.add((line, name))
+                choices = " or ".join(f"'{f}'" for f in found)
+                errors.append(
+                    SrdfError(
+                        f"{kind} '{name}' of {what} could be the URDF's {kind} {choices} "
+                        f"once a prefix is cut; write the URDF's name in {where}",
+                        file=file,
+                        line=line,
+                        kind=kind,
+                        name=name,
+                        suggestions=found,
+                    )
+                )
+                return name
+            target = found[0]
+            clash = next((s for s, t in scope.renamed.items() if t == target and s != name), None)
+            if clash is not None:
+                ambiguous.add((line, name))
+                errors.append(
+                    SrdfError(
+                        f"{kind}s '{clash}' and '{name}' of {what} would both be the URDF's "
+                        f"{kind} '{target}' once their prefixes are cut; keep one of them, "
+                        f"written '{target}', in {where}",
+                        file=file,
+                        line=line,
+                        kind=kind,
+                        name=name,
+                        suggestions=(target,),
+                    )
+                )
+                return name
+            scope.renamed[name] = target
+            scope.kinds.add(kind)
+            return target
+
+        return rename
+
+    group_lines = {g.name: g.line for g in srdf.groups}
+    groups = []
+    for g in srdf.groups:
+        r = mapper(f"group:{g.name}", f"group '{g.name}'", g.line)
+        jl = _lines(g.joint_lines, len(g.joints), g.line)
+        ll = _lines(g.link_lines, len(g.links), g.line)
+        groups.append(
+            replace(
+                g,
+                joints=tuple(r("joint", n, ln) for n, ln in zip(g.joints, jl, strict=True)),
+                links=tuple(r("link", n, ln) for n, ln in zip(g.links, ll, strict=True)),
+                chains=tuple(
+                    GroupChain(
+                        r("link", c.base_link, c.line or g.line),
+                        r("link", c.tip_link, c.line or g.line),
+                        c.line,
+                    )
+                    for c in g.chains
+                ),
+            )
+        )
+    states = []
+    for s in srdf.group_states:
+        key = f"group:{s.group}" if s.group in group_lines else f"state:{s.name}"
+        r = mapper(key, f"group '{s.group}'" if s.group else f"group_state '{s.name}'", s.line)
+        sl = _lines(s.joint_lines, len(s.joint_values), s.line)
+        states.append(
+            replace(
+                s,
+                joint_values=tuple(
+                    (r("joint", j, ln), v) for (j, v), ln in zip(s.joint_values, sl, strict=True)
+                ),
+            )
+        )
+    first = {
+        tag: next((x.line for x in items), None)
+        for tag, items in (
+            ("end_effector", srdf.end_effectors),
+            ("virtual_joint", srdf.virtual_joints),
+            ("passive_joint", srdf.passive_joints),
+            ("disable_collisions", srdf.disabled_collisions),
+            ("enable_collisions", srdf.enabled_collisions),
+            ("disable_default_collisions", srdf.disable_default_collisions),
+        )
+    }
+
+    def kind_mapper(tag: str) -> Callable[..., str]:
+        return mapper(tag, f"the <{tag}> elements", first[tag])
+
+    r_ee, r_vj = kind_mapper("end_effector"), kind_mapper("virtual_joint")
+    r_pj = kind_mapper("passive_joint")
+    r_dc, r_ec = kind_mapper("disable_collisions"), kind_mapper("enable_collisions")
+    r_dd = kind_mapper("disable_default_collisions")
+    mapped = replace(
+        srdf,
+        groups=tuple(groups),
+        group_states=tuple(states),
+        end_effectors=tuple(
+            EndEffector(
+                e.name, r_ee("link", e.parent_link, e.line), e.group, e.parent_group, e.line
+            )
+            for e in srdf.end_effectors
+        ),
+        virtual_joints=tuple(
+            VirtualJoint(v.name, v.type, v.parent_frame, r_vj("link", v.child_link, v.line), v.line)
+            for v in srdf.virtual_joints
+        ),
+        passive_joints=tuple(
+            PassiveJoint(r_pj("joint", p.name, p.line), p.line) for p in srdf.passive_joints
+        ),
+        disabled_collisions=tuple(
+            DisabledCollision(
+                r_dc("link", d.link1, d.line), r_dc("link", d.link2, d.line), d.reason, d.line
+            )
+            for d in srdf.disabled_collisions
+        ),
+        enabled_collisions=tuple(
+            EnabledCollision(
+                r_ec("link", d.link1, d.line), r_ec("link", d.link2, d.line), d.reason, d.line
+            )
+            for d in srdf.enabled_collisions
+        ),
+        disable_default_collisions=tuple(
+            DisableDefaultCollisions(r_dd("link", d.link, d.line), d.line)
+            for d in srdf.disable_default_collisions
+        ),
+    )
+    warnings = [_warning(scope, file) for scope in scopes.values() if scope.renamed]
+    warnings.sort(key=lambda w: w.line if w.line is not None else 1 << 62)
+    errors.sort(key=lambda e: e.line if e.line is not None else 1 << 62)
+    if not warnings and not errors:
+        return PrefixMapping(srdf, (), (), frozenset())
+    return PrefixMapping(mapped, tuple(warnings), tuple(errors), frozenset(ambiguous))
+
+
+def _warning(scope: _Scope, file: str | None) -> RobotSpecError:
+    items = list(scope.renamed.items())
+    prefixes = list(dict.fromkeys(src[: len(src) - len(dst)] for src, dst in items))
+    shown = ", ".join(f"'{s}' as '{d}'" for s, d in items[:SHOWN])
+    more = len(items) - SHOWN
+    kinds = " and ".join(f"{k} names" for k in sorted(scope.kinds))
+    prefix_text = " or ".join(f"'{p}'" for p in prefixes)
+    return SrdfError(
+        f"{scope.what}: {len(items)} {kinds} carry the prefix {prefix_text} that the URDF's "
+        f"names lack; read as the URDF's names ({shown}{f' and {more} more' if more > 0 else ''})",
+        file=file,
+        line=scope.line,
+        kind="prefix",
+        name=prefixes[0],
+        severity="warning",
+    )
+
+
+def self_pair_warnings(srdf: Srdf) -> list[RobotSpecError]:
+    """One warning per ``disable_collisions`` of a link against itself (it is ignored)."""
+    return [
+        SrdfError(
+            f"<disable_collisions> disables link '{d.link1}' against itself; a link is never "
+            "checked against itself, so the entry is ignored (delete it)",
+            file=srdf.file,
+            line=d.line,
+            kind="link",
+            name=d.link1,
+            severity="warning",
+        )
+        for d in srdf.disabled_collisions
+        if d.link1 == d.link2
+    ]
+
+
+def _lines(own: tuple[int | None, ...], count: int, default: int | None) -> list[int | None]:
+    return list(own) if len(own) == count else [default] * count
+
+
+def _short(file: str | None) -> str:
+    if not file:
+        return "the SRDF"
+    return file.rsplit("/", 1)[-1]

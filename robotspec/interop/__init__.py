@@ -1,0 +1,1 @@
+"""Robots handed to other libraries (pinocchio), built from the world model."""

@@ -1,0 +1,80 @@
+"""A compiled robot handed to pinocchio: model, collision model, semantic frame ids.
+
+The world's part is :mod:`robotspec.model.pinocchio`; this room adds what needs the robot and
+its collision rules: the coal geometries with exactly the pairs robotspec checks, and the frame
+ids of every chain tip, tool frame and camera.
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robotspec.collision.checker import SelfCollisionChecker
+from robotspec.collision.rules import pair_key
+from robotspec.model.pinocchio import (
+    PinocchioRobot,
+    import_pinocchio,
+    set_limits,
+    world_to_pinocchio,
+)
+from robotspec.model.pinocchio import (
+    _se3 as se3,
+)
+
+if TYPE_CHECKING:
+    from robotspec.collision.shapes import MeshLibrary, MissingMeshPolicy
+    from robotspec.semantic.robot import AbstractRobot
+
+__all__ = ["robot_to_pinocchio"]
+
+
+def robot_to_pinocchio(
+    robot: AbstractRobot,
+    *,
+    meshes: MeshLibrary | None = None,
+    on_missing_mesh: MissingMeshPolicy = "error",
+) -> PinocchioRobot:
+    """``robot`` as pinocchio objects: see :class:`PinocchioRobot`."""
+    pin = import_pinocchio()
+    world = robot.world
+    model, frames, order = world_to_pinocchio(world)
+    set_limits(model, world, order)
+    checker = SelfCollisionChecker.from_robot(robot, meshes=meshes, on_missing_mesh=on_missing_mesh)
+    gmodel = pin.GeometryModel()
+    geoms = checker.geometry.geometries
+    index_of: list[int] = []
+    for g in geoms:
+        frame = model.frames[frames[g.body]]
+        joint_to_geom = frame.placement.homogeneous @ np.asarray(g.body_T_geometry)
+        obj = pin.GeometryObject(
+            f"{g.body}_{g.element}",
+            frame.parentJoint,
+            frames[g.body],
+            se3(pin, joint_to_geom),
+            g.geometry,
+        )
+        index_of.append(gmodel.addGeometryObject(obj))
+    by_body: dict[str, list[int]] = {}
+    for g, gid in zip(geoms, index_of, strict=True):
+        by_body.setdefault(g.body, []).append(gid)
+    pair_bodies: list[tuple[str, str]] = []
+    for a, b in checker.active_pairs:
+        for i in by_body.get(a, ()):
+            for j in by_body.get(b, ()):
+                gmodel.addCollisionPair(pin.CollisionPair(min(i, j), max(i, j)))
+                pair_bodies.append(pair_key(a, b))
+    return PinocchioRobot(
+        model=model,
+        collision_model=gmodel,
+        frames=MappingProxyType(dict(frames)),
+        chain_tips=MappingProxyType({c.name: frames[c.tip.name] for c in robot.all_chains}),
+        tool_frames=MappingProxyType(
+            {m.name: frames[m.tool_frame.name] for m in robot.manipulators}
+        ),
+        cameras=MappingProxyType({s.name: frames[s.root.name] for s in robot.cameras}),
+        pair_bodies=tuple(pair_bodies),
+        q_index=order,
+    )

@@ -1,0 +1,778 @@
+/*
+ * robotspec.model._kincore: forward kinematics, chain Jacobians and the collision broad phase
+ * of a compiled world, in C.
+ *
+ * Why C: one configuration of a real robot is a few thousand floating-point operations, so in
+ * numpy (a hundred array calls of ~1 us each) or through a binding that copies poses out one by
+ * one, the call overhead is the whole cost. Here one Python call does the whole query and
+ * returns a fresh numpy array. The layout of every table is decided in Python
+ * (robotspec/model/program.py); this file only runs it. No state is kept between calls: tables
+ * live in capsules owned by the Python objects that built them.
+ *
+ * Poses are row-major 4x4 (numpy's layout); the last row is written as 0 0 0 1.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define KIND_FIXED 0
+#define KIND_REVOLUTE 1
+#define KIND_PRISMATIC 2
+
+/* ------------------------------------------------------------------------------- helpers */
+
+static int64_t *copy_i64(PyObject *obj, Py_ssize_t want, const char *what) {
+    PyArrayObject *a = (PyArrayObject *)PyArray_FROMANY(obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    if (a == NULL) return NULL;
+    if (PyArray_SIZE(a) != want) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %zd values, got %zd", what, want,
+                     (Py_ssize_t)PyArray_SIZE(a));
+        Py_DECREF(a);
+        return NULL;
+    }
+    int64_t *out = malloc(sizeof(int64_t) * (size_t)(want > 0 ? want : 1));
+    if (out == NULL) {
+        Py_DECREF(a);
+        PyErr_NoMemory();
+        return NULL;
+    }
+    if (want > 0) memcpy(out, PyArray_DATA(a), sizeof(int64_t) * (size_t)want);
+    Py_DECREF(a);
+    return out;
+}
+
+static double *copy_f64(PyObject *obj, Py_ssize_t want, const char *what) {
+    PyArrayObject *a = (PyArrayObject *)PyArray_FROMANY(obj, NPY_DOUBLE, 0, 0, NPY_ARRAY_IN_ARRAY);
+    if (a == NULL) return NULL;
+    if (PyArray_SIZE(a) != want) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %zd values, got %zd", what, want,
+                     (Py_ssize_t)PyArray_SIZE(a));
+        Py_DECREF(a);
+        return NULL;
+    }
+    double *out = malloc(sizeof(double) * (size_t)(want > 0 ? want : 1));
+    if (out == NULL) {
+        Py_DECREF(a);
+        PyErr_NoMemory();
+        return NULL;
+    }
+    if (want > 0) memcpy(out, PyArray_DATA(a), sizeof(double) * (size_t)want);
+    Py_DECREF(a);
+    return out;
+}
+
+/* A configuration (or batch) as a contiguous float64 array of the given rank and width. */
+static PyArrayObject *as_config(PyObject *obj, int ndim, Py_ssize_t width) {
+    PyArrayObject *a = (PyArrayObject *)PyArray_FROMANY(obj, NPY_DOUBLE, ndim, ndim,
+                                                        NPY_ARRAY_IN_ARRAY);
+    if (a == NULL) return NULL;
+    if (PyArray_DIM(a, ndim - 1) != width) {
+        PyErr_SetString(PyExc_ValueError, "configuration has the wrong number of values");
+        Py_DECREF(a);
+        return NULL;
+    }
+    const double *v = PyArray_DATA(a);
+    npy_intp n = PyArray_SIZE(a);
+    for (npy_intp i = 0; i < n; i++) {
+        if (!isfinite(v[i])) {
+            PyErr_SetString(PyExc_ValueError, "configuration contains NaN or infinite values");
+            Py_DECREF(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+/* out(3x4) = a(3x4) * b(3x4), both read as 4x4 row-major with an implicit last row 0 0 0 1. */
+static inline void mul34(const double *a, const double *b, double *out) {
+    for (int r = 0; r < 3; r++) {
+        const double a0 = a[4 * r], a1 = a[4 * r + 1], a2 = a[4 * r + 2], a3 = a[4 * r + 3];
+        out[4 * r] = a0 * b[0] + a1 * b[4] + a2 * b[8];
+        out[4 * r + 1] = a0 * b[1] + a1 * b[5] + a2 * b[9];
+        out[4 * r + 2] = a0 * b[2] + a1 * b[6] + a2 * b[10];
+        out[4 * r + 3] = a0 * b[3] + a1 * b[7] + a2 * b[11] + a3;
+    }
+}
+
+static inline void sin_cos(double v, double *s, double *c) {
+#if defined(__GLIBC__) && defined(_GNU_SOURCE)
+    sincos(v, s, c);
+#else
+    *s = sin(v);
+    *c = cos(v);
+#endif
+}
+
+/*
+ * Motion codes: the general kinds above, plus rotations about and translations along a frame
+ * axis (x, y, z), which touch two columns or one translation instead of a full product. The
+ * axis's sign is folded into the motion's multiplier and offset when the program is built.
+ */
+#define CODE_ROT_X 3
+#define CODE_PRI_X 6
+
+/* Apply one elementary motion to pose m in place: m = m * Rot(axis, v) or m * Trans(axis v). */
+static inline void apply_motion(double *m, int code, const double *axis, double v) {
+    if (code == KIND_REVOLUTE) {
+        const double x = axis[0], y = axis[1], z = axis[2];
+        double s, c;
+        sin_cos(v, &s, &c);
+        const double t = 1.0 - c;
+        const double r00 = c + x * x * t, r01 = x * y * t - z * s, r02 = x * z * t + y * s;
+        const double r10 = y * x * t + z * s, r11 = c + y * y * t, r12 = y * z * t - x * s;
+        const double r20 = z * x * t - y * s, r21 = z * y * t + x * s, r22 = c + z * z * t;
+        for (int r = 0; r < 3; r++) {
+            const double a0 = m[4 * r], a1 = m[4 * r + 1], a2 = m[4 * r + 2];
+            m[4 * r] = a0 * r00 + a1 * r10 + a2 * r20;
+            m[4 * r + 1] = a0 * r01 + a1 * r11 + a2 * r21;
+            m[4 * r + 2] = a0 * r02 + a1 * r12 + a2 * r22;
+        }
+    } else if (code == KIND_PRISMATIC) {
+        const double dx = axis[0] * v, dy = axis[1] * v, dz = axis[2] * v;
+        for (int r = 0; r < 3; r++) {
+            m[4 * r + 3] += m[4 * r] * dx + m[4 * r + 1] * dy + m[4 * r + 2] * dz;
+        }
+    } else if (code >= CODE_ROT_X && code < CODE_ROT_X + 3) {
+        /* About frame axis k: columns i = k+1 and j = k+2 (mod 3) mix. */
+        const int k = code - CODE_ROT_X, i = (k + 1) % 3, j = (k + 2) % 3;
+        double s, c;
+        sin_cos(v, &s, &c);
+        for (int r = 0; r < 3; r++) {
+            const double ai = m[4 * r + i], aj = m[4 * r + j];
+            m[4 * r + i] = c * ai + s * aj;
+            m[4 * r + j] = c * aj - s * ai;
+        }
+    } else if (code >= CODE_PRI_X && code < CODE_PRI_X + 3) {
+        const int k = code - CODE_PRI_X;
+        m[3] += m[k] * v;
+        m[7] += m[4 + k] * v;
+        m[11] += m[8 + k] * v;
+    }
+}
+
+/* out = a * b where b's rotation is the identity (a translation only). */
+static inline void mul34_translate(const double *a, const double *b, double *out) {
+    for (int r = 0; r < 3; r++) {
+        const double a0 = a[4 * r], a1 = a[4 * r + 1], a2 = a[4 * r + 2];
+        out[4 * r] = a0;
+        out[4 * r + 1] = a1;
+        out[4 * r + 2] = a2;
+        out[4 * r + 3] = a0 * b[3] + a1 * b[7] + a2 * b[11] + a[4 * r + 3];
+    }
+}
+
+static int is_identity_rotation(const double *o) {
+    return o[0] == 1.0 && o[1] == 0.0 && o[2] == 0.0 && o[4] == 0.0 && o[5] == 1.0 &&
+           o[6] == 0.0 && o[8] == 0.0 && o[9] == 0.0 && o[10] == 1.0;
+}
+
+/*
+ * The fast code of a motion about/along a unit frame axis (sign folded into mul and off), or
+ * the general kind.
+ */
+static int motion_code(int kind, const double *axis, double *mul, double *off) {
+    if (kind != KIND_REVOLUTE && kind != KIND_PRISMATIC) return kind;
+    for (int k = 0; k < 3; k++) {
+        const double a = axis[k];
+        if ((a == 1.0 || a == -1.0) && axis[(k + 1) % 3] == 0.0 && axis[(k + 2) % 3] == 0.0) {
+            *mul *= a;
+            *off *= a;
+            return (kind == KIND_REVOLUTE ? CODE_ROT_X : CODE_PRI_X) + k;
+        }
+    }
+    return kind;
+}
+
+static inline void last_row(double *m) {
+    m[12] = 0.0;
+    m[13] = 0.0;
+    m[14] = 0.0;
+    m[15] = 1.0;
+}
+
+static inline void identity(double *m) {
+    memset(m, 0, 16 * sizeof(double));
+    m[0] = m[5] = m[10] = m[15] = 1.0;
+}
+
+/* ------------------------------------------------------------------------------- the tree */
+
+/*
+ * A tree program: op k computes slot child[k] = slot parent[k] * origin[k] * motion_k(q).
+ * Slot 0 is the root (identity); slots below n_out are the returned bodies, the others are
+ * scratch (the intermediate frames of planar and floating connections).
+ */
+typedef struct {
+    Py_ssize_t n_ops, n_slots, n_out, n_dof;
+    int64_t *parent, *child, *kind, *dof;
+    double *origin, *axis, *mul, *off;
+    int *code, *translate; /* motion code (see motion_code), origin without rotation */
+} Tree;
+
+static void tree_free(PyObject *capsule) {
+    Tree *t = PyCapsule_GetPointer(capsule, "robotspec.tree");
+    if (t == NULL) return;
+    free(t->parent);
+    free(t->child);
+    free(t->kind);
+    free(t->dof);
+    free(t->origin);
+    free(t->axis);
+    free(t->mul);
+    free(t->off);
+    free(t->code);
+    free(t->translate);
+    free(t);
+}
+
+static PyObject *py_tree(PyObject *self, PyObject *args) {
+    PyObject *parent, *child, *kind, *origin, *axis, *dof, *mul, *off;
+    Py_ssize_t n_slots, n_out, n_dof;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOnnn", &parent, &child, &kind, &origin, &axis, &dof,
+                          &mul, &off, &n_slots, &n_out, &n_dof))
+        return NULL;
+    Py_ssize_t n = PyObject_Length(parent);
+    if (n < 0) return NULL;
+    Tree *t = calloc(1, sizeof(Tree));
+    if (t == NULL) return PyErr_NoMemory();
+    t->n_ops = n;
+    t->n_slots = n_slots;
+    t->n_out = n_out;
+    t->n_dof = n_dof;
+    PyObject *cap = PyCapsule_New(t, "robotspec.tree", tree_free);
+    if (cap == NULL) {
+        free(t);
+        return NULL;
+    }
+    if (!(t->parent = copy_i64(parent, n, "parent")) || !(t->child = copy_i64(child, n, "child")) ||
+        !(t->kind = copy_i64(kind, n, "kind")) || !(t->dof = copy_i64(dof, n, "dof")) ||
+        !(t->origin = copy_f64(origin, 16 * n, "origin")) ||
+        !(t->axis = copy_f64(axis, 3 * n, "axis")) || !(t->mul = copy_f64(mul, n, "mul")) ||
+        !(t->off = copy_f64(off, n, "off"))) {
+        Py_DECREF(cap);
+        return NULL;
+    }
+    for (Py_ssize_t k = 0; k < n; k++) {
+        if (t->parent[k] < 0 || t->parent[k] >= n_slots || t->child[k] <= 0 ||
+            t->child[k] >= n_slots || t->parent[k] == t->child[k] ||
+            (t->kind[k] != KIND_FIXED && (t->dof[k] < 0 || t->dof[k] >= n_dof))) {
+            PyErr_SetString(PyExc_ValueError, "tree program refers to a slot or DOF out of range");
+            Py_DECREF(cap);
+            return NULL;
+        }
+    }
+    t->code = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+    t->translate = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+    if (t->code == NULL || t->translate == NULL) {
+        Py_DECREF(cap);
+        return PyErr_NoMemory();
+    }
+    for (Py_ssize_t k = 0; k < n; k++) {
+        t->code[k] = motion_code((int)t->kind[k], t->axis + 3 * k, t->mul + k, t->off + k);
+        t->translate[k] = is_identity_rotation(t->origin + 16 * k);
+    }
+    return cap;
+}
+
+/* Every output pose of one configuration into out (n_out x 16); scratch has the other slots. */
+static void tree_run(const Tree *t, const double *q, double *out, double *scratch) {
+    identity(out);
+    for (Py_ssize_t k = 0; k < t->n_ops; k++) {
+        const int64_t p = t->parent[k], c = t->child[k];
+        const double *pp = p < t->n_out ? out + 16 * p : scratch + 16 * (p - t->n_out);
+        double *cp = c < t->n_out ? out + 16 * c : scratch + 16 * (c - t->n_out);
+        if (t->translate[k]) {
+            mul34_translate(pp, t->origin + 16 * k, cp);
+        } else {
+            mul34(pp, t->origin + 16 * k, cp);
+        }
+        const int code = t->code[k];
+        if (code != KIND_FIXED) {
+            apply_motion(cp, code, t->axis + 3 * k, q[t->dof[k]] * t->mul[k] + t->off[k]);
+        }
+        last_row(cp);
+    }
+}
+
+static PyObject *py_fk(PyObject *self, PyObject *args) {
+    PyObject *cap, *qobj;
+    if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
+    const Tree *t = PyCapsule_GetPointer(cap, "robotspec.tree");
+    if (t == NULL) return NULL;
+    PyArrayObject *q = as_config(qobj, 1, t->n_dof);
+    if (q == NULL) return NULL;
+    npy_intp dims[3] = {t->n_out, 4, 4};
+    PyArrayObject *out = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_DOUBLE);
+    if (out == NULL) {
+        Py_DECREF(q);
+        return NULL;
+    }
+    double stack[16 * 32];
+    Py_ssize_t n_scratch = t->n_slots - t->n_out;
+    double *scratch = n_scratch <= 32 ? stack : malloc(sizeof(double) * 16 * (size_t)n_scratch);
+    if (scratch == NULL) {
+        Py_DECREF(q);
+        Py_DECREF(out);
+        return PyErr_NoMemory();
+    }
+    tree_run(t, PyArray_DATA(q), PyArray_DATA(out), scratch);
+    if (scratch != stack) free(scratch);
+    Py_DECREF(q);
+    return (PyObject *)out;
+}
+
+static PyObject *py_fk_batch(PyObject *self, PyObject *args) {
+    PyObject *cap, *qobj;
+    if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
+    const Tree *t = PyCapsule_GetPointer(cap, "robotspec.tree");
+    if (t == NULL) return NULL;
+    PyArrayObject *q = as_config(qobj, 2, t->n_dof);
+    if (q == NULL) return NULL;
+    npy_intp n = PyArray_DIM(q, 0);
+    npy_intp dims[4] = {n, t->n_out, 4, 4};
+    PyArrayObject *out = (PyArrayObject *)PyArray_SimpleNew(4, dims, NPY_DOUBLE);
+    Py_ssize_t n_scratch = t->n_slots - t->n_out;
+    double *scratch = malloc(sizeof(double) * 16 * (size_t)(n_scratch > 0 ? n_scratch : 1));
+    if (out == NULL || scratch == NULL) {
+        free(scratch);
+        Py_DECREF(q);
+        Py_XDECREF(out);
+        return out == NULL ? NULL : PyErr_NoMemory();
+    }
+    const double *qv = PyArray_DATA(q);
+    double *ov = PyArray_DATA(out);
+    Py_BEGIN_ALLOW_THREADS
+    for (npy_intp i = 0; i < n; i++) {
+        tree_run(t, qv + i * t->n_dof, ov + i * 16 * t->n_out, scratch);
+    }
+    Py_END_ALLOW_THREADS
+    free(scratch);
+    Py_DECREF(q);
+    return (PyObject *)out;
+}
+
+/* ------------------------------------------------------------------------------ a chain */
+
+/*
+ * A chain program: T = pre[0] m_0(q) pre[1] m_1(q) ... pre[n-1] m_{n-1}(q) post, where pre[i]
+ * holds the fixed transforms before elementary motion i; col[i] is the Jacobian column motion i
+ * adds to (mimic joints add to their leader's column, scaled by mul[i]).
+ */
+typedef struct {
+    Py_ssize_t n, n_cols, n_dof;
+    int64_t *kind, *dof, *col;
+    double *pre, *post, *axis, *mul, *off;
+} Chain;
+
+static void chain_free(PyObject *capsule) {
+    Chain *c = PyCapsule_GetPointer(capsule, "robotspec.chain");
+    if (c == NULL) return;
+    free(c->kind);
+    free(c->dof);
+    free(c->col);
+    free(c->pre);
+    free(c->post);
+    free(c->axis);
+    free(c->mul);
+    free(c->off);
+    free(c);
+}
+
+static PyObject *py_chain(PyObject *self, PyObject *args) {
+    PyObject *pre, *post, *kind, *axis, *dof, *mul, *off, *col;
+    Py_ssize_t n_cols, n_dof;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOnn", &pre, &post, &kind, &axis, &dof, &mul, &off, &col,
+                          &n_cols, &n_dof))
+        return NULL;
+    Py_ssize_t n = PyObject_Length(kind);
+    if (n < 0) return NULL;
+    Chain *c = calloc(1, sizeof(Chain));
+    if (c == NULL) return PyErr_NoMemory();
+    c->n = n;
+    c->n_cols = n_cols;
+    c->n_dof = n_dof;
+    PyObject *cap = PyCapsule_New(c, "robotspec.chain", chain_free);
+    if (cap == NULL) {
+        free(c);
+        return NULL;
+    }
+    if (!(c->pre = copy_f64(pre, 16 * n, "pre")) || !(c->post = copy_f64(post, 16, "post")) ||
+        !(c->kind = copy_i64(kind, n, "kind")) || !(c->axis = copy_f64(axis, 3 * n, "axis")) ||
+        !(c->dof = copy_i64(dof, n, "dof")) || !(c->mul = copy_f64(mul, n, "mul")) ||
+        !(c->off = copy_f64(off, n, "off")) || !(c->col = copy_i64(col, n, "col"))) {
+        Py_DECREF(cap);
+        return NULL;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (c->dof[i] < 0 || c->dof[i] >= n_dof || c->col[i] < 0 || c->col[i] >= n_cols ||
+            (c->kind[i] != KIND_REVOLUTE && c->kind[i] != KIND_PRISMATIC)) {
+            PyErr_SetString(PyExc_ValueError, "chain program refers to a DOF out of range");
+            Py_DECREF(cap);
+            return NULL;
+        }
+    }
+    return cap;
+}
+
+static void chain_run(const Chain *c, const double *qv, double *o) {
+    double t[16], u[16];
+    identity(t);
+    for (Py_ssize_t i = 0; i < c->n; i++) {
+        mul34(t, c->pre + 16 * i, u);
+        apply_motion(u, (int)c->kind[i], c->axis + 3 * i, qv[c->dof[i]] * c->mul[i] + c->off[i]);
+        memcpy(t, u, 12 * sizeof(double));
+    }
+    mul34(t, c->post, o);
+    last_row(o);
+}
+
+static PyObject *py_chain_fk(PyObject *self, PyObject *args) {
+    PyObject *cap, *qobj;
+    if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
+    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
+    if (c == NULL) return NULL;
+    PyArrayObject *q = as_config(qobj, 1, c->n_dof);
+    if (q == NULL) return NULL;
+    npy_intp dims[2] = {4, 4};
+    PyArrayObject *out = (PyArrayObject *)PyArray_SimpleNew(2, dims, NPY_DOUBLE);
+    if (out != NULL) chain_run(c, PyArray_DATA(q), PyArray_DATA(out));
+    Py_DECREF(q);
+    return (PyObject *)out;
+}
+
+static PyObject *py_chain_fk_batch(PyObject *self, PyObject *args) {
+    PyObject *cap, *qobj;
+    if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
+    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
+    if (c == NULL) return NULL;
+    PyArrayObject *q = as_config(qobj, 2, c->n_dof);
+    if (q == NULL) return NULL;
+    npy_intp n = PyArray_DIM(q, 0);
+    npy_intp dims[3] = {n, 4, 4};
+    PyArrayObject *out = (PyArrayObject *)PyArray_SimpleNew(3, dims, NPY_DOUBLE);
+    if (out != NULL) {
+        const double *qv = PyArray_DATA(q);
+        double *ov = PyArray_DATA(out);
+        Py_BEGIN_ALLOW_THREADS
+        for (npy_intp i = 0; i < n; i++) chain_run(c, qv + i * c->n_dof, ov + 16 * i);
+        Py_END_ALLOW_THREADS
+    }
+    Py_DECREF(q);
+    return (PyObject *)out;
+}
+
+static PyObject *py_chain_jacobian(PyObject *self, PyObject *args) {
+    PyObject *cap, *qobj;
+    if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
+    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
+    if (c == NULL) return NULL;
+    PyArrayObject *q = as_config(qobj, 1, c->n_dof);
+    if (q == NULL) return NULL;
+    const double *qv = PyArray_DATA(q);
+    npy_intp dims[2] = {6, c->n_cols};
+    PyArrayObject *out = (PyArrayObject *)PyArray_ZEROS(2, dims, NPY_DOUBLE, 0);
+    double zbuf[3 * 64], pbuf[3 * 64];
+    double *z = c->n <= 64 ? zbuf : malloc(sizeof(double) * 3 * (size_t)c->n);
+    double *p = c->n <= 64 ? pbuf : malloc(sizeof(double) * 3 * (size_t)c->n);
+    if (out == NULL || z == NULL || p == NULL) {
+        if (z != zbuf) free(z);
+        if (p != pbuf) free(p);
+        Py_DECREF(q);
+        Py_XDECREF(out);
+        return out == NULL ? NULL : PyErr_NoMemory();
+    }
+    double t[16], u[16], tip[16];
+    identity(t);
+    for (Py_ssize_t i = 0; i < c->n; i++) {
+        mul34(t, c->pre + 16 * i, u);
+        const double *a = c->axis + 3 * i;
+        for (int r = 0; r < 3; r++) {
+            z[3 * i + r] = u[4 * r] * a[0] + u[4 * r + 1] * a[1] + u[4 * r + 2] * a[2];
+            p[3 * i + r] = u[4 * r + 3];
+        }
+        apply_motion(u, (int)c->kind[i], a, qv[c->dof[i]] * c->mul[i] + c->off[i]);
+        memcpy(t, u, 12 * sizeof(double));
+    }
+    mul34(t, c->post, tip);
+    double *j = PyArray_DATA(out);
+    const Py_ssize_t w = c->n_cols;
+    for (Py_ssize_t i = 0; i < c->n; i++) {
+        const double *zi = z + 3 * i, *pi = p + 3 * i, m = c->mul[i];
+        const Py_ssize_t k = c->col[i];
+        if (c->kind[i] == KIND_REVOLUTE) {
+            const double dx = tip[3] - pi[0], dy = tip[7] - pi[1], dz = tip[11] - pi[2];
+            j[0 * w + k] += m * (zi[1] * dz - zi[2] * dy);
+            j[1 * w + k] += m * (zi[2] * dx - zi[0] * dz);
+            j[2 * w + k] += m * (zi[0] * dy - zi[1] * dx);
+            j[3 * w + k] += m * zi[0];
+            j[4 * w + k] += m * zi[1];
+            j[5 * w + k] += m * zi[2];
+        } else {
+            j[0 * w + k] += m * zi[0];
+            j[1 * w + k] += m * zi[1];
+            j[2 * w + k] += m * zi[2];
+        }
+    }
+    if (z != zbuf) free(z);
+    if (p != pbuf) free(p);
+    Py_DECREF(q);
+    return (PyObject *)out;
+}
+
+/* ------------------------------------------------------------------ collision broad phase */
+
+/*
+ * Geometries (each on a body, with a body-frame box) and the geometry pairs to test. The broad
+ * phase keeps a (sample, pair) when the boxes' world-aligned bounds come within the margin and
+ * no separating axis of the two oriented boxes (15 axes) parts them by more than the margin:
+ * both tests are conservative, so coal's narrow phase decides every answer.
+ */
+typedef struct {
+    Py_ssize_t n_geom, n_pair, n_body;
+    int64_t *body, *g1, *g2;
+    double *body_T_geom, *center, *half;
+} Geoms;
+
+static void geoms_free(PyObject *capsule) {
+    Geoms *g = PyCapsule_GetPointer(capsule, "robotspec.geoms");
+    if (g == NULL) return;
+    free(g->body);
+    free(g->g1);
+    free(g->g2);
+    free(g->body_T_geom);
+    free(g->center);
+    free(g->half);
+    free(g);
+}
+
+static PyObject *py_geoms(PyObject *self, PyObject *args) {
+    PyObject *body, *btg, *center, *half, *g1, *g2;
+    Py_ssize_t n_body;
+    if (!PyArg_ParseTuple(args, "OOOOOOn", &body, &btg, &center, &half, &g1, &g2, &n_body))
+        return NULL;
+    Py_ssize_t ng = PyObject_Length(body), np_ = PyObject_Length(g1);
+    if (ng < 0 || np_ < 0) return NULL;
+    Geoms *g = calloc(1, sizeof(Geoms));
+    if (g == NULL) return PyErr_NoMemory();
+    g->n_geom = ng;
+    g->n_pair = np_;
+    g->n_body = n_body;
+    PyObject *cap = PyCapsule_New(g, "robotspec.geoms", geoms_free);
+    if (cap == NULL) {
+        free(g);
+        return NULL;
+    }
+    if (!(g->body = copy_i64(body, ng, "body")) ||
+        !(g->body_T_geom = copy_f64(btg, 16 * ng, "body_T_geom")) ||
+        !(g->center = copy_f64(center, 3 * ng, "center")) ||
+        !(g->half = copy_f64(half, 3 * ng, "half")) || !(g->g1 = copy_i64(g1, np_, "g1")) ||
+        !(g->g2 = copy_i64(g2, np_, "g2"))) {
+        Py_DECREF(cap);
+        return NULL;
+    }
+    for (Py_ssize_t i = 0; i < ng; i++) {
+        if (g->body[i] < 0 || g->body[i] >= n_body) {
+            PyErr_SetString(PyExc_ValueError, "geometry on a body out of range");
+            Py_DECREF(cap);
+            return NULL;
+        }
+    }
+    for (Py_ssize_t k = 0; k < np_; k++) {
+        if (g->g1[k] < 0 || g->g1[k] >= ng || g->g2[k] < 0 || g->g2[k] >= ng) {
+            PyErr_SetString(PyExc_ValueError, "geometry pair out of range");
+            Py_DECREF(cap);
+            return NULL;
+        }
+    }
+    return cap;
+}
+
+static int obb_separated(const double *a, const double *ha, const double *b, const double *hb) {
+    /* a, b: world poses (4x4 rows) of the box frames; ha, hb: inflated half extents. */
+    double r[3][3], ar[3][3], t[3], d[3];
+    for (int x = 0; x < 3; x++) d[x] = b[4 * x + 3] - a[4 * x + 3];
+    for (int x = 0; x < 3; x++) {
+        for (int y = 0; y < 3; y++) {
+            r[x][y] = a[x] * b[y] + a[4 + x] * b[4 + y] + a[8 + x] * b[8 + y];
+            ar[x][y] = fabs(r[x][y]) + 1e-9;
+        }
+        t[x] = a[x] * d[0] + a[4 + x] * d[1] + a[8 + x] * d[2];
+    }
+    for (int x = 0; x < 3; x++) {
+        if (fabs(t[x]) > ha[x] + ar[x][0] * hb[0] + ar[x][1] * hb[1] + ar[x][2] * hb[2]) return 1;
+        double tb = t[0] * r[0][x] + t[1] * r[1][x] + t[2] * r[2][x];
+        if (fabs(tb) > ha[0] * ar[0][x] + ha[1] * ar[1][x] + ha[2] * ar[2][x] + hb[x]) return 1;
+    }
+    for (int x = 0; x < 3; x++) {
+        int x1 = (x + 1) % 3, x2 = (x + 2) % 3;
+        for (int y = 0; y < 3; y++) {
+            int y1 = (y + 1) % 3, y2 = (y + 2) % 3;
+            double lhs = fabs(t[x2] * r[x1][y] - t[x1] * r[x2][y]);
+            double rhs = ha[x1] * ar[x2][y] + ha[x2] * ar[x1][y] + hb[y1] * ar[x][y2] +
+                         hb[y2] * ar[x][y1];
+            if (lhs > rhs) return 1;
+        }
+    }
+    return 0;
+}
+
+/*
+ * broad(geoms, body_poses (N, B, 4, 4) or (B, 4, 4), margin, mask or None)
+ *   -> (rows int64 (K,), pairs int64 (K,), geometry poses (N, G, 4, 4))
+ * The candidates come sample by sample, pairs in order; mask (uint8 per pair) drops pairs.
+ */
+static PyObject *py_broad(PyObject *self, PyObject *args) {
+    PyObject *cap, *pobj, *mobj;
+    double margin;
+    if (!PyArg_ParseTuple(args, "OOdO", &cap, &pobj, &margin, &mobj)) return NULL;
+    const Geoms *g = PyCapsule_GetPointer(cap, "robotspec.geoms");
+    if (g == NULL) return NULL;
+    PyArrayObject *poses = (PyArrayObject *)PyArray_FROMANY(pobj, NPY_DOUBLE, 3, 4,
+                                                            NPY_ARRAY_IN_ARRAY);
+    if (poses == NULL) return NULL;
+    int nd = PyArray_NDIM(poses);
+    npy_intp n = nd == 4 ? PyArray_DIM(poses, 0) : 1;
+    if (PyArray_DIM(poses, nd - 3) != g->n_body || PyArray_DIM(poses, nd - 2) != 4 ||
+        PyArray_DIM(poses, nd - 1) != 4) {
+        Py_DECREF(poses);
+        PyErr_SetString(PyExc_ValueError, "body poses have the wrong shape");
+        return NULL;
+    }
+    PyArrayObject *mask = NULL;
+    if (mobj != Py_None) {
+        mask = (PyArrayObject *)PyArray_FROMANY(mobj, NPY_UINT8, 1, 1, NPY_ARRAY_IN_ARRAY);
+        if (mask == NULL || PyArray_SIZE(mask) != g->n_pair) {
+            Py_DECREF(poses);
+            Py_XDECREF(mask);
+            if (mask != NULL) PyErr_SetString(PyExc_ValueError, "pair mask has the wrong size");
+            return NULL;
+        }
+    }
+    npy_intp gdims[4] = {n, g->n_geom, 4, 4};
+    PyArrayObject *gp = (PyArrayObject *)PyArray_SimpleNew(4, gdims, NPY_DOUBLE);
+    size_t cap_k = 64;
+    npy_intp nk = 0;
+    int64_t *rows = malloc(sizeof(int64_t) * cap_k), *ks = malloc(sizeof(int64_t) * cap_k);
+    double *lo = malloc(sizeof(double) * 3 * (size_t)(g->n_geom > 0 ? g->n_geom : 1));
+    double *hi = malloc(sizeof(double) * 3 * (size_t)(g->n_geom > 0 ? g->n_geom : 1));
+    int failed = gp == NULL || rows == NULL || ks == NULL || lo == NULL || hi == NULL;
+    if (!failed) {
+        const double *bp = PyArray_DATA(poses);
+        double *gv = PyArray_DATA(gp);
+        const uint8_t *mv = mask == NULL ? NULL : PyArray_DATA(mask);
+        for (npy_intp s = 0; s < n && !failed; s++) {
+            const double *bs = bp + s * g->n_body * 16;
+            double *gs = gv + s * g->n_geom * 16;
+            for (Py_ssize_t i = 0; i < g->n_geom; i++) {
+                const double *b = bs + 16 * g->body[i];
+                double *o = gs + 16 * i;
+                mul34(b, g->body_T_geom + 16 * i, o);
+                last_row(o);
+                const double *c = g->center + 3 * i, *h = g->half + 3 * i;
+                for (int a = 0; a < 3; a++) {
+                    const double *row = b + 4 * a;
+                    double cen = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + row[3];
+                    double hw = fabs(row[0]) * h[0] + fabs(row[1]) * h[1] + fabs(row[2]) * h[2];
+                    lo[3 * i + a] = cen - hw - margin;
+                    hi[3 * i + a] = cen + hw;
+                }
+            }
+            for (Py_ssize_t k = 0; k < g->n_pair; k++) {
+                if (mv != NULL && !mv[k]) continue;
+                const int64_t i = g->g1[k], j = g->g2[k];
+                int apart = 0;
+                for (int a = 0; a < 3 && !apart; a++) {
+                    apart = !(lo[3 * i + a] <= hi[3 * j + a] && lo[3 * j + a] <= hi[3 * i + a]);
+                }
+                if (apart) continue;
+                /* Box frames: the body pose with the box centre as origin. */
+                double fa[16], fb[16], ha[3], hb[3];
+                const double *ba = bs + 16 * g->body[i], *bb = bs + 16 * g->body[j];
+                memcpy(fa, ba, 12 * sizeof(double));
+                memcpy(fb, bb, 12 * sizeof(double));
+                const double *ca = g->center + 3 * i, *cb = g->center + 3 * j;
+                for (int a = 0; a < 3; a++) {
+                    fa[4 * a + 3] = ba[4 * a] * ca[0] + ba[4 * a + 1] * ca[1] +
+                                    ba[4 * a + 2] * ca[2] + ba[4 * a + 3];
+                    fb[4 * a + 3] = bb[4 * a] * cb[0] + bb[4 * a + 1] * cb[1] +
+                                    bb[4 * a + 2] * cb[2] + bb[4 * a + 3];
+                    ha[a] = g->half[3 * i + a] + margin / 2.0;
+                    hb[a] = g->half[3 * j + a] + margin / 2.0;
+                }
+                if (obb_separated(fa, ha, fb, hb)) continue;
+                if ((size_t)nk == cap_k) {
+                    cap_k *= 2;
+                    int64_t *r2 = realloc(rows, sizeof(int64_t) * cap_k);
+                    if (r2 != NULL) rows = r2;
+                    int64_t *k2 = realloc(ks, sizeof(int64_t) * cap_k);
+                    if (k2 != NULL) ks = k2;
+                    if (r2 == NULL || k2 == NULL) {
+                        failed = 1;
+                        break;
+                    }
+                }
+                rows[nk] = s;
+                ks[nk] = k;
+                nk++;
+            }
+        }
+    }
+    free(lo);
+    free(hi);
+    Py_DECREF(poses);
+    Py_XDECREF(mask);
+    if (failed) {
+        free(rows);
+        free(ks);
+        Py_XDECREF(gp);
+        return PyErr_Occurred() ? NULL : PyErr_NoMemory();
+    }
+    npy_intp kd[1] = {nk};
+    PyArrayObject *ra = (PyArrayObject *)PyArray_SimpleNew(1, kd, NPY_INT64);
+    PyArrayObject *ka = (PyArrayObject *)PyArray_SimpleNew(1, kd, NPY_INT64);
+    if (ra == NULL || ka == NULL) {
+        free(rows);
+        free(ks);
+        Py_XDECREF(ra);
+        Py_XDECREF(ka);
+        Py_DECREF(gp);
+        return NULL;
+    }
+    if (nk > 0) {
+        memcpy(PyArray_DATA(ra), rows, sizeof(int64_t) * (size_t)nk);
+        memcpy(PyArray_DATA(ka), ks, sizeof(int64_t) * (size_t)nk);
+    }
+    free(rows);
+    free(ks);
+    return Py_BuildValue("NNN", ra, ka, gp);
+}
+
+/* ---------------------------------------------------------------------------------- module */
+
+static PyMethodDef methods[] = {
+    {"tree", py_tree, METH_VARARGS, "Compile a tree program (see robotspec.model.program)."},
+    {"fk", py_fk, METH_VARARGS, "Every output pose (B, 4, 4) of one configuration."},
+    {"fk_batch", py_fk_batch, METH_VARARGS, "Every output pose (N, B, 4, 4) of a batch."},
+    {"chain", py_chain, METH_VARARGS, "Compile a chain program."},
+    {"chain_fk", py_chain_fk, METH_VARARGS, "root_T_tip (4, 4) of one configuration."},
+    {"chain_fk_batch", py_chain_fk_batch, METH_VARARGS, "root_T_tip (N, 4, 4) of a batch."},
+    {"chain_jacobian", py_chain_jacobian, METH_VARARGS, "The chain's Jacobian (6, n)."},
+    {"geoms", py_geoms, METH_VARARGS, "Compile the geometries and pairs of a checker."},
+    {"broad", py_broad, METH_VARARGS, "Candidate (sample, pair)s and geometry poses."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_kincore",
+    "Forward kinematics, chain Jacobians and the collision broad phase, in C.", -1, methods,
+};
+
+PyMODINIT_FUNC PyInit__kincore(void) {
+    import_array();
+    return PyModule_Create(&module);
+}

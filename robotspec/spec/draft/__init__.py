@@ -1,0 +1,44 @@
+"""``robotspec init``: a first spec drafted from a robot's URDF (and SRDF, when there is one).
+
+Why a draft and not a guess presented as fact: which links form an arm, where a tool frame is and
+what a camera sees are decisions a person makes once. The draft takes everything the files say
+(SRDF groups in every form, end effectors, group states, the virtual joint), reads the rest from
+the kinematic tree (arms, legs, parallel grippers, tool frames, cameras, neck, torso, drive), marks
+each guess with a ``# DECIDE:`` comment and its reason, and is valid as written, so ``robotspec
+validate`` works from the start.
+
+One module per job: ``tree`` (segments and the default pose), ``limbs`` (arms, legs), ``hands``
+(grippers, tool frames), ``sensors`` (cameras, neck), ``srdf_groups`` (what the SRDF says),
+``build`` (joining them), ``render`` (YAML that survives any name), ``paths`` (portable file
+references).
+"""
+
+from __future__ import annotations
+
+from robotspec.spec.draft.build import draft_spec
+from robotspec.spec.draft.model import (
+    Draft,
+    DraftCamera,
+    DraftChain,
+    DraftDrive,
+    DraftFinger,
+    DraftFrame,
+    DraftManipulator,
+)
+from robotspec.spec.draft.paths import portable_ref, relative_path
+from robotspec.spec.draft.render import SCHEMA_FILE, render_draft
+
+__all__ = [
+    "SCHEMA_FILE",
+    "Draft",
+    "DraftCamera",
+    "DraftChain",
+    "DraftDrive",
+    "DraftFinger",
+    "DraftFrame",
+    "DraftManipulator",
+    "draft_spec",
+    "portable_ref",
+    "relative_path",
+    "render_draft",
+]

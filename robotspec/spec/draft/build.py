@@ -1,0 +1,307 @@
+"""``draft_spec``: the detectors' findings joined into one draft, SRDF first, the tree always.
+
+Order of trust: what the SRDF states (groups, end effectors, virtual joint, group states) is taken
+as written, in its own names; the tree fills in what the SRDF does not say (the hands' structure,
+tool frames, cameras, neck, torso, drive) and is the only source without an SRDF. Anything the
+tree suggests is a guess and carries a ``DECIDE`` reason.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robotspec.description.srdf import Srdf
+from robotspec.model.entities import Body
+from robotspec.model.world import World
+from robotspec.spec.draft.hands import (
+    Gripper,
+    facing_quaternion,
+    find_gripper,
+    find_tool_frame,
+    hand_joints,
+)
+from robotspec.spec.draft.limbs import Limb, find_limbs
+from robotspec.spec.draft.model import (
+    Draft,
+    DraftChain,
+    DraftDrive,
+    DraftFrame,
+    DraftManipulator,
+)
+from robotspec.spec.draft.naming import (
+    join,
+    named_side,
+    role_by_name,
+    side_labels,
+    side_of,
+    unique,
+)
+from robotspec.spec.draft.parts import add_drive, add_sensors, add_states, add_torso
+from robotspec.spec.draft.srdf_groups import end_effector_root, group_chains
+from robotspec.spec.draft.tree import Tree, words
+
+__all__ = ["Drafter", "draft_spec"]
+
+
+class Drafter:
+    """One drafting run; each method fills one part of ``self.draft``."""
+
+    def __init__(
+        self, world: World, srdf: Srdf | None, name: str, urdf: str, srdf_ref: str | None
+    ) -> None:
+        self.world = world
+        self.srdf = srdf
+        self.names: set[str] = set()
+        root = world.root
+        drive: DraftDrive | None = None
+        vj = None
+        if srdf is not None:
+            vj = next((v for v in srdf.virtual_joints if world.has_body(v.child_link)), None)
+        if vj is not None:
+            root = world.get_body_by_name(vj.child_link)
+            kind = {"planar": "omni", "floating": "floating", "fixed": "fixed"}.get(vj.type)
+            if kind is not None and (kind == "fixed" or root is world.root):
+                drive = DraftDrive(
+                    kind, vj.name, vj.parent_frame, f"the SRDF's virtual joint '{vj.name}'"
+                )
+        self.tree = Tree(world, root)
+        self.limbs = find_limbs(self.tree)
+        self.draft = Draft(
+            name=name,
+            urdf=urdf,
+            srdf=srdf_ref,
+            root=root.name,
+            drive=drive,
+            chains=[],
+            manipulators=[],
+            cameras=[],
+        )
+
+    # ------------------------------------------------------------------------------ chains
+    def chains(self) -> list[tuple[DraftChain, Limb | None]]:
+        """SRDF groups that are chains (matched to the tree's limbs), then the other limbs."""
+        limbs = self.limbs
+        out: list[tuple[DraftChain, Limb | None]] = []
+        used: set[int] = set()
+        if self.srdf is not None:
+            found = group_chains(self.world, self.srdf)
+            sets = [lb.joints for lb in limbs] + [gc.joints for gc in found]
+            accepted: list[frozenset[str]] = []
+            for gc in found:
+                if any(s < gc.joints for s in sets) or gc.joints in accepted:
+                    self.draft.notes.append(
+                        f"SRDF group {gc.group.name!r} joins or repeats other chains; not drafted"
+                    )
+                    continue
+                hands = [lb.hand for lb in limbs if lb.hand is not None]
+                if any(self.world.is_ancestor(h, gc.root) for h in hands):
+                    continue  # a hand's own joints (Panda's 'hand'): its manipulator has them
+                accepted.append(gc.joints)
+                limb_i = next(
+                    (i for i, lb in enumerate(limbs) if lb.joints & gc.joints and i not in used),
+                    None,
+                )
+                limb = limbs[limb_i] if limb_i is not None else None
+                if limb_i is not None:
+                    used.add(limb_i)
+                c = DraftChain(
+                    unique(gc.group.name, self.names),
+                    gc.root.name,
+                    gc.tip.name,
+                    f"the SRDF group '{gc.group.name}'",
+                    role=limb.kind if limb is not None else role_by_name(gc.group.name),
+                    group=gc.group.name if gc.single_chain else None,
+                    srdf_group=gc.group.name,
+                    joints=gc.joints,
+                )
+                out.append((c, limb))
+        rest = [lb for i, lb in enumerate(limbs) if i not in used]
+        for kind in ("arm", "leg"):
+            group = [lb for lb in rest if lb.kind == kind]
+            if not group:
+                continue
+            labels, by_name = side_labels(self.tree, group)
+            for lb, label in zip(group, labels, strict=True):
+                c = DraftChain(
+                    unique(join(label, kind), self.names),
+                    lb.root.name,
+                    lb.tip.name,
+                    "the URDF tree",
+                    role=kind,
+                    joints=lb.joints,
+                )
+                c.decide.append(f"{'an arm' if kind == 'arm' else 'a leg'}: {lb.why}")
+                named = named_side(lb)
+                if by_name and kind == "arm" and label in ("left", "right"):
+                    c.side = label
+                    c.decide.append("the default pose does not tell the sides; its links do")
+                elif label in ("left", "right") and named not in (None, label):
+                    c.decide.append(f"{label} by position, but its links say {named}")
+                out.append((c, lb))
+        return out
+
+    # ----------------------------------------------------------------------- manipulators
+    def manipulator(
+        self, chain: DraftChain, limb: Limb | None, name: str, start: Body | None = None
+    ) -> DraftManipulator | None:
+        """The hand at a chain's end (``start``: where an SRDF end effector says it begins)."""
+        tree, world = self.tree, self.world
+        tip = world.get_body_by_name(chain.tip)
+        hand = start if start is not None else (limb.hand if limb is not None else None)
+        if hand is not None and not world.is_ancestor(tip, hand):
+            hand = None
+        decide: list[str] = []
+        gripper, why = find_gripper(tree, hand) if hand is not None else (None, "no hand")
+        top = gripper.root if gripper is not None else (hand or tip)
+        others = frozenset(
+            b.index
+            for lb in self.limbs
+            if limb is None or lb.segment is not limb.segment
+            if not world.is_ancestor(world.bodies[lb.segment.joints[0].child], tip)
+            for b in world.subtree(world.bodies[lb.segment.joints[0].child])
+        )
+        tool = find_tool_frame(tree, top, others)
+        if tool is None and top is not tip:
+            tool = find_tool_frame(tree, tip, others)
+            if tool is not None:
+                decide.append(f"the only named tool frame is above the hand: root '{tip.name}'")
+                top = tip
+        if gripper is not None and not world.is_ancestor(top, gripper.root):
+            gripper = None
+        frame: DraftFrame | None = None
+        if tool is not None:
+            tool_name = tool.name
+        elif gripper is not None:
+            tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))
+            mid = (tree.poses[gripper.thumb_tip.index] + tree.poses[gripper.finger_tip.index])[
+                :3, 3
+            ] / 2
+            local = np.linalg.inv(tree.poses[gripper.root.index]) @ np.append(mid, 1.0)
+            xyz = (round(float(local[0]), 4), round(float(local[1]), 4), round(float(local[2]), 4))
+            frame = DraftFrame(
+                tool_name,
+                gripper.root.name,
+                xyz,
+                "the URDF has no tool frame: between the finger tips in the default pose",
+            )
+        else:
+            tool_name = top.name
+            decide.append("no tool frame link found; add one under description.frames")
+        if any(m.tool_frame == tool_name for m in self.draft.manipulators):
+            self.draft.notes.append(
+                f"chain {chain.name!r}: its tool frame {tool_name!r} has a manipulator already"
+            )
+            return None
+        if frame is not None:
+            self.draft.frames.append(frame)
+        m = DraftManipulator(unique(name, self.names), top.name, tool_name, "", decide)
+        if gripper is not None:
+            m.thumb, m.finger = gripper.thumb, gripper.finger
+            m.source = f"two finger branches below '{gripper.root.name}'"
+            if gripper.decide:
+                decide.append(gripper.decide)
+        else:
+            m.source = "the end of the chain" if hand is None else f"the hand at '{hand.name}'"
+            if chain.role == "leg":
+                decide.append("a foot")
+            elif hand is not None:
+                decide.append(f"a generic hand: {why}")
+        m.joints = hand_joints(tree, top)
+        self._facing(m, gripper, tip, frame)
+        self.draft.manipulators.append(m)
+        chain.manipulator = m.name
+        return m
+
+    def _facing(
+        self, m: DraftManipulator, gripper: Gripper | None, tip: Body, frame: DraftFrame | None
+    ) -> None:
+        """Grasp along the hand's reach: root to finger tips, or chain tip to tool frame."""
+        tree, world = self.tree, self.world
+        tool = world.get_body_by_name(frame.parent if frame is not None else m.tool_frame)
+        rot = tree.poses[tool.index][:3, :3]
+        if gripper is not None:
+            ref = tree.poses[gripper.root.index][:3, 3]
+            target = (
+                tree.poses[gripper.thumb_tip.index][:3, 3]
+                + tree.poses[gripper.finger_tip.index][:3, 3]
+            ) / 2
+        else:
+            ref, target = tree.poses[tip.index][:3, 3], tree.poses[tool.index][:3, 3]
+        axis = rot.T @ (target - ref)
+        q = facing_quaternion(axis) if float(np.linalg.norm(axis)) > 0.01 else None
+        if q is None:
+            m.decide.append("which way does the tool face? (x forward here)")
+        else:
+            m.front_facing = q
+            m.decide.append("front_facing_orientation: grasping along the hand's reach")
+
+    def end_effectors(self, chains: list[tuple[DraftChain, Limb | None]]) -> None:
+        """SRDF end effectors become the manipulators of the chains they hang from."""
+        assert self.srdf is not None
+        world = self.world
+        for ee in self.srdf.end_effectors:
+            start = end_effector_root(world, self.srdf, ee)
+            if start is None:
+                self.draft.notes.append(f"end effector {ee.name!r}: its links are not in the URDF")
+                continue
+            owners = [
+                (c, lb)
+                for c, lb in chains
+                if world.is_ancestor(c.tip, start)
+                and (ee.parent_group is None or c.group in (None, ee.parent_group))
+            ]
+            named = [
+                o for o in owners if ee.parent_group is not None and o[0].name == ee.parent_group
+            ]
+            pick = named or sorted(owners, key=lambda o: -world.depth(o[0].tip))
+            if not pick:
+                self.draft.notes.append(f"end effector {ee.name!r} is on no drafted chain")
+                continue
+            chain, limb = pick[0]
+            if chain.manipulator is not None:
+                self.draft.notes.append(
+                    f"end effector {ee.name!r}: chain {chain.name!r} has one already"
+                )
+                continue
+            hand_start = start
+            if (
+                limb is not None
+                and limb.hand is not None
+                and (world.is_ancestor(start, limb.hand) or world.is_ancestor(limb.hand, start))
+            ):
+                hand_start = limb.hand  # the EE names a link of the hand; the tree knows its root
+            name = ee.name
+            if name in self.names:  # Talos' feet are named as their legs
+                name = f"{ee.name}_{'foot' if chain.role == 'leg' else 'hand'}"
+            m = self.manipulator(chain, limb, name, hand_start)
+            if m is not None:
+                m.source = f"the SRDF end effector '{ee.name}' ({m.source})"
+
+
+def draft_spec(
+    world: World, *, urdf_ref: str, srdf: Srdf | None, srdf_ref: str | None, name: str
+) -> Draft:
+    """Decide what the files say and what a person must; see the module docstring."""
+    d = Drafter(world, srdf, name, urdf_ref, srdf_ref)
+    chains = d.chains()
+    d.draft.chains = [c for c, _ in chains]
+    if srdf is not None:
+        d.end_effectors(chains)
+    arms = [(c, lb) for c, lb in chains if c.role in ("arm", "chain") and c.manipulator is None]
+    for c, lb in arms:
+        if c.role == "chain" and (lb is None or lb.hand is None):
+            continue  # an SRDF chain of the tree's unknowns: no hand to offer
+        side = side_of(c.name)
+        word = "gripper"
+        if lb is not None and lb.hand is not None:
+            g, _ = find_gripper(d.tree, lb.hand)
+            if g is None:
+                word = "hand" if "hand" in words(lb.hand.name) else "tool"
+        else:
+            word = "tool"
+        d.manipulator(c, lb, join(side, word) if side else word)
+    add_sensors(d)
+    add_torso(d)
+    add_drive(d)
+    add_states(d)
+    return d.draft

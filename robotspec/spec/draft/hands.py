@@ -1,0 +1,212 @@
+"""What sits at an arm's end: a parallel gripper (two finger branches) or a tool, and its frame.
+
+A parallel gripper is a hand whose tree splits into exactly two moving branches with geometry
+(linkage helpers without geometry, such as PR2's parallel links, do not count). The thumb is the
+finger driven by its own joint; the finger is the one that mimics it (PR2, Panda, Baxter). When
+both are driven or both mimic, the left one (seen from the gripper) is taken for the thumb, and
+the draft says so.
+
+Tool frames are searched only in the manipulator's own subtree, so two arms never share one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from robotspec.model.entities import Body
+from robotspec.spec.draft.model import DraftFinger
+from robotspec.spec.draft.tree import Tree, words
+
+__all__ = ["Gripper", "facing_quaternion", "find_gripper", "find_tool_frame", "hand_joints"]
+
+#: How tool frames are usually named, best first: (substring of the name, or a whole word).
+TOOL_HINTS: tuple[str, ...] = (
+    "tool_frame",
+    "tcp",
+    "grasping_frame",
+    "grasp_frame",
+    "grasp",
+    "tool0",
+    "end_effector",
+    "endeffector",
+    "ee_link",
+    "eef",
+    "ee",
+    "endpoint",
+    "tool_link",
+    "tool",
+    "flange",
+)
+
+
+@dataclass(frozen=True)
+class Gripper:
+    """A two-finger gripper found below a hand."""
+
+    root: Body
+    thumb: DraftFinger
+    finger: DraftFinger
+    thumb_tip: Body
+    finger_tip: Body
+    decide: str | None
+
+
+def _has_geometry(tree: Tree, body: Body) -> bool:
+    return any(b.collisions or b.visuals for b in tree.world.subtree(body))
+
+
+def _finger_tip(tree: Tree, branch: Body) -> Body:
+    """The deepest body of a finger branch that a moving joint carries, with geometry if any.
+
+    Geometry first: PR2's xacro hangs a bare frame on a prismatic joint below the finger tip.
+    """
+    world = tree.world
+    moved = [
+        b
+        for b in world.subtree(branch)
+        if (c := world.parent_connection(b)) is not None and not c.is_fixed
+    ]
+    solid = [b for b in moved if b.collisions or b.visuals]
+    return max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
+
+
+def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | None:
+    """Finger branches grouped into two sides of the hand, or ``None`` if they are not two sides.
+
+    Two branches are two sides. A linkage gripper (Robotiq's, on Tiago Pro) has two branches a
+    side, an inner and an outer link: each branch goes to the side of the farther-apart pair of
+    tips it is nearer to, and a side holds at most two.
+    """
+    if len(branches) == 2:
+        return [[branches[0]], [branches[1]]]
+    if len(branches) != 4:
+        return None
+    world = tree.world
+    dofs = {
+        d
+        for k in branches
+        for b in world.subtree(k)
+        if (c := world.parent_connection(b)) is not None
+        for d in c.dofs
+    }
+    if len(dofs) != 1:
+        return None  # a linkage moves with one actuator; several make a hand of fingers
+    if any("thumb" in b.name.lower() for k in branches for b in world.subtree(k)):
+        return None  # a one-motor hand with a thumb and three fingers (Romeo's) is a hand
+    inv = np.linalg.inv(tree.poses[root.index])
+    at = {b.index: (inv @ tree.poses[_finger_tip(tree, b).index])[:3, 3] for b in branches}
+    pairs = [(a, b) for i, a in enumerate(branches) for b in branches[i + 1 :]]
+    a, b = max(pairs, key=lambda p: float(np.linalg.norm(at[p[0].index] - at[p[1].index])))
+    sides: list[list[Body]] = [[a], [b]]
+    for k in branches:
+        if k is a or k is b:
+            continue
+        near_a = np.linalg.norm(at[k.index] - at[a.index]) <= np.linalg.norm(
+            at[k.index] - at[b.index]
+        )
+        sides[0 if near_a else 1].append(k)
+    return sides if all(len(side) == 2 for side in sides) else None
+
+
+def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
+    """A parallel gripper at or below ``hand``, or ``None`` and why not."""
+    world = tree.world
+    body = hand
+    while True:
+        kids = tree.moving_children(body)
+        if len(kids) != 1:
+            break
+        body = kids[0]
+    branches = [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
+    sides = _sides(tree, body, branches)
+    if sides is None:
+        if not branches:
+            return None, "no finger branches below it"
+        return None, f"{len(branches)} finger branches below '{body.name}', not two sides"
+    # A side's tip is its deepest moving link; it is driven when one of its joints is not a mimic.
+    tips: list[Body] = []
+    leaders: list[bool] = []
+    for side in sides:
+        ends = [_finger_tip(tree, k) for k in side]
+        tips.append(max(ends, key=lambda b: (world.depth(b), -b.index)))
+        leaders.append(
+            any(
+                c.is_active
+                for k in side
+                for c in world.compute_chain_of_connections(body, _finger_tip(tree, k))
+            )
+        )
+    decide = None
+    if leaders[0] != leaders[1]:
+        thumb_i = 0 if leaders[0] else 1
+    else:
+        # Neither mimics the other: the thumb is the finger on the hand's +y side.
+        rot = np.linalg.inv(tree.poses[body.index])
+        ys = [(rot @ tree.poses[t.index])[1, 3] for t in tips]
+        thumb_i = 0 if ys[0] >= ys[1] else 1
+        decide = "both fingers are driven; the thumb is the one on the hand's +y side"
+    finger_i = 1 - thumb_i
+    gripper = Gripper(
+        root=body,
+        thumb=DraftFinger(body.name, tips[thumb_i].name),
+        finger=DraftFinger(body.name, tips[finger_i].name),
+        thumb_tip=tips[thumb_i],
+        finger_tip=tips[finger_i],
+        decide=decide,
+    )
+    return gripper, "two finger branches"
+
+
+def _matches(hint: str, name: str) -> bool:
+    if "_" in hint or len(hint) > 4:
+        return hint in name.lower()
+    return hint in words(name)
+
+
+def find_tool_frame(tree: Tree, top: Body, exclude: frozenset[int] = frozenset()) -> Body | None:
+    """The best-named tool frame in ``top``'s subtree (``exclude``: bodies of other parts)."""
+    world = tree.world
+    candidates = [b for b in world.subtree(top) if b.index not in exclude]
+    joint = {b.index: world.parent_connection(b) for b in candidates}
+    for hint in TOOL_HINTS:
+        # The link's name, or its joint's (Baxter's 'right_gripper' hangs on 'right_endpoint').
+        hits = [
+            b
+            for b in candidates
+            if _matches(hint, b.name)
+            or ((c := joint[b.index]) is not None and c.is_fixed and _matches(hint, c.name))
+        ]
+        if hits:
+            return min(hits, key=lambda b: (world.depth(b), b.index))
+    return None
+
+
+def hand_joints(tree: Tree, top: Body) -> frozenset[str]:
+    """The actuated joints below ``top`` (a hand's own joints)."""
+    inside = {b.index for b in tree.world.subtree(top)}
+    return frozenset(
+        c.name
+        for c in tree.world.connections
+        if c.parent in inside and c.child in inside and c.is_active
+    )
+
+
+def facing_quaternion(axis: np.ndarray) -> tuple[float, float, float, float] | None:
+    """The quaternion ``q`` whose ``R^T x`` is ``axis`` (the spec's front-facing convention)."""
+    n = float(np.linalg.norm(axis))
+    if n < 1e-9:
+        return None
+    a = axis / n
+    # R maps a onto x: rotate about a x x by the angle between them.
+    cross = np.cross(a, np.array([1.0, 0.0, 0.0]))
+    s, c = float(np.linalg.norm(cross)), float(a[0])
+    if s < 1e-9:
+        return (0.0, 0.0, 0.0, 1.0) if c > 0 else (0.0, 0.0, 1.0, 0.0)
+    k = cross / s
+    angle = math.atan2(s, c)
+    h = math.sin(angle / 2)
+    q = (float(k[0] * h), float(k[1] * h), float(k[2] * h), math.cos(angle / 2))
+    return tuple(round(v, 7) for v in q)  # type: ignore[return-value]

@@ -1,0 +1,136 @@
+"""Arms, legs and hands from the kinematic tree alone.
+
+An arm is a serial run of at least three actuated joints from a branching point of the tree to a
+hand (or to the end of the run); a leg is the same run ending on the ground. What is not a limb:
+fingers (short runs inside a hand, or runs whose links are named as fingers), and runs shorter
+than a forearm. The hand starts at the first link named as a hand (``gripper``, ``hand``,
+``palm``) or where the run splits into fingers; its joints do not belong to the arm.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robotspec.model.entities import Body, Connection
+from robotspec.spec.draft.tree import Segment, Tree, words
+
+__all__ = ["Limb", "find_limbs"]
+
+HAND_WORDS = frozenset({"gripper", "hand", "palm", "eef", "jaw", "claw", "effector"})
+FINGER_WORDS = frozenset(
+    {"finger", "thumb", "knuckle", "phalanx", "index", "middle", "ring", "pinky", "little"}
+    | {"fingertip", "digit", "jaw", "claw"}
+)
+LEG_WORDS = frozenset(
+    {"leg", "foot", "feet", "knee", "ankle", "thigh", "calf", "shank", "shin", "sole", "toe"}
+    | {"haa", "hfe", "kfe"}  # ANYmal's hip abduction / hip flexion / knee flexion
+)
+#: Words also recognised inside longer words (``upperleg``, ``lowerleg``).
+INNER_WORDS = frozenset({"leg", "foot", "knee", "ankle", "thigh", "calf", "shank"})
+ARM_WORDS = frozenset({"arm", "shoulder", "elbow", "wrist", "forearm"})
+WORLD_WORDS = frozenset({"world", "map", "odom"})
+HEAD_WORDS = frozenset({"head", "neck", "eye", "eyes", "gaze"})
+#: Fewest actuated joints of a limb.
+MIN_LIMB_JOINTS = 3
+#: Shortest limb (sum of joint offsets, m): fingers are shorter.
+MIN_LIMB_LENGTH = 0.2
+#: A hand reaches no farther than this from where it splits into fingers (m).
+MAX_HAND_SPAN = 0.3
+#: A leg's end is this close to the lowest point of the robot (m) ...
+FOOT_CLEARANCE = 0.1
+#: ... and this far below where the leg starts (m).
+LEG_DROP = 0.15
+
+
+@dataclass(frozen=True)
+class Limb:
+    """An arm or a leg: ``root`` (above its first joint) to ``tip`` (below its last)."""
+
+    kind: str  # "arm" | "leg"
+    root: Body
+    tip: Body
+    hand: Body | None
+    joints: frozenset[str]
+    segment: Segment
+    why: str
+
+
+def _span(tree: Tree, body: Body) -> float:
+    """How far the subtree of ``body`` reaches from it in the default pose (m)."""
+    here = tree.position(body)
+    return max(
+        (float(np.linalg.norm(tree.position(b) - here)) for b in tree.world.subtree(body)),
+        default=0.0,
+    )
+
+
+def _named(bodies: tuple[Body, ...], vocabulary: frozenset[str]) -> bool:
+    return any(words(b.name) & vocabulary for b in bodies)
+
+
+def _count(bodies: tuple[Body, ...], vocabulary: frozenset[str]) -> int:
+    return sum(1 for b in bodies if is_named(b.name, vocabulary))
+
+
+def is_named(name: str, vocabulary: frozenset[str]) -> bool:
+    """Whether a name holds one of the words (long words also inside others: ``upperleg``)."""
+    low = name.lower()
+    return bool(words(name) & vocabulary) or any(w in low for w in vocabulary & INNER_WORDS)
+
+
+def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
+    world = tree.world
+    cut = next((i for i, b in enumerate(seg.bodies) if i > 0 and words(b.name) & HAND_WORDS), None)
+    bodies = seg.bodies[:cut]
+    moving: list[Connection] = []
+    for b in bodies:
+        c = world.parent_connection(b)
+        if c is not None and not c.is_fixed:
+            moving.append(c)
+    actuated = [c for c in moving if c.is_active]
+    if len(actuated) < MIN_LIMB_JOINTS or _named(bodies, FINGER_WORDS):
+        return None
+    reach = tree.length(seg, cut)
+    if reach < MIN_LIMB_LENGTH:
+        return None
+    # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.
+    root = seg.start
+    top = world.parent_connection(seg.bodies[0])
+    if root.index == tree.root.index and words(root.name) & WORLD_WORDS and top and top.is_fixed:
+        root = seg.bodies[0]
+    tip = world.bodies[actuated[-1].child]
+    hand: Body | None = None
+    if cut is not None:
+        hand = seg.bodies[cut]
+    elif len(tree.moving_children(seg.end)) >= 2:
+        if _span(tree, seg.end) > MAX_HAND_SPAN:
+            return None  # limbs branch off here: a trunk (simple_humanoid's waist), not an arm
+        hand = seg.end
+    if hand is None and _named(bodies, HEAD_WORDS) and not _named(bodies, ARM_WORDS):
+        return None  # a head (see sensors.find_neck)
+    joints = frozenset(c.name for c in actuated)
+    z_tip, z_root = tree.position(tip)[2], tree.position(root)[2]
+    legs_named = _count(bodies, LEG_WORDS) > _count(bodies, ARM_WORDS)
+    grounded = hand is None and z_tip - low < FOOT_CLEARANCE and z_root - z_tip > LEG_DROP
+    if legs_named or grounded:
+        why = "its links are named as a leg's" if legs_named else "it ends on the ground"
+        return Limb("leg", root, tip, None, joints, seg, f"{len(actuated)} joints; {why}")
+    ends = f"a hand at '{hand.name}'" if hand is not None else "the end of the branch"
+    why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"
+    return Limb("arm", root, tip, hand, joints, seg, why)
+
+
+def find_limbs(tree: Tree) -> list[Limb]:
+    """Every arm and leg of the tree, top-down; runs inside a found hand are fingers, not limbs."""
+    world = tree.world
+    low = tree.lowest_z()
+    limbs: list[Limb] = []
+    for seg in tree.segments:
+        if any(world.is_ancestor(lb.tip, seg.start) for lb in limbs):
+            continue  # inside a hand (fingers) or hanging below a limb's end
+        limb = _limb(tree, seg, low)
+        if limb is not None:
+            limbs.append(limb)
+    return limbs

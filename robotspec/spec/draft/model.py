@@ -1,0 +1,132 @@
+"""The decisions a draft holds, before they are written as YAML.
+
+Kept apart from the detectors and the writer so that tests (and the robot zoo) can look at what
+``robotspec init`` decided without parsing its text. Every guess carries its reason (``decide``);
+the writer turns it into a ``# DECIDE:`` comment.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+__all__ = [
+    "Draft",
+    "DraftCamera",
+    "DraftChain",
+    "DraftDrive",
+    "DraftFinger",
+    "DraftFrame",
+    "DraftManipulator",
+    "JointState",
+]
+
+#: A named joint state: joint name -> position (rad or m).
+JointState = dict[str, float]
+
+
+@dataclass
+class DraftFinger:
+    """One finger of a parallel gripper, as the spec's ``FingerSpec`` (root to tip)."""
+
+    root: str
+    tip: str
+
+
+@dataclass
+class DraftManipulator:
+    """A hand or tool on a chain: a parallel gripper when two finger branches were found."""
+
+    name: str
+    root: str
+    tool_frame: str
+    source: str
+    decide: list[str] = field(default_factory=list)
+    finger: DraftFinger | None = None
+    thumb: DraftFinger | None = None
+    states: dict[str, JointState] = field(default_factory=dict)
+    front_facing: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+    #: Actuated joints of the hand (for group states); not written.
+    joints: frozenset[str] = frozenset()
+
+    @property
+    def is_gripper(self) -> bool:
+        """Whether the draft writes a ``parallel_gripper`` (both fingers known)."""
+        return self.finger is not None and self.thumb is not None
+
+
+@dataclass
+class DraftChain:
+    """An arm, a leg, a torso or a neck: ``root`` to ``tip`` (or an SRDF ``group``)."""
+
+    name: str
+    root: str
+    tip: str
+    source: str
+    role: str = "arm"  # arm | leg | chain | torso | neck
+    group: str | None = None  # written as ``group:`` (an SRDF group of one <chain>)
+    srdf_group: str | None = None  # the SRDF group it came from, in any form
+    decide: list[str] = field(default_factory=list)
+    manipulator: str | None = None
+    sensors: list[str] = field(default_factory=list)
+    states: dict[str, JointState] = field(default_factory=dict)
+    side: str | None = None  # written only when the default pose cannot tell the sides
+    yaw_body: str | None = None
+    pitch_body: str | None = None
+    #: Actuated (non-mimic) joints between root and tip; the chain's identity when comparing.
+    joints: frozenset[str] = frozenset()
+
+
+@dataclass
+class DraftCamera:
+    """A camera on ``body``; ``optical`` frames look along +z (REP 103), others along +x."""
+
+    name: str
+    body: str
+    optical: bool
+    decide: list[str] = field(default_factory=list)
+
+
+@dataclass
+class DraftFrame:
+    """A frame the URDF lacks, proposed under ``description.frames`` (a gripper's tool frame)."""
+
+    name: str
+    parent: str
+    xyz: tuple[float, float, float]
+    reason: str
+
+
+@dataclass
+class DraftDrive:
+    """How the base moves, and why the draft thinks so."""
+
+    type: str
+    joint: str | None = None
+    parent_frame: str | None = None
+    source: str = ""
+    decide: str | None = None
+
+
+@dataclass
+class Draft:
+    """Everything ``render_draft`` writes; see the detectors for how each part is found."""
+
+    name: str
+    urdf: str
+    srdf: str | None
+    root: str
+    drive: DraftDrive | None
+    chains: list[DraftChain]
+    manipulators: list[DraftManipulator]
+    cameras: list[DraftCamera]
+    torso: DraftChain | None = None
+    neck: DraftChain | None = None
+    frames: list[DraftFrame] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    package_paths: list[str] = field(default_factory=list)
+    states: dict[str, JointState] = field(default_factory=dict)
+
+    @property
+    def arms(self) -> list[DraftChain]:
+        """The chains that are arms."""
+        return [c for c in self.chains if c.role == "arm"]

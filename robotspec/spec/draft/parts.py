@@ -1,0 +1,182 @@
+"""The parts that hang off the chains: cameras and the neck, the torso, the drive, named states.
+
+Run after the chains and manipulators are decided, because each of these is defined by them: the
+torso ends where the arms branch off, the neck is what carries cameras and is not an arm, a camera
+rides on the chain it hangs from, a named state belongs to every part whose joints it sets.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from robotspec.model.entities import Body
+from robotspec.model.world import World
+from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
+from robotspec.spec.draft.naming import unique
+from robotspec.spec.draft.sensors import find_cameras, find_neck
+from robotspec.spec.draft.srdf_groups import state_values
+from robotspec.spec.draft.tree import words
+
+if TYPE_CHECKING:
+    from robotspec.spec.draft.build import Drafter
+
+__all__ = ["add_drive", "add_sensors", "add_states", "add_torso"]
+
+
+# ------------------------------------------------------------------ sensors, torso, neck
+def add_sensors(d: Drafter) -> None:
+    """Cameras, the neck that carries the head's cameras, and the arms that carry the rest."""
+    tree, world, draft = d.tree, d.world, d.draft
+    found = find_cameras(tree)
+    name_of: dict[str, str] = {}
+    for seen in found:
+        cam = DraftCamera(unique(seen.name, d.names), seen.body.name, seen.optical)
+        if not seen.optical:
+            cam.decide.append("named as a camera, but not rotated as an optical frame")
+        draft.cameras.append(cam)
+        name_of[cam.body] = cam.name
+    tops = [_first_moving(world, c) for c in draft.chains if c.role in ("arm", "leg")]
+    neck = find_neck(tree, found, tops)
+    carried: set[str] = set()
+    if neck is not None:
+        n = DraftChain(
+            "neck",
+            neck.root.name,
+            neck.tip.name,
+            "the URDF tree",
+            role="neck",
+            joints=frozenset(j.name for j in neck.joints if j.is_active),
+            yaw_body=None if neck.yaw is None else neck.yaw.name,
+            pitch_body=None if neck.pitch is None else neck.pitch.name,
+        )
+        n.decide.append(f"{len(neck.joints)} joint(s) carrying cameras at the end of a branch")
+        for seen in found:
+            if world.is_ancestor(neck.tip, seen.body):
+                n.sensors.append(name_of[seen.body.name])
+                carried.add(seen.body.name)
+        draft.neck = n
+        kept = []
+        for chain in draft.chains:
+            if chain.joints == n.joints:
+                n.source = f"{chain.source} (a neck: it carries cameras)"
+                n.srdf_group = chain.srdf_group
+                n.decide.clear()
+                continue
+            kept.append(chain)
+        draft.chains = kept
+    for cam in draft.cameras:
+        if cam.body in carried:
+            continue
+        body = world.get_body_by_name(cam.body)
+        holders = [c for c in draft.chains if world.is_ancestor(_first_moving(world, c), body)]
+        if holders:
+            best = max(holders, key=lambda c: world.depth(c.tip))
+            best.sensors.append(cam.name)
+
+
+def add_torso(d: Drafter) -> None:
+    """The moving joints between the robot's root and where its arms branch off."""
+    world, draft = d.world, d.draft
+    arms = [c for c in draft.chains if c.role == "arm"]
+    if not arms:
+        return
+    branch = world.get_body_by_name(arms[0].root)
+    for c in arms[1:]:
+        branch = world.common_ancestor(branch, c.root)
+    root = d.tree.root
+    if not world.is_ancestor(root, branch):
+        return
+    path = [c for c in world.compute_chain_of_connections(root, branch) if not c.is_fixed]
+    joints = frozenset(c.name for c in path if c.is_active)
+    if not joints or any(
+        c.name in ch.joints for c in path for ch in draft.chains if ch.joints != joints
+    ):
+        return
+    t = DraftChain(
+        "torso",
+        world.bodies[path[0].parent].name,
+        world.bodies[path[-1].child].name,
+        "the URDF tree",
+        role="torso",
+        joints=joints,
+    )
+    t.decide.append(f"the joints between the root and where the arms branch ('{branch.name}')")
+    kept = []
+    for c in draft.chains:
+        if c.joints == joints:
+            t.source, t.srdf_group = c.source, c.srdf_group
+            t.decide.clear()
+            continue
+        kept.append(c)
+    draft.chains = kept
+    draft.torso = t
+
+
+# ------------------------------------------------------------------------------ drive
+def add_drive(d: Drafter) -> None:
+    """From the SRDF's virtual joint, else guessed from wheels, legs or rotors."""
+    draft, world = d.draft, d.world
+    if draft.drive is not None:
+        return
+    joints = [c for c in world.connections if not c.is_fixed]
+    wheels = [c for c in joints if "wheel" in words(c.name) and c.is_active]
+    casters = [c for c in joints if "caster" in words(c.name) and "wheel" not in words(c.name)]
+    legs = [c for c in draft.chains if c.role == "leg"]
+    rotors = [c for c in joints if words(c.name) & {"rotor", "propeller", "prop"}]
+    movable = d.tree.root is world.root
+    if wheels and movable:
+        kind = "differential" if len(wheels) == 2 else "omni"
+        why = f"{len(wheels)} wheel joints" + (f", {len(casters)} steered casters" * bool(casters))
+        draft.drive = DraftDrive(kind, None, None, "the URDF tree", f"{why}: {kind}?")
+    elif (len(legs) >= 2 or rotors) and movable:
+        why = f"{len(legs)} legs" if len(legs) >= 2 else f"{len(rotors)} rotors"
+        draft.drive = DraftDrive("floating", None, None, "the URDF tree", f"{why}: floating")
+    else:
+        draft.drive = DraftDrive(
+            "fixed", None, None, "the URDF tree", "no wheels, legs or rotors: a fixed base"
+        )
+
+
+# ----------------------------------------------------------------------------- states
+def add_states(d: Drafter) -> None:
+    """SRDF group states become named states of every part whose joints they set."""
+    if d.srdf is None:
+        return
+    world, draft = d.world, d.draft
+    parts: list[tuple[str | None, frozenset[str], dict[str, dict[str, float]], str]] = []
+    for c in [*draft.chains, *(p for p in (draft.torso, draft.neck) if p is not None)]:
+        parts.append((c.srdf_group, c.joints, c.states, c.name))
+    for m in draft.manipulators:
+        parts.append((None, m.joints, m.states, m.name))
+    for state, group, values in state_values(d.srdf):
+        for part_group, joints, states, part in parts:
+            if not joints or state in states:
+                continue
+            if not (joints <= values.keys() or (group is not None and group == part_group)):
+                continue
+            chosen = {
+                j: v
+                for j, v in values.items()
+                if j in joints and world.get_connection_by_name(j).is_1dof
+            }
+            if not chosen:
+                continue
+            bad = [j for j, v in chosen.items() if not _within(world, j, v)]
+            if bad:
+                draft.notes.append(
+                    f"SRDF state {state!r} of {part!r} left out: {bad[0]!r} is outside its limits"
+                )
+                continue
+            states[state] = chosen
+
+
+def _first_moving(world: World, chain: DraftChain) -> Body:
+    """The body below a chain's first moving joint (what the chain carries starts there)."""
+    conns = world.compute_chain_of_connections(chain.root, chain.tip)
+    first = next((c for c in conns if not c.is_fixed), conns[-1] if conns else None)
+    return world.get_body_by_name(chain.tip) if first is None else world.bodies[first.child]
+
+
+def _within(world: World, joint: str, value: float) -> bool:
+    dof = world.degrees_of_freedom[world.get_connection_by_name(joint).dofs[0]]
+    return dof.lower - 1e-9 <= value <= dof.upper + 1e-9

@@ -1,0 +1,44 @@
+"""How a draft refers to files: portable (``package://`` or relative), never this machine's path.
+
+Why: a spec is shared (committed, sent to a colleague); an absolute path of the author's machine
+works nowhere else, so ``init`` writes a ``package://`` URI when a file is inside a known package
+and a path relative to the spec otherwise.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+__all__ = ["portable_ref", "relative_path"]
+
+
+def portable_ref(
+    path: Path, spec_folder: Path, packages: Mapping[str, Path]
+) -> tuple[str, Path | None]:
+    """A path as the spec should write it, and the package folder the URI relies on.
+
+    Why: a ``package://`` URI works on another machine, a relative path only in this checkout;
+    so a file inside a known package is written as a URI (the caller makes sure the spec can
+    find that package).
+    """
+    real = path.resolve()
+    best: tuple[int, str, Path] | None = None
+    for name, folder in packages.items():
+        root = folder.resolve()
+        if real.is_relative_to(root):
+            depth = len(root.parts)
+            if best is None or depth > best[0]:
+                best = (depth, f"package://{name}/{real.relative_to(root).as_posix()}", root)
+    if best is not None:
+        return best[1], best[2]
+    return relative_path(real, spec_folder), None
+
+
+def relative_path(path: Path, spec_folder: Path) -> str:
+    """``path`` relative to the spec's folder (absolute when on another drive)."""
+    try:
+        return Path(os.path.relpath(path.resolve(), spec_folder.resolve())).as_posix()
+    except ValueError:  # another drive (Windows)
+        return path.resolve().as_posix()

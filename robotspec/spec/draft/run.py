@@ -1,0 +1,65 @@
+"""Drafting from files: load the robot, write portable references, decide, render.
+
+Shared by ``robotspec init`` and the robot zoo (``tools/zoo.py``), so the zoo checks the
+very drafts users get.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from robotspec.description.load import Description, load_description
+from robotspec.spec.draft.build import draft_spec
+from robotspec.spec.draft.model import Draft
+from robotspec.spec.draft.paths import portable_ref, relative_path
+
+__all__ = ["draft_from_files"]
+
+
+def draft_from_files(
+    urdf: str,
+    srdf: str | None,
+    *,
+    folder: Path,
+    package_paths: Sequence[str | Path] = (),
+    name: str | None = None,
+    base_folder: Path | None = None,
+) -> tuple[Draft, Description]:
+    """The draft of a spec to be written in ``folder``, and the files it was drafted from.
+
+    References are ``package://`` URIs where the file is in a package the spec can find, else
+    paths relative to ``folder``; packages found only beside the URDF get their parent folder
+    written into ``description.package_paths`` (relative too), so the spec works elsewhere.
+    """
+    from robotspec.files.packages import PackageResolver
+
+    base = base_folder or Path.cwd()
+    desc = load_description(
+        urdf, srdf=srdf, package_paths=package_paths, meshes="keep", base_folder=base
+    )
+    findable = PackageResolver.create(None, extra_paths=package_paths).packages()
+    findable_roots = {p.resolve() for p in findable.values()}
+    packages = desc.resolver.packages()
+    extra_paths: list[str] = []
+
+    def ref(given: str) -> str:
+        if "://" in given:
+            return given
+        path = Path(given) if Path(given).is_absolute() else base / given
+        text, pkg_root = portable_ref(path, folder, packages)
+        if pkg_root is not None and pkg_root not in findable_roots:
+            entry = relative_path(pkg_root.parent, folder)
+            if entry not in extra_paths:
+                extra_paths.append(entry)
+        return text
+
+    draft = draft_spec(
+        desc.world,
+        urdf_ref=ref(urdf),
+        srdf=desc.srdf,
+        srdf_ref=None if srdf is None else ref(srdf),
+        name=name or desc.world.name,
+    )
+    draft.package_paths = extra_paths
+    return draft, desc

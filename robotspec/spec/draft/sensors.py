@@ -1,0 +1,152 @@
+"""Cameras and the neck that points them.
+
+A frame is an *optical* frame when its rotation from its parent is REP 103's (z forward, x right,
+y down), whatever its name; a frame named as a camera without that rotation is a camera looking
+along its x axis. IMUs, lasers, range finders and force sensors are never cameras, whatever their
+rotation. One device often has several frames (PR2's ``wide_stereo`` with its simulated left and
+right cameras, an Xtion's ``rgb`` and ``depth`` channels): one camera per device, its shortest-named
+optical frame. The neck is the run of one to three revolute joints that carries cameras and ends
+the branch it is on (four for a run whose links are named as a head's).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from robotspec.model.entities import Body, Connection
+from robotspec.spec.draft.limbs import HEAD_WORDS
+from robotspec.spec.draft.tree import Tree, words
+
+__all__ = ["CameraFound", "NeckFound", "find_cameras", "find_neck"]
+
+CAMERA_WORDS = frozenset(
+    {"camera", "cam", "optical", "rgb", "rgbd", "xtion", "kinect", "realsense", "stereo"}
+    | {"webcam", "zed", "eye", "vision", "d435", "d415", "asus"}
+)
+NOT_CAMERA_WORDS = frozenset(
+    {"imu", "laser", "lidar", "scan", "hokuyo", "accelerometer", "accel", "gyro", "range"}
+    | {"sonar", "ft", "force", "torque", "contact", "velodyne", "ultrasound", "projector"}
+    | {"gps", "magnetometer", "bumper", "led", "axis"}
+)
+#: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
+_OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+_STEM = re.compile(r"(_optical)?(_frame|_link)?$")
+
+
+@dataclass(frozen=True)
+class CameraFound:
+    """A camera: its device name, the frame it sees from, and whether that frame is optical."""
+
+    name: str
+    body: Body
+    optical: bool
+
+
+@dataclass(frozen=True)
+class NeckFound:
+    """A neck: root above its first joint, tip below its last, and its yaw/pitch bodies."""
+
+    root: Body
+    tip: Body
+    joints: tuple[Connection, ...]
+    yaw: Body | None
+    pitch: Body | None
+
+
+def is_optical(tree: Tree, body: Body) -> bool:
+    """Whether ``body`` is rotated from its parent as REP 103 optical frames are."""
+    c = tree.world.parent_connection(body)
+    if c is None or not c.is_fixed:
+        return False
+    return bool(np.allclose(c.origin[:3, :3], _OPTICAL, atol=1e-3))
+
+
+def _stem(name: str) -> str:
+    return _STEM.sub("", name)
+
+
+def find_cameras(tree: Tree) -> list[CameraFound]:
+    """One camera per device, in tree order."""
+    world = tree.world
+    found: list[CameraFound] = []
+    for b in world.bodies:
+        if b.index not in tree.inside or b is tree.root:
+            continue
+        w = words(b.name)
+        if w & NOT_CAMERA_WORDS:
+            continue
+        optical = is_optical(tree, b)
+        parent = world.parent_connection(b)
+        parent_words = words(world.bodies[parent.parent].name) if parent is not None else set()
+        if optical and parent_words & NOT_CAMERA_WORDS:
+            continue
+        if optical or (w & CAMERA_WORDS and not world.child_bodies(b)):
+            found.append(CameraFound(_stem(b.name) or b.name, b, optical))
+    # One per device: drop a camera whose name extends another's on the same rigid body.
+    kept: list[CameraFound] = []
+    for cam in sorted(found, key=lambda c: (len(c.name), not c.optical, c.body.index)):
+        carrier = _rigid_root(tree, cam.body)
+        dup = any(
+            _rigid_root(tree, k.body) is carrier
+            and (cam.name == k.name or cam.name.startswith(k.name + "_"))
+            for k in kept
+        )
+        if not dup:
+            kept.append(cam)
+    kept.sort(key=lambda c: c.body.index)
+    return kept
+
+
+def _rigid_root(tree: Tree, body: Body) -> Body:
+    """The body a frame is rigidly fixed to: up through fixed joints to a moving one."""
+    world = tree.world
+    b = body
+    while True:
+        c = world.parent_connection(b)
+        if c is None or not c.is_fixed or b is tree.root:
+            return b
+        b = world.bodies[c.parent]
+
+
+def find_neck(tree: Tree, cameras: list[CameraFound], limb_tops: list[Body]) -> NeckFound | None:
+    """The neck carrying the most cameras: 1-3 revolute joints ending a branch, cameras on top.
+
+    Of a run, only its last revolute joints count; what is below them (a lift) is not the neck.
+    """
+    world = tree.world
+    best: tuple[int, float, NeckFound] | None = None
+    for seg in tree.segments:
+        if tree.moving_children(seg.end) or not seg.joints:
+            continue
+        # The run's last revolute joints (HSR-B's head sits on a lift that mimics the arm's).
+        joints: list[Connection] = []
+        for c in reversed(seg.joints):
+            if c.type.value not in ("revolute", "continuous") or c.is_mimic:
+                break
+            joints.insert(0, c)
+        most = 4 if any(words(b.name) & HEAD_WORDS for b in seg.bodies) else 3
+        if not 1 <= len(joints) <= most:
+            continue
+        if any(world.is_ancestor(top, seg.start) for top in limb_tops):
+            continue  # on an arm (a wrist camera's pan), not a neck
+        tip = world.bodies[joints[-1].child]
+        carried = [c for c in cameras if world.is_ancestor(tip, c.body)]
+        if not carried:
+            continue
+        root = world.bodies[joints[0].parent]
+        yaw = pitch = None
+        for c in joints:
+            axis = np.abs(tree.axis_in_root(c))
+            child = world.bodies[c.child]
+            if axis[2] > 0.9 and yaw is None:
+                yaw = child
+            elif axis[1] > 0.9 and pitch is None:
+                pitch = child
+        neck = NeckFound(root, tip, tuple(joints), yaw, pitch)
+        key = (len(carried), float(tree.position(tip)[2]))
+        if best is None or key > best[:2]:
+            best = (key[0], key[1], neck)
+    return None if best is None else best[2]

@@ -376,26 +376,6 @@ def test_terminal_escapes_in_names_are_echoed_escaped(tmp: Path) -> None:
     assert "x\\x1b]0;pwned\\x07" in r.text
 
 
-def test_init_escapes_names_it_writes(tmp: Path) -> None:
-    work = tmp / "work"
-    evil = "a&#10;injected: 1"
-    names = ["base", "l1", "l2", evil]
-    joints = "".join(
-        f'<joint name="j{i}" type="revolute"><parent link="{p}"/><child link="{c}"/>'
-        '<limit lower="0" upper="1" effort="1" velocity="1"/></joint>'
-        for i, (p, c) in enumerate(zip(names, names[1:], strict=False))
-    )
-    links = "".join(f'<link name="{n}"/>' for n in names)
-    write(work / "r.urdf", f'<robot name="r">{links}{joints}</robot>\n')
-    r = run_cli(tmp, "init", "r.urdf", "-o", "r.yaml")
-    assert r.code == 0, r.err
-    import yaml
-
-    data = yaml.safe_load((work / "r.yaml").read_text())
-    assert "injected" not in data
-    assert data["chains"]["chain_1"]["tip"] == "a\ninjected: 1"
-
-
 # --------------------------------------------------------------------------- deep but valid
 def test_deep_srdf_groups_and_a_long_chain_are_no_internal_errors(tmp: Path) -> None:
     work = tmp / "work"

@@ -49,10 +49,18 @@ __all__ = [
 SPEC_VERSION = 1
 
 
+_NOT_IN_XML = frozenset(chr(c) for c in (*range(0x20), 0x7F)) - {"\t", "\n", "\r"}
+
+
 def _no_control(value: str) -> str:
-    """Names are echoed to terminals and written into YAML and XML: no control characters."""
-    if not value.isprintable():
-        bad = next(c for c in value if not c.isprintable())
+    """Names are written into SRDF and URDF files: no character XML cannot carry.
+
+    Why not every non-printable character: a URDF may name a link with a newline (XML allows
+    it), and a spec must be able to name that link. Echoed names are escaped by the CLI
+    (:func:`robotspec.errors.printable`) and drafts quote them, so a newline is harmless.
+    """
+    bad = next((c for c in value if c in _NOT_IN_XML), None)
+    if bad is not None:
         raise ValueError(f"names must not contain control characters (found U+{ord(bad):04X})")
     return value
 

@@ -67,6 +67,29 @@ class Diagnostics:
     def _at(self, loc: Loc) -> tuple[str, int | None, int | None]:
         return self.loaded.position(loc)
 
+    def _problem(
+        self,
+        loc: Loc,
+        message: str,
+        *,
+        severity: str,
+        name: str | None = None,
+        kind: str | None = None,
+        suggestions: Iterable[str] = (),
+    ) -> SpecError:
+        file, line, col = self._at(loc)
+        return SpecError(
+            f"{loc_text(loc)}: {message}" if loc else message,
+            file=file,
+            line=line,
+            column=col,
+            name=name,
+            kind=kind,
+            suggestions=suggestions,
+            location=loc,
+            severity=severity,
+        )
+
     def error(
         self,
         loc: Loc,
@@ -77,34 +100,15 @@ class Diagnostics:
         suggestions: Iterable[str] = (),
     ) -> None:
         """Record an error about the spec node at ``loc``."""
-        file, line, col = self._at(loc)
         self.errors.append(
-            SpecError(
-                f"{loc_text(loc)}: {message}" if loc else message,
-                file=file,
-                line=line,
-                column=col,
-                name=name,
-                kind=kind,
-                suggestions=suggestions,
-                location=loc,
+            self._problem(
+                loc, message, severity="error", name=name, kind=kind, suggestions=suggestions
             )
         )
 
     def warning(self, loc: Loc, message: str, *, name: str | None = None) -> None:
         """Record a warning (an error in strict mode)."""
-        file, line, col = self._at(loc)
-        self.warnings.append(
-            SpecError(
-                f"{loc_text(loc)}: {message}" if loc else message,
-                file=file,
-                line=line,
-                column=col,
-                name=name,
-                location=loc,
-                severity="warning",
-            )
-        )
+        self.warnings.append(self._problem(loc, message, severity="warning", name=name))
 
     def not_found(
         self, loc: Loc, kind: str, name: str, candidates: Iterable[str], where: str

@@ -10,10 +10,10 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from robotspec.cli.progress import Progress
 from robotspec.collision import (
     CollisionRules,
     MeshLibrary,
-    Progress,
     SelfCollisionChecker,
     adjacent_pairs,
     build_geometry_model,

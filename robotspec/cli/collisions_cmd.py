@@ -17,6 +17,7 @@ from robotspec.cli.options import (
     QOpt,
     SkipMeshes,
     SpecArg,
+    StateOpt,
     joint_values,
     load_robot,
     write_output,
@@ -35,17 +36,6 @@ collisions_app = typer.Typer(
     help="Self-collision checks and collision matrices (coal).", no_args_is_help=True
 )
 app.add_typer(collisions_app, name="collisions")
-
-StateOpt = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--state",
-        "-s",
-        help="A named joint state (left_arm.park, park = every part's park, or an SRDF group "
-        "state); repeatable, applied in order.",
-        show_default=False,
-    ),
-]
 
 
 @collisions_app.command("check")
@@ -182,7 +172,8 @@ def generate(
     it) and a convergence report (pairs first seen colliding in the last half of the samples)
     go to stderr.
     """
-    from robotspec.collision import Progress, compare_pairs, generate_for_robot
+    from robotspec.cli.progress import Progress
+    from robotspec.collision import compare_pairs, generate_for_robot
     from robotspec.collision.convergence import compare_with_srdf, convergence
     from robotspec.description.srdf import load_srdf
     from robotspec.export.srdf import write_srdf
@@ -196,17 +187,13 @@ def generate(
     )
     bar = Progress(0, "collision matrix", enabled=progress)
 
-    def report(done: int, total: int) -> None:
-        bar.total = total
-        bar.update(done - bar.done)
-
     with bar:
         matrix = generate_for_robot(
             robot,
             samples=samples,
             seed=seed,
             processes=jobs,
-            progress=report,
+            progress=bar.report,
             on_missing_mesh="skip" if skip_missing_meshes else "error",
         )
     report_skipped(matrix.skipped, reported)
@@ -273,15 +260,11 @@ def audit(
     that the SRDF does not.
     """
     from robotspec.cli.audit_report import audit_json, audit_text
-    from robotspec.collision import Progress
+    from robotspec.cli.progress import Progress
     from robotspec.collision.audit import audit_srdf
 
     robot = load_robot(spec, package_path)
     bar = Progress(0, "audit", enabled=progress)
-
-    def report(done: int, total: int) -> None:
-        bar.total = total
-        bar.update(done - bar.done)
 
     with bar:
         result = audit_srdf(
@@ -289,7 +272,7 @@ def audit(
             samples=samples,
             seed=seed,
             processes=jobs,
-            progress=report,
+            progress=bar.report,
             on_missing_mesh="skip" if skip_missing_meshes else "error",
         )
     if as_json:

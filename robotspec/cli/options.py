@@ -124,6 +124,17 @@ def load_robot(spec: str, package_path: list[Path] | None) -> AbstractRobot:
     return load(spec, package_paths=package_path or ())
 
 
+StateOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--state",
+        "-s",
+        help="A named joint state (left_arm.park, park = every part's park, or an SRDF group "
+        "state); repeatable, applied in order over the default pose.",
+        show_default=False,
+    ),
+]
+
 QOpt = Annotated[
     list[str] | None,
     typer.Option(

@@ -14,6 +14,7 @@ from robotspec.cli.options import (
     QOpt,
     SkipMeshes,
     SpecArg,
+    StateOpt,
     joint_values,
     load_robot,
 )
@@ -23,18 +24,6 @@ if TYPE_CHECKING:
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
-
-
-StateOpt = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--state",
-        "-s",
-        help="A named joint state (left_arm.park, park = every part's park, or an SRDF group "
-        "state); repeatable, applied in order over the default pose.",
-        show_default=False,
-    ),
-]
 
 
 @app.command("render")

@@ -14,7 +14,6 @@ from robotspec.collision.matrix import (
     generate_collision_matrix,
     generate_for_robot,
 )
-from robotspec.collision.progress import Progress
 from robotspec.collision.rules import CollisionRules, adjacent_pairs, pair_key
 from robotspec.collision.sampling import (
     default_configuration,
@@ -37,7 +36,6 @@ __all__ = [
     "MatrixEntry",
     "MeshLibrary",
     "PairDistance",
-    "Progress",
     "SelfCollisionChecker",
     "adjacent_pairs",
     "build_geometry_model",

@@ -1,7 +1,8 @@
-"""A one-line progress bar on stderr, for long runs (collision matrix generation).
+"""A one-line progress bar on stderr, for long commands (collision matrix, SRDF audit).
 
-Why not tqdm: one dependency less, and the bar must stay off when stderr is not a terminal (CI
-logs, pipes) unless asked for, which is this module's whole policy.
+A CLI concern: the library reports progress through a ``progress(done, total)`` callback and
+never draws. Why not rich's bar (installed with typer): the policy here is small and tested to
+the character: off when stderr is not a terminal (CI logs, pipes) unless asked for.
 """
 
 from __future__ import annotations
@@ -49,6 +50,11 @@ class Progress:
         if self.enabled and (now - self._last >= 0.1 or self.done == self.total):
             self._last = now
             self._draw(now)
+
+    def report(self, done: int, total: int) -> None:
+        """The library's ``progress(done, total)`` callback: set the total, advance to ``done``."""
+        self.total = max(int(total), 0)
+        self.update(done - self.done)
 
     def _draw(self, now: float) -> None:
         frac = self.done / self.total if self.total else 1.0

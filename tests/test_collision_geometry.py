@@ -18,7 +18,7 @@ from robotspec.collision import (
     adjacent_pairs,
     build_geometry_model,
 )
-from robotspec.description.srdf import parse_srdf_bytes
+from robotspec.description.srdf_reader import parse_srdf_bytes
 from robotspec.description.urdf import load_urdf
 from robotspec.errors import CollisionError
 

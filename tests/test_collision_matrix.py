@@ -8,7 +8,7 @@ import pytest
 
 from robotspec.collision import CollisionMatrix, compare_pairs, generate_for_robot
 from robotspec.collision.rules import ADJACENT
-from robotspec.description.srdf import parse_srdf_bytes
+from robotspec.description.srdf_reader import parse_srdf_bytes
 from robotspec.export.srdf import write_srdf
 from robotspec.semantic import AbstractRobot
 from tests.conftest import erd_robots

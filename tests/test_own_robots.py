@@ -14,8 +14,8 @@ import pytest
 from robotspec.cli.app import app
 from robotspec.cli.render import run_app
 from robotspec.compiler import check_spec, compile_robot
-from robotspec.description.srdf import parse_srdf_bytes
 from robotspec.description.srdf_names import map_prefixed_names
+from robotspec.description.srdf_reader import parse_srdf_bytes
 from robotspec.errors import KinematicsError
 from robotspec.files.packages import PackageResolver
 from robotspec.model.geometry import Mesh

@@ -26,11 +26,9 @@ from robotspec.description.srdf import (
     Srdf,
     SrdfNotFoundError,
     VirtualJoint,
-    check_srdf_against,
-    check_srdf_references,
-    load_srdf,
-    parse_srdf_bytes,
 )
+from robotspec.description.srdf_checks import check_srdf_against, check_srdf_references
+from robotspec.description.srdf_reader import load_srdf, parse_srdf_bytes
 from robotspec.errors import NotFoundError, RobotSpecError, RobotSpecErrors, SrdfError
 from robotspec.export.srdf import write_srdf
 from robotspec.files.xmlsafe import parse_xml_file

@@ -14,12 +14,9 @@ import pytest
 from robotspec.cli.app import app
 from robotspec.cli.render import run_app
 from robotspec.compiler import check_spec
-from robotspec.description.srdf import (
-    Srdf,
-    check_srdf_against,
-    check_srdf_references,
-    parse_srdf_bytes,
-)
+from robotspec.description.srdf import Srdf
+from robotspec.description.srdf_checks import check_srdf_against, check_srdf_references
+from robotspec.description.srdf_reader import parse_srdf_bytes
 from robotspec.export.srdf import srdf_from_robot, write_srdf
 from robotspec.semantic import AbstractRobot
 

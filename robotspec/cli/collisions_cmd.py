@@ -175,7 +175,7 @@ def generate(
     from robotspec.cli.progress import Progress
     from robotspec.collision import compare_pairs, generate_for_robot
     from robotspec.collision.convergence import compare_with_srdf, convergence
-    from robotspec.description.srdf import load_srdf
+    from robotspec.description.srdf_reader import load_srdf
     from robotspec.export.srdf import write_srdf
 
     robot = load_robot(spec, package_path)

@@ -150,7 +150,7 @@ def _check_srdf(
 
     A composed robot's SRDF was renamed part by part already (``own_file`` is false for it).
     """
-    from robotspec.description.srdf import check_srdf_against, check_srdf_references
+    from robotspec.description.srdf_checks import check_srdf_against, check_srdf_references
     from robotspec.description.srdf_names import map_prefixed_names, self_pair_warnings
 
     ambiguous: frozenset[tuple[int | None, str]] = frozenset()
@@ -241,7 +241,7 @@ def _compile(
         base_world, urdf_name = world, (world.source or world.name).rsplit("/", 1)[-1]
     srdf = None if composition is None else composition.srdf
     if composition is None and desc_spec.srdf is not None:
-        from robotspec.description.srdf import load_srdf
+        from robotspec.description.srdf_reader import load_srdf
 
         try:
             srdf = load_srdf(resolve_file(desc_spec.srdf, loaded.folder, resolver), strict=False)

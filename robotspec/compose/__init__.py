@@ -6,7 +6,9 @@ builds like any other; ``robotspec export urdf`` writes the joined tree for othe
 
 from __future__ import annotations
 
-from robotspec.compose.assembly import ComposedPart, Composition, compose, description_tree
+from robotspec.compose.assembly import Composition, compose
 from robotspec.compose.naming import PartNames
+from robotspec.compose.parts import description_tree
+from robotspec.compose.weld import ComposedPart
 
 __all__ = ["ComposedPart", "Composition", "PartNames", "compose", "description_tree"]

@@ -95,8 +95,8 @@ def load_description(
     )
     srdf_data = None
     if srdf is not None:
-        from robotspec.description.srdf import load_srdf
         from robotspec.description.srdf_names import map_prefixed_names, self_pair_warnings
+        from robotspec.description.srdf_reader import load_srdf
 
         srdf_path = resolve_file(str(srdf), base, resolver)
         srdf_data = load_srdf(srdf_path, strict=False)

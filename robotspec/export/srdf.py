@@ -132,7 +132,7 @@ def write_srdf(srdf: Srdf) -> str:
     """The SRDF as MoveIt writes it: one element kind after another, four-space indentation.
 
     Deterministic (the records' order is kept), always in MoveIt's dialect, and read back by
-    :func:`robotspec.description.srdf.parse_srdf_bytes` into an equal value (except ``file``
+    :func:`robotspec.description.srdf_reader.parse_srdf_bytes` into an equal value (except ``file``
     and line numbers).
     """
     root = etree.Element("robot", name=srdf.robot_name)

@@ -277,7 +277,7 @@ class AbstractRobot:
         The reference's rule: a disabled pair counts only when both bodies have collision
         geometry; ``disable_default_collisions`` disables a body entirely.
         """
-        from robotspec.description.srdf import load_srdf
+        from robotspec.description.srdf_reader import load_srdf
 
         srdf = self.srdf if path is None else load_srdf(path)
         if srdf is None:

@@ -11,7 +11,7 @@ import pytest
 import yaml
 
 from robotspec.cli.app import app
-from robotspec.cli.render import run_app
+from robotspec.cli.output import run_app
 from robotspec.compiler import check_spec
 from robotspec.shipped import shipped_schema_path
 from robotspec.spec.load import json_schema_text

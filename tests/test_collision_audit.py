@@ -223,7 +223,7 @@ def test_audit_is_deterministic(arm: AbstractRobot, arm_audit: SrdfAudit) -> Non
 def test_cli_audit_without_srdf_and_compare_with_a_missing_file(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from robotspec.cli.render import run_app
+    from robotspec.cli.output import run_app
 
     erd_robots()
     code = run_app(app, ["collisions", "audit", "tiago", "-n", "10", "-j", "1"])

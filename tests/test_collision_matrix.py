@@ -99,7 +99,7 @@ def test_srdf_output_and_merge(pr2: AbstractRobot, matrix: CollisionMatrix) -> N
 
 def test_cli_check_and_generate(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     from robotspec.cli.app import app
-    from robotspec.cli.render import run_app
+    from robotspec.cli.output import run_app
 
     erd_robots()
     assert run_app(app, ["collisions", "check", "pr2", "--state", "park"]) == 0

@@ -116,7 +116,7 @@ def test_examples_run(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     erd_robots()
-    from robotspec.cli.render import run_app
+    from robotspec.cli.output import run_app
     from robotspec.compiler import check_spec
     from robotspec.errors import RobotSpecError
 

@@ -12,7 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from robotspec.cli.app import app
-from robotspec.cli.render import run_app
+from robotspec.cli.output import run_app
 from robotspec.compiler import check_spec
 from robotspec.model.entities import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic
 from robotspec.model.geometry import Box, Shape

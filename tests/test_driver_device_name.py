@@ -15,7 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from robotspec.cli.app import app
-from robotspec.cli.render import run_app
+from robotspec.cli.output import run_app
 from robotspec.driver.robot_info import read_robot_info, read_robot_info_text
 from robotspec.driver.rr_names import (
     MAX_RR_NAME_CHARS,

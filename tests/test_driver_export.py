@@ -294,7 +294,7 @@ def test_yaml_is_reference_shaped(pr2: World) -> None:
 def run_cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
     """Run ``robotspec ARGV`` in-process; returns (exit code, stdout, stderr)."""
     from robotspec.cli.app import app
-    from robotspec.cli.render import run_app
+    from robotspec.cli.output import run_app
 
     code = run_app(app, list(argv))
     out = capsys.readouterr()

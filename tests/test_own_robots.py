@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from robotspec.cli.app import app
-from robotspec.cli.render import run_app
+from robotspec.cli.output import run_app
 from robotspec.compiler import check_spec, compile_robot
 from robotspec.description.srdf_names import map_prefixed_names
 from robotspec.description.srdf_reader import parse_srdf_bytes

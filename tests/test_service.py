@@ -31,7 +31,7 @@ pytest.importorskip(
     reason="robotraconteurcompanion is not installed (pip install robotspec[robotraconteur])",
 )
 
-from robotspec.cli import render
+from robotspec.cli import output
 from robotspec.cli.app import app
 from robotspec.driver.robot_info import load_robot_info
 from robotspec.driver.sim import Fault, SimRobot
@@ -365,7 +365,7 @@ def test_cli_port_taken_exits_1_without_traceback(
 ) -> None:
     busy, port = _busy_port()
     try:
-        code = render.run_app(
+        code = output.run_app(
             app,
             [
                 "drive",
@@ -707,7 +707,7 @@ def test_cli_passes_public_through(
 
     monkeypatch.setattr(service_serve, "RobotServer", Recording)
     for extra in ([], ["--public"]):
-        code = render.run_app(
+        code = output.run_app(
             app,
             [
                 "drive",

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from robotspec.cli.app import app
-from robotspec.cli.render import run_app
+from robotspec.cli.output import run_app
 from robotspec.compiler import check_spec
 from robotspec.description.srdf import Srdf
 from robotspec.description.srdf_checks import check_srdf_against, check_srdf_references

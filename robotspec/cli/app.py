@@ -16,7 +16,7 @@ from robotspec.cli import (
     init_cmd,
     inspect_cmd,
     misc_cmd,
-    render,
+    output,
     render_cmd,
     validate_cmd,
 )
@@ -59,5 +59,5 @@ for _module in (  # in the order a user meets them: check, look, start, write, d
 
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point: run the app, render package errors, never leak a traceback."""
-    code = render.run_app(app, argv)
+    code = output.run_app(app, argv)
     sys.exit(code)

@@ -63,6 +63,6 @@ def report_skipped(skipped: Iterable[RobotSpecError], reported: frozenset[str]) 
 
 
 def _print(detail: ErrorDetail) -> None:
-    from robotspec.cli.render import styled
+    from robotspec.cli.output import styled
 
     sys.stderr.write(styled(detail, sys.stderr) + "\n")

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from robotspec.cli.render import styled
+from robotspec.cli.output import styled
 
 __all__ = ["report_validation"]
 

@@ -1,4 +1,4 @@
-"""Rendering of robotspec errors, and the exit-code policy (0 ok, 1 invalid, 2 usage)."""
+"""What the CLI prints for robotspec errors, and the exit-code policy (0 ok, 1 invalid, 2 usage)."""
 
 from __future__ import annotations
 

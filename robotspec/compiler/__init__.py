@@ -1,28 +1,21 @@
-"""The compiler: a spec file (or a shipped robot's name) to an ``AbstractRobot``.
+"""The compiler's face: a spec file (or a shipped robot's name) to an ``AbstractRobot``.
 
-Pipeline: validate the YAML (``spec``), load the description files (``description``), add the
-spec's extra frames and the base connection to the world, cross-check the SRDF against the URDF,
-then resolve and check every part (``build``). All problems of one spec are reported together.
+``check_spec`` (what ``validate`` runs), ``compile_robot`` and ``compile_spec_for_world`` (the
+seed's ``from_world``) resolve the reference and hand the loaded spec to
+:mod:`~robotspec.compiler.pipeline`; all problems of one spec are reported together.
 """
 
 from __future__ import annotations
 
-import copy
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
-from robotspec.compiler.arm_sides import check_arm_sides
-from robotspec.compiler.build import Build, build_robot
-from robotspec.description.srdf import Srdf
-from robotspec.diagnostics import Diagnostics
-from robotspec.errors import RobotSpecError, SpecError, missing_file
-from robotspec.model.world import ConnectionType, World
+from robotspec.compiler.pipeline import CompileResult, compile_loaded, load_camera_presets
+from robotspec.errors import NotFoundError, SpecError, missing_file
+from robotspec.model.world import World
 from robotspec.semantic import AbstractRobot
-from robotspec.shipped import package_data, shipped_spec_files
-from robotspec.spec.load import LoadedSpec, load_spec
+from robotspec.shipped import shipped_spec_files
+from robotspec.spec.load import load_spec
 
 __all__ = [
     "CompileResult",
@@ -31,16 +24,8 @@ __all__ = [
     "compile_spec_for_world",
     "load_camera_presets",
     "resolve_spec",
+    "shipped_specs",
 ]
-
-
-@dataclass(frozen=True)
-class CompileResult:
-    """What ``robotspec validate`` reports: the robot (if it compiled) and every warning."""
-
-    loaded: LoadedSpec
-    robot: AbstractRobot
-    warnings: tuple[RobotSpecError, ...]
 
 
 def shipped_specs() -> dict[str, Path]:
@@ -59,213 +44,14 @@ def resolve_spec(ref: str | Path) -> Path:
         return shipped[key]
     if p.suffix in (".yaml", ".yml") or "/" in str(ref):
         raise missing_file(ref, SpecError)
-    from robotspec.errors import NotFoundError
-
     raise NotFoundError("robot or spec file", str(ref), shipped, where="the shipped robots")
-
-
-_PRESETS: dict[tuple[str, int], dict[str, dict[str, Any]]] = {}
-
-
-def load_camera_presets() -> dict[str, dict[str, Any]]:
-    """Camera models from ``templates/cameras.yaml`` (a fresh copy for each caller).
-
-    Parsed once per version of the file: every compilation needs them, and parsing the YAML
-    again cost more than the compiler's own checks.
-    """
-    from robotspec.files.yamlio import load_yaml
-
-    file = package_data("templates", "cameras.yaml")
-    key = (str(file), file.stat().st_mtime_ns)
-    if key not in _PRESETS:
-        _PRESETS.clear()
-        _PRESETS[key] = dict(load_yaml(file).data or {})
-    return copy.deepcopy(_PRESETS[key])
-
-
-def _prepare_world(
-    loaded: LoadedSpec, world: World, srdf: Any, diag: Diagnostics, *, add_drive: bool
-) -> World:
-    """Add the spec's frames and the base connection (drive or SRDF virtual joint)."""
-    spec = loaded.spec
-    frames = []
-    for name, f in spec.files.frames.items():
-        loc = ("description", "frames", name)
-        if f.rpy is not None and f.quaternion is not None:
-            diag.error(loc, "give rpy or quaternion, not both")
-            continue
-        if f.quaternion is not None:
-            n = math.sqrt(sum(x * x for x in f.quaternion))
-            if abs(n - 1.0) > 1e-3:
-                diag.error((*loc, "quaternion"), f"must be a unit quaternion, its norm is {n:.4g}")
-                continue
-        if world.has_body(name):
-            if add_drive:  # loading our own files: a clash is a mistake
-                diag.error(loc, f"frame '{name}' already exists in the URDF")
-            continue  # from_world: the user's world already has it
-        if not world.has_body(f.parent):
-            diag.not_found(
-                (*loc, "parent"),
-                "link",
-                f.parent,
-                world.body_names,
-                (world.source or world.name).rsplit("/", 1)[-1],
-            )
-            continue
-        frames.append((name, f.parent, f.pose()))
-    if frames:
-        world = world.add_frames(frames)
-    if not add_drive or world.parent_connection(world.root) is not None:
-        return world
-    drive = spec.drive
-    vj = None
-    if srdf is not None:
-        vj = next((v for v in srdf.virtual_joints if v.child_link == world.root.name), None)
-    if drive is not None:
-        if drive.type == "fixed":
-            return world
-        if spec.root_link != world.root.name:
-            diag.error(
-                ("drive",),
-                f"a drive moves the URDF's root link '{world.root.name}', "
-                f"but the robot's root is '{spec.root}'",
-            )
-            return world
-        kind = ConnectionType.FLOATING if drive.type == "floating" else ConnectionType.PLANAR
-        parent = drive.parent_frame
-        joint = drive.joint or f"{parent}_T_{world.root.name}"
-        return world.with_base_connection(joint, parent, kind)
-    if vj is not None:
-        kind = {"planar": ConnectionType.PLANAR, "floating": ConnectionType.FLOATING}.get(
-            vj.type, ConnectionType.FIXED
-        )
-        return world.with_base_connection(vj.name, vj.parent_frame, kind)
-    return world
-
-
-def _check_srdf(
-    srdf: Srdf, world: World, urdf_name: str, diag: Diagnostics, *, own_file: bool
-) -> Srdf:
-    """The SRDF as the compiler uses it: prefixed names read as the URDF's, problems recorded.
-
-    A composed robot's SRDF was renamed part by part already (``own_file`` is false for it).
-    """
-    from robotspec.description.srdf_checks import check_srdf_against, check_srdf_references
-    from robotspec.description.srdf_names import map_prefixed_names, self_pair_warnings
-
-    ambiguous: frozenset[tuple[int | None, str]] = frozenset()
-    if own_file:
-        mapping = map_prefixed_names(srdf, world.body_names, world.connection_names)
-        srdf, ambiguous = mapping.srdf, mapping.ambiguous
-        for err in (*mapping.warnings, *mapping.errors):
-            diag.add(err)
-    for err in [
-        *check_srdf_references(srdf),
-        *check_srdf_against(srdf, world.body_names, world.connection_names, urdf_name=urdf_name),
-    ]:
-        if (err.line, err.name) in ambiguous:
-            continue  # its error already says what to change
-        # An SRDF often outlives its URDF (HSRB's names odom_x/y/t); like MoveIt, warn and
-        # ignore the element. A spec that *uses* a stale name still fails on its own line.
-        diag.add(err.with_severity("warning"))
-    for err in self_pair_warnings(srdf):
-        diag.add(err)
-    return srdf
-
-
-def _compile(
-    loaded: LoadedSpec,
-    *,
-    package_paths: Sequence[str | Path] = (),
-    world: World | None = None,
-    robot_class: type[AbstractRobot] = AbstractRobot,
-    strict: bool = False,
-) -> CompileResult:
-    from robotspec.description.load import load_description, resolve_file
-    from robotspec.spec.load import check_package_paths
-
-    check_package_paths(loaded, package_paths)
-    composition = None
-    if loaded.spec.parts:
-        from robotspec.compose import compose
-
-        composition = compose(loaded, package_paths=package_paths)
-        loaded = composition.loaded
-    spec = loaded.spec
-    desc_spec = spec.files
-    diag = Diagnostics(loaded)
-    paths = [*desc_spec.package_paths, *map(str, package_paths)]
-    if world is None and composition is not None:
-        from robotspec.description.urdf import world_from_urdf_xml
-
-        issues: list[RobotSpecError] = []
-        base_world = world_from_urdf_xml(
-            copy.deepcopy(composition.urdf),
-            composition.source,
-            resolver=composition.resolver,
-            meshes="report",
-            issues=issues,
-            checked=True,  # each part's file was checked; composition checked the joins
-        )
-        for w in issues:
-            diag.add(w)
-        resolver, urdf_name = composition.resolver, composition.source
-    elif world is None:
-        try:
-            desc = load_description(
-                desc_spec.urdf,
-                srdf=None,
-                package_paths=paths,
-                xacro_args=desc_spec.xacro_args,
-                base_folder=loaded.folder,
-            )
-        except RobotSpecError as exc:
-            diag.add_all(exc, ("description", "urdf"))
-            diag.raise_if_failed()
-            raise
-        for w in desc.warnings:
-            diag.add(w)
-        base_world, resolver, urdf_name = desc.world, desc.resolver, desc.urdf_file.name
-    else:
-        # from_world: the caller's world is the description; the spec's URDF is not read
-        # again (it may not even be on this machine's package path). The SRDF is found next
-        # to the world's source file or on the package path.
-        from robotspec.files.packages import PackageResolver
-
-        source = Path(world.source) if world.source else None
-        folder = loaded.folder
-        extra = [p if Path(p).is_absolute() else folder / p for p in paths]
-        resolver = PackageResolver.create(
-            source if source is not None and source.is_file() else None, extra_paths=extra
-        )
-        base_world, urdf_name = world, (world.source or world.name).rsplit("/", 1)[-1]
-    srdf = None if composition is None else composition.srdf
-    if composition is None and desc_spec.srdf is not None:
-        from robotspec.description.srdf_reader import load_srdf
-
-        try:
-            srdf = load_srdf(resolve_file(desc_spec.srdf, loaded.folder, resolver), strict=False)
-        except RobotSpecError as exc:
-            diag.add_all(exc, ("description", "srdf"))
-    if srdf is not None:
-        srdf = _check_srdf(srdf, base_world, urdf_name, diag, own_file=composition is None)
-    prepared = _prepare_world(loaded, base_world, srdf, diag, add_drive=world is None)
-    build = Build(
-        loaded=loaded, world=prepared, diag=diag, srdf=srdf, presets=load_camera_presets()
-    )
-    robot = build_robot(build, robot_class)
-    check_arm_sides(robot, loaded.spec.chains, diag)
-    diag.raise_if_failed(strict=strict)
-    return CompileResult(
-        loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))
-    )
 
 
 def check_spec(
     ref: str | Path, *, package_paths: Sequence[str | Path] = (), strict: bool = False
 ) -> CompileResult:
     """Compile a spec and return its warnings; every error is raised together."""
-    return _compile(load_spec(resolve_spec(ref)), package_paths=package_paths, strict=strict)
+    return compile_loaded(load_spec(resolve_spec(ref)), package_paths=package_paths, strict=strict)
 
 
 def compile_robot(
@@ -279,7 +65,7 @@ def compile_robot(
     ``robot_class`` is the class built; :func:`robotspec.robots.load` picks the shipped robot's
     own class (the compiler does not know the registry of shipped robots).
     """
-    result = _compile(
+    result = compile_loaded(
         load_spec(resolve_spec(ref)), package_paths=package_paths, robot_class=robot_class
     )
     return result.robot
@@ -298,7 +84,7 @@ def compile_spec_for_world(
     makes a new world: the robot's ``world`` is then that one). The SRDF, if any, is read from
     the spec's files for its collision rules.
     """
-    result = _compile(
+    result = compile_loaded(
         load_spec(resolve_spec(ref)),
         package_paths=package_paths,
         world=world,

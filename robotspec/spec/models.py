@@ -8,13 +8,9 @@ kept (``yamlio``) so the compiler can report ``file:line:col`` for any name it c
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import (
-    AfterValidator,
-    BaseModel,
-    ConfigDict,
     Field,
     field_validator,
     model_validator,
@@ -24,6 +20,22 @@ from robotspec.errors import SpecError
 
 if TYPE_CHECKING:
     from robotspec.model.geometry import Matrix
+
+from robotspec.spec.base import Name, SpecModel, States, finite_values
+from robotspec.spec.parts import (
+    CameraSpec,
+    ChainSpec,
+    DriveSpec,
+    FieldOfViewSpec,
+    FingerSpec,
+    GenericManipulatorSpec,
+    GenericSensorSpec,
+    ManipulatorSpec,
+    NeckSpec,
+    ParallelGripperSpec,
+    SensorSpec,
+    TorsoSpec,
+)
 
 __all__ = [
     "AttachSpec",
@@ -49,42 +61,7 @@ __all__ = [
 SPEC_VERSION = 1
 
 
-_NOT_IN_XML = frozenset(chr(c) for c in (*range(0x20), 0x7F)) - {"\t", "\n", "\r"}
-
-
-def _no_control(value: str) -> str:
-    """Names are written into SRDF and URDF files: no character XML cannot carry.
-
-    Why not every non-printable character: a URDF may name a link with a newline (XML allows
-    it), and a spec must be able to name that link. Echoed names are escaped by the CLI
-    (:func:`robotspec.errors.printable`) and drafts quote them, so a newline is harmless.
-    """
-    bad = next((c for c in value if c in _NOT_IN_XML), None)
-    if bad is not None:
-        raise ValueError(f"names must not contain control characters (found U+{ord(bad):04X})")
-    return value
-
-
-Name = Annotated[str, Field(min_length=1, max_length=256), AfterValidator(_no_control)]
-JointValues = dict[Name, float]
-States = dict[Name, JointValues]
-
-
-def _finite(values: tuple[float, ...]) -> tuple[float, ...]:
-    if not all(math.isfinite(v) for v in values):
-        raise ValueError("values must be finite numbers")
-    return values
-
-
-class _Model(BaseModel):
-    # NaN and infinity are refused wherever a number enters (``abs(x - y) > tol`` is False for
-    # NaN, so a NaN would pass every later check).
-    model_config = ConfigDict(
-        extra="forbid", frozen=True, populate_by_name=True, allow_inf_nan=False
-    )
-
-
-class FrameSpec(_Model):
+class FrameSpec(SpecModel):
     """A frame the URDF lacks, fixed to ``parent`` (HSRB's ``hand_gripper_tool_frame``)."""
 
     parent: Name = Field(description="the link the frame is on", examples=["hand_palm_link"])
@@ -107,7 +84,7 @@ class FrameSpec(_Model):
     )
 
     _check_xyz = field_validator("xyz", "rpy", "quaternion")(
-        lambda v: v if v is None else _finite(v)
+        lambda v: v if v is None else finite_values(v)
     )
 
     def pose(self) -> Matrix:
@@ -128,7 +105,7 @@ def _pose(
     return pose_from_xyz_rpy(xyz, rpy or (0.0, 0.0, 0.0))
 
 
-class DescriptionSpec(_Model):
+class DescriptionSpec(SpecModel):
     """Where the robot's files are: paths relative to the spec, absolute, or ``package://``."""
 
     urdf: Name = Field(
@@ -155,7 +132,7 @@ class DescriptionSpec(_Model):
     )
 
 
-class AttachSpec(_Model):
+class AttachSpec(SpecModel):
     """Where a part is welded: a link of an earlier part, and the pose of the part's root there.
 
     Names here are the parent part's own names (before its prefix), so renaming a part never
@@ -195,14 +172,16 @@ class AttachSpec(_Model):
         examples=[True],
     )
 
-    _check = field_validator("xyz", "rpy", "quaternion")(lambda v: v if v is None else _finite(v))
+    _check = field_validator("xyz", "rpy", "quaternion")(
+        lambda v: v if v is None else finite_values(v)
+    )
 
     def pose(self) -> Matrix:
         """The pose of the part's root link in ``link``."""
         return _pose(self.xyz, self.rpy, self.quaternion)
 
 
-class PartSpec(_Model):
+class PartSpec(SpecModel):
     """One part of a composed robot: a description (URDF/xacro or a spec) and where it is welded."""
 
     spec: Name | None = Field(
@@ -252,230 +231,7 @@ class PartSpec(_Model):
         return self
 
 
-class DriveSpec(_Model):
-    """How the base moves; by default taken from the SRDF's virtual joint."""
-
-    type: Literal["omni", "differential", "fixed", "floating"] = Field(
-        description="omni/differential: planar base; floating: 6 DOF; fixed: none",
-        examples=["omni"],
-    )
-    joint: Name | None = Field(
-        default=None, description="name of the base connection", examples=["world_joint"]
-    )
-    parent_frame: Name = Field(
-        default="odom", description="the frame the base moves in", examples=["odom_combined"]
-    )
-
-
-class FingerSpec(_Model):
-    """A finger as a chain from ``root`` to ``tip``."""
-
-    root: Name = Field(description="the finger's first link", examples=["l_gripper_l_finger_link"])
-    tip: Name = Field(description="the finger's tip link", examples=["l_gripper_l_finger_tip_link"])
-
-
-class _ManipulatorBase(_Model):
-    root: Name = Field(
-        description="the link the manipulator starts at", examples=["l_gripper_palm_link"]
-    )
-    tool_frame: Name = Field(
-        description="the frame that grasps (the TCP)", examples=["l_gripper_tool_frame"]
-    )
-    front_facing_orientation: tuple[float, float, float, float] = Field(
-        default=(0.0, 0.0, 0.0, 1.0),
-        description="tool-frame orientation of a front grasp, quaternion [x, y, z, w]",
-        examples=[[-0.7071068, 0, -0.7071068, 0]],
-    )
-    front_facing_axis: tuple[float, float, float] | None = Field(
-        default=None,
-        description="derived from the orientation (R^T x) when omitted",
-        examples=[[0, 0, 1]],
-    )
-    states: States = Field(
-        default_factory=dict,
-        description="named joint states",
-        examples=[{"open": {"l_gripper_l_finger_joint": 0.548}}],
-        json_schema_extra={"unit": "rad or m (per joint)"},
-    )
-
-    _check = field_validator("front_facing_orientation", "front_facing_axis")(
-        lambda v: v if v is None else _finite(v)
-    )
-
-
-class ParallelGripperSpec(_ManipulatorBase):
-    """A two-finger gripper; the thumb is the finger that always touches the object."""
-
-    type: Literal["parallel_gripper"] = Field(
-        description="selects this kind", examples=["parallel_gripper"]
-    )
-    finger: FingerSpec = Field(
-        description="the other finger",
-        examples=[{"root": "l_gripper_r_finger_link", "tip": "l_gripper_r_finger_tip_link"}],
-    )
-    thumb: FingerSpec = Field(
-        description="the finger that always touches the object",
-        examples=[{"root": "l_gripper_l_finger_link", "tip": "l_gripper_l_finger_tip_link"}],
-    )
-
-
-class GenericManipulatorSpec(_ManipulatorBase):
-    """Any other end effector: a tool frame and an orientation."""
-
-    type: Literal["generic"] = Field(description="selects this kind", examples=["generic"])
-
-
-ManipulatorSpec = Annotated[
-    ParallelGripperSpec | GenericManipulatorSpec, Field(discriminator="type")
-]
-
-
-class FieldOfViewSpec(_Model):
-    """Angles in radians."""
-
-    horizontal: float = Field(
-        description="full horizontal angle, in (0, pi)",
-        examples=[0.99483],
-        json_schema_extra={"unit": "rad"},
-    )
-    vertical: float = Field(
-        description="full vertical angle, in (0, pi)",
-        examples=[0.75049],
-        json_schema_extra={"unit": "rad"},
-    )
-
-
-class CameraSpec(_Model):
-    """A camera on ``body``; fields missing here are taken from ``preset`` (templates)."""
-
-    type: Literal["camera"] = Field(description="selects this kind", examples=["camera"])
-    body: Name = Field(
-        description="the link the camera looks from", examples=["wide_stereo_optical_frame"]
-    )
-    preset: Name | None = Field(
-        default=None, description="a camera model from templates/", examples=["kinect_v1"]
-    )
-    forward_facing_axis: tuple[float, float, float] | None = Field(
-        default=None,
-        description="viewing axis in the body's frame, a unit vector "
-        "(default: the preset's, else +z)",
-        examples=[[0, 0, 1]],
-    )
-    field_of_view: FieldOfViewSpec | None = Field(
-        default=None,
-        description="default: the preset's",
-        examples=[{"horizontal": 0.99483, "vertical": 0.75049}],
-        json_schema_extra={"unit": "rad"},
-    )
-    minimal_height: float | None = Field(
-        default=None,
-        description="lowest height of the camera's frame above the robot's root over the "
-        "limits of the joints that move it (checked by FK; default: the preset's, else 0)",
-        examples=[1.166],
-        json_schema_extra={"unit": "m"},
-    )
-    maximal_height: float | None = Field(
-        default=None,
-        description="highest height of the camera's frame above the robot's root over the "
-        "limits of the joints that move it (checked by FK; default: the preset's, else 1)",
-        examples=[1.583],
-        json_schema_extra={"unit": "m"},
-    )
-    default: bool = Field(default=False, description="the robot's default camera", examples=[True])
-
-
-class GenericSensorSpec(_Model):
-    """Any other sensor attached to a body."""
-
-    type: Literal["generic"] = Field(description="selects this kind", examples=["generic"])
-    body: Name = Field(description="the link it is on", examples=["base_laser_link"])
-    kind: Name | None = Field(
-        default=None, description="free-form, e.g. 'lidar' or 'ft'", examples=["lidar"]
-    )
-
-
-SensorSpec = Annotated[CameraSpec | GenericSensorSpec, Field(discriminator="type")]
-
-
-class ChainSpec(_Model):
-    """A kinematic chain, by ``root``/``tip`` or by SRDF ``group`` name."""
-
-    kind: Literal["arm", "chain"] = Field(
-        default="arm",
-        description="informational; a chain with a manipulator is an arm",
-        examples=["arm"],
-    )
-    root: Name | None = Field(
-        default=None, description="the link the chain starts at", examples=["torso_lift_link"]
-    )
-    tip: Name | None = Field(
-        default=None, description="the link the chain ends at", examples=["l_wrist_roll_link"]
-    )
-    group: Name | None = Field(
-        default=None, description="an SRDF group with one chain", examples=["left_arm"]
-    )
-    manipulator: Name | None = Field(
-        default=None,
-        description="name of the manipulator (from `manipulators`) at its tip",
-        examples=["left_gripper"],
-    )
-    side: Literal["left", "right"] | None = Field(
-        default=None,
-        description="which arm of a two-arm robot this is, for `left_arm` / `right_arm`; "
-        "default: the arm lying on the root's +y side in the default pose",
-        examples=["left"],
-    )
-    sensors: list[Name] = Field(
-        default_factory=list,
-        description="names of sensors (from `sensors`) the chain carries",
-        examples=[["hand_camera"]],
-    )
-    states: States = Field(
-        default_factory=dict,
-        description="named joint states",
-        examples=[{"park": {"l_elbow_flex_joint": -2.12}}],
-        json_schema_extra={"unit": "rad or m (per joint)"},
-    )
-
-
-class TorsoSpec(_Model):
-    """The chain that connects the base to the other chains."""
-
-    root: Name = Field(description="the link the torso starts at", examples=["base_link"])
-    tip: Name = Field(description="the link the torso ends at", examples=["torso_lift_link"])
-    states: States = Field(
-        default_factory=dict,
-        description="named joint states",
-        examples=[{"low": {"torso_lift_joint": 0.0}}],
-        json_schema_extra={"unit": "rad or m (per joint)"},
-    )
-
-
-class NeckSpec(_Model):
-    """The chain carrying the head sensors; pitch and yaw bodies are optional."""
-
-    root: Name = Field(description="the link the neck starts at", examples=["torso_lift_link"])
-    tip: Name = Field(description="the link the neck ends at", examples=["head_tilt_link"])
-    pitch_body: Name | None = Field(
-        default=None, description="the link the tilt joint moves", examples=["head_tilt_link"]
-    )
-    yaw_body: Name | None = Field(
-        default=None, description="the link the pan joint moves", examples=["head_pan_link"]
-    )
-    sensors: list[Name] = Field(
-        default_factory=list,
-        description="names of sensors (from `sensors`) the neck carries; at least one",
-        examples=[["kinect"]],
-    )
-    states: States = Field(
-        default_factory=dict,
-        description="named joint states",
-        examples=[{"forward": {"head_pan_joint": 0.0}}],
-        json_schema_extra={"unit": "rad or m (per joint)"},
-    )
-
-
-class VelocityLimitsSpec(_Model):
+class VelocityLimitsSpec(SpecModel):
     """Velocity caps (rad/s or m/s); they only tighten the URDF's limits, of the robot's joints."""
 
     default: float | None = Field(
@@ -493,7 +249,7 @@ class VelocityLimitsSpec(_Model):
     )
 
 
-class CollisionSpec(_Model):
+class CollisionSpec(SpecModel):
     """Self-collision configuration (the seed's ``default_collision_config``)."""
 
     buffer_distance: float = Field(
@@ -520,7 +276,7 @@ class CollisionSpec(_Model):
     )
 
 
-class RobotSpec(_Model):
+class RobotSpec(SpecModel):
     """A robot: its files, its root, and its semantic parts."""
 
     robotspec: Literal[1] = Field(default=1, description="spec format version", examples=[1])

@@ -21,7 +21,8 @@ from robotspec.compose.urdf_merge import (
 from robotspec.description.srdf import Srdf
 from robotspec.diagnostics import Diagnostics, Loc
 from robotspec.errors import SpecError
-from robotspec.files.yamlio import LocatedYaml, validation_errors
+from robotspec.files.validation import validation_errors
+from robotspec.files.yamlio import LocatedYaml
 from robotspec.spec.load import LoadedSpec, merge_data
 from robotspec.spec.models import RobotSpec
 

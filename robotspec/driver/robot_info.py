@@ -37,7 +37,8 @@ from pydantic import (
 
 from robotspec.driver.rr_names import rr_name_problem, rr_name_suggestion
 from robotspec.errors import RobotInfoError, RobotSpecErrors, closest_names
-from robotspec.files.yamlio import LocatedYaml, load_yaml, load_yaml_text, validation_errors
+from robotspec.files.validation import validation_errors
+from robotspec.files.yamlio import LocatedYaml, load_yaml, load_yaml_text
 
 __all__ = [
     "CAPABILITY_BITS",

@@ -36,7 +36,8 @@ from robotspec.driver.sim import Fault, SimRobot
 from robotspec.driver.state import StateFlags
 from robotspec.driver.trajectory import JointTrajectory, Waypoint
 from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names
-from robotspec.files.yamlio import LocatedYaml, load_yaml, validation_errors
+from robotspec.files.validation import validation_errors
+from robotspec.files.yamlio import LocatedYaml, load_yaml
 
 __all__ = ["CALLS", "Scenario", "StepResult", "load_scenario", "run_scenario"]
 

@@ -16,7 +16,8 @@ from typing import Any
 from pydantic import ValidationError
 
 from robotspec.errors import NotFoundError, RobotSpecError, SpecError, raise_collected
-from robotspec.files.yamlio import LocatedYaml, load_yaml, validation_errors
+from robotspec.files.validation import validation_errors
+from robotspec.files.yamlio import LocatedYaml, load_yaml
 from robotspec.shipped import shipped_spec_files
 from robotspec.spec.models import RobotSpec
 

@@ -21,8 +21,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.collision.checker import SelfCollisionChecker
 from robotspec.collision.convergence import SrdfComparison, compare_with_srdf
 from robotspec.collision.matrix import CollisionMatrix, generate_for_robot
@@ -35,7 +35,6 @@ from robotspec.semantic.robot import AbstractRobot
 
 __all__ = ["AuditEntry", "SrdfAudit", "audit_srdf"]
 
-F64 = NDArray[np.float64]
 
 #: Verdicts, in the order the report lists them.
 OK = "ok"

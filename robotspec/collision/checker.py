@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from robotspec.arrays import F64, I64
 from robotspec.collision.rules import CollisionRules, pair_key
 from robotspec.collision.shapes import (
     GeometryModel,
@@ -39,8 +40,6 @@ if TYPE_CHECKING:
 
 __all__ = ["PairDistance", "SelfCollisionChecker"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 Bools = NDArray[np.bool_]
 
 #: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).

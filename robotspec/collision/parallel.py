@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.collision.checker import SelfCollisionChecker
 from robotspec.collision.rules import CollisionRules
 from robotspec.collision.shapes import MissingMeshPolicy
@@ -27,7 +28,6 @@ from robotspec.model.world import Body, Connection, DegreeOfFreedom, World
 __all__ = ["CheckerInputs", "default_processes", "ever_colliding_parallel"]
 
 Bools = NDArray[np.bool_]
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

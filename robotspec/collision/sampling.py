@@ -13,8 +13,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.errors import CollisionError
 from robotspec.model.world import ConnectionType, World
 
@@ -23,8 +23,6 @@ __all__ = [
     "random_configurations",
     "sampling_bounds",
 ]
-
-F64 = NDArray[np.float64]
 
 
 def sampling_bounds(world: World) -> tuple[F64, F64]:

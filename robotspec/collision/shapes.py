@@ -18,8 +18,8 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.errors import CollisionError, RobotSpecError
 from robotspec.files.meshes import read_triangles
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
@@ -37,7 +37,6 @@ __all__ = [
     "import_coal",
 ]
 
-F64 = NDArray[np.float64]
 
 MissingMeshPolicy = Literal["error", "skip"]
 """``error``: a missing or unreadable mesh raises a CollisionError naming the body and the path.

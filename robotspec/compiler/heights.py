@@ -25,13 +25,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.model.world import Body, Connection, ConnectionType, World
 
 __all__ = ["HeightRange", "chain_fk_batch", "height_range", "leader_bounds"]
 
-F64 = NDArray[np.float64]
 
 #: |z component| of a unit axis above which the axis counts as vertical.
 _VERTICAL = 1.0 - 1e-9

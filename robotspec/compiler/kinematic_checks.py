@@ -14,8 +14,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.compiler.context import Build
 from robotspec.compiler.heights import HeightRange, chain_fk_batch, height_range
 from robotspec.compiler.parts import CameraValues
@@ -25,7 +25,6 @@ from robotspec.spec.models import CameraSpec, ParallelGripperSpec
 
 __all__ = ["HEIGHT_TOL", "KinematicInputs", "check_kinematics"]
 
-F64 = NDArray[np.float64]
 
 #: Heights (m) agree when they differ by less than this.
 HEIGHT_TOL = 0.01

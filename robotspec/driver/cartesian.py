@@ -21,11 +21,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
+
+from robotspec.arrays import F64
 
 __all__ = ["DIRECTION_TOLERANCE_DEG", "TwistRates", "chain_reach", "twist_rates"]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: A Cartesian jog is refused (or stopped) when the achievable motion is further than this from
 #: the requested one, in degrees of the weighted twist space.
@@ -40,7 +40,7 @@ DAMPING_FRACTION = 0.02
 class TwistRates:
     """Joint rates for a twist and how well they achieve it."""
 
-    rates: FloatArray
+    rates: F64
     #: Angle between the achieved and the requested twist (weighted), degrees.
     direction_error_deg: float
     #: Smallest singular value of the weighted Jacobian, metres per radian (or metre).
@@ -54,14 +54,14 @@ class TwistRates:
         return self.sigma_min < SINGULAR_FRACTION * self.reach
 
 
-def chain_reach(p: FloatArray, flange_position: FloatArray) -> float:
+def chain_reach(p: F64, flange_position: F64) -> float:
     """A characteristic length of a chain: the sum of its link offsets after the base (metres)."""
     links = float(np.sum(np.linalg.norm(p[1:], axis=1))) if p.shape[0] > 1 else 0.0
     reach = links + float(np.linalg.norm(flange_position))
     return reach if reach > 1e-3 else 1.0
 
 
-def twist_rates(jacobian: FloatArray, twist: FloatArray, reach: float) -> TwistRates:
+def twist_rates(jacobian: F64, twist: F64, reach: float) -> TwistRates:
     """Joint rates moving the TCP along ``twist`` ``[wx, wy, wz, vx, vy, vz]`` (base frame).
 
     ``jacobian`` is ``(6, n)``, angular rows first. A zero twist gives zero rates and no error.
@@ -80,7 +80,7 @@ def twist_rates(jacobian: FloatArray, twist: FloatArray, reach: float) -> TwistR
         lam2 = (1.0 - (s_min / eps) ** 2) * (DAMPING_FRACTION * reach) ** 2
     safe = np.where(s > 0.0, s, 1.0)
     inv = s / (s * s + lam2) if lam2 > 0.0 else np.where(s > 0.0, 1.0 / safe, 0.0)
-    rates: FloatArray = vt.T @ (inv * (u.T @ xw))
+    rates: F64 = vt.T @ (inv * (u.T @ xw))
     norm_req = float(np.linalg.norm(xw))
     if norm_req == 0.0:
         return TwistRates(np.zeros(n), 0.0, s_min, reach)

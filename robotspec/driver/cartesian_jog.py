@@ -9,8 +9,8 @@ tool could not follow the twist there or a joint would reach its limit.
 from __future__ import annotations
 
 import numpy as np
-import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.cartesian import DIRECTION_TOLERANCE_DEG, twist_rates
 from robotspec.driver.errors import (
     OperationFailedError,
@@ -20,13 +20,11 @@ from robotspec.driver.state_fill import StateFill
 
 __all__ = ["CartesianJog"]
 
-FloatArray = npt.NDArray[np.float64]
-
 
 class CartesianJog(StateFill):
     """The Cartesian side of step 4: rates for ``jog_cartesian`` and its stop rules."""
 
-    def _limit_reason(self, q: FloatArray) -> str:
+    def _limit_reason(self, q: F64) -> str:
         lo, hi = self._limits.lower, self._limits.upper
         worst = int(np.argmin(np.minimum(q - lo, hi - q)))
         side = "lower" if q[worst] - lo[worst] < hi[worst] - q[worst] else "upper"
@@ -43,7 +41,7 @@ class CartesianJog(StateFill):
             )
             self._jog_waiter = None
 
-    def _cartesian_rates(self, chain: int, q: FloatArray, twist: FloatArray) -> FloatArray | str:
+    def _cartesian_rates(self, chain: int, q: F64, twist: F64) -> F64 | str:
         """Joint velocities (all joints) for ``twist`` at ``q``, or why it cannot be done."""
         idx = self._chain_joints[chain]
         tf = self._tool_tf[chain]

@@ -16,13 +16,12 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-import numpy.typing as npt
+
+from robotspec.arrays import F64
 
 __all__ = [
     "HPChain",
 ]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 def _axis_kind(h: tuple[float, ...]) -> tuple[int, float]:
@@ -33,7 +32,7 @@ def _axis_kind(h: tuple[float, ...]) -> tuple[int, float]:
     return -1, 1.0
 
 
-def _skew(v: FloatArray) -> FloatArray:
+def _skew(v: F64) -> F64:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
@@ -50,11 +49,11 @@ class HPChain:
 
     def __init__(
         self,
-        h: FloatArray,
-        p: FloatArray,
+        h: F64,
+        p: F64,
         prismatic: Sequence[bool] | None = None,
-        flange_rotation: FloatArray | None = None,
-        flange_position: FloatArray | None = None,
+        flange_rotation: F64 | None = None,
+        flange_position: F64 | None = None,
     ) -> None:
         self.h = np.asarray(h, dtype=np.float64).reshape(-1, 3)
         self.p = np.asarray(p, dtype=np.float64).reshape(-1, 3)
@@ -82,10 +81,10 @@ class HPChain:
         self._origins = np.zeros((self.n, 3))
         self._jac = np.zeros((6, self.n))
 
-    def _joint_rotations(self, q: FloatArray) -> FloatArray:
+    def _joint_rotations(self, q: F64) -> F64:
         s = np.where(self._rev, np.sin(q), 0.0)
         c = np.where(self._rev, 1.0 - np.cos(q), 0.0)
-        out: FloatArray = np.eye(3) + s[:, None, None] * self._k + c[:, None, None] * self._k2
+        out: F64 = np.eye(3) + s[:, None, None] * self._k + c[:, None, None] * self._k2
         return out
 
     def tcp_state(
@@ -218,20 +217,20 @@ class HPChain:
 
     def fk(
         self,
-        q: FloatArray,
-        tool_rotation: FloatArray | None = None,
-        tool_position: FloatArray | None = None,
-    ) -> tuple[FloatArray, FloatArray]:
+        q: F64,
+        tool_rotation: F64 | None = None,
+        tool_position: F64 | None = None,
+    ) -> tuple[F64, F64]:
         """Rotation and position of the flange (or of the tool TCP when given) at ``q``."""
         r, p, _ = self._walk(np.asarray(q, dtype=np.float64), tool_rotation, tool_position, False)
         return r, p
 
     def fk_jacobian(
         self,
-        q: FloatArray,
-        tool_rotation: FloatArray | None = None,
-        tool_position: FloatArray | None = None,
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        q: F64,
+        tool_rotation: F64 | None = None,
+        tool_position: F64 | None = None,
+    ) -> tuple[F64, F64, F64]:
         """Pose and ``(6, n)`` Jacobian (angular rows first) at the flange or tool TCP.
 
         The Jacobian maps joint velocities to the TCP's spatial velocity in the base frame:
@@ -241,11 +240,11 @@ class HPChain:
 
     def _walk(
         self,
-        q: FloatArray,
-        tool_rotation: FloatArray | None,
-        tool_position: FloatArray | None,
+        q: F64,
+        tool_rotation: F64 | None,
+        tool_position: F64 | None,
         with_jacobian: bool,
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+    ) -> tuple[F64, F64, F64]:
         rj = self._joint_rotations(q)
         r = np.eye(3)
         p = self.p[0].copy()

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.errors import InvalidArgumentError
 from robotspec.driver.robot_info import RobotInfo
 
@@ -27,8 +28,6 @@ __all__ = [
     "check_speed_ratio",
     "joint_array",
 ]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -43,7 +42,7 @@ class RobotJointCommand:
 
     seqno: int
     state_seqno: int
-    command: FloatArray
+    command: F64
     units: Sequence[str] = ()
 
     def __post_init__(self) -> None:
@@ -65,13 +64,13 @@ SPEED_RATIO_MAX = 10.0
 class JointLimitArrays:
     """Per-joint limits as arrays, built once so the loop never touches pydantic models."""
 
-    lower: FloatArray
-    upper: FloatArray
-    velocity: FloatArray
-    acceleration: FloatArray
-    reduced_velocity: FloatArray
-    reduced_acceleration: FloatArray
-    home: FloatArray
+    lower: F64
+    upper: F64
+    velocity: F64
+    acceleration: F64
+    reduced_velocity: F64
+    reduced_acceleration: F64
+    home: F64
     prismatic: npt.NDArray[np.bool_]
 
     @classmethod
@@ -102,7 +101,7 @@ class JointLimitArrays:
         return int(self.lower.shape[0])
 
 
-def joint_array(name: str, value: Any, n: int) -> FloatArray:
+def joint_array(name: str, value: Any, n: int) -> F64:
     """``value`` as a finite float array of length ``n``, or InvalidArgument.
 
     Why here: NaN or infinity in any client input must be refused before it reaches a profile,
@@ -166,9 +165,7 @@ class CommandGuard:
         self.clamped = 0
         self.refused = 0
 
-    def position(
-        self, cmd: FloatArray, reference: FloatArray, dt: float | None = None
-    ) -> FloatArray | None:
+    def position(self, cmd: F64, reference: F64, dt: float | None = None) -> F64 | None:
         """The safe position command for ``cmd``, given the previous command or measured q.
 
         ``dt`` is the time the step covers (default: the period): the velocity limit allows
@@ -196,7 +193,7 @@ class CommandGuard:
             self.clamped += 1
         return np.array(out)
 
-    def velocity(self, cmd: FloatArray, measured: FloatArray) -> FloatArray | None:
+    def velocity(self, cmd: F64, measured: F64) -> F64 | None:
         """The safe velocity command for ``cmd`` at measured position ``measured``."""
         if not _finite(cmd):
             self.refused += 1
@@ -214,6 +211,6 @@ class CommandGuard:
         return out.copy()
 
 
-def _finite(a: FloatArray) -> bool:
+def _finite(a: F64) -> bool:
     """``np.all(np.isfinite(a))`` for the loop's short arrays, at a quarter of the cost."""
     return all(map(math.isfinite, a.tolist()))

@@ -6,15 +6,13 @@ import math
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.commands import RobotJointCommand
 from robotspec.driver.errors import InvalidArgumentError, InvalidOperationError
 from robotspec.driver.robot_info import ToolInfo
 from robotspec.driver.state import CommandMode
 from robotspec.model.rotations import quat_wxyz_to_matrix
-
-FloatArray = npt.NDArray[np.float64]
 
 POSITION_UNITS = {
     "implicit": 1.0,
@@ -57,7 +55,7 @@ def parse_mode(value: CommandMode | int | str) -> CommandMode:
     return mode
 
 
-def tool_transform(tool: ToolInfo | None) -> tuple[FloatArray, FloatArray] | None:
+def tool_transform(tool: ToolInfo | None) -> tuple[F64, F64] | None:
     """A tool's TCP as (rotation, translation) in the flange frame; None without a tool."""
     if tool is None:
         return None
@@ -68,7 +66,7 @@ def tool_transform(tool: ToolInfo | None) -> tuple[FloatArray, FloatArray] | Non
 
 
 def as_lists(
-    tf: tuple[FloatArray, FloatArray] | None,
+    tf: tuple[F64, F64] | None,
 ) -> tuple[list[float], list[float]] | None:
     """A transform as plain lists (row-major rotation, translation), for frozen state."""
     if tf is None:
@@ -89,7 +87,7 @@ def twist_vector(velocity: Any) -> Any:
     return velocity
 
 
-def convert_command(cmd: RobotJointCommand, n: int, units: dict[str, float]) -> FloatArray | None:
+def convert_command(cmd: RobotJointCommand, n: int, units: dict[str, float]) -> F64 | None:
     """A streamed command in SI units, or None when it must be ignored."""
     values = cmd.command  # a float64 vector (RobotJointCommand converts anything else)
     if values.shape[0] != n or not np.all(np.isfinite(values)):

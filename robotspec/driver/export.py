@@ -35,9 +35,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 import yaml
 
+from robotspec.arrays import F64
 from robotspec.driver.robot_info import (
     DeviceClass,
     DeviceInfo,
@@ -68,7 +68,6 @@ __all__ = [
     "robot_info_from_chain",
 ]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: Default acceleration limit = this factor times the velocity limit (full speed in 0.2 s).
 DEFAULT_ACCELERATION_FACTOR = 5.0
@@ -97,7 +96,7 @@ class ExportedRobotInfo:
     notes: tuple[str, ...] = ()
 
 
-def _clean(v: FloatArray) -> FloatArray:
+def _clean(v: F64) -> F64:
     out = np.where(np.abs(v) < _CLEAN_TOL, 0.0, v)
     return np.asarray(out + 0.0, dtype=np.float64)  # + 0.0 turns -0.0 into 0.0
 
@@ -106,7 +105,7 @@ def _body(world: World, body: Body | str) -> Body:
     return world.get_body_by_name(body) if isinstance(body, str) else body
 
 
-def _vec(v: FloatArray) -> Vector3:
+def _vec(v: F64) -> Vector3:
     return Vector3(x=float(v[0]), y=float(v[1]), z=float(v[2]))
 
 
@@ -201,8 +200,8 @@ def export_chain(
             )
 
     r_acc = np.eye(3)
-    p_list: list[FloatArray] = [np.zeros(3)]
-    h_list: list[FloatArray] = []
+    p_list: list[F64] = [np.zeros(3)]
+    h_list: list[F64] = []
     movable: list[Connection] = []
     for c in [*to_tip, *after_tip]:
         if c.is_mimic:

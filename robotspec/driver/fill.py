@@ -10,8 +10,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.cartesian_jog import CartesianJog
 from robotspec.driver.conversions import (
     POSITION_UNITS,
@@ -37,7 +37,6 @@ __all__ = [
     "CommandFill",
 ]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: Position-stream commands more than this many state seqnos old are ignored (reference: 10).
 STREAM_STALE_SEQNOS = 10
@@ -67,7 +66,7 @@ class CommandFill(CartesianJog):
     #: A waiting jog fails when the arm has not arrived this long after the motion finished (s).
     jog_settle_timeout: float = JOG_SETTLE_TIMEOUT_S
 
-    def _fill_robot_command(self, now: float) -> tuple[bool, FloatArray | None, FloatArray | None]:
+    def _fill_robot_command(self, now: float) -> tuple[bool, F64 | None, F64 | None]:
         """Step 4: the command for this step from the mode and the client's requests."""
         mode = self._command_mode
         prev, self._prev_mode = self._prev_mode, mode
@@ -127,7 +126,7 @@ class CommandFill(CartesianJog):
             return True, None, None
         return False, None, None
 
-    def _start_point(self) -> tuple[FloatArray, FloatArray]:
+    def _start_point(self) -> tuple[F64, F64]:
         """Where a new motion starts: the last command if one went out last step, else measured.
 
         The velocity is the last command's, or else the measured one (an arm braking by itself
@@ -142,13 +141,13 @@ class CommandFill(CartesianJog):
             return self._joint_position.copy(), self._joint_velocity.copy()
         return self._joint_position.copy(), np.zeros(n)
 
-    def _new_motion(self, q: FloatArray, v: FloatArray) -> JogMotion:
+    def _new_motion(self, q: F64, v: F64) -> JogMotion:
         vlim, alim = self._jog_limits()
         return JogMotion(
             q, v, vlim, alim, self._limits.lower, self._limits.upper, self._update_period
         )
 
-    def _fill_jog(self, now: float) -> FloatArray | None:
+    def _fill_jog(self, now: float) -> F64 | None:
         motion = self._jog
         if motion is None:
             # Hold where the last jog ended, so a lagging arm settles there instead of braking.
@@ -202,7 +201,7 @@ class CommandFill(CartesianJog):
             self._jog_waiter = None
             self._jog_settle_deadline = None
 
-    def _fill_trajectory(self, now: float) -> FloatArray | None:
+    def _fill_trajectory(self, now: float) -> F64 | None:
         task = self._traj_active
         if task is None:
             # Hold the end of the last trajectory: an arm that lagged still reaches it.
@@ -256,7 +255,7 @@ class CommandFill(CartesianJog):
             self._stream_target = None
         return lim
 
-    def _fill_position_stream(self, now: float) -> FloatArray | None:
+    def _fill_position_stream(self, now: float) -> F64 | None:
         cmd = self._stream_position
         if cmd is None:
             return None
@@ -293,7 +292,7 @@ class CommandFill(CartesianJog):
             target_velocity = velocity
         return limiter.position(target, target_velocity, self._step_dt)
 
-    def _fill_velocity_stream(self) -> FloatArray | None:
+    def _fill_velocity_stream(self) -> F64 | None:
         cmd = self._stream_velocity
         if cmd is None:
             return None
@@ -314,9 +313,7 @@ class CommandFill(CartesianJog):
             horizon,
         )
 
-    def _guard_command(
-        self, pos: FloatArray | None, vel: FloatArray | None
-    ) -> tuple[FloatArray | None, FloatArray | None]:
+    def _guard_command(self, pos: F64 | None, vel: F64 | None) -> tuple[F64 | None, F64 | None]:
         """Every outgoing command passes the guard (limits, rate, finiteness)."""
         if pos is not None:
             ref = (
@@ -339,7 +336,7 @@ class CommandFill(CartesianJog):
             return None, outv
         return None, None
 
-    def _record_sent(self, pos: FloatArray | None, vel: FloatArray | None) -> None:
+    def _record_sent(self, pos: F64 | None, vel: F64 | None) -> None:
         if pos is not None:
             consecutive = self._last_sent is not None and self._sent_last_step
             self._prev_sent = self._last_sent if consecutive else None
@@ -358,7 +355,7 @@ class CommandFill(CartesianJog):
             self._prev_sent = None
 
     @property
-    def _last_sent_velocity(self) -> FloatArray:
+    def _last_sent_velocity(self) -> F64:
         """The velocity of the last command sent (zero when none went out last step).
 
         The velocity command, or the difference of the last two consecutive position commands
@@ -368,7 +365,7 @@ class CommandFill(CartesianJog):
         if self._sent_velocity is not None:
             return self._sent_velocity
         if self._prev_sent is not None and self._last_sent is not None and self._sent_dt > 0.0:
-            velocity: FloatArray = (self._last_sent - self._prev_sent) / self._sent_dt
+            velocity: F64 = (self._last_sent - self._prev_sent) / self._sent_dt
             return velocity
         return np.zeros(self._joint_count)
 

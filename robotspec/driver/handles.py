@@ -11,9 +11,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
-import numpy.typing as npt
-
+from robotspec.arrays import F64
 from robotspec.driver.errors import (
     OperationAbortedError,
 )
@@ -31,7 +29,6 @@ __all__ = [
     "TrajectoryStatus",
 ]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: ``Next()`` returns ``running`` after this long without an outcome (reference: 5 s).
 NEXT_TIMEOUT_S = 5.0
@@ -81,7 +78,7 @@ class TrajectoryTask:
         self.start_time = 0.0
         self.time = 0.0
         self.waypoint = 0
-        self.last_setpoint: FloatArray | None = None
+        self.last_setpoint: F64 | None = None
         self.complete = False
         self.error: DriverError | None = None
         self.outcome_reported = False

@@ -28,9 +28,7 @@ import threading
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 
-import numpy as np
-import numpy.typing as npt
-
+from robotspec.arrays import F64
 from robotspec.driver.clock import step_duration
 from robotspec.driver.commands import (
     RobotJointCommand,
@@ -70,7 +68,6 @@ __all__ = [
     "TrajectoryStatus",
 ]
 
-FloatArray = npt.NDArray[np.float64]
 
 #: A blocking call in manual stepping mode gives up after this much (simulated) time.
 MAX_WAIT_S = 3600.0
@@ -97,7 +94,7 @@ class DriverLoop(CommandFill, ABC):
 
     @abstractmethod
     def _send_robot_command(
-        self, now: float, joint_pos_cmd: FloatArray | None, joint_vel_cmd: FloatArray | None
+        self, now: float, joint_pos_cmd: F64 | None, joint_vel_cmd: F64 | None
     ) -> None:
         """Step 6: send a position or velocity command (both None: no command this step)."""
 

@@ -15,8 +15,8 @@ from collections import deque
 from collections.abc import Callable
 
 import numpy as np
-import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.cartesian import chain_reach
 from robotspec.driver.chain_kinematics import HPChain
 from robotspec.driver.clock import Clock, RealClock
@@ -55,8 +55,6 @@ from robotspec.driver.state import (
 from robotspec.model.rotations import quat_wxyz_to_matrix
 
 __all__ = ["LoopState"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class LoopState:
@@ -103,14 +101,14 @@ class LoopState:
         self._current_tool: list[ToolInfo | None] = [c.current_tool for c in chains]
         self._current_payload: list[PayloadInfo | None] = [c.current_payload for c in chains]
         self._current_payload_pose: list[Pose | None] = [None for _ in chains]
-        self._tool_tf: list[tuple[FloatArray, FloatArray] | None] = [
+        self._tool_tf: list[tuple[F64, F64] | None] = [
             tool_transform(t) for t in self._current_tool
         ]
         self._tool_tf_lists = [as_lists(t) for t in self._tool_tf]
         self._chain_idx_list = [list(c.joint_numbers) for c in chains]
         self._chain_is_all = [idx == list(range(n)) for idx in self._chain_idx_list]
         self._endpoint_key: tuple[bytes, bytes, int] | None = None
-        self._endpoint_cache: tuple[list[TcpPose], list[FloatArray]] | None = None
+        self._endpoint_cache: tuple[list[TcpPose], list[F64]] | None = None
         self._keep_going = False
         self._update_period = update_period
         self._speed_ratio = 1.0
@@ -119,13 +117,13 @@ class LoopState:
         self._command_mode = CommandMode.halt
         self._operational_mode = OperationalMode.manual_reduced_speed
         self._controller_state = ControllerState.undefined
-        self._joint_position: FloatArray = np.zeros(0)
-        self._joint_velocity: FloatArray = np.zeros(0)
-        self._joint_effort: FloatArray = np.zeros(0)
-        self._position_command: FloatArray | None = None
-        self._velocity_command: FloatArray | None = None
+        self._joint_position: F64 = np.zeros(0)
+        self._joint_velocity: F64 = np.zeros(0)
+        self._joint_effort: F64 = np.zeros(0)
+        self._position_command: F64 | None = None
+        self._velocity_command: F64 | None = None
         self._endpoint_pose: list[TcpPose] | None = None
-        self._endpoint_vel: list[FloatArray] | None = None
+        self._endpoint_vel: list[F64] | None = None
         self._last_robot_state = -math.inf
         self._last_joint_state = -math.inf
         self._last_endpoint_state = -math.inf
@@ -161,23 +159,23 @@ class LoopState:
         #: The duration of the current step (real elapsed time, see clock.step_duration).
         self._step_dt = update_period
         self._last_step_now: float | None = None
-        self._jog_cartesian: tuple[int, FloatArray] | None = None
+        self._jog_cartesian: tuple[int, F64] | None = None
         self._halt_ramp: JogMotion | None = None
         self._homing: Completion | None = None
         self._traj_active: TrajectoryTask | None = None
         self._traj_queue: deque[TrajectoryTask] = deque()
         self._traj_failed_this_step = False
-        self._traj_hold: FloatArray | None = None
-        self._jog_hold: FloatArray | None = None
+        self._traj_hold: F64 | None = None
+        self._jog_hold: F64 | None = None
         self._stream_position: RobotJointCommand | None = None
         self._stream_velocity: RobotJointCommand | None = None
         self._stream_last_seqno = -1
         self._stream_valid = StateFlags.none
-        self._last_sent: FloatArray | None = None
+        self._last_sent: F64 | None = None
         # What _last_sent_velocity derives from, lazily (it is read only when a motion starts):
         # the position sent the step before _last_sent, or the velocity command sent.
-        self._prev_sent: FloatArray | None = None
-        self._sent_velocity: FloatArray | None = None
+        self._prev_sent: F64 | None = None
+        self._sent_velocity: F64 | None = None
         self._sent_dt = update_period
         self._sent_last_step = False
         self._epoch = self._clock.now()

@@ -8,8 +8,8 @@ the limits of the current operational mode.
 from __future__ import annotations
 
 import numpy as np
-import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.errors import (
     InvalidOperationError,
     OperationAbortedError,
@@ -23,8 +23,6 @@ from robotspec.driver.state import (
 from robotspec.errors import DriverError
 
 __all__ = ["ModeMachine"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class ModeMachine(LoopState):
@@ -126,7 +124,7 @@ class ModeMachine(LoopState):
             self._homing.fail(error)
             self._homing = None
 
-    def _jog_limits(self) -> tuple[FloatArray, FloatArray]:
+    def _jog_limits(self) -> tuple[F64, F64]:
         op = self._operational_mode
         if op is OperationalMode.manual_reduced_speed:
             return self._limits.reduced_velocity, self._limits.reduced_acceleration

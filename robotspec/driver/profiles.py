@@ -24,7 +24,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import numpy.typing as npt
+
+from robotspec.arrays import F64
 
 __all__ = [
     "BRAKING_MARGIN",
@@ -42,8 +43,6 @@ BRAKING_MARGIN = 0.95
 #: ``a dt**2``: the extra velocity change is then at most 5 % of what one step allows.
 SNAP_FRACTION = 0.05
 
-FloatArray = npt.NDArray[np.float64]
-
 
 def braking_speed(distance: float, amax: float, dt: float) -> float:
     """The highest speed toward a stop point ``distance`` away for a step of ``dt`` seconds.
@@ -58,13 +57,13 @@ def braking_speed(distance: float, amax: float, dt: float) -> float:
     return two_ad / (math.sqrt(adt * adt + two_ad) + adt)
 
 
-def rest_to_rest_time(distance: FloatArray, vmax: FloatArray, amax: FloatArray) -> FloatArray:
+def rest_to_rest_time(distance: F64, vmax: F64, amax: F64) -> F64:
     """Time of a trapezoidal (or triangular) rest-to-rest move per joint."""
     d = np.abs(distance)
     tri = d < vmax * vmax / amax
     t_tri = 2.0 * np.sqrt(d / amax)
     t_trap = d / vmax + vmax / amax
-    out: FloatArray = np.where(tri, t_tri, t_trap)
+    out: F64 = np.where(tri, t_tri, t_trap)
     return out
 
 
@@ -83,12 +82,12 @@ class JogMotion:
 
     def __init__(
         self,
-        q: FloatArray,
-        v: FloatArray,
-        vmax: FloatArray,
-        amax: FloatArray,
-        lower: FloatArray,
-        upper: FloatArray,
+        q: F64,
+        v: F64,
+        vmax: F64,
+        amax: F64,
+        lower: F64,
+        upper: F64,
         dt: float,
     ) -> None:
         self.q = np.array(q, dtype=np.float64)
@@ -98,8 +97,8 @@ class JogMotion:
         self.lower = lower
         self.upper = upper
         self.dt = dt
-        self.target_position: FloatArray | None = None
-        self.target_velocity: FloatArray | None = None
+        self.target_position: F64 | None = None
+        self.target_velocity: F64 | None = None
         #: Scale velocity changes of all joints together (a Cartesian jog keeps its direction
         #: while it speeds up and brakes) instead of joint by joint.
         self.coordinated = False
@@ -113,7 +112,7 @@ class JogMotion:
         self._lists_for: tuple[object, ...] = ()
         self._lists: tuple[list[float], ...] = ()
 
-    def to_position(self, target: FloatArray, synchronize: bool = True) -> None:
+    def to_position(self, target: F64, synchronize: bool = True) -> None:
         """Move to ``target``; joints are time-synchronised when starting from rest.
 
         Why synchronise: a freespace jog should reach the goal on all joints together, as the
@@ -135,7 +134,7 @@ class JogMotion:
                 self.vmax = self.vmax * lam
                 self.amax = self.amax * lam * lam
 
-    def at_velocity(self, velocity: FloatArray, until: float) -> None:
+    def at_velocity(self, velocity: F64, until: float) -> None:
         """Hold ``velocity`` until jog time ``until``, then brake to rest."""
         self.target_velocity = np.clip(np.array(velocity, dtype=np.float64), -self.vmax, self.vmax)
         self.target_position = None
@@ -149,7 +148,7 @@ class JogMotion:
             self._lists = tuple(a.tolist() for a in key)
         return self._lists
 
-    def step(self, dt: float | None = None) -> FloatArray:
+    def step(self, dt: float | None = None) -> F64:
         """Advance by ``dt`` seconds (default: the nominal period); return the new position.
 
         Per joint in plain floats: on the handful of joints of an arm this is several times
@@ -259,12 +258,12 @@ class StreamLimiter:
 
     def __init__(
         self,
-        q: FloatArray,
-        v: FloatArray,
-        vmax: FloatArray,
-        amax: FloatArray,
-        lower: FloatArray,
-        upper: FloatArray,
+        q: F64,
+        v: F64,
+        vmax: F64,
+        amax: F64,
+        lower: F64,
+        upper: F64,
     ) -> None:
         self.q: list[float] = [float(x) for x in q]
         self.v: list[float] = [float(x) for x in v]
@@ -273,9 +272,7 @@ class StreamLimiter:
         self._lower = lower.tolist()
         self._upper = upper.tolist()
 
-    def position(
-        self, target: list[float], target_velocity: list[float] | None, dt: float
-    ) -> FloatArray:
+    def position(self, target: list[float], target_velocity: list[float] | None, dt: float) -> F64:
         """The next position command toward the streamed ``target`` after ``dt`` seconds.
 
         Why ``target_velocity``: a stream that moves steadily must be followed without lag, so the
@@ -316,7 +313,7 @@ class StreamLimiter:
 
     def velocity(
         self, command: list[float], measured: list[float], dt: float, horizon: float
-    ) -> FloatArray:
+    ) -> F64:
         """The next velocity command for the streamed ``command`` at position ``measured``.
 
         ``dt`` is the time since the last command (the acceleration budget); ``horizon`` the time

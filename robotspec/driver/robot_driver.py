@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from robotspec.arrays import F64
 from robotspec.driver.commands import (
     JointLimitArrays,
     RobotJointCommand,
@@ -42,7 +43,7 @@ from robotspec.driver.handles import (
     TrajectoryGenerator,
     TrajectoryTask,
 )
-from robotspec.driver.loop import DriverLoop, FloatArray
+from robotspec.driver.loop import DriverLoop
 from robotspec.driver.profiles import JogMotion
 from robotspec.driver.robot_info import (
     MAX_OFFSET_M,
@@ -365,7 +366,7 @@ class RobotDriver(DriverLoop):
             self._wait_completion(waiter)
 
     def _velocity_jog(
-        self, qd: FloatArray, timeout: float, wait: bool, vlim: FloatArray, alim: FloatArray
+        self, qd: F64, timeout: float, wait: bool, vlim: F64, alim: F64
     ) -> Completion | None:
         existing = self._jog
         if existing is None:
@@ -590,9 +591,7 @@ class RobotDriver(DriverLoop):
         raise NotImplementedDriverError("Not implemented")
 
 
-def _check_frame(
-    what: str, rotation: Quaternion, frame: tuple[FloatArray, FloatArray] | None
-) -> None:
+def _check_frame(what: str, rotation: Quaternion, frame: tuple[F64, F64] | None) -> None:
     """Refuse a tool TCP or payload pose with NaN, infinity, bad rotation or absurd offset.
 
     Why here as well as in the models: a ``ToolInfo`` built with ``model_construct`` (or by

@@ -29,8 +29,8 @@ import math
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.clock import Clock, step_duration
 from robotspec.driver.errors import InvalidArgumentError
 from robotspec.driver.faults import Fault, fault_param, fault_param_value
@@ -41,8 +41,6 @@ from robotspec.driver.robot_info import RobotInfo
 from robotspec.driver.state import EstopSource
 
 __all__ = ["Fault", "SimRobot"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class SimRobot(RobotDriver):
@@ -83,13 +81,13 @@ class SimRobot(RobotDriver):
         self._acc_l: list[float] = lim.acceleration.tolist()
         self._lower_l: list[float] = lim.lower.tolist()
         self._upper_l: list[float] = lim.upper.tolist()
-        self._pending_pos: FloatArray | None = None
+        self._pending_pos: F64 | None = None
         self._pending_t = 0.0
         #: The position command before ``_pending_pos`` and when it was sent (consecutive only).
         self._prior_pos: list[float] | None = None
         self._prior_t = 0.0
         self._settle_on: list[float] | None = None
-        self._pending_vel: FloatArray | None = None
+        self._pending_vel: F64 | None = None
         self._sim_enabled = True
         self._sim_error = False
         self._sim_estop = EstopSource.none
@@ -97,7 +95,7 @@ class SimRobot(RobotDriver):
         self._frozen = False
         self._raise_in_step = False
         self._sim_homed = False
-        self._homing_target: FloatArray | None = None
+        self._homing_target: F64 | None = None
         self._homing_completion: Completion | None = None
         self._homing_speed = homing_speed
         self._sim_last_t: float | None = None
@@ -108,17 +106,17 @@ class SimRobot(RobotDriver):
         #: Every command actually sent, as (now, position or None, velocity or None); only kept
         #: when ``record_commands`` is True (tests check invariants on it).
         self.record_commands = False
-        self.sent: list[tuple[float, FloatArray | None, FloatArray | None]] = []
+        self.sent: list[tuple[float, F64 | None, F64 | None]] = []
 
     # ------------------------------------------------------------------ the simulated arm
 
     @property
-    def sim_position(self) -> FloatArray:
+    def sim_position(self) -> F64:
         """The simulated arm's true joint positions (a copy)."""
         return self._q.copy()
 
     @property
-    def sim_velocity(self) -> FloatArray:
+    def sim_velocity(self) -> F64:
         """The simulated arm's true joint velocities (a copy)."""
         return self._v.copy()
 
@@ -264,7 +262,7 @@ class SimRobot(RobotDriver):
         self._last_endpoint_state = now
 
     def _send_robot_command(
-        self, now: float, joint_pos_cmd: FloatArray | None, joint_vel_cmd: FloatArray | None
+        self, now: float, joint_pos_cmd: F64 | None, joint_vel_cmd: F64 | None
     ) -> None:
         previous = self._pending_pos
         if joint_pos_cmd is not None and previous is not None:

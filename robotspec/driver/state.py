@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 from enum import IntEnum, IntFlag
 
 import numpy as np
-import numpy.typing as npt
+
+from robotspec.arrays import F64
 
 __all__ = [
     "ActionStatus",
@@ -23,8 +24,6 @@ __all__ = [
     "StateFlags",
     "TcpPose",
 ]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class CommandMode(IntEnum):
@@ -115,11 +114,11 @@ class ActionStatus(IntEnum):
 class TcpPose:
     """A chain's TCP pose: position (m) and unit quaternion ``(w, x, y, z)``, in the base frame."""
 
-    position: FloatArray
-    orientation: FloatArray
+    position: F64
+    orientation: F64
 
 
-def _frozen(a: FloatArray) -> FloatArray:
+def _frozen(a: F64) -> F64:
     if a.dtype == np.float64 and a.ndim == 1:
         # A read-only view of a bytes copy: a third of the cost of copy-then-lock (the loop
         # freezes five arrays a step), and its WRITEABLE flag cannot be turned back on.
@@ -147,13 +146,13 @@ class RobotState:
     operational_mode: OperationalMode
     controller_state: ControllerState
     flags: StateFlags
-    joint_position: FloatArray = field(default_factory=lambda: _EMPTY)
-    joint_velocity: FloatArray = field(default_factory=lambda: _EMPTY)
-    joint_effort: FloatArray = field(default_factory=lambda: _EMPTY)
-    position_command: FloatArray = field(default_factory=lambda: _EMPTY)
-    velocity_command: FloatArray = field(default_factory=lambda: _EMPTY)
+    joint_position: F64 = field(default_factory=lambda: _EMPTY)
+    joint_velocity: F64 = field(default_factory=lambda: _EMPTY)
+    joint_effort: F64 = field(default_factory=lambda: _EMPTY)
+    position_command: F64 = field(default_factory=lambda: _EMPTY)
+    velocity_command: F64 = field(default_factory=lambda: _EMPTY)
     kin_chain_tcp: tuple[TcpPose, ...] = ()
-    kin_chain_tcp_vel: tuple[FloatArray, ...] = ()
+    kin_chain_tcp_vel: tuple[F64, ...] = ()
     trajectory_running: bool = False
     trajectory_time: float = 0.0
     trajectory_max_time: float = 0.0
@@ -168,7 +167,7 @@ class RobotState:
         return bool(self.flags & StateFlags.ready)
 
 
-def frozen_array(a: FloatArray | None) -> FloatArray:
+def frozen_array(a: F64 | None) -> F64:
     """A read-only copy of ``a`` (empty when None) for a snapshot."""
     return _EMPTY if a is None else _frozen(a)
 
@@ -188,7 +187,7 @@ def robot_state_snapshot(**fields: object) -> RobotState:
     return state
 
 
-def tcp_pose_snapshot(position: FloatArray, orientation: FloatArray) -> TcpPose:
+def tcp_pose_snapshot(position: F64, orientation: F64) -> TcpPose:
     """A :class:`TcpPose` without the frozen-dataclass ``__init__`` (see above)."""
     pose: TcpPose = _new_object(TcpPose)
     pose.__dict__.update(position=position, orientation=orientation)

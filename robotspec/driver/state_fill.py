@@ -5,8 +5,8 @@ from __future__ import annotations
 import struct
 
 import numpy as np
-import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.modes import ModeMachine
 from robotspec.driver.state import (
     ESTOP_SOURCE_FLAGS,
@@ -19,8 +19,6 @@ from robotspec.driver.state import (
 from robotspec.model.rotations import matrix_to_quat_wxyz_tuple
 
 __all__ = ["StateFill"]
-
-FloatArray = npt.NDArray[np.float64]
 
 
 class StateFill(ModeMachine):
@@ -94,13 +92,13 @@ class StateFill(ModeMachine):
         poses = self._endpoint_pose or self._calc_endpoint_poses()
         return poses[chain]
 
-    def _calc_endpoint_vels(self) -> list[FloatArray]:
+    def _calc_endpoint_vels(self) -> list[F64]:
         """TCP spatial velocity ``[angular, linear]`` of every chain."""
         if self._endpoint_vel is None:
             self._calc_endpoint_poses()
         return list(self._endpoint_vel or [])
 
-    def _calc_endpoint_vel(self, chain: int) -> FloatArray:
+    def _calc_endpoint_vel(self, chain: int) -> F64:
         """TCP spatial velocity of ``chain``."""
         return self._calc_endpoint_vels()[chain]
 

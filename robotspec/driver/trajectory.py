@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robotspec.arrays import F64
 from robotspec.driver.commands import JointLimitArrays
 from robotspec.driver.errors import InvalidArgumentError
 
@@ -38,7 +39,6 @@ __all__ = [
     "MAX_WAYPOINT_GAP",
 ]
 
-FloatArray = npt.NDArray[np.float64]
 
 MIN_WAYPOINTS = 5
 MAX_WAYPOINT_GAP = 0.1
@@ -54,7 +54,7 @@ def _yield() -> None:
     time.sleep(0)
 
 
-def _to_lists(a: FloatArray) -> list[Any]:
+def _to_lists(a: F64) -> list[Any]:
     """``a.tolist()`` in chunks (see :data:`CHUNK`)."""
     out: list[Any] = []
     for start in range(0, a.shape[0], CHUNK):
@@ -63,7 +63,7 @@ def _to_lists(a: FloatArray) -> list[Any]:
     return out
 
 
-def _rows(rows: Sequence[Sequence[float]], n: int) -> FloatArray:
+def _rows(rows: Sequence[Sequence[float]], n: int) -> F64:
     """``np.array(rows)`` as an ``(m, n)`` float array, in chunks (see :data:`CHUNK`)."""
     m = len(rows)
     out = np.empty((m, n))
@@ -126,7 +126,7 @@ class JointTrajectory:
 class TrajectoryInterpolator:
     """Samples a checked trajectory at any time with preallocated buffers (PCHIP)."""
 
-    def __init__(self, times: FloatArray, positions: FloatArray) -> None:
+    def __init__(self, times: F64, positions: F64) -> None:
         self.times = times
         self.positions = positions
         self.max_time = float(times[-1])
@@ -158,7 +158,7 @@ class TrajectoryInterpolator:
         self._segment = -1
         self._rows: tuple[list[float], list[float], list[float], list[float]] = ([], [], [], [])
 
-    def evaluate(self, t: float) -> tuple[FloatArray, int]:
+    def evaluate(self, t: float) -> tuple[F64, int]:
         """Position at time ``t`` (clamped to the ends; a new array) and the segment's start.
 
         Per joint in plain floats: on an arm's few joints that is several times faster than

@@ -11,9 +11,13 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.model.rotations import quaternion_to_matrix, rpy_to_matrix
+
+#: A rotation or homogeneous transform (3x3 or 4x4 float64).
+Matrix = F64
+
 
 __all__ = [
     "Box",
@@ -29,8 +33,6 @@ __all__ = [
     "UNIT_TOL",
     "unit_norm",
 ]
-
-Matrix = NDArray[np.float64]
 
 
 def frozen_array(values: object, shape: tuple[int, ...] | None = None) -> Matrix:

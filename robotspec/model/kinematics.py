@@ -17,15 +17,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.errors import KinematicsError
 from robotspec.model import _kincore
 from robotspec.model.world import Body, Connection, ConnectionType, World
 
 __all__ = ["ChainKinematics", "Kinematics"]
 
-F64 = NDArray[np.float64]
 
 # Motion kinds, as the C core (_kincore.c) numbers them.
 _FIXED = 0

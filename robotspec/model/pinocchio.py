@@ -30,15 +30,13 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.errors import KinematicsError, RobotSpecError
 from robotspec.model.entities import Connection, ConnectionType
 from robotspec.model.world import World
 
 __all__ = ["PinocchioRobot", "import_pinocchio", "set_limits", "world_to_pinocchio"]
-
-F64 = NDArray[np.float64]
 
 
 def import_pinocchio() -> Any:

@@ -11,7 +11,12 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from numpy.typing import NDArray
+
+from robotspec.arrays import F64
+
+#: A rotation or homogeneous transform (3x3 or 4x4 float64).
+Matrix = F64
+
 
 __all__ = [
     "matrix_to_quat_wxyz",
@@ -21,8 +26,6 @@ __all__ = [
     "quaternion_to_matrix",
     "rpy_to_matrix",
 ]
-
-Matrix = NDArray[np.float64]
 
 
 def rpy_to_matrix(roll: float, pitch: float, yaw: float) -> Matrix:

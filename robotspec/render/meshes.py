@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64, I64
 from robotspec.errors import DescriptionError, RobotSpecError
 from robotspec.files.meshes import read_triangles
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
@@ -23,8 +23,6 @@ from robotspec.model.world import Body
 
 __all__ = ["MissingMeshPolicy", "Triangles", "TriangleLibrary", "cluster_decimate"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 
 MissingMeshPolicy = Literal["error", "skip"]
 """``error``: an unreadable mesh raises a DescriptionError naming the body and the file.

@@ -14,13 +14,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError
 from robotspec.render.raster import ViewCamera, flat_shade, rasterize
 from robotspec.render.scene import LegendEntry, RobotScene, Segment
 
 __all__ = ["BACKGROUND", "Picture", "RenderOptions", "render_scene"]
 
-F64 = NDArray[np.float64]
 U8 = NDArray[np.uint8]
 
 BACKGROUND = (255, 255, 255)

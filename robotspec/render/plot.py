@@ -18,14 +18,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.driver.state import RobotState
 from robotspec.errors import RobotSpecError
 
 __all__ = ["JointTrace", "PlotSummary", "plot_joint_trace"]
-
-F64 = NDArray[np.float64]
 
 
 class JointTrace:

@@ -15,14 +15,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64, I64
 from robotspec.errors import RobotSpecError
 
 __all__ = ["VIEWS", "ViewCamera", "rasterize", "view_axes"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 
 #: Viewing direction (from the camera into the scene) and the world's up on screen, per view.
 #: front: from the robot's front (+x), its left (+y) on the image's right; side: from its right

@@ -17,8 +17,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError
 from robotspec.model.entities import ConnectionType
 from robotspec.model.kinematics import Kinematics
@@ -41,7 +41,6 @@ __all__ = [
     "frustum_corners",
 ]
 
-F64 = NDArray[np.float64]
 RGB = tuple[int, int, int]
 
 #: Chain colours, chosen apart in chromaticity so a shaded pixel still tells its chain, and away

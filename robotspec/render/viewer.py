@@ -22,8 +22,8 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError, ServiceError
 from robotspec.model.world import ConnectionType
 from robotspec.render.meshes import MissingMeshPolicy, TriangleLibrary
@@ -38,7 +38,6 @@ from robotspec.semantic import AbstractRobot
 
 __all__ = ["RobotViewer", "slider_range"]
 
-F64 = NDArray[np.float64]
 
 _COLLISION_COLOUR = (90, 200, 90)
 _COLLIDING_COLOUR = (230, 20, 20)

@@ -13,8 +13,8 @@ from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 
+from robotspec.arrays import F64
 from robotspec.errors import CollisionError, NotFoundError
 
 if TYPE_CHECKING:
@@ -22,8 +22,6 @@ if TYPE_CHECKING:
     from robotspec.semantic.robot import AbstractRobot
 
 __all__ = ["state_configuration"]
-
-F64 = NDArray[np.float64]
 
 
 def state_configuration(

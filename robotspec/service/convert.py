@@ -18,7 +18,6 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 from pydantic import ValidationError
 
 from robotspec.driver.errors import InvalidArgumentError
@@ -52,7 +51,6 @@ __all__ = [
     "trajectory_from_rr",
 ]
 
-FloatArray = npt.NDArray[np.float64]
 
 ROBOT_INFO_TYPE = "com.robotraconteur.robotics.robot.RobotInfo"
 _MAP_KEYS = frozenset({"extended", "associated_devices", "tags"})

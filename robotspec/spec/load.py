@@ -157,7 +157,7 @@ def check_package_paths(loaded: LoadedSpec, package_paths: Sequence[str | Path] 
     """
     if not loaded.foreign_paths:
         return
-    from robotspec.files.packages import user_roots
+    from robotspec.files.package_search import user_roots
 
     roots = [os.path.realpath(r) for r in user_roots(package_paths)]
     problems: list[RobotSpecError] = []

@@ -13,6 +13,7 @@ Everything is built on the first query (meshes read once), so constructing a che
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -388,7 +389,20 @@ class SelfCollisionChecker:
         req = coal.DistanceRequest()  # coal >= 3 always fills the nearest points
         res = coal.DistanceResult()
         tf = c.transforms
-        g1s, g2s, owner = c.pair_geom1.tolist(), c.pair_geom2.tolist(), c.pair_of.tolist()
+        owner = c.pair_of.tolist()
+        # The transforms are updated in place, so each pair's functor and transforms are bound
+        # once; per-pair bests stay Python floats until the row ends (numpy scalar indexing per
+        # pair cost more than a third of coal's own time on robots with many small pairs).
+        work = tuple(
+            zip(
+                fns,
+                (tf[i] for i in c.pair_geom1.tolist()),
+                (tf[j] for j in c.pair_geom2.tolist()),
+                owner,
+                strict=True,
+            )
+        )
+        clear, near1, near2 = res.clear, res.getNearestPoint1, res.getNearestPoint2
         none = np.zeros(len(c.pair_of), dtype=np.uint8)  # poses only, no broad phase
         for start in range(0, n, _BLOCK):
             _, _, poses = self._broad(c, qs[start : start + _BLOCK], 0.0, none)
@@ -396,15 +410,21 @@ class SelfCollisionChecker:
                 for g in range(len(tf)):
                     tf[g].setRotation(poses[r, g, :3, :3])
                     tf[g].setTranslation(poses[r, g, :3, 3])
-                row = start + r
-                for qi, (i, j, p) in enumerate(zip(g1s, g2s, owner, strict=True)):
-                    res.clear()
-                    d = float(fns[qi](tf[i], tf[j], req, res))
-                    if d < dist[row, p]:
-                        dist[row, p] = d
+                best = [math.inf] * npairs
+                near: list[tuple[F64, F64] | None] = [None] * npairs
+                for fn, t1, t2, p in work:
+                    clear()
+                    d = fn(t1, t2, req, res)
+                    if d < best[p]:
+                        best[p] = d
                         if with_points:
-                            points[row, p, 0] = res.getNearestPoint1()
-                            points[row, p, 1] = res.getNearestPoint2()
+                            near[p] = (near1(), near2())
+                row = start + r
+                dist[row] = best
+                if with_points:
+                    for p, pair_points in enumerate(near):
+                        if pair_points is not None:
+                            points[row, p, 0], points[row, p, 1] = pair_points
         return dist, points
 
     def distances(self, q: object) -> tuple[PairDistance, ...]:

@@ -67,10 +67,6 @@ class _Compiled:
     """Arrays of the built checker: geometries and the pairs to test, in flat index form."""
 
     model: GeometryModel
-    geom_body: I64  # (G,) body index in the world
-    body_T_geom: F64  # noqa: N815 - frame notation a_T_b; (G, 4, 4)
-    aabb_center: F64  # (G, 3) in the body frame
-    aabb_half: F64  # (G, 3)
     pair_geom1: I64  # (Q,) geometry indices of each geometry pair
     pair_geom2: I64
     pair_of: I64  # (Q,) index of the body pair each geometry pair belongs to
@@ -82,13 +78,11 @@ class _Compiled:
     pair_geom1_list: list[int] = field(init=False)
     pair_geom2_list: list[int] = field(init=False)
     pair_of_list: list[int] = field(init=False)
-    pair_index_list: list[int] = field(init=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "pair_geom1_list", self.pair_geom1.tolist())
         object.__setattr__(self, "pair_geom2_list", self.pair_geom2.tolist())
         object.__setattr__(self, "pair_of_list", self.pair_of.tolist())
-        object.__setattr__(self, "pair_index_list", list(range(len(self.pair_of))))
 
 
 class SelfCollisionChecker:
@@ -196,14 +190,12 @@ class SelfCollisionChecker:
                     g1.append(i)
                     g2.append(j)
                     owner.append(k)
+        pair_geom1 = np.array(g1, dtype=np.int64)
+        pair_geom2 = np.array(g2, dtype=np.int64)
         self._compiled = _Compiled(
             model=model,
-            geom_body=np.array([g.body_index for g in geoms], dtype=np.int64),
-            body_T_geom=np.array([g.body_T_geometry for g in geoms]).reshape(-1, 4, 4),
-            aabb_center=np.array([g.aabb_center for g in geoms]).reshape(-1, 3),
-            aabb_half=np.array([g.aabb_half for g in geoms]).reshape(-1, 3),
-            pair_geom1=np.array(g1, dtype=np.int64),
-            pair_geom2=np.array(g2, dtype=np.int64),
+            pair_geom1=pair_geom1,
+            pair_geom2=pair_geom2,
             pair_of=np.array(owner, dtype=np.int64),
             collide=tuple(
                 coal.ComputeCollision(geoms[i].geometry, geoms[j].geometry)
@@ -215,8 +207,8 @@ class SelfCollisionChecker:
                 np.array([g.body_T_geometry for g in geoms], dtype=np.float64).reshape(-1, 4, 4),
                 np.array([g.aabb_center for g in geoms], dtype=np.float64).reshape(-1, 3),
                 np.array([g.aabb_half for g in geoms], dtype=np.float64).reshape(-1, 3),
-                np.array(g1, dtype=np.int64),
-                np.array(g2, dtype=np.int64),
+                pair_geom1,
+                pair_geom2,
                 len(self.world.bodies),
             ),
         )
@@ -375,7 +367,7 @@ class SelfCollisionChecker:
             geoms = c.model.geometries
             self._distance_fns = tuple(
                 coal.ComputeDistance(geoms[i].geometry, geoms[j].geometry)
-                for i, j in zip(c.pair_geom1.tolist(), c.pair_geom2.tolist(), strict=True)
+                for i, j in zip(c.pair_geom1_list, c.pair_geom2_list, strict=True)
             )
         return self._distance_fns
 
@@ -389,15 +381,15 @@ class SelfCollisionChecker:
         req = coal.DistanceRequest()  # coal >= 3 always fills the nearest points
         res = coal.DistanceResult()
         tf = c.transforms
-        owner = c.pair_of.tolist()
+        owner = c.pair_of_list
         # The transforms are updated in place, so each pair's functor and transforms are bound
         # once; per-pair bests stay Python floats until the row ends (numpy scalar indexing per
         # pair cost more than a third of coal's own time on robots with many small pairs).
         work = tuple(
             zip(
                 fns,
-                (tf[i] for i in c.pair_geom1.tolist()),
-                (tf[j] for j in c.pair_geom2.tolist()),
+                (tf[i] for i in c.pair_geom1_list),
+                (tf[j] for j in c.pair_geom2_list),
                 owner,
                 strict=True,
             )

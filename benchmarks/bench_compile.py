@@ -18,12 +18,11 @@ from __future__ import annotations
 
 import argparse
 import cProfile
-import importlib.metadata as md
 import io
 import pstats
 from pathlib import Path
 
-from rows import Row, add_json_flag, median_times, print_rows
+from rows import Row, add_json_flag, erd_share, median_times, print_rows
 
 
 def main() -> None:
@@ -38,13 +37,7 @@ def main() -> None:
 
     from robotspec.compiler import compile_robot
 
-    share = Path(
-        str(
-            md.distribution("example-robot-data").locate_file(
-                "cmeel.prefix/share/example-robot-data"
-            )
-        )
-    )
+    share = erd_share()
     pr2 = share / "robots" / "pr2_description"
     urdf, srdf = pr2 / "urdf" / "pr2.urdf", pr2 / "srdf" / "pr2.srdf"
     package_dirs = [str(share / "robots"), str(share.parent)]

@@ -10,12 +10,14 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib.metadata as md
 import json
 import statistics
 import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 
 @dataclass(frozen=True)
@@ -102,3 +104,11 @@ def median_times(fns: Sequence[Callable[[], object]], repeat: int) -> list[float
             fn()
             out.append(time.perf_counter() - t)
     return [statistics.median(t) for t in times]
+
+
+def erd_share() -> Path:
+    """example-robot-data's share folder (``robots/`` inside); the benchmarks' real robot files."""
+    share = md.distribution("example-robot-data").locate_file(
+        "cmeel.prefix/share/example-robot-data"
+    )
+    return Path(str(share))

@@ -6,7 +6,7 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import Annotated, Any
 
 import typer
 
@@ -24,9 +24,6 @@ from robotspec.cli.options import (
 )
 from robotspec.cli.table import render_table
 from robotspec.errors import CollisionError
-
-if TYPE_CHECKING:
-    pass
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()

@@ -25,6 +25,7 @@ are redirected to a temporary folder so nothing is written outside it.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import statistics
@@ -39,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from rows import Row, add_json_flag, erd_share, run_report
+from rows import Row, add_json_flag, erd_share, print_rows
 
 SHARED = Path(__file__).resolve().parents[2] / "shared"
 ABB = SHARED / "robotinfo" / "abb_irb1200_5_90.yml"
@@ -409,7 +410,12 @@ def main() -> None:
     parser.add_argument("--skip-reference", action="store_true")
     add_json_flag(parser)
     args = parser.parse_args()
-    run_report(run, args)
+    if args.json:  # the report goes to stderr, stdout gets one JSON object per row
+        with contextlib.redirect_stdout(sys.stderr):
+            rows = run(args)
+        print_rows(rows, True)
+        return
+    run(args)
 
 
 def run(args: argparse.Namespace) -> list[Row]:

@@ -17,11 +17,13 @@ overshot by up to 0.18 rad. Simulated time: the figures do not depend on the mac
 from __future__ import annotations
 
 import argparse
+import contextlib
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
-from rows import Row, add_json_flag, run_report
+from rows import Row, add_json_flag, print_rows
 
 from robotspec.driver.clock import JitteryClock
 from robotspec.driver.loop import JOG_ARRIVAL_TOLERANCE
@@ -65,7 +67,12 @@ def main() -> None:
     ap.add_argument("--max-late", type=float, default=15.0, help="ms")
     add_json_flag(ap)
     args = ap.parse_args()
-    run_report(run, args)
+    if args.json:  # the report goes to stderr, stdout gets one JSON object per row
+        with contextlib.redirect_stdout(sys.stderr):
+            rows = run(args)
+        print_rows(rows, True)
+        return
+    run(args)
 
 
 def run(args: argparse.Namespace) -> list[Row]:

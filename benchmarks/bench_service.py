@@ -20,6 +20,7 @@ and Jacobian in its feedback step, as in the reference note's measurement).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import json
 import os
@@ -33,7 +34,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from rows import Row, add_json_flag, run_report
+from rows import Row, add_json_flag, print_rows
 
 HERE = Path(__file__).resolve()
 SHARED_INFO = HERE.parents[2] / "shared" / "robotinfo" / "abb_irb1200_5_90.yml"
@@ -307,7 +308,12 @@ def main() -> None:
     if args.client:
         client_main(args.client, args.seconds)
         return
-    run_report(run, args)
+    if args.json:  # the report goes to stderr, stdout gets one JSON object per row
+        with contextlib.redirect_stdout(sys.stderr):
+            rows = run(args)
+        print_rows(rows, True)
+        return
+    run(args)
 
 
 def run(args: argparse.Namespace) -> list[Row]:

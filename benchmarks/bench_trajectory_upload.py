@@ -18,14 +18,16 @@ upload froze the loop for 0.6 s (issue 17). The checks now run outside the lock,
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
+import sys
 import threading
 import time
 from pathlib import Path
 
 import numpy as np
-from rows import Row, add_json_flag, run_report
+from rows import Row, add_json_flag, print_rows
 
 from robotspec.driver.robot_info import load_robot_info
 from robotspec.driver.sim import SimRobot
@@ -57,7 +59,12 @@ def main() -> None:
     ap.add_argument("--uploads", type=int, default=3)
     add_json_flag(ap)
     args = ap.parse_args()
-    run_report(run, args)
+    if args.json:  # the report goes to stderr, stdout gets one JSON object per row
+        with contextlib.redirect_stdout(sys.stderr):
+            rows = run(args)
+        print_rows(rows, True)
+        return
+    run(args)
 
 
 def run(args: argparse.Namespace) -> list[Row]:

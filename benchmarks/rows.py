@@ -9,11 +9,9 @@ versions. ``peer_s`` and ``ratio`` are ``null`` for a row without a peer (a targ
 from __future__ import annotations
 
 import argparse
-import contextlib
 import importlib.metadata as md
 import json
 import statistics
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -49,19 +47,6 @@ def add_json_flag(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--json", action="store_true", help="print each row as one JSON object per line"
     )
-
-
-def run_report(run: Callable[[argparse.Namespace], list[Row]], args: argparse.Namespace) -> None:
-    """Run a benchmark that prints its own report and returns its rows.
-
-    With ``--json`` the report goes to stderr so that stdout holds only one JSON object per row.
-    """
-    if args.json:
-        with contextlib.redirect_stdout(sys.stderr):
-            rows = run(args)
-        print_rows(rows, True)
-        return
-    run(args)
 
 
 def fmt(t: float | None) -> str:

@@ -9,14 +9,12 @@ robotspec time: above 1 means robotspec is faster.
 from __future__ import annotations
 
 import argparse
-import importlib.metadata as md
 import statistics
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
-from rows import Row, add_json_flag, print_rows
+from rows import Row, add_json_flag, erd_share, print_rows
 
 
 def median_time(fn: Callable[[], object], repeat: int) -> float:
@@ -50,7 +48,7 @@ def main() -> None:
     from robotspec.compiler import check_spec
     from robotspec.description.urdf import load_urdf
 
-    share = Path(str(md.distribution("example-robot-data").locate_file("cmeel.prefix/share")))
+    share = erd_share().parent
     urdf = share / "example-robot-data/robots/pr2_description/urdf/pr2.urdf"
     robot = check_spec("pr2").robot
     assert robot is not None and robot.srdf is not None

@@ -18,32 +18,11 @@ from __future__ import annotations
 
 import argparse
 import cProfile
-import importlib.metadata as md
 import io
 import pstats
-import statistics
-import time
-from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from rows import Row, add_json_flag, print_rows
-
-
-def median_times(fns: Sequence[Callable[[], object]], repeat: int) -> list[float]:
-    """Median wall time (seconds) of each function over ``repeat`` rounds, after a warm-up.
-
-    Why rounds: the functions take turns (one call each per round), so a slow spell of this
-    shared machine hits both sides of a ratio alike instead of one side's whole series.
-    """
-    for fn in fns:
-        fn()
-    times: list[list[float]] = [[] for _ in fns]
-    for _ in range(repeat):
-        for fn, out in zip(fns, times, strict=True):
-            t = time.perf_counter()
-            fn()
-            out.append(time.perf_counter() - t)
-    return [statistics.median(t) for t in times]
+from rows import Row, add_json_flag, erd_share, median_times, print_rows
 
 
 def main() -> None:
@@ -58,13 +37,7 @@ def main() -> None:
 
     from robotspec.compiler import compile_robot
 
-    share = Path(
-        str(
-            md.distribution("example-robot-data").locate_file(
-                "cmeel.prefix/share/example-robot-data"
-            )
-        )
-    )
+    share = erd_share()
     pr2 = share / "robots" / "pr2_description"
     urdf, srdf = pr2 / "urdf" / "pr2.urdf", pr2 / "srdf" / "pr2.srdf"
     package_dirs = [str(share / "robots"), str(share.parent)]

@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from rows import Row, add_json_flag, print_rows
+from rows import Row, add_json_flag, erd_share, print_rows
 
 SHARED = Path(__file__).resolve().parents[2] / "shared"
 ABB = SHARED / "robotinfo" / "abb_irb1200_5_90.yml"
@@ -428,18 +428,10 @@ def run(args: argparse.Namespace) -> list[Row]:
         yaml_text = ABB.read_text()
         robot_name = "ABB IRB1200 (6 joints)"
     else:
-        import importlib.metadata as md
-
         from robotspec.description.urdf import load_urdf
         from robotspec.driver.export import robot_info_from_chain
 
-        share = Path(
-            str(
-                md.distribution("example-robot-data").locate_file(
-                    "cmeel.prefix/share/example-robot-data"
-                )
-            )
-        )
+        share = erd_share()
         world = load_urdf(share / "robots/pr2_description/urdf/pr2.urdf", meshes="keep")
         exported = robot_info_from_chain(
             world, "torso_lift_link", "r_wrist_roll_link", device_name="pr2_right_arm"

@@ -13,7 +13,6 @@ Run: ``python benchmarks/bench_init.py [--repeat N]`` (needs example-robot-data)
 from __future__ import annotations
 
 import argparse
-import importlib.metadata as md
 import resource
 import statistics
 import subprocess
@@ -22,7 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from rows import Row, add_json_flag, print_rows
+from rows import Row, add_json_flag, erd_share, print_rows
 
 
 def _child_cpu() -> float:
@@ -36,8 +35,7 @@ def main() -> None:
     add_json_flag(parser)
     args = parser.parse_args()
     say = (lambda *a, **k: None) if args.json else print
-    share = Path(str(md.distribution("example-robot-data").locate_file("cmeel.prefix/share")))
-    talos = share / "example-robot-data/robots/talos_data"
+    talos = erd_share() / "robots/talos_data"
     urdf, srdf = talos / "robots/talos_reduced.urdf", talos / "srdf/talos.srdf"
     out = Path(tempfile.mkdtemp()) / "talos.yaml"
     init = [sys.executable, "-m", "robotspec", "init", str(urdf), "--srdf", str(srdf)]

@@ -15,13 +15,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 import subprocess
 import sys
-import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 
-from rows import Row, add_json_flag, print_rows
+from rows import Row, add_json_flag, median_times, print_rows
 
 _NO_CHECKS = """
 import sys
@@ -32,19 +30,6 @@ from robotspec.cli.app import main
 main(sys.argv[1:])
 """
 _WITH_CHECKS = "import sys\nfrom robotspec.cli.app import main\nmain(sys.argv[1:])\n"
-
-
-def median_times(fns: Sequence[Callable[[], object]], repeat: int) -> list[float]:
-    """Median wall time (seconds) of each function over ``repeat`` rounds, after a warm-up."""
-    for fn in fns:
-        fn()
-    times: list[list[float]] = [[] for _ in fns]
-    for _ in range(repeat):
-        for fn, out in zip(fns, times, strict=True):
-            t = time.perf_counter()
-            fn()
-            out.append(time.perf_counter() - t)
-    return [statistics.median(t) for t in times]
 
 
 def main() -> None:

@@ -10,10 +10,9 @@ import argparse
 import statistics
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
-from rows import Row, add_json_flag, print_rows
+from rows import Row, add_json_flag, erd_share, print_rows
 
 
 def best_of(fn: Callable[[], object], repeat: int, number: int = 1) -> float:
@@ -33,21 +32,13 @@ def main() -> None:
     add_json_flag(parser)
     args = parser.parse_args()
 
-    import importlib.metadata as md
-
     import pinocchio as pin
     import yourdfpy
 
     from robotspec.description.urdf import load_urdf
     from robotspec.model.kinematics import Kinematics
 
-    share = Path(
-        str(
-            md.distribution("example-robot-data").locate_file(
-                "cmeel.prefix/share/example-robot-data"
-            )
-        )
-    )
+    share = erd_share()
     urdf = share / "robots/pr2_description/urdf/pr2.urdf"
     rows: list[tuple[str, float, str, float]] = []
 

@@ -1,4 +1,5 @@
-"""One benchmark row, printed as text or as JSON (``--json``), shared by every benchmark.
+"""One benchmark row, printed as text or as JSON (``--json``), and the interleaved timing
+shared by every benchmark.
 
 JSON: one object per line with keys ``what``, ``ours_s``, ``peer``, ``peer_s``, ``ratio`` (peer
 time / robotspec time; above 1 means robotspec is faster), so figures can be compared across
@@ -8,8 +9,13 @@ versions. ``peer_s`` and ``ratio`` are ``null`` for a row without a peer (a targ
 from __future__ import annotations
 
 import argparse
+import importlib.metadata as md
 import json
+import statistics
+import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 
 @dataclass(frozen=True)
@@ -66,3 +72,28 @@ def print_rows(rows: list[Row], as_json: bool, *, width: int = 44, peer_width: i
             f"{r.what:{width}} {fmt(r.ours_s):>10}   {r.peer:{peer_width}} "
             f"{fmt(r.peer_s):>10}  {ratio:>6}"
         )
+
+
+def median_times(fns: Sequence[Callable[[], object]], repeat: int) -> list[float]:
+    """Median wall time (seconds) of each function over ``repeat`` rounds, after a warm-up.
+
+    Why rounds: the functions take turns (one call each per round), so a slow spell of this
+    shared machine hits both sides of a ratio alike instead of one side's whole series.
+    """
+    for fn in fns:
+        fn()
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for fn, out in zip(fns, times, strict=True):
+            t = time.perf_counter()
+            fn()
+            out.append(time.perf_counter() - t)
+    return [statistics.median(t) for t in times]
+
+
+def erd_share() -> Path:
+    """example-robot-data's share folder (``robots/`` inside); the benchmarks' real robot files."""
+    share = md.distribution("example-robot-data").locate_file(
+        "cmeel.prefix/share/example-robot-data"
+    )
+    return Path(str(share))

@@ -5,24 +5,20 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from robotspec.driver.clock import SimClock
 from robotspec.driver.robot_info import load_robot_info
 from robotspec.driver.sim import SimRobot
 
-SHARED = Path(__file__).resolve().parents[2] / "shared"
+from .conftest import DATA, SHARED, shared_path
+
 ROBOTINFO_DIR = SHARED / "robotinfo"
-DATA = Path(__file__).resolve().parent / "data"
 RRP = DATA / "driver_rrp.yml"
 
 
 def robotinfo(name: str) -> Path:
     """A file of ../shared/robotinfo, or skip when the shared folder is absent."""
-    p = ROBOTINFO_DIR / name
-    if not p.exists():
-        pytest.skip(f"needs {p} (the shared robot files beside the checkout), which is absent")
-    return p
+    return shared_path("robotinfo", name)
 
 
 def shared_robotinfo_files() -> list[Path]:

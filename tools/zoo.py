@@ -16,7 +16,6 @@ so it is not in the package (whose drafting layer must not import the compiler).
 from __future__ import annotations
 
 import argparse
-import importlib.metadata
 import sys
 import sysconfig
 import tempfile
@@ -86,12 +85,10 @@ class ZooRow:
 
 def erd_robots_folder() -> Path | None:
     """example-robot-data's ``robots`` folder, or ``None`` when it is not installed."""
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    robots = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
-    return robots if robots.is_dir() else None
+    from robotspec.files.package_search import example_robot_data_folders
+
+    folders = example_robot_data_folders()  # [share/robots, share] when installed
+    return folders[0] if folders and folders[0].is_dir() else None
 
 
 def zoo_entries(robots: Path) -> list[ZooEntry]:

@@ -6,7 +6,7 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import Annotated, Any
 
 import typer
 
@@ -24,9 +24,6 @@ from robotspec.cli.options import (
 )
 from robotspec.cli.table import render_table
 from robotspec.errors import CollisionError
-
-if TYPE_CHECKING:
-    pass
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
@@ -129,13 +126,26 @@ def check(
         raise typer.Exit(1)
 
 
+#: The sampling options that ``collisions generate`` and ``collisions audit`` share.
+SeedOpt = Annotated[int, typer.Option("--seed", help="Seed of the sampler.")]
+JobsOpt = Annotated[
+    int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes (default: CPUs).")
+]
+ProgressOpt = Annotated[
+    bool | None,
+    typer.Option(
+        "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
+    ),
+]
+
+
 @collisions_app.command("generate")
 def generate(
     spec: SpecArg,
     samples: Annotated[
         int, typer.Option("--samples", "-n", min=0, help="Random configurations to sample.")
     ] = 10_000,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the sampler.")] = 0,
+    seed: SeedOpt = 0,
     output: Annotated[
         Path | None, typer.Option("--output", "-o", help="Write the SRDF here (default: stdout).")
     ] = None,
@@ -145,15 +155,8 @@ def generate(
             "--merge", help="Add the pairs to the robot's SRDF (its own entries are kept)."
         ),
     ] = False,
-    jobs: Annotated[
-        int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes (default: CPUs).")
-    ] = None,
-    progress: Annotated[
-        bool | None,
-        typer.Option(
-            "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
-        ),
-    ] = None,
+    jobs: JobsOpt = None,
+    progress: ProgressOpt = None,
     compare: Annotated[
         Path | None,
         typer.Option(
@@ -234,19 +237,12 @@ def audit(
             "--samples", "-n", min=0, help="Random configurations for the regenerated matrix."
         ),
     ] = 10_000,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the sampler.")] = 0,
-    jobs: Annotated[
-        int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes (default: CPUs).")
-    ] = None,
+    seed: SeedOpt = 0,
+    jobs: JobsOpt = None,
     show_ok: Annotated[
         bool, typer.Option("--all", help="Also list the entries that are right.")
     ] = False,
-    progress: Annotated[
-        bool | None,
-        typer.Option(
-            "--progress/--no-progress", help="Progress bar on stderr (default: on a terminal)."
-        ),
-    ] = None,
+    progress: ProgressOpt = None,
     as_json: JsonFlag = False,
     skip_missing_meshes: SkipMeshes = False,
     package_path: PackagePath = None,

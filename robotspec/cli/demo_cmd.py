@@ -84,7 +84,7 @@ def demo(
     from robotspec.cli.chain_table import print_chains
     from robotspec.cli.driving import run_driver
     from robotspec.cli.validation_report import report_validation
-    from robotspec.export.robotinfo import export_spec_chain
+    from robotspec.export.robotinfo import export_robot_chain
     from robotspec.robots import load
 
     def head(text: str) -> None:
@@ -104,7 +104,7 @@ def demo(
             return
         # The last arm, as the help says: on the PR2 the right arm, the one the driver guide uses.
         chain = arms[-1].name
-    exported = export_spec_chain(robot, chain, package_path)
+    exported = export_robot_chain(compiled, chain)  # the robot compiled above, not again
     for note in exported.notes:
         sys.stderr.write(f"note: {note}\n")
     info = exported.info

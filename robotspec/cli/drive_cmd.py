@@ -78,7 +78,9 @@ def drive(
         raise typer.BadParameter("give either --sim or --spec, not both")
     if spec is not None and chain is None:
         raise typer.BadParameter("--spec needs --chain NAME")
-    if log is not None and log.suffix.lower() not in (".csv", ".jsonl", ".json", ".ndjson"):
+    from robotspec.driver.statelog import LOG_SUFFIXES
+
+    if log is not None and log.suffix.lower() not in LOG_SUFFIXES:
         raise typer.BadParameter(
             f"unknown log format '{log.suffix}' (use .csv or .jsonl)", param_hint="--log"
         )

@@ -5,16 +5,13 @@ from __future__ import annotations
 import json
 import math
 import sys
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import typer
 
 from robotspec.cli.notes import print_notes
 from robotspec.cli.options import JsonFlag, PackagePath, SpecArg, load_robot
 from robotspec.cli.table import emit_table
-
-if TYPE_CHECKING:
-    pass
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import Annotated
 
 import typer
 
@@ -18,9 +18,6 @@ from robotspec.cli.options import (
     joint_values,
     load_robot,
 )
-
-if TYPE_CHECKING:
-    pass
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()

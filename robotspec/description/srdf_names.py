@@ -24,6 +24,7 @@ from robotspec.description.srdf import (
     Srdf,
     VirtualJoint,
 )
+from robotspec.description.srdf_checks import by_line
 from robotspec.errors import RobotSpecError, SrdfError
 
 __all__ = ["PrefixMapping", "map_prefixed_names", "self_pair_warnings"]
@@ -67,6 +68,22 @@ def _candidates(name: str, known: Collection[str]) -> list[str]:
         start = cut + 1
 
 
+def _has_prefixed_name(srdf: Srdf) -> bool:
+    """Whether any link or joint name the SRDF refers to has a ``/`` (only those are mapped)."""
+    names = [
+        *(n for g in srdf.groups for n in (*g.joints, *g.links)),
+        *(n for g in srdf.groups for c in g.chains for n in (c.base_link, c.tip_link)),
+        *(j for s in srdf.group_states for j, _ in s.joint_values),
+        *(e.parent_link for e in srdf.end_effectors),
+        *(v.child_link for v in srdf.virtual_joints),
+        *(p.name for p in srdf.passive_joints),
+        *(n for d in srdf.disabled_collisions for n in (d.link1, d.link2)),
+        *(n for d in srdf.enabled_collisions for n in (d.link1, d.link2)),
+        *(d.link for d in srdf.disable_default_collisions),
+    ]
+    return any("/" in n for n in names)
+
+
 def map_prefixed_names(
     srdf: Srdf, links: Collection[str], joints: Collection[str]
 ) -> PrefixMapping:
@@ -75,6 +92,8 @@ def map_prefixed_names(
     A name the URDF has is never touched. Only a prefix ending in ``/`` is cut (a ROS namespace
     or ``tf_prefix``): cutting other text would guess.
     """
+    if not _has_prefixed_name(srdf):  # the common case: nothing to map, nothing to rebuild
+        return PrefixMapping(srdf, (), (), frozenset())
     link_set = set(links)
     joint_set = set(joints) | {v.name for v in srdf.virtual_joints}
     file = srdf.file
@@ -219,8 +238,8 @@ def map_prefixed_names(
         ),
     )
     warnings = [_warning(scope, file) for scope in scopes.values() if scope.renamed]
-    warnings.sort(key=lambda w: w.line if w.line is not None else 1 << 62)
-    errors.sort(key=lambda e: e.line if e.line is not None else 1 << 62)
+    warnings.sort(key=by_line)
+    errors.sort(key=by_line)
     if not warnings and not errors:
         return PrefixMapping(srdf, (), (), frozenset())
     return PrefixMapping(mapped, tuple(warnings), tuple(errors), frozenset(ambiguous))

@@ -10,10 +10,14 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from robotspec.driver.export import ExportedRobotInfo, export_chain
 
-__all__ = ["export_spec_chain", "rr_device_name"]
+if TYPE_CHECKING:
+    from robotspec.semantic import AbstractRobot
+
+__all__ = ["export_robot_chain", "export_spec_chain", "rr_device_name"]
 
 
 def rr_device_name(robot_name: str, chain_name: str) -> str:
@@ -32,7 +36,11 @@ def export_spec_chain(
     """
     from robotspec.compiler import compile_robot
 
-    robot = compile_robot(spec, package_paths=package_paths or ())
+    return export_robot_chain(compile_robot(spec, package_paths=package_paths or ()), chain)
+
+
+def export_robot_chain(robot: AbstractRobot, chain: str) -> ExportedRobotInfo:
+    """An already compiled robot's chain ``chain`` as a RobotInfo (``demo`` compiles once)."""
     c = robot.get_chain(chain)
     device = rr_device_name(robot.name, c.name)
     return export_chain(

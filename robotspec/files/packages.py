@@ -78,6 +78,8 @@ class PackageResolver:
         default_factory=dict, compare=False, repr=False
     )
     _real_roots: list[Path] = field(default_factory=list, compare=False, repr=False)
+    #: Folder -> its real path; shared like ``_crawls`` (a composed robot's resolvers see the
+    #: same package folders, and resolving each again was a third of composing).
     _real_dirs: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
     #: (root, root + separator) of each resolved root, for prefix tests on path strings.
     _root_prefixes: list[tuple[str, str]] = field(default_factory=list, compare=False, repr=False)
@@ -146,6 +148,7 @@ class PackageResolver:
             flat_folders=_unique(Path(os.path.normpath(f)) for f in flat if f.is_dir()),
             missing_folders=missing,
             _crawls={} if share_crawls_with is None else share_crawls_with._crawls,
+            _real_dirs={} if share_crawls_with is None else share_crawls_with._real_dirs,
         )
 
     @property
@@ -154,12 +157,12 @@ class PackageResolver:
 
         These are :attr:`roots` and the packages found on the search path, each on its own.
         """
-        packages = (Path(os.path.realpath(f)) for f in self._packages().values())
+        packages = (self._real_folder(f) for f in self._packages().values())
         return _unique([*self.roots, *self._resolved_roots(), *packages])
 
     def _resolved_roots(self) -> list[Path]:
         if not self._real_roots:
-            self._real_roots.extend(_unique(Path(os.path.realpath(r)) for r in self.roots))
+            self._real_roots.extend(_unique(self._real_folder(r) for r in self.roots))
         return self._real_roots
 
     def packages(self) -> dict[str, Path]:
@@ -207,6 +210,7 @@ class PackageResolver:
             description=None,
             bare_name_folders=union("bare_name_folders"),
             flat_folders=union("flat_folders"),
+            _real_dirs=resolvers[0]._real_dirs if resolvers else {},
         )
         index: dict[str, Path] = {}
         for r in resolvers:
@@ -258,11 +262,15 @@ class PackageResolver:
         parent, name = os.path.split(text)
         if not name or os.path.islink(text):
             return Path(os.path.realpath(text))
-        real_parent = self._real_dirs.get(parent)
-        if real_parent is None:
-            real_parent = os.path.realpath(parent)
-            self._real_dirs[parent] = real_parent
-        return Path(real_parent, name)
+        return Path(self._real_folder(parent), name)
+
+    def _real_folder(self, folder: str | Path) -> Path:
+        """``os.path.realpath`` of a folder, resolved once per compilation (see ``_real_dirs``)."""
+        key = os.fspath(folder)
+        real = self._real_dirs.get(key)
+        if real is None:
+            real = self._real_dirs[key] = os.path.realpath(key)
+        return Path(real)
 
     def _inside(self, real: Path) -> bool:
         """Inside an allowed root, or inside a package found on the search path.
@@ -274,7 +282,7 @@ class PackageResolver:
         text = str(real)
         if not self._root_prefixes:
             folders = [*self._resolved_roots()]
-            folders += _unique(Path(os.path.realpath(f)) for f in self._packages().values())
+            folders += _unique(self._real_folder(f) for f in self._packages().values())
             for r in _unique(folders):
                 root = str(r)
                 self._root_prefixes.append((root, root.rstrip(os.sep) + os.sep))

@@ -179,8 +179,9 @@ def _build(
     key_marks: dict[Loc, tuple[int, int]],
     file: str,
     depth: int,
+    max_depth: int,
 ) -> Any:
-    if depth > limits().max_yaml_depth:  # _check_shape refused such documents already
+    if depth > max_depth:  # _check_shape refused such documents already
         raise RobotSpecError("YAML nested too deeply", file=file, line=node.start_mark.line + 1)
     marks[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
     if node.tag not in _PLAIN_TAGS:
@@ -215,11 +216,13 @@ def _build(
                 )
             child = (*path, key)
             key_marks[child] = (key_node.start_mark.line + 1, key_node.start_mark.column + 1)
-            out[key] = _build(value_node, loader, child, marks, key_marks, file, depth + 1)
+            out[key] = _build(
+                value_node, loader, child, marks, key_marks, file, depth + 1, max_depth
+            )
         return out
     if isinstance(node, yaml.SequenceNode):
         return [
-            _build(item, loader, (*path, i), marks, key_marks, file, depth + 1)
+            _build(item, loader, (*path, i), marks, key_marks, file, depth + 1, max_depth)
             for i, item in enumerate(node.value)
         ]
     value = _scalar(node, loader, file)  # type: ignore[arg-type]
@@ -261,7 +264,7 @@ def _compose(loader_type: type[yaml.SafeLoader], text: str, file: str) -> Locate
             return LocatedYaml(data=None, file=file)
         marks: dict[Loc, tuple[int, int]] = {}
         key_marks: dict[Loc, tuple[int, int]] = {}
-        data = _build(node, loader, (), marks, key_marks, file, 0)
+        data = _build(node, loader, (), marks, key_marks, file, 0, limits().max_yaml_depth)
     finally:
         if loader is not None:
             loader.dispose()

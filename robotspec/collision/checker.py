@@ -22,8 +22,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.arrays import F64, I64
+from robotspec.collision import _meshcore
 from robotspec.collision.rules import CollisionRules, pair_key
 from robotspec.collision.shapes import (
+    CollisionGeometry,
     GeometryModel,
     MeshLibrary,
     MissingMeshPolicy,
@@ -45,6 +47,10 @@ Bools = NDArray[np.bool_]
 
 #: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).
 _BLOCK = 512
+#: Room (m) beyond the margin by which a mesh pair must be proven apart before coal is skipped:
+#: coal's own collision test between triangles stops within about 1e-6 m, so a pair proven this far
+#: apart is one coal calls apart too, and the answers stay coal's.
+_APART_SLACK = 1e-5
 
 
 @dataclass(frozen=True)
@@ -73,6 +79,7 @@ class _Compiled:
     collide: tuple[Any, ...]  # coal.ComputeCollision per geometry pair
     transforms: tuple[Any, ...]  # one reusable coal.Transform3s per geometry
     broad: object  # the C core's table of geometries and pairs (_kincore.geoms)
+    meshes: object | None  # box trees of the mesh geometries (_meshcore.mesh_set), if any pair
 
     # Python lists for the per-pair loop (indexing a list is several times cheaper).
     pair_geom1_list: list[int] = field(init=False)
@@ -211,6 +218,7 @@ class SelfCollisionChecker:
                 pair_geom2,
                 len(self.world.bodies),
             ),
+            meshes=_mesh_trees(geoms, g1, g2),
         )
         return self._compiled
 
@@ -229,12 +237,19 @@ class SelfCollisionChecker:
     ) -> tuple[list[int], list[int], F64]:
         """Candidate (sample, geometry pair)s of ``qs`` and every geometry's pose (n, G, 4, 4).
 
-        A candidate's boxes come within ``margin``; every other pair is farther apart than that,
-        so coal's narrow phase on the candidates gives the exact answer.
+        A candidate's boxes come within ``margin``, and its meshes (when both are meshes) were
+        not proven apart by more than that; every other pair is farther apart, so coal's narrow
+        phase on the candidates gives the exact answer.
         """
         kin = self.kinematics
         bodies = kin.forward(qs[0]) if qs.shape[0] == 1 else kin.forward_batch(qs)
         rows, ks, poses = _kincore.broad(c.broad, bodies, margin, mask)
+        if c.meshes is not None and len(ks):
+            apart = _meshcore.apart(
+                c.meshes, poses, rows, ks, c.pair_geom1, c.pair_geom2, margin + _APART_SLACK
+            )
+            keep = apart == 0
+            rows, ks = rows[keep], ks[keep]
         return rows.tolist(), ks.tolist(), poses
 
     # ------------------------------------------------------------------------- queries
@@ -451,3 +466,14 @@ class SelfCollisionChecker:
                 f"pair '{a}' - '{b}' is not checked{why}", kind="pair", name=f"{a} {b}"
             )
         return self._pair_index[key]
+
+
+def _mesh_trees(geoms: Sequence[CollisionGeometry], g1: list[int], g2: list[int]) -> object | None:
+    """Box trees of the meshes that meet another mesh in a pair (None if no pair is two meshes)."""
+    used: set[int] = set()
+    for i, j in zip(g1, g2, strict=True):
+        if geoms[i].triangles is not None and geoms[j].triangles is not None:
+            used.update((i, j))
+    if not used:
+        return None
+    return _meshcore.mesh_set([g.triangles if k in used else None for k, g in enumerate(geoms)])

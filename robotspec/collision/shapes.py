@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from robotspec.arrays import F64
+from robotspec.arrays import F64, I64
 from robotspec.errors import CollisionError, RobotSpecError
 from robotspec.files.meshes import read_triangles
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
@@ -78,6 +78,8 @@ class CollisionGeometry:
     aabb_center: F64 = field(repr=False, compare=False)
     aabb_half: F64 = field(repr=False, compare=False)
     kind: str = "mesh"
+    #: A mesh's vertices (V, 3, in the geometry's frame) and triangles (T, 3); None otherwise.
+    triangles: tuple[F64, I64] | None = field(default=None, repr=False, compare=False)
 
 
 @dataclass(frozen=True)
@@ -105,13 +107,13 @@ class MeshLibrary:
     """
 
     def __init__(self) -> None:
-        self._cache: dict[tuple[str, tuple[float, float, float]], tuple[Any, F64]] = {}
+        self._cache: dict[tuple[str, tuple[float, float, float]], tuple[Any, F64, I64]] = {}
 
     def __len__(self) -> int:
         return len(self._cache)
 
-    def load(self, path: str, scale: tuple[float, float, float]) -> tuple[Any, F64]:
-        """The BVH model of ``path`` scaled by ``scale`` and its vertices (V, 3).
+    def load(self, path: str, scale: tuple[float, float, float]) -> tuple[Any, F64, I64]:
+        """The BVH model of ``path`` scaled by ``scale``, its vertices (V, 3) and triangles (T, 3).
 
         Raises a bare CollisionError (the caller adds the body) when the file cannot be read or
         holds no triangles.
@@ -129,8 +131,9 @@ class MeshLibrary:
         model.addTriangles(faces)
         model.endModel()
         model.computeLocalAABB()
-        self._cache[key] = (model, vertices)
-        return model, vertices
+        triangles = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+        self._cache[key] = (model, vertices, triangles)
+        return model, vertices, triangles
 
 
 def _primitive(shape: Shape, coal: Any) -> tuple[Any, F64, str]:
@@ -201,9 +204,10 @@ def build_geometry_model(
             _check_dimensions(shape, body, world.source)
             origin = np.asarray(shape.origin, dtype=np.float64)
             rot, trans = origin[:3, :3], origin[:3, 3]
+            triangles: tuple[F64, I64] | None = None
             if isinstance(shape.geometry, Mesh):
                 try:
-                    geom, vertices = _load_mesh(library, shape.geometry, body)
+                    geom, vertices, faces = _load_mesh(library, shape.geometry, body)
                 except CollisionError as exc:
                     if on_missing_mesh == "error":
                         raise
@@ -212,6 +216,7 @@ def build_geometry_model(
                 in_body = vertices @ rot.T + trans
                 lo, hi = in_body.min(axis=0), in_body.max(axis=0)
                 center, half, kind = (lo + hi) / 2.0, (hi - lo) / 2.0, "mesh"
+                triangles = (vertices, faces)
             else:
                 geom, local_half, kind = _primitive(shape, coal)
                 center, half = trans.copy(), np.abs(rot) @ local_half
@@ -225,12 +230,15 @@ def build_geometry_model(
                     aabb_center=center,
                     aabb_half=half,
                     kind=kind,
+                    triangles=triangles,
                 )
             )
     return GeometryModel(geometries=tuple(out), skipped=tuple(skipped))
 
 
-def _load_mesh(library: MeshLibrary, mesh: Mesh, body: Body) -> tuple[coal.BVHModelOBBRSS, F64]:
+def _load_mesh(
+    library: MeshLibrary, mesh: Mesh, body: Body
+) -> tuple[coal.BVHModelOBBRSS, F64, I64]:
     if mesh.path is None:
         raise CollisionError(
             f"link '{body.name}': collision mesh '{mesh.uri}' was not resolved to a file",

@@ -1,0 +1,641 @@
+/*
+ * robotspec.collision._meshcore: proofs that two triangle meshes are apart, in C.
+ *
+ * Why: coal tests a mesh pair by descending both bounding-volume trees and running GJK on every
+ * pair of leaf triangles whose volumes come within its break distance. Pairs that nearly touch
+ * in every configuration (a gripper palm in its forearm's wrist clevis, 0.4 mm apart) then cost
+ * 200-300 us a test, and the collision matrix runs 10,000 of them per pair. Most such tests end
+ * with "apart", which a separating axis proves in a few dozen operations a box or triangle pair.
+ *
+ * What it answers: for each candidate (sample, geometry pair) of the broad phase whose both
+ * geometries are meshes, 1 when every pair of triangles is proven apart by more than eps (a
+ * separating axis with that much room, found box by box down an axis-aligned box tree), 0 when
+ * it could not prove it (they may touch: the caller runs coal, whose answer stands). A 1 is
+ * therefore never a guess: the two surfaces are more than eps apart, so coal, whose collision
+ * test compares the surfaces' distance with the security margin, says "no collision" too when
+ * eps exceeds margin plus its own tolerance (the caller's choice).
+ *
+ * Poses are row-major 4x4 (numpy's layout). Trees live in one capsule per checker.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LEAF_TRIANGLES 2
+
+typedef struct {
+    double c[3], h[3]; /* box centre (mesh frame) and half extents along its axes */
+    double ax[9];      /* the box's axes as columns (row-major), in the mesh frame */
+    int32_t left, right; /* children (nodes), or -1 for a leaf */
+    int32_t first, count; /* a leaf's triangles: order[first .. first + count) */
+} Node;
+
+/* A triangle as the separating-axis test reads it: corners, edges and normal (21 doubles). */
+#define FEAT 21
+
+typedef struct {
+    int32_t n_tri, n_node;
+    double *v;      /* 9 doubles per triangle: its three corners, in triangle order */
+    double *f;      /* FEAT doubles per triangle: corners, edges, normal */
+    int32_t *order; /* triangle index per leaf slot */
+    Node *nodes;    /* node 0 is the root */
+} Tree;
+
+typedef struct {
+    Py_ssize_t n;
+    Tree **trees; /* one per geometry; NULL where the geometry is not a mesh */
+} MeshSet;
+
+/* ------------------------------------------------------------------------------ building */
+
+/* Eigenvectors of a symmetric 3x3 matrix m (row-major, destroyed) as the columns of v, by cyclic
+ * Jacobi rotations: the axes of a node's box follow its triangles (a rotated cylinder gets a box
+ * along its axis), which is what keeps the boxes of nearly touching meshes apart. */
+static void eigenvectors(double *m, double *v) {
+    for (int i = 0; i < 9; i++) v[i] = (i % 4 == 0) ? 1.0 : 0.0;
+    for (int sweep = 0; sweep < 32; sweep++) {
+        double off = fabs(m[1]) + fabs(m[2]) + fabs(m[5]);
+        if (off < 1e-30) break;
+        for (int p = 0; p < 2; p++) {
+            for (int q = p + 1; q < 3; q++) {
+                double apq = m[3 * p + q];
+                if (fabs(apq) < 1e-300) continue;
+                double theta = (m[3 * q + q] - m[3 * p + p]) / (2.0 * apq);
+                double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), sn = t * c;
+                for (int k = 0; k < 3; k++) { /* m = J^T m J */
+                    double mkp = m[3 * k + p], mkq = m[3 * k + q];
+                    m[3 * k + p] = c * mkp - sn * mkq;
+                    m[3 * k + q] = sn * mkp + c * mkq;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double mpk = m[3 * p + k], mqk = m[3 * q + k];
+                    m[3 * p + k] = c * mpk - sn * mqk;
+                    m[3 * q + k] = sn * mpk + c * mqk;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double vkp = v[3 * k + p], vkq = v[3 * k + q];
+                    v[3 * k + p] = c * vkp - sn * vkq;
+                    v[3 * k + q] = sn * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    /* v is a product of rotations, so orthonormal; its handedness does not matter to the
+     * separating-axis test (only absolute projections enter it). */
+}
+
+/* The oriented box of a node's triangles: axes from the covariance of their corners, extents
+ * from the corners' projections (so it holds every corner, hence every triangle). */
+static void box_of(const Tree *t, int32_t first, int32_t count, Node *nd) {
+    double mean[3] = {0, 0, 0}, cov[9] = {0};
+    double n = 3.0 * count;
+    for (int32_t s = first; s < first + count; s++) {
+        const double *p = t->v + 9 * t->order[s];
+        for (int k = 0; k < 9; k++) mean[k % 3] += p[k] / n;
+    }
+    for (int32_t s = first; s < first + count; s++) {
+        const double *p = t->v + 9 * t->order[s];
+        for (int k = 0; k < 3; k++) {
+            double d[3] = {p[3 * k] - mean[0], p[3 * k + 1] - mean[1], p[3 * k + 2] - mean[2]};
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++) cov[3 * a + b] += d[a] * d[b];
+        }
+    }
+    eigenvectors(cov, nd->ax);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t s = first; s < first + count; s++) {
+        const double *p = t->v + 9 * t->order[s];
+        for (int k = 0; k < 3; k++) {
+            for (int a = 0; a < 3; a++) {
+                double x = nd->ax[a] * p[3 * k] + nd->ax[3 + a] * p[3 * k + 1] +
+                           nd->ax[6 + a] * p[3 * k + 2];
+                if (x < lo[a]) lo[a] = x;
+                if (x > hi[a]) hi[a] = x;
+            }
+        }
+    }
+    double mid[3];
+    for (int a = 0; a < 3; a++) {
+        mid[a] = (lo[a] + hi[a]) / 2.0;
+        /* A hair of room: the corners were projected with rounding. */
+        nd->h[a] = (hi[a] - lo[a]) / 2.0 + 1e-12 * (fabs(lo[a]) + fabs(hi[a]));
+    }
+    for (int a = 0; a < 3; a++) {
+        nd->c[a] = nd->ax[3 * a] * mid[0] + nd->ax[3 * a + 1] * mid[1] + nd->ax[3 * a + 2] * mid[2];
+    }
+}
+
+/* Sort key for the split: triangle centroids along one axis (qsort has no context). */
+typedef struct {
+    double key;
+    int32_t tri;
+} Keyed;
+
+static int by_key(const void *a, const void *b) {
+    double x = ((const Keyed *)a)->key, y = ((const Keyed *)b)->key;
+    if (x < y) return -1;
+    if (x > y) return 1;
+    return ((const Keyed *)a)->tri - ((const Keyed *)b)->tri; /* stable: same tree every run */
+}
+
+static int tree_build(Tree *t, Keyed *scratch) {
+    /* Top down, with an explicit stack of (node, first, count): no recursion on any input. */
+    int32_t cap = 64, top = 0;
+    int32_t *stack = malloc(sizeof(int32_t) * 3 * (size_t)cap);
+    if (stack == NULL) return -1;
+    t->n_node = 1;
+    stack[0] = 0;
+    stack[1] = 0;
+    stack[2] = t->n_tri;
+    top = 1;
+    while (top > 0) {
+        top--;
+        int32_t id = stack[3 * top], first = stack[3 * top + 1], count = stack[3 * top + 2];
+        Node *nd = &t->nodes[id];
+        box_of(t, first, count, nd);
+        nd->left = nd->right = -1;
+        nd->first = first;
+        nd->count = count;
+        if (count <= LEAF_TRIANGLES) continue;
+        /* Split at the median centroid along the box's longest side. */
+        int axis = 0;
+        if (nd->h[1] > nd->h[axis]) axis = 1;
+        if (nd->h[2] > nd->h[axis]) axis = 2;
+        const double u[3] = {nd->ax[axis], nd->ax[3 + axis], nd->ax[6 + axis]};
+        for (int32_t s = 0; s < count; s++) {
+            int32_t tri = t->order[first + s];
+            const double *p = t->v + 9 * tri;
+            scratch[s].key = u[0] * (p[0] + p[3] + p[6]) + u[1] * (p[1] + p[4] + p[7]) +
+                             u[2] * (p[2] + p[5] + p[8]);
+            scratch[s].tri = tri;
+        }
+        qsort(scratch, (size_t)count, sizeof(Keyed), by_key);
+        for (int32_t s = 0; s < count; s++) t->order[first + s] = scratch[s].tri;
+        int32_t half = count / 2;
+        nd->left = t->n_node;
+        nd->right = t->n_node + 1;
+        nd->count = 0;
+        t->n_node += 2;
+        if (top + 2 > cap) {
+            cap *= 2;
+            int32_t *s2 = realloc(stack, sizeof(int32_t) * 3 * (size_t)cap);
+            if (s2 == NULL) {
+                free(stack);
+                return -1;
+            }
+            stack = s2;
+        }
+        int32_t left = nd->left, right = nd->right;
+        stack[3 * top] = left;
+        stack[3 * top + 1] = first;
+        stack[3 * top + 2] = half;
+        top++;
+        stack[3 * top] = right;
+        stack[3 * top + 1] = first + half;
+        stack[3 * top + 2] = count - half;
+        top++;
+    }
+    free(stack);
+    return 0;
+}
+
+static inline void sub3(const double *a, const double *b, double *o) {
+    o[0] = a[0] - b[0];
+    o[1] = a[1] - b[1];
+    o[2] = a[2] - b[2];
+}
+
+static inline void cross3(const double *a, const double *b, double *o) {
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Corners (9), edges (9) and normal (3) of the triangle with corners v. */
+static void features(const double *v, double *f) {
+    memcpy(f, v, 9 * sizeof(double));
+    sub3(v + 3, v, f + 9);
+    sub3(v + 6, v + 3, f + 12);
+    sub3(v, v + 6, f + 15);
+    cross3(f + 9, f + 12, f + 18);
+}
+
+static void tree_free(Tree *t) {
+    if (t == NULL) return;
+    free(t->v);
+    free(t->f);
+    free(t->order);
+    free(t->nodes);
+    free(t);
+}
+
+/* A tree from vertices (V, 3) and triangles (T, 3); NULL with an exception set on bad input. */
+static Tree *tree_new(PyObject *vobj, PyObject *fobj) {
+    PyArrayObject *va = (PyArrayObject *)PyArray_FROMANY(vobj, NPY_DOUBLE, 2, 2, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *fa = (PyArrayObject *)PyArray_FROMANY(fobj, NPY_INT64, 2, 2, NPY_ARRAY_IN_ARRAY);
+    Tree *t = NULL;
+    Keyed *scratch = NULL;
+    if (va == NULL || fa == NULL) goto fail;
+    if (PyArray_DIM(va, 1) != 3 || PyArray_DIM(fa, 1) != 3 || PyArray_DIM(fa, 0) < 1 ||
+        PyArray_DIM(fa, 0) > INT32_MAX / 4) {
+        PyErr_SetString(PyExc_ValueError, "a mesh needs vertices (V, 3) and triangles (T >= 1, 3)");
+        goto fail;
+    }
+    npy_intp nv = PyArray_DIM(va, 0), nt = PyArray_DIM(fa, 0);
+    const double *v = PyArray_DATA(va);
+    const int64_t *f = PyArray_DATA(fa);
+    t = calloc(1, sizeof(Tree));
+    if (t == NULL) goto nomem;
+    t->n_tri = (int32_t)nt;
+    t->v = malloc(sizeof(double) * 9 * (size_t)nt);
+    t->f = malloc(sizeof(double) * FEAT * (size_t)nt);
+    t->order = malloc(sizeof(int32_t) * (size_t)nt);
+    t->nodes = malloc(sizeof(Node) * 2 * (size_t)nt);
+    scratch = malloc(sizeof(Keyed) * (size_t)nt);
+    if (t->v == NULL || t->f == NULL || t->order == NULL || t->nodes == NULL || scratch == NULL)
+        goto nomem;
+    for (npy_intp k = 0; k < nt; k++) {
+        for (int c = 0; c < 3; c++) {
+            int64_t i = f[3 * k + c];
+            if (i < 0 || i >= nv) {
+                PyErr_SetString(PyExc_ValueError, "a triangle refers to a vertex out of range");
+                goto fail;
+            }
+            for (int a = 0; a < 3; a++) {
+                double x = v[3 * i + a];
+                if (!isfinite(x)) {
+                    PyErr_SetString(PyExc_ValueError, "a mesh vertex is not finite");
+                    goto fail;
+                }
+                t->v[9 * k + 3 * c + a] = x;
+            }
+        }
+        t->order[k] = (int32_t)k;
+        features(t->v + 9 * k, t->f + FEAT * k);
+    }
+    if (tree_build(t, scratch) != 0) goto nomem;
+    free(scratch);
+    Py_DECREF(va);
+    Py_DECREF(fa);
+    return t;
+nomem:
+    PyErr_NoMemory();
+fail:
+    free(scratch);
+    tree_free(t);
+    Py_XDECREF(va);
+    Py_XDECREF(fa);
+    return NULL;
+}
+
+static void set_free(PyObject *capsule) {
+    MeshSet *s = PyCapsule_GetPointer(capsule, "robotspec.meshset");
+    if (s == NULL) return;
+    for (Py_ssize_t i = 0; i < s->n; i++) tree_free(s->trees[i]);
+    free(s->trees);
+    free(s);
+}
+
+/* mesh_set([(vertices, triangles) or None, ...]) -> capsule */
+static PyObject *py_mesh_set(PyObject *self, PyObject *args) {
+    PyObject *seq;
+    if (!PyArg_ParseTuple(args, "O", &seq)) return NULL;
+    PyObject *fast = PySequence_Fast(seq, "mesh_set needs a sequence");
+    if (fast == NULL) return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(fast);
+    MeshSet *s = calloc(1, sizeof(MeshSet));
+    if (s == NULL) {
+        Py_DECREF(fast);
+        return PyErr_NoMemory();
+    }
+    s->trees = calloc((size_t)(n > 0 ? n : 1), sizeof(Tree *));
+    PyObject *cap = PyCapsule_New(s, "robotspec.meshset", set_free);
+    if (s->trees == NULL || cap == NULL) {
+        free(s->trees);
+        free(s);
+        Py_XDECREF(cap);
+        Py_DECREF(fast);
+        return PyErr_NoMemory();
+    }
+    s->n = n;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *item = PySequence_Fast_GET_ITEM(fast, i);
+        if (item == Py_None) continue;
+        PyObject *vobj, *fobj;
+        if (!PyArg_ParseTuple(item, "OO", &vobj, &fobj) ||
+            (s->trees[i] = tree_new(vobj, fobj)) == NULL) {
+            Py_DECREF(fast);
+            Py_DECREF(cap);
+            return NULL;
+        }
+    }
+    Py_DECREF(fast);
+    return cap;
+}
+
+/* ------------------------------------------------------------------------------- queries */
+
+/*
+ * Box a (half extents ha0, its own frame) and box b (half extents hb, centred at t with axes the
+ * columns of r, in a's frame): 1 when one of the fifteen separating axes leaves more than eps
+ * between them (a grown by eps on every side holds the ball of radius eps around it). The
+ * absolute rotation entries get a little extra so rounding never turns an overlap into a gap.
+ */
+static int boxes_apart(const double *r, const double *t, const double *ha0, const double *hb,
+                       double eps) {
+    double ar[9], ha[3];
+    for (int k = 0; k < 9; k++) ar[k] = fabs(r[k]) + 1e-12;
+    for (int x = 0; x < 3; x++) ha[x] = ha0[x] + eps;
+    for (int x = 0; x < 3; x++) {
+        if (fabs(t[x]) > ha[x] + ar[3 * x] * hb[0] + ar[3 * x + 1] * hb[1] + ar[3 * x + 2] * hb[2])
+            return 1;
+    }
+    for (int y = 0; y < 3; y++) {
+        double tb = t[0] * r[y] + t[1] * r[3 + y] + t[2] * r[6 + y];
+        if (fabs(tb) > ha[0] * ar[y] + ha[1] * ar[3 + y] + ha[2] * ar[6 + y] + hb[y]) return 1;
+    }
+    for (int x = 0; x < 3; x++) {
+        int x1 = (x + 1) % 3, x2 = (x + 2) % 3;
+        for (int y = 0; y < 3; y++) {
+            int y1 = (y + 1) % 3, y2 = (y + 2) % 3;
+            double lhs = fabs(t[x2] * r[3 * x1 + y] - t[x1] * r[3 * x2 + y]);
+            double rhs = ha[x1] * ar[3 * x2 + y] + ha[x2] * ar[3 * x1 + y] +
+                         hb[y1] * ar[3 * x + y2] + hb[y2] * ar[3 * x + y1];
+            if (lhs > rhs) return 1;
+        }
+    }
+    return 0;
+}
+
+/* Nodes na (of A) and nb (of B), B's mesh frame at (r, p) in A's: apart by more than eps? */
+static int nodes_apart(const Node *na, const Node *nb, const double *r, const double *p,
+                       double eps) {
+    /* b's box in a's box frame: rotation Ra^T r Rb, centre Ra^T (r cb + p - ca). */
+    double rb[9], rel[9], d[3], t[3];
+    for (int x = 0; x < 3; x++) {
+        for (int y = 0; y < 3; y++) {
+            rb[3 * x + y] = r[3 * x] * nb->ax[y] + r[3 * x + 1] * nb->ax[3 + y] +
+                            r[3 * x + 2] * nb->ax[6 + y];
+        }
+        d[x] = r[3 * x] * nb->c[0] + r[3 * x + 1] * nb->c[1] + r[3 * x + 2] * nb->c[2] + p[x] -
+               na->c[x];
+    }
+    for (int x = 0; x < 3; x++) {
+        for (int y = 0; y < 3; y++) {
+            rel[3 * x + y] = na->ax[x] * rb[y] + na->ax[3 + x] * rb[3 + y] + na->ax[6 + x] * rb[6 + y];
+        }
+        t[x] = na->ax[x] * d[0] + na->ax[3 + x] * d[1] + na->ax[6 + x] * d[2];
+    }
+    return boxes_apart(rel, t, na->h, nb->h, eps);
+}
+
+/* 1 when triangles a and b (corners, 9 doubles each) project on axis n with a gap of more than
+ * eps |n| (compared squared: no square root). */
+static inline int axis_apart(const double *n, const double *a, const double *b, double eps2) {
+    double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    double a0 = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+    double a1 = n[0] * a[3] + n[1] * a[4] + n[2] * a[5];
+    double a2 = n[0] * a[6] + n[1] * a[7] + n[2] * a[8];
+    double b0 = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
+    double b1 = n[0] * b[3] + n[1] * b[4] + n[2] * b[5];
+    double b2 = n[0] * b[6] + n[1] * b[7] + n[2] * b[8];
+    double gap = fmin(b0, fmin(b1, b2)) - fmax(a0, fmax(a1, a2));
+    double gap2 = fmin(a0, fmin(a1, a2)) - fmax(b0, fmax(b1, b2));
+    if (gap2 > gap) gap = gap2;
+    /* nn == 0 (a degenerate axis) leaves gap <= 0 or proves a real gap along no direction:
+     * gap > 0 with nn == 0 is impossible (all projections are 0). */
+    return gap > 0.0 && gap * gap > eps2 * nn;
+}
+
+/* A face normal: a's corners project to one value, so only b's three are computed. */
+static inline int normal_apart(const double *n, const double *a, const double *b, double eps2) {
+    double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    double d = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+    double b0 = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
+    double b1 = n[0] * b[3] + n[1] * b[4] + n[2] * b[5];
+    double b2 = n[0] * b[6] + n[1] * b[7] + n[2] * b[8];
+    double gap = fmin(b0, fmin(b1, b2)) - d;
+    double gap2 = d - fmax(b0, fmax(b1, b2));
+    if (gap2 > gap) gap = gap2;
+    return gap > 0.0 && gap * gap > eps2 * nn;
+}
+
+/* 1 when triangles fa and fb (features, one frame) are proven more than eps apart by one of the
+ * eleven separating axes of two triangles (two normals, nine edge-edge products). */
+static int triangles_apart(const double *fa, const double *fb, double eps2) {
+    if (normal_apart(fa + 18, fa, fb, eps2) || normal_apart(fb + 18, fb, fa, eps2)) return 1;
+    double n[3];
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            cross3(fa + 9 + 3 * i, fb + 9 + 3 * j, n);
+            if (axis_apart(n, fa, fb, eps2)) return 1;
+        }
+    }
+    return 0;
+}
+
+/* Per query: B's triangles moved into A's frame, each once (stamp says for which query). */
+typedef struct {
+    double *f;
+    int64_t *stamp;
+    int64_t now;
+    int32_t cap;
+} Moved;
+
+static const double *moved(Moved *m, const Tree *b, int32_t tri, const double *r,
+                           const double *p) {
+    double *o = m->f + FEAT * (size_t)tri;
+    if (m->stamp[tri] == m->now) return o;
+    m->stamp[tri] = m->now;
+    const double *src = b->f + FEAT * (size_t)tri;
+    for (int k = 0; k < 7; k++) {
+        const double *x = src + 3 * k;
+        double *y = o + 3 * k;
+        for (int i = 0; i < 3; i++) y[i] = r[3 * i] * x[0] + r[3 * i + 1] * x[1] + r[3 * i + 2] * x[2];
+        if (k < 3) {
+            y[0] += p[0];
+            y[1] += p[1];
+            y[2] += p[2];
+        }
+    }
+    return o;
+}
+
+typedef struct {
+    int32_t *pairs;
+    size_t cap;
+} Stack;
+
+/* 1 when meshes a and b are proven more than eps apart; b's frame is (r, p) in a's frame. 0 when
+ * not proven, -1 when out of memory. */
+static int meshes_apart(const Tree *a, const Tree *b, const double *r, const double *p, double eps,
+                        Stack *st, Moved *mv) {
+    const double eps2 = eps * eps;
+    size_t top = 0;
+    st->pairs[0] = 0;
+    st->pairs[1] = 0;
+    top = 1;
+    mv->now++;
+    while (top > 0) {
+        top--;
+        const Node *na = &a->nodes[st->pairs[2 * top]], *nb = &b->nodes[st->pairs[2 * top + 1]];
+        if (nodes_apart(na, nb, r, p, eps)) continue;
+        int leaf_a = na->left < 0, leaf_b = nb->left < 0;
+        if (leaf_a && leaf_b) {
+            for (int32_t w = nb->first; w < nb->first + nb->count; w++) {
+                const double *fb = moved(mv, b, b->order[w], r, p);
+                for (int32_t u = na->first; u < na->first + na->count; u++) {
+                    if (!triangles_apart(a->f + FEAT * (size_t)a->order[u], fb, eps2)) return 0;
+                }
+            }
+            continue;
+        }
+        if (top + 2 > st->cap) {
+            size_t cap = st->cap * 2;
+            int32_t *p2 = realloc(st->pairs, sizeof(int32_t) * 2 * cap);
+            if (p2 == NULL) return -1;
+            st->pairs = p2;
+            st->cap = cap;
+        }
+        /* Split the bigger box (a leaf cannot be split). */
+        double va = na->h[0] * na->h[1] * na->h[2], vb = nb->h[0] * nb->h[1] * nb->h[2];
+        int32_t ia = (int32_t)(na - a->nodes), ib = (int32_t)(nb - b->nodes);
+        if (leaf_b || (!leaf_a && va >= vb)) {
+            st->pairs[2 * top] = na->left;
+            st->pairs[2 * top + 1] = ib;
+            st->pairs[2 * top + 2] = na->right;
+            st->pairs[2 * top + 3] = ib;
+        } else {
+            st->pairs[2 * top] = ia;
+            st->pairs[2 * top + 1] = nb->left;
+            st->pairs[2 * top + 2] = ia;
+            st->pairs[2 * top + 3] = nb->right;
+        }
+        top += 2;
+    }
+    return 1;
+}
+
+/*
+ * apart(set, poses (N, G, 4, 4), rows (K,), pairs (K,), g1 (Q,), g2 (Q,), eps) -> uint8 (K,)
+ * Candidate c is (sample rows[c], geometry pair pairs[c] = (g1, g2)); poses are the geometries'
+ * world poses. 1: both are meshes, proven more than eps apart; 0: not proven (or not meshes).
+ */
+static PyObject *py_apart(PyObject *self, PyObject *args) {
+    PyObject *cap, *pobj, *robj, *kobj, *g1obj, *g2obj;
+    double eps;
+    if (!PyArg_ParseTuple(args, "OOOOOOd", &cap, &pobj, &robj, &kobj, &g1obj, &g2obj, &eps))
+        return NULL;
+    const MeshSet *s = PyCapsule_GetPointer(cap, "robotspec.meshset");
+    if (s == NULL) return NULL;
+    if (!(eps >= 1e-9) || !isfinite(eps)) {
+        /* At least a nanometre: the squared comparisons leave rounding no room below that. */
+        PyErr_SetString(PyExc_ValueError, "eps must be finite and >= 1e-9");
+        return NULL;
+    }
+    PyArrayObject *poses = (PyArrayObject *)PyArray_FROMANY(pobj, NPY_DOUBLE, 4, 4,
+                                                            NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *rows = (PyArrayObject *)PyArray_FROMANY(robj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *ks = (PyArrayObject *)PyArray_FROMANY(kobj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *g1 = (PyArrayObject *)PyArray_FROMANY(g1obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *g2 = (PyArrayObject *)PyArray_FROMANY(g2obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *out = NULL;
+    Stack st = {NULL, 0};
+    Moved mv = {NULL, NULL, 0, 0};
+    if (poses == NULL || rows == NULL || ks == NULL || g1 == NULL || g2 == NULL) goto done;
+    npy_intp n = PyArray_DIM(poses, 0), ng = PyArray_DIM(poses, 1), nc = PyArray_DIM(rows, 0);
+    npy_intp nq = PyArray_DIM(g1, 0);
+    if (ng != s->n || PyArray_DIM(poses, 2) != 4 || PyArray_DIM(poses, 3) != 4 ||
+        PyArray_DIM(ks, 0) != nc || PyArray_DIM(g2, 0) != nq) {
+        PyErr_SetString(PyExc_ValueError, "apart: arrays of the wrong shape");
+        goto done;
+    }
+    const int64_t *rv = PyArray_DATA(rows), *kv = PyArray_DATA(ks);
+    const int64_t *g1v = PyArray_DATA(g1), *g2v = PyArray_DATA(g2);
+    for (npy_intp c = 0; c < nc; c++) {
+        if (rv[c] < 0 || rv[c] >= n || kv[c] < 0 || kv[c] >= nq || g1v[kv[c]] < 0 ||
+            g1v[kv[c]] >= ng || g2v[kv[c]] < 0 || g2v[kv[c]] >= ng) {
+            PyErr_SetString(PyExc_ValueError, "apart: a candidate is out of range");
+            goto done;
+        }
+    }
+    npy_intp od[1] = {nc};
+    out = (PyArrayObject *)PyArray_ZEROS(1, od, NPY_UINT8, 0);
+    st.cap = 256;
+    st.pairs = malloc(sizeof(int32_t) * 2 * st.cap);
+    int32_t most = 1;
+    for (Py_ssize_t i = 0; i < s->n; i++) {
+        if (s->trees[i] != NULL && s->trees[i]->n_tri > most) most = s->trees[i]->n_tri;
+    }
+    mv.f = malloc(sizeof(double) * FEAT * (size_t)most);
+    mv.stamp = malloc(sizeof(int64_t) * (size_t)most);
+    if (mv.stamp != NULL) {
+        for (int32_t k = 0; k < most; k++) mv.stamp[k] = -1;
+    }
+    if (out == NULL || st.pairs == NULL || mv.f == NULL || mv.stamp == NULL) {
+        if (out != NULL) PyErr_NoMemory();
+        Py_CLEAR(out);
+        goto done;
+    }
+    const double *pv = PyArray_DATA(poses);
+    uint8_t *ov = PyArray_DATA(out);
+    int oom = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (npy_intp c = 0; c < nc && !oom; c++) {
+        const int64_t i = g1v[kv[c]], j = g2v[kv[c]];
+        const Tree *ta = s->trees[i], *tb = s->trees[j];
+        if (ta == NULL || tb == NULL) continue;
+        const double *pa = pv + (rv[c] * ng + i) * 16, *pb = pv + (rv[c] * ng + j) * 16;
+        /* B in A: r = Ra^T Rb, p = Ra^T (tb - ta). */
+        double r[9], p[3], d[3];
+        for (int x = 0; x < 3; x++) d[x] = pb[4 * x + 3] - pa[4 * x + 3];
+        for (int x = 0; x < 3; x++) {
+            for (int y = 0; y < 3; y++) {
+                r[3 * x + y] = pa[x] * pb[y] + pa[4 + x] * pb[4 + y] + pa[8 + x] * pb[8 + y];
+            }
+            p[x] = pa[x] * d[0] + pa[4 + x] * d[1] + pa[8 + x] * d[2];
+        }
+        int res = meshes_apart(ta, tb, r, p, eps, &st, &mv);
+        if (res < 0) oom = 1;
+        ov[c] = res == 1;
+    }
+    Py_END_ALLOW_THREADS
+    if (oom) {
+        Py_CLEAR(out);
+        PyErr_NoMemory();
+    }
+done:
+    free(st.pairs);
+    free(mv.f);
+    free(mv.stamp);
+    Py_XDECREF(poses);
+    Py_XDECREF(rows);
+    Py_XDECREF(ks);
+    Py_XDECREF(g1);
+    Py_XDECREF(g2);
+    return (PyObject *)out;
+}
+
+/* ---------------------------------------------------------------------------------- module */
+
+static PyMethodDef methods[] = {
+    {"mesh_set", py_mesh_set, METH_VARARGS, "Box trees of the meshes of a checker."},
+    {"apart", py_apart, METH_VARARGS, "Per candidate: 1 when its two meshes are proven apart."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_meshcore", "Proofs that two triangle meshes are apart, in C.", -1,
+    methods,
+};
+
+PyMODINIT_FUNC PyInit__meshcore(void) {
+    import_array();
+    return PyModule_Create(&module);
+}

@@ -160,7 +160,10 @@ def test_nearly_touching_real_meshes_agree_with_coal(
 
 def _without_proof(checker: SelfCollisionChecker) -> SelfCollisionChecker:
     twin = SelfCollisionChecker(checker.world, checker.rules, pairs=checker.active_pairs)
-    twin._compiled = dataclasses.replace(checker._build(), meshes=None)
+    compiled = checker._build()
+    twin._compiled = dataclasses.replace(
+        compiled, meshes=None, two_meshes=[False] * len(compiled.two_meshes)
+    )
     return twin
 
 

@@ -26,11 +26,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define LEAF_TRIANGLES 2
+#define LEAF_TRIANGLES 1
 
 typedef struct {
     double c[3], h[3]; /* box centre (mesh frame) and half extents along its axes */
     double ax[9];      /* the box's axes as columns (row-major), in the mesh frame */
+    double rad;        /* half diagonal: the radius of a ball around c that holds the box */
     int32_t left, right; /* children (nodes), or -1 for a leaf */
     int32_t first, count; /* a leaf's triangles: order[first .. first + count) */
 } Node;
@@ -46,9 +47,23 @@ typedef struct {
     Node *nodes;    /* node 0 is the root */
 } Tree;
 
+/*
+ * Per query: B's triangles (FEAT doubles) and nodes (axes and centre, 12 doubles) moved into A's
+ * frame, each once, and the traversal's stack. A stamp tells which query an entry was moved for.
+ */
+typedef struct Scratch {
+    double *tri, *node;
+    int64_t *tri_stamp, *node_stamp;
+    int64_t now;
+    int32_t *pairs;
+    size_t cap;
+} Scratch;
+
 typedef struct {
     Py_ssize_t n;
     Tree **trees; /* one per geometry; NULL where the geometry is not a mesh */
+    int32_t most_tri;
+    Scratch *one; /* apart_one's scratch: used only with the GIL held, so never shared */
 } MeshSet;
 
 /* ------------------------------------------------------------------------------ building */
@@ -129,6 +144,7 @@ static void box_of(const Tree *t, int32_t first, int32_t count, Node *nd) {
     for (int a = 0; a < 3; a++) {
         nd->c[a] = nd->ax[3 * a] * mid[0] + nd->ax[3 * a + 1] * mid[1] + nd->ax[3 * a + 2] * mid[2];
     }
+    nd->rad = sqrt(nd->h[0] * nd->h[0] + nd->h[1] * nd->h[1] + nd->h[2] * nd->h[2]);
 }
 
 /* Sort key for the split: triangle centroids along one axis (qsort has no context). */
@@ -294,10 +310,15 @@ fail:
     return NULL;
 }
 
+static void scratch_free(Scratch *s);
+static int scratch_init(Scratch *s, int32_t most_tri);
+
 static void set_free(PyObject *capsule) {
     MeshSet *s = PyCapsule_GetPointer(capsule, "robotspec.meshset");
     if (s == NULL) return;
     for (Py_ssize_t i = 0; i < s->n; i++) tree_free(s->trees[i]);
+    if (s->one != NULL) scratch_free(s->one);
+    free(s->one);
     free(s->trees);
     free(s);
 }
@@ -336,6 +357,15 @@ static PyObject *py_mesh_set(PyObject *self, PyObject *args) {
         }
     }
     Py_DECREF(fast);
+    s->most_tri = 1;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (s->trees[i] != NULL && s->trees[i]->n_tri > s->most_tri) s->most_tri = s->trees[i]->n_tri;
+    }
+    s->one = calloc(1, sizeof(Scratch));
+    if (s->one == NULL || scratch_init(s->one, s->most_tri) != 0) {
+        Py_DECREF(cap);
+        return PyErr_NoMemory();
+    }
     return cap;
 }
 
@@ -373,19 +403,15 @@ static int boxes_apart(const double *r, const double *t, const double *ha0, cons
     return 0;
 }
 
-/* Nodes na (of A) and nb (of B), B's mesh frame at (r, p) in A's: apart by more than eps? */
-static int nodes_apart(const Node *na, const Node *nb, const double *r, const double *p,
+/* Nodes na (of A) and nb (of B), nb's axes (rb) and centre (cb) already moved into A's frame:
+ * apart by more than eps? Balls first (three products), the boxes' fifteen axes only if they meet. */
+static int nodes_apart(const Node *na, const Node *nb, const double *rb, const double *cb,
                        double eps) {
-    /* b's box in a's box frame: rotation Ra^T r Rb, centre Ra^T (r cb + p - ca). */
-    double rb[9], rel[9], d[3], t[3];
-    for (int x = 0; x < 3; x++) {
-        for (int y = 0; y < 3; y++) {
-            rb[3 * x + y] = r[3 * x] * nb->ax[y] + r[3 * x + 1] * nb->ax[3 + y] +
-                            r[3 * x + 2] * nb->ax[6 + y];
-        }
-        d[x] = r[3 * x] * nb->c[0] + r[3 * x + 1] * nb->c[1] + r[3 * x + 2] * nb->c[2] + p[x] -
-               na->c[x];
-    }
+    double d[3] = {cb[0] - na->c[0], cb[1] - na->c[1], cb[2] - na->c[2]};
+    double reach = na->rad + nb->rad + eps;
+    if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > reach * reach * (1.0 + 1e-12)) return 1;
+    /* b's box in a's box frame: rotation Ra^T rb, centre Ra^T d. */
+    double rel[9], t[3];
     for (int x = 0; x < 3; x++) {
         for (int y = 0; y < 3; y++) {
             rel[3 * x + y] = na->ax[x] * rb[y] + na->ax[3 + x] * rb[3 + y] + na->ax[6 + x] * rb[6 + y];
@@ -440,19 +466,39 @@ static int triangles_apart(const double *fa, const double *fb, double eps2) {
     return 0;
 }
 
-/* Per query: B's triangles moved into A's frame, each once (stamp says for which query). */
-typedef struct {
-    double *f;
-    int64_t *stamp;
-    int64_t now;
-    int32_t cap;
-} Moved;
+static void scratch_free(Scratch *s) {
+    free(s->tri);
+    free(s->node);
+    free(s->tri_stamp);
+    free(s->node_stamp);
+    free(s->pairs);
+    memset(s, 0, sizeof(Scratch));
+}
 
-static const double *moved(Moved *m, const Tree *b, int32_t tri, const double *r,
-                           const double *p) {
-    double *o = m->f + FEAT * (size_t)tri;
-    if (m->stamp[tri] == m->now) return o;
-    m->stamp[tri] = m->now;
+/* Room for meshes of up to most_tri triangles; 0, or -1 when out of memory. */
+static int scratch_init(Scratch *s, int32_t most_tri) {
+    size_t nt = (size_t)(most_tri > 0 ? most_tri : 1), nn = 2 * nt;
+    memset(s, 0, sizeof(Scratch));
+    s->cap = 256;
+    s->tri = malloc(sizeof(double) * FEAT * nt);
+    s->node = malloc(sizeof(double) * 12 * nn);
+    s->tri_stamp = malloc(sizeof(int64_t) * nt);
+    s->node_stamp = malloc(sizeof(int64_t) * nn);
+    s->pairs = malloc(sizeof(int32_t) * 2 * s->cap);
+    if (!s->tri || !s->node || !s->tri_stamp || !s->node_stamp || !s->pairs) {
+        scratch_free(s);
+        return -1;
+    }
+    for (size_t k = 0; k < nt; k++) s->tri_stamp[k] = -1;
+    for (size_t k = 0; k < nn; k++) s->node_stamp[k] = -1;
+    return 0;
+}
+
+static const double *moved_tri(Scratch *m, const Tree *b, int32_t tri, const double *r,
+                               const double *p) {
+    double *o = m->tri + FEAT * (size_t)tri;
+    if (m->tri_stamp[tri] == m->now) return o;
+    m->tri_stamp[tri] = m->now;
     const double *src = b->f + FEAT * (size_t)tri;
     for (int k = 0; k < 7; k++) {
         const double *x = src + 3 * k;
@@ -467,29 +513,42 @@ static const double *moved(Moved *m, const Tree *b, int32_t tri, const double *r
     return o;
 }
 
-typedef struct {
-    int32_t *pairs;
-    size_t cap;
-} Stack;
+/* Node id of B: its axes (9, r Rb) and centre (3, r cb + p) in A's frame. */
+static const double *moved_node(Scratch *m, const Tree *b, int32_t id, const double *r,
+                                const double *p) {
+    double *o = m->node + 12 * (size_t)id;
+    if (m->node_stamp[id] == m->now) return o;
+    m->node_stamp[id] = m->now;
+    const Node *nb = &b->nodes[id];
+    for (int x = 0; x < 3; x++) {
+        for (int y = 0; y < 3; y++) {
+            o[3 * x + y] = r[3 * x] * nb->ax[y] + r[3 * x + 1] * nb->ax[3 + y] +
+                           r[3 * x + 2] * nb->ax[6 + y];
+        }
+        o[9 + x] = r[3 * x] * nb->c[0] + r[3 * x + 1] * nb->c[1] + r[3 * x + 2] * nb->c[2] + p[x];
+    }
+    return o;
+}
 
 /* 1 when meshes a and b are proven more than eps apart; b's frame is (r, p) in a's frame. 0 when
  * not proven, -1 when out of memory. */
 static int meshes_apart(const Tree *a, const Tree *b, const double *r, const double *p, double eps,
-                        Stack *st, Moved *mv) {
+                        Scratch *st) {
     const double eps2 = eps * eps;
-    size_t top = 0;
+    size_t top = 1;
     st->pairs[0] = 0;
     st->pairs[1] = 0;
-    top = 1;
-    mv->now++;
+    st->now++;
     while (top > 0) {
         top--;
-        const Node *na = &a->nodes[st->pairs[2 * top]], *nb = &b->nodes[st->pairs[2 * top + 1]];
-        if (nodes_apart(na, nb, r, p, eps)) continue;
+        const int32_t ia = st->pairs[2 * top], ib = st->pairs[2 * top + 1];
+        const Node *na = &a->nodes[ia], *nb = &b->nodes[ib];
+        const double *mb = moved_node(st, b, ib, r, p);
+        if (nodes_apart(na, nb, mb, mb + 9, eps)) continue;
         int leaf_a = na->left < 0, leaf_b = nb->left < 0;
         if (leaf_a && leaf_b) {
             for (int32_t w = nb->first; w < nb->first + nb->count; w++) {
-                const double *fb = moved(mv, b, b->order[w], r, p);
+                const double *fb = moved_tri(st, b, b->order[w], r, p);
                 for (int32_t u = na->first; u < na->first + na->count; u++) {
                     if (!triangles_apart(a->f + FEAT * (size_t)a->order[u], fb, eps2)) return 0;
                 }
@@ -503,10 +562,9 @@ static int meshes_apart(const Tree *a, const Tree *b, const double *r, const dou
             st->pairs = p2;
             st->cap = cap;
         }
-        /* Split the bigger box (a leaf cannot be split). */
-        double va = na->h[0] * na->h[1] * na->h[2], vb = nb->h[0] * nb->h[1] * nb->h[2];
-        int32_t ia = (int32_t)(na - a->nodes), ib = (int32_t)(nb - b->nodes);
-        if (leaf_b || (!leaf_a && va >= vb)) {
+        /* Split the bigger box (a leaf cannot be split); size is the diagonal, not the volume,
+         * which is zero for the flat boxes of planar patches. */
+        if (leaf_b || (!leaf_a && na->rad >= nb->rad)) {
             st->pairs[2 * top] = na->left;
             st->pairs[2 * top + 1] = ib;
             st->pairs[2 * top + 2] = na->right;
@@ -520,6 +578,23 @@ static int meshes_apart(const Tree *a, const Tree *b, const double *r, const dou
         top += 2;
     }
     return 1;
+}
+
+/* Candidate: geometry i against j at the poses pa, pb (row-major 4x4, world). */
+static int candidate_apart(const MeshSet *s, int64_t i, int64_t j, const double *pa,
+                           const double *pb, double eps, Scratch *st) {
+    const Tree *ta = s->trees[i], *tb = s->trees[j];
+    if (ta == NULL || tb == NULL) return 0;
+    /* B in A: r = Ra^T Rb, p = Ra^T (tb - ta). */
+    double r[9], p[3], d[3];
+    for (int x = 0; x < 3; x++) d[x] = pb[4 * x + 3] - pa[4 * x + 3];
+    for (int x = 0; x < 3; x++) {
+        for (int y = 0; y < 3; y++) {
+            r[3 * x + y] = pa[x] * pb[y] + pa[4 + x] * pb[4 + y] + pa[8 + x] * pb[8 + y];
+        }
+        p[x] = pa[x] * d[0] + pa[4 + x] * d[1] + pa[8 + x] * d[2];
+    }
+    return meshes_apart(ta, tb, r, p, eps, st);
 }
 
 /*
@@ -546,8 +621,8 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
     PyArrayObject *g1 = (PyArrayObject *)PyArray_FROMANY(g1obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
     PyArrayObject *g2 = (PyArrayObject *)PyArray_FROMANY(g2obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
     PyArrayObject *out = NULL;
-    Stack st = {NULL, 0};
-    Moved mv = {NULL, NULL, 0, 0};
+    Scratch st;
+    memset(&st, 0, sizeof(Scratch));
     if (poses == NULL || rows == NULL || ks == NULL || g1 == NULL || g2 == NULL) goto done;
     npy_intp n = PyArray_DIM(poses, 0), ng = PyArray_DIM(poses, 1), nc = PyArray_DIM(rows, 0);
     npy_intp nq = PyArray_DIM(g1, 0);
@@ -567,20 +642,10 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
     }
     npy_intp od[1] = {nc};
     out = (PyArrayObject *)PyArray_ZEROS(1, od, NPY_UINT8, 0);
-    st.cap = 256;
-    st.pairs = malloc(sizeof(int32_t) * 2 * st.cap);
-    int32_t most = 1;
-    for (Py_ssize_t i = 0; i < s->n; i++) {
-        if (s->trees[i] != NULL && s->trees[i]->n_tri > most) most = s->trees[i]->n_tri;
-    }
-    mv.f = malloc(sizeof(double) * FEAT * (size_t)most);
-    mv.stamp = malloc(sizeof(int64_t) * (size_t)most);
-    if (mv.stamp != NULL) {
-        for (int32_t k = 0; k < most; k++) mv.stamp[k] = -1;
-    }
-    if (out == NULL || st.pairs == NULL || mv.f == NULL || mv.stamp == NULL) {
-        if (out != NULL) PyErr_NoMemory();
+    if (out == NULL) goto done;
+    if (scratch_init(&st, s->most_tri) != 0) {
         Py_CLEAR(out);
+        PyErr_NoMemory();
         goto done;
     }
     const double *pv = PyArray_DATA(poses);
@@ -589,19 +654,8 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
     Py_BEGIN_ALLOW_THREADS
     for (npy_intp c = 0; c < nc && !oom; c++) {
         const int64_t i = g1v[kv[c]], j = g2v[kv[c]];
-        const Tree *ta = s->trees[i], *tb = s->trees[j];
-        if (ta == NULL || tb == NULL) continue;
-        const double *pa = pv + (rv[c] * ng + i) * 16, *pb = pv + (rv[c] * ng + j) * 16;
-        /* B in A: r = Ra^T Rb, p = Ra^T (tb - ta). */
-        double r[9], p[3], d[3];
-        for (int x = 0; x < 3; x++) d[x] = pb[4 * x + 3] - pa[4 * x + 3];
-        for (int x = 0; x < 3; x++) {
-            for (int y = 0; y < 3; y++) {
-                r[3 * x + y] = pa[x] * pb[y] + pa[4 + x] * pb[4 + y] + pa[8 + x] * pb[8 + y];
-            }
-            p[x] = pa[x] * d[0] + pa[4 + x] * d[1] + pa[8 + x] * d[2];
-        }
-        int res = meshes_apart(ta, tb, r, p, eps, &st, &mv);
+        int res = candidate_apart(s, i, j, pv + (rv[c] * ng + i) * 16, pv + (rv[c] * ng + j) * 16,
+                                  eps, &st);
         if (res < 0) oom = 1;
         ov[c] = res == 1;
     }
@@ -611,9 +665,7 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
         PyErr_NoMemory();
     }
 done:
-    free(st.pairs);
-    free(mv.f);
-    free(mv.stamp);
+    scratch_free(&st);
     Py_XDECREF(poses);
     Py_XDECREF(rows);
     Py_XDECREF(ks);
@@ -622,11 +674,50 @@ done:
     return (PyObject *)out;
 }
 
+/*
+ * apart_one(set, poses (N, G, 4, 4) float64 C-contiguous, row, i, j, eps) -> bool
+ * One candidate, for a caller that tests candidates one by one and stops early (an "any
+ * collision" query). Holds the GIL: its scratch lives in the set.
+ */
+static PyObject *py_apart_one(PyObject *self, PyObject *args) {
+    PyObject *cap, *pobj;
+    Py_ssize_t row, i, j;
+    double eps;
+    if (!PyArg_ParseTuple(args, "OOnnnd", &cap, &pobj, &row, &i, &j, &eps)) return NULL;
+    const MeshSet *s = PyCapsule_GetPointer(cap, "robotspec.meshset");
+    if (s == NULL) return NULL;
+    if (!PyArray_Check(pobj)) {
+        PyErr_SetString(PyExc_TypeError, "apart_one: poses must be a numpy array");
+        return NULL;
+    }
+    PyArrayObject *poses = (PyArrayObject *)pobj;
+    if (PyArray_TYPE(poses) != NPY_DOUBLE || !PyArray_IS_C_CONTIGUOUS(poses) ||
+        PyArray_NDIM(poses) != 4 || PyArray_DIM(poses, 1) != s->n || PyArray_DIM(poses, 2) != 4 ||
+        PyArray_DIM(poses, 3) != 4) {
+        PyErr_SetString(PyExc_ValueError, "apart_one: poses of the wrong type or shape");
+        return NULL;
+    }
+    if (row < 0 || row >= PyArray_DIM(poses, 0) || i < 0 || i >= s->n || j < 0 || j >= s->n) {
+        PyErr_SetString(PyExc_ValueError, "apart_one: a candidate is out of range");
+        return NULL;
+    }
+    if (!(eps >= 1e-9) || !isfinite(eps)) {
+        PyErr_SetString(PyExc_ValueError, "eps must be finite and >= 1e-9");
+        return NULL;
+    }
+    const double *pv = PyArray_DATA(poses);
+    int res = candidate_apart(s, i, j, pv + (row * s->n + i) * 16, pv + (row * s->n + j) * 16, eps,
+                              s->one);
+    if (res < 0) return PyErr_NoMemory();
+    return PyBool_FromLong(res == 1);
+}
+
 /* ---------------------------------------------------------------------------------- module */
 
 static PyMethodDef methods[] = {
     {"mesh_set", py_mesh_set, METH_VARARGS, "Box trees of the meshes of a checker."},
     {"apart", py_apart, METH_VARARGS, "Per candidate: 1 when its two meshes are proven apart."},
+    {"apart_one", py_apart_one, METH_VARARGS, "Whether one candidate's meshes are proven apart."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -14,9 +14,9 @@ Everything is built on the first query (meshes read once), so constructing a che
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,6 +44,7 @@ if TYPE_CHECKING:
 __all__ = ["PairDistance", "SelfCollisionChecker"]
 
 Bools = NDArray[np.bool_]
+Point = tuple[float, float, float]
 
 #: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).
 _BLOCK = 512
@@ -400,74 +401,67 @@ class SelfCollisionChecker:
             )
         return self._distance_fns
 
-    def _distance_scan(self, qs: F64, with_points: bool) -> tuple[F64, F64]:
+    def _distance_rows(
+        self, qs: F64, with_points: bool
+    ) -> Iterator[tuple[list[float], list[tuple[list[float], list[float]] | None]]]:
+        """Per configuration of ``qs``: each pair's distance and (``with_points``) closest points.
+
+        Everything per pair stays in Python lists: numpy scalar indexing and small arrays per
+        pair cost more than coal's own time on robots with many small pairs.
+        """
         c = self._build()
         coal = import_coal()
         fns = self._distance_functors(c)
-        n, npairs = qs.shape[0], len(self._pairs)
-        dist = np.full((n, npairs), np.inf)
-        points = np.full((n, npairs, 2, 3), np.nan) if with_points else np.zeros((0, 0, 2, 3))
+        npairs = len(self._pairs)
         req = coal.DistanceRequest()  # coal >= 3 always fills the nearest points
         res = coal.DistanceResult()
         tf = c.transforms
-        owner = c.pair_of_list
         # The transforms are updated in place, so each pair's functor and transforms are bound
-        # once; per-pair bests stay Python floats until the row ends (numpy scalar indexing per
-        # pair cost more than a third of coal's own time on robots with many small pairs).
+        # once.
         work = tuple(
             zip(
                 fns,
                 (tf[i] for i in c.pair_geom1_list),
                 (tf[j] for j in c.pair_geom2_list),
-                owner,
+                c.pair_of_list,
                 strict=True,
             )
         )
         clear, near1, near2 = res.clear, res.getNearestPoint1, res.getNearestPoint2
         none = np.zeros(len(c.pair_of), dtype=np.uint8)  # poses only, no broad phase
-        for start in range(0, n, _BLOCK):
+        for start in range(0, qs.shape[0], _BLOCK):
             _, _, poses = self._broad(c, qs[start : start + _BLOCK], 0.0, none)
             for r in range(poses.shape[0]):
-                for g in range(len(tf)):
-                    tf[g].setRotation(poses[r, g, :3, :3])
-                    tf[g].setTranslation(poses[r, g, :3, 3])
+                for g, pose in enumerate(poses[r]):
+                    tf[g].setRotation(pose[:3, :3])
+                    tf[g].setTranslation(pose[:3, 3])
                 best = [math.inf] * npairs
-                near: list[tuple[F64, F64] | None] = [None] * npairs
+                near: list[tuple[list[float], list[float]] | None] = [None] * npairs
                 for fn, t1, t2, p in work:
                     clear()
                     d = fn(t1, t2, req, res)
                     if d < best[p]:
                         best[p] = d
                         if with_points:
-                            near[p] = (near1(), near2())
-                row = start + r
-                dist[row] = best
-                if with_points:
-                    for p, pair_points in enumerate(near):
-                        if pair_points is not None:
-                            points[row, p, 0], points[row, p, 1] = pair_points
-        return dist, points
+                            near[p] = (near1().tolist(), near2().tolist())
+                yield best, near
 
     def distances(self, q: object) -> tuple[PairDistance, ...]:
         """Minimum distance and closest points of every checked pair at ``q``."""
-        dist, points = self._distance_scan(self._as_batch(q)[:1], with_points=True)
-        out = []
-        for k, (a, b) in enumerate(self._pairs):
-            p1, p2 = points[0, k, 0], points[0, k, 1]
-            out.append(
-                PairDistance(
-                    link1=a,
-                    link2=b,
-                    distance=float(dist[0, k]),
-                    point1=(float(p1[0]), float(p1[1]), float(p1[2])),
-                    point2=(float(p2[0]), float(p2[1]), float(p2[2])),
-                )
-            )
+        nan: Point = (math.nan, math.nan, math.nan)
+        out: list[PairDistance] = []
+        for best, near in self._distance_rows(self._as_batch(q)[:1], with_points=True):
+            for (a, b), d, x in zip(self._pairs, best, near, strict=True):
+                p1, p2 = (cast(Point, tuple(x[0])), cast(Point, tuple(x[1]))) if x else (nan, nan)
+                out.append(PairDistance(a, b, d, p1, p2))
         return tuple(out)
 
     def distances_batch(self, qs: object) -> F64:
         """Minimum distance of every checked pair (N, P) for each configuration of ``qs``."""
-        dist, _ = self._distance_scan(self._as_batch(qs), with_points=False)
+        batch = self._as_batch(qs)
+        dist = np.full((batch.shape[0], len(self._pairs)), np.inf)
+        for row, (best, _) in enumerate(self._distance_rows(batch, with_points=False)):
+            dist[row] = best
         return dist
 
     def pair_index(self, a: str, b: str) -> int:

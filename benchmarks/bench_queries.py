@@ -253,6 +253,25 @@ def batch_rows(samples: int, collision_configs: int, rounds: int) -> list[Row]:
             t[1],
         )
     ]
+    buffer = np.empty((len(qs), len(robot.world.bodies), 4, 4))
+    t = duel(lambda _: kin.forward_batch(qs, out=buffer), [0], pin_loop, [0], rounds)
+    rows.append(
+        Row(
+            f"pr2: batched FK, {samples} configs, all bodies, into a reused array (out=)",
+            t[0],
+            "Python loop of framesForwardKinematics",
+            t[1],
+        )
+    )
+    t = duel(lambda _: kin.forward_batch(qs, threads=1), [0], pin_loop, [0], rounds)
+    rows.append(
+        Row(
+            f"pr2: batched FK, {samples} configs, all bodies, one thread",
+            t[0],
+            "Python loop of framesForwardKinematics",
+            t[1],
+        )
+    )
     t = duel(lambda _: kin.forward_batch(qs), [0], pin_loop_read, [0], 1)
     rows.append(
         Row(

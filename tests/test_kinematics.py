@@ -78,6 +78,32 @@ def test_batch_equals_single(pr2) -> None:
     np.testing.assert_allclose(small, batch[:3], atol=1e-12)
 
 
+def test_batch_threads_and_out_give_the_same_poses(pr2) -> None:
+    world, k, _ = pr2
+    rng = np.random.default_rng(4)
+    qs = rng.uniform(-2, 2, (2100, len(world.degrees_of_freedom)))  # above PARALLEL_BATCH
+    one = k.forward_batch(qs, threads=1)
+    np.testing.assert_array_equal(k.forward_batch(qs), one)
+    for threads in (2, 3, 64):
+        np.testing.assert_array_equal(k.forward_batch(qs[:101], threads=threads), one[:101])
+    out = np.full_like(one, np.nan)
+    got = k.forward_batch(qs, out=out, threads=2)
+    assert got is out
+    np.testing.assert_array_equal(out, one)
+    # Reusing the buffer for another batch overwrites every entry.
+    k.forward_batch(qs[::-1], out=out)
+    np.testing.assert_array_equal(out, one[::-1])
+    with pytest.raises(KinematicsError, match="threads"):
+        k.forward_batch(qs, threads=0)
+    for bad in (out[:-1], out.astype(np.float32), out[:, ::-1], np.zeros(3), [[1.0]]):
+        with pytest.raises(KinematicsError, match="out must be"):
+            k.forward_batch(qs, out=bad)  # type: ignore[arg-type]
+    frozen = out.copy()
+    frozen.flags.writeable = False
+    with pytest.raises(KinematicsError, match="writeable"):
+        k.forward_batch(qs, out=frozen)
+
+
 def test_chain_fk_equals_relative_pose(pr2) -> None:
     w, k, _ = pr2
     q = np.random.default_rng(3).uniform(-2, 2, len(w.degrees_of_freedom))

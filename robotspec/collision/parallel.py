@@ -9,7 +9,6 @@ the pairs) and builds its own checker once. Either way the answers are the same.
 from __future__ import annotations
 
 import multiprocessing
-import os
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -23,6 +22,7 @@ from robotspec.arrays import F64
 from robotspec.collision.checker import SelfCollisionChecker
 from robotspec.collision.rules import CollisionRules
 from robotspec.collision.shapes import MissingMeshPolicy
+from robotspec.model.kinematics import available_cpus
 from robotspec.model.world import Body, Connection, DegreeOfFreedom, World
 
 __all__ = ["CheckerInputs", "default_processes", "ever_colliding_parallel"]
@@ -87,10 +87,7 @@ def _ever_colliding_task(qs: F64, mask: Bools, margin: float) -> Bools:
 
 def default_processes() -> int:
     """The CPUs this process may run on."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover - not on Linux
-        return max(1, os.cpu_count() or 1)
+    return available_cpus()
 
 
 def ever_colliding_parallel(

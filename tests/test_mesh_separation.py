@@ -172,10 +172,20 @@ def test_checker_answers_are_coals_on_every_pr2_pair(
     pr2_checker: SelfCollisionChecker, margin: float
 ) -> None:
     qs = random_configurations(pr2_checker.world, 120, seed=3)
-    ours = pr2_checker.collisions_batch(qs, margin=margin)
-    theirs = _without_proof(pr2_checker).collisions_batch(qs, margin=margin)
+    twin = _without_proof(pr2_checker)
+    ours = pr2_checker.collisions_batch(qs, margin=margin)  # proofs in one C call per block
+    theirs = twin.collisions_batch(qs, margin=margin)
     assert ours.any() and not ours.all()
     np.testing.assert_array_equal(ours, theirs)
+    # One configuration at a time, and "any hit": proofs one candidate at a time.
+    for q in qs[:25]:
+        assert pr2_checker.colliding_pairs(q, margin=margin) == twin.colliding_pairs(
+            q, margin=margin
+        )
+    np.testing.assert_array_equal(
+        pr2_checker.in_collision_batch(qs, margin=margin),
+        twin.in_collision_batch(qs, margin=margin),
+    )
 
 
 def test_checker_answers_are_coals_on_tiago() -> None:

@@ -51,6 +51,8 @@ _BLOCK = 512
 #: A mesh pair that collided at this many tests in a row goes straight to coal: proving it apart
 #: would most likely fail, after a search of its trees.
 _STREAK = 2
+#: Candidates of a block from which mesh proofs run in one C call rather than one by one.
+_BATCH_PROOFS = 64
 #: Room (m) beyond the margin by which a mesh pair must be proven apart before coal is skipped:
 #: coal's own collision test between triangles stops within about 1e-6 m, so a pair proven this far
 #: apart is one coal calls apart too, and the answers stay coal's.
@@ -300,11 +302,17 @@ class SelfCollisionChecker:
             elif drop_found and start:
                 geom_mask = (~np.asarray(found, dtype=np.bool_)[c.pair_of]).astype(np.uint8)
             rows, ks, poses = self._broad(c, block, margin, geom_mask)
+            tried = [False] * len(ks)
+            if meshes is not None and not first_only and len(ks) >= _BATCH_PROOFS:
+                # Every candidate is tested, so the mesh proofs run in one C call (no Python per
+                # candidate); an any-hit query proves them one by one instead, and stops early,
+                # and so do a few candidates (numpy's fixed cost would exceed the calls saved).
+                rows, ks, tried = self._prove_apart(c, poses, rows, ks, eps)
             stamp = [-1] * len(tf)
             last_row = -1
             skip_row = False
             row_hits: set[int] = set()
-            for r, k in zip(rows, ks, strict=True):
+            for r, k, done in zip(rows, ks, tried, strict=True):
                 if r != last_row:
                     last_row, skip_row = r, False
                     row_hits = set()
@@ -316,7 +324,12 @@ class SelfCollisionChecker:
                 i, j = g1s[k], g2s[k]
                 # Two meshes: try to prove them apart in C first (tens of times cheaper than
                 # coal when they nearly touch), unless the pair collided at its last tests.
-                if two_meshes[k] and streak[k] < _STREAK and apart(meshes, poses, r, i, j, eps):
+                if (
+                    two_meshes[k]
+                    and not done
+                    and streak[k] < _STREAK
+                    and apart(meshes, poses, r, i, j, eps)
+                ):
                     continue
                 if stamp[i] != r:
                     stamp[i] = r
@@ -341,6 +354,25 @@ class SelfCollisionChecker:
                 skip_row = first_only
         hits[hit_rows, hit_pairs] = True
         return hits
+
+    def _prove_apart(
+        self, c: _Compiled, poses: F64, rows: list[int], ks: list[int], eps: float
+    ) -> tuple[list[int], list[int], list[bool]]:
+        """The candidates left once the mesh pairs proven apart are dropped, and which were tried.
+
+        Pairs on a streak of collisions are not tried (see ``_STREAK``).
+        """
+        r = np.asarray(rows, dtype=np.int64)
+        k = np.asarray(ks, dtype=np.int64)
+        streak = np.asarray(self._streak, dtype=np.int64)
+        tried = np.asarray(c.two_meshes, dtype=np.bool_)[k] & (streak[k] < _STREAK)
+        at = np.flatnonzero(tried)
+        if not len(at):
+            return rows, ks, [False] * len(ks)
+        proven = _meshcore.apart(c.meshes, poses, r[at], k[at], c.pair_geom1, c.pair_geom2, eps)
+        keep = np.ones(len(k), dtype=np.bool_)
+        keep[at[proven == 1]] = False
+        return r[keep].tolist(), k[keep].tolist(), tried[keep].tolist()
 
     def _requests(self, margin: float) -> tuple[Any, Any]:
         """A coal collision request for ``margin`` and a result to reuse (kept per checker)."""

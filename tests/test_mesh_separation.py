@@ -9,6 +9,7 @@ millimetres apart, and whole checkers with and without the proof on every pair o
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -229,3 +230,27 @@ def test_bad_meshes_and_arguments_are_refused() -> None:
     far = np.array([[np.eye(4), _pose((5.0, 0.0, 0.0), (0.0, 0.0, 0.0))]])
     assert _meshcore.apart(s, far, np.array([0]), np.array([0]), one, one + 1, 1e-5)[0] == 0
     assert _apart(meshes, far, 1e-5)[0] == 1
+
+
+def test_a_mesh_scaled_past_float_range_is_a_located_error(tmp_path: Path) -> None:
+    import trimesh
+
+    from robotspec.description.urdf import load_urdf
+    from robotspec.errors import CollisionError
+
+    trimesh.creation.box(extents=(1e30, 1e30, 1e30)).export(str(tmp_path / "big.stl"))
+    trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(str(tmp_path / "cube.stl"))
+    (tmp_path / "two.urdf").write_text(
+        '<robot name="two">'
+        '<link name="a"><collision><geometry>'
+        '<mesh filename="big.stl" scale="1e300 1e300 1e300"/></geometry></collision></link>'
+        '<link name="b"><collision><geometry><mesh filename="cube.stl"/></geometry></collision>'
+        '</link><joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<origin xyz="3 0 0"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    world = load_urdf(tmp_path / "two.urdf")
+    checker = SelfCollisionChecker(world, CollisionRules(bodies=("a", "b")), pairs=[("a", "b")])
+    with pytest.raises(CollisionError, match=r"link 'a'.*beyond the float range") as info:
+        checker.in_collision(world.configuration())
+    assert info.value.file is not None and info.value.file.endswith("big.stl")

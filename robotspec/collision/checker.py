@@ -516,4 +516,10 @@ def _mesh_trees(geoms: Sequence[CollisionGeometry], g1: list[int], g2: list[int]
             used.update((i, j))
     if not used:
         return None
-    return _meshcore.mesh_set([g.triangles if k in used else None for k, g in enumerate(geoms)])
+    try:
+        return _meshcore.mesh_set([g.triangles if k in used else None for k, g in enumerate(geoms)])
+    except ValueError as exc:  # a vertex scaled past float range: the reader checked the rest
+        bodies = sorted({geoms[k].body for k in used})
+        raise CollisionError(
+            f"a collision mesh of {', '.join(bodies)} cannot be used: {exc}", kind="mesh"
+        ) from None

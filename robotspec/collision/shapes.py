@@ -123,7 +123,13 @@ class MeshLibrary:
         if hit is not None:
             return hit
         vertices, faces = read_triangles(path, CollisionError)
-        vertices = vertices * np.asarray(scale, dtype=np.float64)
+        with np.errstate(over="ignore", invalid="ignore"):
+            vertices = vertices * np.asarray(scale, dtype=np.float64)
+        if not np.all(np.isfinite(vertices)):
+            # Checked before coal sees them: its tree builder has no answer for infinities.
+            raise CollisionError(
+                f"mesh scaled by {scale} has vertices beyond the float range", kind="mesh"
+            )
         coal = import_coal()
         model = coal.BVHModelOBBRSS()
         model.beginModel(len(faces), len(vertices))

@@ -106,7 +106,10 @@ def test_proven_apart_soups_are_apart_for_coal(
     fa = np.arange(len(va), dtype=np.int64).reshape(-1, 3)
     fb = np.arange(len(vb), dtype=np.int64).reshape(-1, 3)
     pose_a, pose_b = _pose((0.01, -0.02, 0.03), (0.3, -0.2, 0.1)), _pose(xyz, rpy)
-    proven = _apart([(va, fa), (vb, fb)], np.array([[pose_a, pose_b]]), eps)[0]
+    poses = np.array([[pose_a, pose_b]])
+    proven = _apart([(va, fa), (vb, fb)], poses, eps)[0]
+    one = _meshcore.apart_one(_meshcore.mesh_set([(va, fa), (vb, fb)]), poses, 0, 0, 1, eps)
+    assert one == bool(proven)  # the one-by-one entry point gives the batch's answer
     if proven:
         ma, mb = _bvh(va, fa), _bvh(vb, fb)
         assert _coal_distance(ma, pose_a, mb, pose_b) > eps - 1e-9

@@ -44,3 +44,19 @@ def erd_robots() -> Path:
     if not share.is_dir():
         pytest.skip(f"example-robot-data's share folder {share} is missing")
     return share / "robots"
+
+
+def all_pairs_checker(name: str) -> object:
+    """A collision checker of every pair of a shipped robot's bodies with geometry, no rules.
+
+    What the collision matrix checks; the tests that compare checkers (workers, mesh proofs) use
+    it. Skips when example-robot-data is absent.
+    """
+    from robotspec.collision import CollisionRules, SelfCollisionChecker
+    from robotspec.compiler import compile_robot
+
+    erd_robots()
+    robot = compile_robot(name)
+    names = tuple(b.name for b in robot.bodies_with_collisions)
+    pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
+    return SelfCollisionChecker(robot.world, CollisionRules(bodies=names), pairs=pairs)

@@ -7,24 +7,19 @@ plain records. Both must agree with the single-process answer on a real robot, p
 from __future__ import annotations
 
 import multiprocessing
+from typing import cast
 
 import numpy as np
 import pytest
 
-from robotspec.collision import CollisionRules, SelfCollisionChecker, random_configurations
+from robotspec.collision import SelfCollisionChecker, random_configurations
 from robotspec.collision.parallel import ever_colliding_parallel
-from tests.conftest import erd_robots
+from tests.conftest import all_pairs_checker
 
 
 @pytest.fixture(scope="module")
 def checker() -> SelfCollisionChecker:
-    from robotspec.compiler import compile_robot
-
-    erd_robots()
-    robot = compile_robot("pr2")
-    names = tuple(b.name for b in robot.bodies_with_collisions)
-    pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
-    return SelfCollisionChecker(robot.world, CollisionRules(bodies=names), pairs=pairs)
+    return cast(SelfCollisionChecker, all_pairs_checker("pr2"))
 
 
 @pytest.mark.parametrize("method", ["fork", "spawn"])

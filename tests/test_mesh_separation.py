@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import pytest
@@ -23,7 +24,7 @@ from robotspec.collision import (
     random_configurations,
 )
 from robotspec.model.rotations import rpy_to_matrix
-from tests.conftest import erd_robots
+from tests.conftest import all_pairs_checker
 
 coal = pytest.importorskip("coal")
 
@@ -118,13 +119,7 @@ def test_proven_apart_soups_are_apart_for_coal(
 
 @pytest.fixture(scope="module")
 def pr2_checker() -> SelfCollisionChecker:
-    from robotspec.compiler import compile_robot
-
-    erd_robots()
-    robot = compile_robot("pr2")
-    names = tuple(b.name for b in robot.bodies_with_collisions)
-    pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
-    return SelfCollisionChecker(robot.world, CollisionRules(bodies=names), pairs=pairs)
+    return cast(SelfCollisionChecker, all_pairs_checker("pr2"))
 
 
 @pytest.mark.parametrize(
@@ -193,14 +188,8 @@ def test_checker_answers_are_coals_on_every_pr2_pair(
 
 
 def test_checker_answers_are_coals_on_tiago() -> None:
-    from robotspec.compiler import compile_robot
-
-    erd_robots()
-    robot = compile_robot("tiago")
-    names = tuple(b.name for b in robot.bodies_with_collisions)
-    pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
-    checker = SelfCollisionChecker(robot.world, CollisionRules(bodies=names), pairs=pairs)
-    qs = random_configurations(robot.world, 40, seed=5)
+    checker = cast(SelfCollisionChecker, all_pairs_checker("tiago"))
+    qs = random_configurations(checker.world, 40, seed=5)
     np.testing.assert_array_equal(
         checker.collisions_batch(qs), _without_proof(checker).collisions_batch(qs)
     )

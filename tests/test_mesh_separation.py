@@ -24,7 +24,7 @@ from robotspec.collision import (
     random_configurations,
 )
 from robotspec.model.rotations import rpy_to_matrix
-from tests.conftest import all_pairs_checker
+from tests.conftest import all_pairs_checker, erd_robots
 
 coal = pytest.importorskip("coal")
 
@@ -246,3 +246,56 @@ def test_a_mesh_scaled_past_float_range_is_a_located_error(tmp_path: Path) -> No
     with pytest.raises(CollisionError, match=r"link 'a'.*beyond the float range") as info:
         checker.in_collision(world.configuration())
     assert info.value.file is not None and info.value.file.endswith("big.stl")
+
+
+def _without_hulls(checker: SelfCollisionChecker) -> SelfCollisionChecker:
+    twin = SelfCollisionChecker(checker.world, checker.rules, pairs=checker.active_pairs)
+    twin._compiled = checker._build()
+    twin._hull_fns = (None,) * len(twin._compiled.pair_of)
+    return twin
+
+
+@pytest.mark.parametrize("name", ["pr2", "tiago", "b1_ur5_allegro"])
+def test_hull_first_distances_are_coals_mesh_distances(name: str) -> None:
+    from robotspec.compiler import compile_robot
+
+    erd_robots()
+    robot = compile_robot(name)
+    checker = SelfCollisionChecker.from_robot(robot)
+    compiled = checker._build()
+    hulls = checker._hull_functors(compiled)
+    with_mesh = [g.triangles is not None for g in compiled.model.geometries]
+    pairs = zip(compiled.pair_geom1_list, compiled.pair_geom2_list, strict=True)
+    meshy = [k for k, (i, j) in enumerate(pairs) if with_mesh[i] or with_mesh[j]]
+    assert meshy and sum(hulls[k] is not None for k in meshy) >= 0.9 * len(meshy)
+    twin = _without_hulls(checker)
+    for q in random_configurations(robot.world, 3, seed=13):
+        ours, theirs = checker.distances(q), twin.distances(q)
+        got = np.array([d.distance for d in ours])
+        want = np.array([d.distance for d in theirs])
+        # Mesh to mesh both are exact; against a curved primitive coal's GJK stops within 1e-6.
+        np.testing.assert_allclose(got, want, atol=2e-6, rtol=0)
+        for d in ours:
+            if d.distance > 1e-5:  # closest points as far apart as the distance says
+                gap = float(np.linalg.norm(np.subtract(d.point1, d.point2)))
+                assert gap == pytest.approx(d.distance, abs=1e-8)
+
+
+def test_points_on_a_mesh_are_told_from_points_off_it() -> None:
+    v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    f = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])  # a tetrahedron's surface
+    s = _meshcore.mesh_set([(v, f)])
+    pose = _pose((1.0, 2.0, 3.0), (0.4, -0.3, 1.2))
+    poses = np.array([[pose]])
+
+    def world(p: list[float]) -> np.ndarray:
+        return np.asarray(pose[:3, :3] @ np.asarray(p) + pose[:3, 3])
+
+    for p in ([0.0, 0, 0], [0.25, 0.25, 0], [1 / 3, 1 / 3, 1 / 3], [0.5, 0, 0.5]):
+        assert _meshcore.on_surface(s, poses, 0, 0, world(p), 1e-9), p
+    for p in ([0.1, 0.1, 0.1], [0.5, 0.5, 0.5], [0.25, 0.25, 1e-6]):  # inside, outside, just off
+        assert not _meshcore.on_surface(s, poses, 0, 0, world(p), 1e-9), p
+    with pytest.raises(ValueError, match="wrong type or shape"):
+        _meshcore.on_surface(s, poses, 0, 0, np.zeros(2), 1e-9)
+    with pytest.raises(ValueError, match="out of range"):
+        _meshcore.on_surface(s, poses, 1, 0, np.zeros(3), 1e-9)

@@ -712,12 +712,145 @@ static PyObject *py_apart_one(PyObject *self, PyObject *args) {
     return PyBool_FromLong(res == 1);
 }
 
+/* ------------------------------------------------------------------------ points on a mesh */
+
+static inline double dot3(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The point of triangle abc closest to p (Ericson, Real-Time Collision Detection, 5.1.5). */
+static void point_triangle(const double *p, const double *a, const double *b, const double *c,
+                           double *o) {
+    double ab[3], ac[3], ap[3], bp[3], cp[3];
+    sub3(b, a, ab);
+    sub3(c, a, ac);
+    sub3(p, a, ap);
+    double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) {
+        memcpy(o, a, 3 * sizeof(double));
+        return;
+    }
+    sub3(p, b, bp);
+    double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) {
+        memcpy(o, b, 3 * sizeof(double));
+        return;
+    }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        double v = d1 / (d1 - d3);
+        for (int k = 0; k < 3; k++) o[k] = a[k] + v * ab[k];
+        return;
+    }
+    sub3(p, c, cp);
+    double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) {
+        memcpy(o, c, 3 * sizeof(double));
+        return;
+    }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        double w = d2 / (d2 - d6);
+        for (int k = 0; k < 3; k++) o[k] = a[k] + w * ac[k];
+        return;
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (int k = 0; k < 3; k++) o[k] = b[k] + w * (c[k] - b[k]);
+        return;
+    }
+    double den = 1.0 / (va + vb + vc);
+    double v = vb * den, w = vc * den;
+    for (int k = 0; k < 3; k++) o[k] = a[k] + ab[k] * v + ac[k] * w;
+}
+
+/* 1 when point p (the mesh's frame) is within tol of one of the mesh's triangles, else 0; -1 when
+ * out of memory. A box farther than tol from p is not entered. */
+static int point_on_mesh(const Tree *t, const double *p, double tol, Scratch *st) {
+    const double tol2 = tol * tol;
+    size_t top = 1;
+    st->pairs[0] = 0;
+    while (top > 0) {
+        const Node *n = &t->nodes[st->pairs[--top]];
+        double d[3] = {p[0] - n->c[0], p[1] - n->c[1], p[2] - n->c[2]}, out = 0.0;
+        for (int a = 0; a < 3; a++) {
+            double excess = fabs(n->ax[a] * d[0] + n->ax[3 + a] * d[1] + n->ax[6 + a] * d[2]) -
+                            n->h[a];
+            if (excess > 0.0) out += excess * excess;
+        }
+        if (out > tol2) continue;
+        if (n->left < 0) {
+            for (int32_t s = n->first; s < n->first + n->count; s++) {
+                const double *v = t->v + 9 * t->order[s];
+                double q[3], g[3];
+                point_triangle(p, v, v + 3, v + 6, q);
+                sub3(p, q, g);
+                if (dot3(g, g) <= tol2) return 1;
+            }
+            continue;
+        }
+        if (top + 2 > st->cap) {
+            size_t cap = st->cap * 2;
+            int32_t *p2 = realloc(st->pairs, sizeof(int32_t) * 2 * cap);
+            if (p2 == NULL) return -1;
+            st->pairs = p2;
+            st->cap = cap;
+        }
+        st->pairs[top++] = n->left;
+        st->pairs[top++] = n->right;
+    }
+    return 0;
+}
+
+/*
+ * on_surface(set, poses (N, G, 4, 4), row, g, point (3,), tol) -> bool
+ * Whether a point (world frame) lies within tol of geometry g's mesh at sample row: the test that
+ * a convex hull's closest point is one of the mesh's own (see SelfCollisionChecker.distances).
+ * False when g is not a mesh of the set.
+ */
+static PyObject *py_on_surface(PyObject *self, PyObject *args) {
+    PyObject *cap, *pobj, *xobj;
+    Py_ssize_t row, g;
+    double tol;
+    if (!PyArg_ParseTuple(args, "OOnnOd", &cap, &pobj, &row, &g, &xobj, &tol)) return NULL;
+    const MeshSet *s = PyCapsule_GetPointer(cap, "robotspec.meshset");
+    if (s == NULL) return NULL;
+    if (!PyArray_Check(pobj) || !PyArray_Check(xobj)) {
+        PyErr_SetString(PyExc_TypeError, "on_surface: poses and point must be numpy arrays");
+        return NULL;
+    }
+    PyArrayObject *poses = (PyArrayObject *)pobj, *xa = (PyArrayObject *)xobj;
+    if (PyArray_TYPE(poses) != NPY_DOUBLE || !PyArray_IS_C_CONTIGUOUS(poses) ||
+        PyArray_NDIM(poses) != 4 || PyArray_DIM(poses, 1) != s->n || PyArray_DIM(poses, 2) != 4 ||
+        PyArray_DIM(poses, 3) != 4 || PyArray_TYPE(xa) != NPY_DOUBLE ||
+        !PyArray_IS_C_CONTIGUOUS(xa) || PyArray_SIZE(xa) != 3) {
+        PyErr_SetString(PyExc_ValueError, "on_surface: poses or point of the wrong type or shape");
+        return NULL;
+    }
+    if (row < 0 || row >= PyArray_DIM(poses, 0) || g < 0 || g >= s->n || !(tol >= 0.0) ||
+        !isfinite(tol)) {
+        PyErr_SetString(PyExc_ValueError, "on_surface: row, geometry or tolerance out of range");
+        return NULL;
+    }
+    const Tree *t = s->trees[g];
+    if (t == NULL) Py_RETURN_FALSE;
+    const double *m = (const double *)PyArray_DATA(poses) + (row * s->n + g) * 16;
+    const double *x = PyArray_DATA(xa);
+    double d[3] = {x[0] - m[3], x[1] - m[7], x[2] - m[11]}, p[3];
+    for (int a = 0; a < 3; a++) p[a] = m[a] * d[0] + m[4 + a] * d[1] + m[8 + a] * d[2];
+    int res = point_on_mesh(t, p, tol, s->one);
+    if (res < 0) return PyErr_NoMemory();
+    return PyBool_FromLong(res);
+}
+
 /* ---------------------------------------------------------------------------------- module */
 
 static PyMethodDef methods[] = {
     {"mesh_set", py_mesh_set, METH_VARARGS, "Box trees of the meshes of a checker."},
     {"apart", py_apart, METH_VARARGS, "Per candidate: 1 when its two meshes are proven apart."},
     {"apart_one", py_apart_one, METH_VARARGS, "Whether one candidate's meshes are proven apart."},
+    {"on_surface", py_on_surface, METH_VARARGS, "Whether a point lies on a geometry's mesh."},
     {NULL, NULL, 0, NULL},
 };
 

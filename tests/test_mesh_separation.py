@@ -108,13 +108,15 @@ def test_proven_apart_soups_are_apart_for_coal(
     fb = np.arange(len(vb), dtype=np.int64).reshape(-1, 3)
     pose_a, pose_b = _pose((0.01, -0.02, 0.03), (0.3, -0.2, 0.1)), _pose(xyz, rpy)
     poses = np.array([[pose_a, pose_b]])
-    proven = _apart([(va, fa), (vb, fb)], poses, eps)[0]
+    proof = int(_apart([(va, fa), (vb, fb)], poses, eps)[0])
     one = _meshcore.apart_one(_meshcore.mesh_set([(va, fa), (vb, fb)]), poses, 0, 0, 1, eps)
-    assert one == bool(proven)  # the one-by-one entry point gives the batch's answer
-    if proven:
-        ma, mb = _bvh(va, fa), _bvh(vb, fb)
+    assert one == proof  # the one-by-one entry point gives the batch's answer
+    ma, mb = _bvh(va, fa), _bvh(vb, fb)
+    if proof == 1:  # apart by more than eps
         assert _coal_distance(ma, pose_a, mb, pose_b) > eps - 1e-9
         assert not _coal_collides(ma, pose_a, mb, pose_b)
+    elif proof == 2:  # two triangles cross
+        assert _coal_collides(ma, pose_a, mb, pose_b)
 
 
 @pytest.fixture(scope="module")
@@ -150,11 +152,14 @@ def test_nearly_touching_real_meshes_agree_with_coal(
         assert proven.dtype == np.uint8
         for s in range(len(qs)):
             d = _coal_distance(a.geometry, pose_a[s], b.geometry, pose_b[s])
-            if proven[s]:
-                assert d > eps - 1e-9, (pair, s, d)
+            hit = _coal_collides(a.geometry, pose_a[s], b.geometry, pose_b[s])
+            if proven[s] == 1:
+                assert d > eps - 1e-9 and not hit, (pair, s, d)
+            elif proven[s] == 2:
+                assert hit, (pair, s, d)
             # Room to spare is proven: the proof is useful, not only safe.
             if d > 2 * eps + 5e-3:
-                assert proven[s], (pair, s, d)
+                assert proven[s] == 1, (pair, s, d)
 
 
 def _without_proof(checker: SelfCollisionChecker) -> SelfCollisionChecker:
@@ -193,6 +198,21 @@ def test_checker_answers_are_coals_on_tiago() -> None:
     np.testing.assert_array_equal(
         checker.collisions_batch(qs), _without_proof(checker).collisions_batch(qs)
     )
+
+
+def test_crossing_triangles_are_proven_and_touching_ones_left_to_coal() -> None:
+    a = (np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    b = (np.array([[0.2, 0.2, -0.5], [0.35, 0.25, 0.5], [0.15, 0.3, 0.5]]), np.array([[0, 1, 2]]))
+    poses = np.array([[np.eye(4), np.eye(4)]])
+    s = _meshcore.mesh_set([a, b])
+    assert _meshcore.apart_one(s, poses, 0, 0, 1, 1e-5) == 2  # b pierces a
+    touching = (np.array([[0.0, 0, 0], [-1, 0, 0.5], [0, -1, 0.5]]), np.array([[0, 1, 2]]))
+    s = _meshcore.mesh_set([a, touching])  # one shared corner: coal's to call
+    assert _meshcore.apart_one(s, poses, 0, 0, 1, 1e-5) == 0
+    far = poses.copy()
+    far[0, 1, 2, 3] = 1.0
+    s = _meshcore.mesh_set([a, b])
+    assert _meshcore.apart_one(s, far, 0, 0, 1, 1e-5) == 1
 
 
 def test_bad_meshes_and_arguments_are_refused() -> None:

@@ -233,6 +233,10 @@ static inline void cross3(const double *a, const double *b, double *o) {
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 
+static inline double dot3(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
 /* Corners (9), edges (9) and normal (3) of the triangle with corners v. */
 static void features(const double *v, double *f) {
     memcpy(f, v, 9 * sizeof(double));
@@ -530,8 +534,53 @@ static const double *moved_node(Scratch *m, const Tree *b, int32_t id, const dou
     return o;
 }
 
-/* 1 when meshes a and b are proven more than eps apart; b's frame is (r, p) in a's frame. 0 when
- * not proven, -1 when out of memory. */
+/* How far the projections of triangles a and b on axis n would have to move apart to separate,
+ * over |n| (negative: they are separated by that much). A flat triangle projects to a point on its
+ * own normal, so this is the depth of that point inside the other's interval, not the width of
+ * the intersection (which would be zero). */
+static inline double overlap_on(const double *n, const double *a, const double *b) {
+    double a0 = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+    double a1 = n[0] * a[3] + n[1] * a[4] + n[2] * a[5];
+    double a2 = n[0] * a[6] + n[1] * a[7] + n[2] * a[8];
+    double b0 = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
+    double b1 = n[0] * b[3] + n[1] * b[4] + n[2] * b[5];
+    double b2 = n[0] * b[6] + n[1] * b[7] + n[2] * b[8];
+    double depth = fmin(fmax(a0, fmax(a1, a2)) - fmin(b0, fmin(b1, b2)),
+                        fmax(b0, fmax(b1, b2)) - fmin(a0, fmin(a1, a2)));
+    return depth / sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+/*
+ * 1 when triangles fa and fb (features, one frame) are proven to cross: neither is degenerate,
+ * they are not near-parallel, no pair of their edges is near-parallel, and their projections
+ * overlap by more than eps on all eleven separating axes. Those axes are complete for two such
+ * triangles, so no plane separates them: they intersect, and any exact test says so (eps covers
+ * the rounding of the projections). 0 when not proven (nearly touching, parallel or degenerate:
+ * coal decides).
+ */
+static int triangles_cross(const double *fa, const double *fb, double eps) {
+    const double *na = fa + 18, *nb = fb + 18;
+    double la = sqrt(dot3(na, na)), lb = sqrt(dot3(nb, nb)), n[3];
+    if (!(la > 1e-300) || !(lb > 1e-300)) return 0;
+    cross3(na, nb, n);
+    if (!(sqrt(dot3(n, n)) > 1e-6 * la * lb)) return 0; /* near-parallel planes */
+    if (!(overlap_on(na, fa, fb) > eps) || !(overlap_on(nb, fa, fb) > eps)) return 0;
+    for (int i = 0; i < 3; i++) {
+        const double *ea = fa + 9 + 3 * i;
+        double lea = sqrt(dot3(ea, ea));
+        for (int j = 0; j < 3; j++) {
+            const double *eb = fb + 9 + 3 * j;
+            cross3(ea, eb, n);
+            if (!(sqrt(dot3(n, n)) > 1e-6 * lea * sqrt(dot3(eb, eb)))) return 0;
+            if (!(overlap_on(n, fa, fb) > eps)) return 0;
+        }
+    }
+    return 1;
+}
+
+/* 1 when meshes a and b are proven more than eps apart, 2 when two of their triangles are proven
+ * to cross (the first pair that is not apart is tried); b's frame is (r, p) in a's frame. 0 when
+ * neither is proven, -1 when out of memory. */
 static int meshes_apart(const Tree *a, const Tree *b, const double *r, const double *p, double eps,
                         Scratch *st) {
     const double eps2 = eps * eps;
@@ -550,7 +599,8 @@ static int meshes_apart(const Tree *a, const Tree *b, const double *r, const dou
             for (int32_t w = nb->first; w < nb->first + nb->count; w++) {
                 const double *fb = moved_tri(st, b, b->order[w], r, p);
                 for (int32_t u = na->first; u < na->first + na->count; u++) {
-                    if (!triangles_apart(a->f + FEAT * (size_t)a->order[u], fb, eps2)) return 0;
+                    const double *fa = a->f + FEAT * (size_t)a->order[u];
+                    if (!triangles_apart(fa, fb, eps2)) return triangles_cross(fa, fb, eps) ? 2 : 0;
                 }
             }
             continue;
@@ -600,7 +650,8 @@ static int candidate_apart(const MeshSet *s, int64_t i, int64_t j, const double 
 /*
  * apart(set, poses (N, G, 4, 4), rows (K,), pairs (K,), g1 (Q,), g2 (Q,), eps) -> uint8 (K,)
  * Candidate c is (sample rows[c], geometry pair pairs[c] = (g1, g2)); poses are the geometries'
- * world poses. 1: both are meshes, proven more than eps apart; 0: not proven (or not meshes).
+ * world poses. 1: both are meshes, proven more than eps apart; 2: proven to cross (two triangles
+ * intersect); 0: neither proven (or not meshes).
  */
 static PyObject *py_apart(PyObject *self, PyObject *args) {
     PyObject *cap, *pobj, *robj, *kobj, *g1obj, *g2obj;
@@ -657,7 +708,7 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
         int res = candidate_apart(s, i, j, pv + (rv[c] * ng + i) * 16, pv + (rv[c] * ng + j) * 16,
                                   eps, &st);
         if (res < 0) oom = 1;
-        ov[c] = res == 1;
+        ov[c] = res > 0 ? (uint8_t)res : 0;
     }
     Py_END_ALLOW_THREADS
     if (oom) {
@@ -675,7 +726,7 @@ done:
 }
 
 /*
- * apart_one(set, poses (N, G, 4, 4) float64 C-contiguous, row, i, j, eps) -> bool
+ * apart_one(set, poses (N, G, 4, 4) float64 C-contiguous, row, i, j, eps) -> 0, 1 or 2 (as apart)
  * One candidate, for a caller that tests candidates one by one and stops early (an "any
  * collision" query). Holds the GIL: its scratch lives in the set.
  */
@@ -709,14 +760,10 @@ static PyObject *py_apart_one(PyObject *self, PyObject *args) {
     int res = candidate_apart(s, i, j, pv + (row * s->n + i) * 16, pv + (row * s->n + j) * 16, eps,
                               s->one);
     if (res < 0) return PyErr_NoMemory();
-    return PyBool_FromLong(res == 1);
+    return PyLong_FromLong(res);
 }
 
 /* ------------------------------------------------------------------------ points on a mesh */
-
-static inline double dot3(const double *a, const double *b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 
 /* The point of triangle abc closest to p (Ericson, Real-Time Collision Detection, 5.1.5). */
 static void point_triangle(const double *p, const double *a, const double *b, const double *c,

@@ -57,6 +57,8 @@ _STREAK = 2
 _HULL_TOLERANCE = 1e-10
 _HULL_GAP = 1e-5
 _ON_SURFACE = 1e-9
+#: What the mesh core proved of a candidate (its codes), and "not asked".
+_UNKNOWN, _APART, _CROSS, _UNTRIED = 0, 1, 2, -1
 #: Candidates of a block from which mesh proofs run in one C call rather than one by one.
 _BATCH_PROOFS = 64
 #: Room (m) beyond the margin by which a mesh pair must be proven apart before coal is skipped:
@@ -309,7 +311,7 @@ class SelfCollisionChecker:
             elif drop_found and start:
                 geom_mask = (~np.asarray(found, dtype=np.bool_)[c.pair_of]).astype(np.uint8)
             rows, ks, poses = self._broad(c, block, margin, geom_mask)
-            tried = [False] * len(ks)
+            tried = [_UNTRIED] * len(ks)
             if meshes is not None and not first_only and len(ks) >= _BATCH_PROOFS:
                 # Every candidate is tested, so the mesh proofs run in one C call (no Python per
                 # candidate); an any-hit query proves them one by one instead, and stops early,
@@ -319,7 +321,7 @@ class SelfCollisionChecker:
             last_row = -1
             skip_row = False
             row_hits: set[int] = set()
-            for r, k, done in zip(rows, ks, tried, strict=True):
+            for r, k, proof in zip(rows, ks, tried, strict=True):
                 if r != last_row:
                     last_row, skip_row = r, False
                     row_hits = set()
@@ -331,12 +333,17 @@ class SelfCollisionChecker:
                 i, j = g1s[k], g2s[k]
                 # Two meshes: try to prove them apart in C first (tens of times cheaper than
                 # coal when they nearly touch), unless the pair collided at its last tests.
-                if (
-                    two_meshes[k]
-                    and not done
-                    and streak[k] < _STREAK
-                    and apart(meshes, poses, r, i, j, eps)
-                ):
+                if proof == _UNTRIED and two_meshes[k] and streak[k] < _STREAK:
+                    proof = apart(meshes, poses, r, i, j, eps)
+                    if proof == _APART:
+                        continue
+                if proof == _CROSS:  # two triangles proven to cross: a collision, coal or not
+                    streak[k] += 1
+                    row_hits.add(p)
+                    hit_rows.append(start + r)
+                    hit_pairs.append(p)
+                    found[p] = True
+                    skip_row = first_only
                     continue
                 if stamp[i] != r:
                     stamp[i] = r
@@ -364,22 +371,22 @@ class SelfCollisionChecker:
 
     def _prove_apart(
         self, c: _Compiled, poses: F64, rows: list[int], ks: list[int], eps: float
-    ) -> tuple[list[int], list[int], list[bool]]:
-        """The candidates left once the mesh pairs proven apart are dropped, and which were tried.
+    ) -> tuple[list[int], list[int], list[int]]:
+        """The candidates left once the mesh pairs proven apart are dropped, and their proofs.
 
-        Pairs on a streak of collisions are not tried (see ``_STREAK``).
+        Each is ``_UNTRIED``, ``_UNKNOWN`` or ``_CROSS``. Pairs on a streak of collisions are not
+        tried (see ``_STREAK``).
         """
         r = np.asarray(rows, dtype=np.int64)
         k = np.asarray(ks, dtype=np.int64)
         streak = np.asarray(self._streak, dtype=np.int64)
-        tried = np.asarray(c.two_meshes, dtype=np.bool_)[k] & (streak[k] < _STREAK)
-        at = np.flatnonzero(tried)
+        at = np.flatnonzero(np.asarray(c.two_meshes, dtype=np.bool_)[k] & (streak[k] < _STREAK))
+        proofs = np.full(len(k), _UNTRIED, dtype=np.int64)
         if not len(at):
-            return rows, ks, [False] * len(ks)
-        proven = _meshcore.apart(c.meshes, poses, r[at], k[at], c.pair_geom1, c.pair_geom2, eps)
-        keep = np.ones(len(k), dtype=np.bool_)
-        keep[at[proven == 1]] = False
-        return r[keep].tolist(), k[keep].tolist(), tried[keep].tolist()
+            return rows, ks, proofs.tolist()
+        proofs[at] = _meshcore.apart(c.meshes, poses, r[at], k[at], c.pair_geom1, c.pair_geom2, eps)
+        keep = proofs != _APART
+        return r[keep].tolist(), k[keep].tolist(), proofs[keep].tolist()
 
     def _requests(self, margin: float) -> tuple[Any, Any]:
         """A coal collision request for ``margin`` and a result to reuse (kept per checker)."""

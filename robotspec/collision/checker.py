@@ -48,9 +48,6 @@ Point = tuple[float, float, float]
 
 #: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).
 _BLOCK = 512
-#: A mesh pair that collided at this many tests in a row goes straight to coal: proving it apart
-#: would most likely fail, after a search of its trees.
-_STREAK = 2
 #: Hull distances: GJK's tolerance (polytopes end exactly; curved primitives need it tight to agree
 #: with coal's exact mesh distances), the gap below which hulls count as touching (coal answers,
 #: with its conventions for contact), and how near a hull's closest point must be to the mesh.
@@ -138,8 +135,6 @@ class SelfCollisionChecker:
         self._distance_fns: tuple[Any, ...] | None = None
         self._hull_fns: tuple[Any, ...] | None = None
         self._request: tuple[float, Any, Any] | None = None
-        # Per geometry pair: how many of its latest coal tests in a row found a collision.
-        self._streak: list[int] = []
         self._robot: AbstractRobot | None = None
 
     @classmethod
@@ -298,9 +293,7 @@ class SelfCollisionChecker:
         fns = c.collide
         owner = c.pair_of_list
         g1s, g2s = c.pair_geom1_list, c.pair_geom2_list
-        if len(self._streak) != len(g1s):
-            self._streak = [0] * len(g1s)
-        meshes, two_meshes, streak = c.meshes, c.two_meshes, self._streak
+        meshes, two_meshes = c.meshes, c.two_meshes
         apart, eps = _meshcore.apart_one, margin + _APART_SLACK
         hit_rows: list[int] = []
         hit_pairs: list[int] = []
@@ -311,17 +304,17 @@ class SelfCollisionChecker:
             elif drop_found and start:
                 geom_mask = (~np.asarray(found, dtype=np.bool_)[c.pair_of]).astype(np.uint8)
             rows, ks, poses = self._broad(c, block, margin, geom_mask)
-            tried = [_UNTRIED] * len(ks)
+            proofs = [_UNTRIED] * len(ks)
             if meshes is not None and not first_only and len(ks) >= _BATCH_PROOFS:
                 # Every candidate is tested, so the mesh proofs run in one C call (no Python per
                 # candidate); an any-hit query proves them one by one instead, and stops early,
                 # and so do a few candidates (numpy's fixed cost would exceed the calls saved).
-                rows, ks, tried = self._prove_apart(c, poses, rows, ks, eps)
+                rows, ks, proofs = self._prove_apart(c, poses, rows, ks, eps)
             stamp = [-1] * len(tf)
             last_row = -1
             skip_row = False
             row_hits: set[int] = set()
-            for r, k, proof in zip(rows, ks, tried, strict=True):
+            for r, k, proof in zip(rows, ks, proofs, strict=True):
                 if r != last_row:
                     last_row, skip_row = r, False
                     row_hits = set()
@@ -331,36 +324,27 @@ class SelfCollisionChecker:
                 if p in row_hits or (drop_found and found[p]):
                     continue
                 i, j = g1s[k], g2s[k]
-                # Two meshes: try to prove them apart in C first (tens of times cheaper than
-                # coal when they nearly touch), unless the pair collided at its last tests.
-                if proof == _UNTRIED and two_meshes[k] and streak[k] < _STREAK:
+                # Two meshes: the C core proves them apart or crossing first (tens of times
+                # cheaper than coal when they nearly touch); coal decides what it cannot.
+                if proof == _UNTRIED and two_meshes[k]:
                     proof = apart(meshes, poses, r, i, j, eps)
                     if proof == _APART:
                         continue
-                if proof == _CROSS:  # two triangles proven to cross: a collision, coal or not
-                    streak[k] += 1
-                    row_hits.add(p)
-                    hit_rows.append(start + r)
-                    hit_pairs.append(p)
-                    found[p] = True
-                    skip_row = first_only
-                    continue
-                if stamp[i] != r:
-                    stamp[i] = r
-                    pose = poses[r, i]
-                    tf[i].setRotation(pose[:3, :3])
-                    tf[i].setTranslation(pose[:3, 3])
-                if stamp[j] != r:
-                    stamp[j] = r
-                    pose = poses[r, j]
-                    tf[j].setRotation(pose[:3, :3])
-                    tf[j].setTranslation(pose[:3, 3])
-                clear()
-                fns[k](tf[i], tf[j], req, res)
-                if not is_collision():
-                    streak[k] = 0
-                    continue
-                streak[k] += 1
+                if proof != _CROSS:
+                    if stamp[i] != r:
+                        stamp[i] = r
+                        pose = poses[r, i]
+                        tf[i].setRotation(pose[:3, :3])
+                        tf[i].setTranslation(pose[:3, 3])
+                    if stamp[j] != r:
+                        stamp[j] = r
+                        pose = poses[r, j]
+                        tf[j].setRotation(pose[:3, :3])
+                        tf[j].setTranslation(pose[:3, 3])
+                    clear()
+                    fns[k](tf[i], tf[j], req, res)
+                    if not is_collision():
+                        continue
                 row_hits.add(p)
                 hit_rows.append(start + r)
                 hit_pairs.append(p)
@@ -374,13 +358,11 @@ class SelfCollisionChecker:
     ) -> tuple[list[int], list[int], list[int]]:
         """The candidates left once the mesh pairs proven apart are dropped, and their proofs.
 
-        Each is ``_UNTRIED``, ``_UNKNOWN`` or ``_CROSS``. Pairs on a streak of collisions are not
-        tried (see ``_STREAK``).
+        Each is ``_UNKNOWN`` or ``_CROSS`` (coal decides the first, the second is a collision).
         """
         r = np.asarray(rows, dtype=np.int64)
         k = np.asarray(ks, dtype=np.int64)
-        streak = np.asarray(self._streak, dtype=np.int64)
-        at = np.flatnonzero(np.asarray(c.two_meshes, dtype=np.bool_)[k] & (streak[k] < _STREAK))
+        at = np.flatnonzero(np.asarray(c.two_meshes, dtype=np.bool_)[k])
         proofs = np.full(len(k), _UNTRIED, dtype=np.int64)
         if not len(at):
             return rows, ks, proofs.tolist()

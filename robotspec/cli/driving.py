@@ -7,9 +7,14 @@ status line, log, plot, scenario report and the summary line.
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
+from types import FrameType
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -17,6 +22,32 @@ if TYPE_CHECKING:
     from robotspec.driver.state import RobotState
 
 __all__ = ["drive_target", "run_driver"]
+
+
+@contextmanager
+def _sigterm_interrupts(received: list[str]) -> Iterator[None]:
+    """While inside, SIGTERM ends the run as Ctrl-C does (``KeyboardInterrupt``).
+
+    Why: the default SIGTERM kills the process on the spot, so a ``--log`` was cut mid-line and
+    no summary was printed; a run stopped by a process manager must end like one stopped by hand.
+    The served path has its own handlers (:mod:`robotspec.service.serve`). Signal handlers can
+    only be set from the main thread; elsewhere nothing is changed.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGTERM)
+
+    def on_term(_signum: int, _frame: FrameType | None) -> None:
+        received.append("SIGTERM")
+        signal.signal(signal.SIGTERM, previous)  # a second SIGTERM is the default again
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, on_term)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def drive_target(
@@ -100,44 +131,50 @@ def run_driver(
     interrupted = False
     stopped_by = "Ctrl-C"
     wall0 = time.perf_counter()
+    terminated: list[str] = []
     try:
-        driver.step()
-        if serve:
-            from robotspec.service.serve import serve_driver
+        with ExitStack() as guard:
+            if not serve:  # the served path handles its signals itself
+                guard.enter_context(_sigterm_interrupts(terminated))
+            driver.step()
+            if serve:
+                from robotspec.service.serve import serve_driver
 
-            stop_signal = serve_driver(
-                driver,
-                info,
-                port=port,
-                public=public,
-                node_name=node_name,
-                state_dir=state_dir,
-                duration=duration,
-                fallback_name=fallback_name,
-            )
-            if stop_signal is not None:
-                interrupted, stopped_by = True, stop_signal
-        elif scenario is not None:
+                stop_signal = serve_driver(
+                    driver,
+                    info,
+                    port=port,
+                    public=public,
+                    node_name=node_name,
+                    state_dir=state_dir,
+                    duration=duration,
+                    fallback_name=fallback_name,
+                )
+                if stop_signal is not None:
+                    interrupted, stopped_by = True, stop_signal
+            elif scenario is not None:
 
-            def report(r: object) -> None:
-                from robotspec.driver.script import StepResult
+                def report(r: object) -> None:
+                    from robotspec.driver.script import StepResult
 
-                assert isinstance(r, StepResult)
-                status.clear()
-                mark = "ok  " if r.ok else "FAIL"
-                extra = f": {r.detail}" if r.detail else ""
-                sys.stdout.write(f"{mark} step {r.index} {r.description}{extra}\n")
+                    assert isinstance(r, StepResult)
+                    status.clear()
+                    mark = "ok  " if r.ok else "FAIL"
+                    extra = f": {r.detail}" if r.detail else ""
+                    sys.stdout.write(f"{mark} step {r.index} {r.description}{extra}\n")
 
-            results = run_scenario(driver, scenario, on_result=report)
-            if duration is not None:
-                driver.run_for(max(0.0, duration - driver._stopwatch_ellapsed_s()))
-        elif duration is not None:
-            driver.run_for(duration)
-        else:
-            while True:
-                driver.step()
+                results = run_scenario(driver, scenario, on_result=report)
+                if duration is not None:
+                    driver.run_for(max(0.0, duration - driver._stopwatch_ellapsed_s()))
+            elif duration is not None:
+                driver.run_for(duration)
+            else:
+                while True:
+                    driver.step()
     except KeyboardInterrupt:
         interrupted = True
+        if terminated:
+            stopped_by = terminated[0]
     finally:
         status.clear()
         if statelog is not None:

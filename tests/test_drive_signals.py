@@ -1,0 +1,48 @@
+"""``robotspec drive --sim`` (not served) ends on SIGTERM as it does on Ctrl-C.
+
+Before: the default SIGTERM killed the process on the spot, so the summary was never printed and
+a ``--log`` could end mid-row. The drive runs as a subprocess (signals are process-wide) and the
+signal goes to that child by its handle.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from .driver_support import RRP
+
+
+@pytest.mark.parametrize(("sig", "said"), [(signal.SIGTERM, "SIGTERM"), (signal.SIGINT, "Ctrl-C")])
+def test_signal_ends_a_drive_with_its_summary_and_a_whole_log(
+    tmp_path: Path, sig: signal.Signals, said: str
+) -> None:
+    log = tmp_path / "states.jsonl"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "robotspec", "drive", "--sim", str(RRP), "--log", str(log)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline and (not log.exists() or log.stat().st_size < 4096):
+            time.sleep(0.05)  # running: the log grows
+        assert proc.poll() is None, proc.communicate()
+        proc.send_signal(sig)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()  # only our own child, by its handle
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert f"stopped by {said} after" in out
+    assert "Traceback" not in err
+    rows = [json.loads(line) for line in log.read_text(encoding="utf-8").splitlines()]
+    assert rows and f"wrote {len(rows)} states to" in out  # every row whole, the count told

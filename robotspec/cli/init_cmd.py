@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from robotspec.cli.options import PackagePath, write_output
+from robotspec.cli.output import plural
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
@@ -51,8 +52,9 @@ def init(
     text = render_draft(draft, presets=camera_presets())
     if write_output(text, output):
         sys.stderr.write(
-            f"wrote {output}: {len(draft.chains)} chains, {len(draft.manipulators)} manipulators, "
-            f"{len(draft.cameras)} cameras"
+            f"wrote {output}: {plural(len(draft.chains), 'chain')}, "
+            f"{plural(len(draft.manipulators), 'manipulator')}, "
+            f"{plural(len(draft.cameras), 'camera')}"
             + (", a torso" if draft.torso is not None else "")
             + (", a neck" if draft.neck is not None else "")
             + "; check the lines marked DECIDE, then run "

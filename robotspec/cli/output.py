@@ -85,3 +85,8 @@ def run_app(app: typer.Typer, argv: Sequence[str] | None) -> int:
         )
         return EXIT_INTERNAL
     return EXIT_OK
+
+
+def plural(n: int, word: str) -> str:
+    """``1 chain``, ``2 chains``: a count in a message (regular plurals only)."""
+    return f"{n} {word}{'' if n == 1 else 's'}"

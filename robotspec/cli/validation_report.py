@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from robotspec.cli.output import styled
+from robotspec.cli.output import plural, styled
 
 __all__ = ["report_validation"]
 
@@ -61,8 +61,8 @@ def report_validation(
         n_specs = len(results)
         bad = sum(1 for r in results if not r["valid"])
         summary = (
-            f"{n_specs - bad} of {_plural(n_specs, 'spec')} valid; "
-            f"{_plural(n_err, 'error')}, {_plural(n_warn, 'warning')}"
+            f"{n_specs - bad} of {plural(n_specs, 'spec')} valid; "
+            f"{plural(n_err, 'error')}, {plural(n_warn, 'warning')}"
         )
         sys.stdout.write(summary + "\n")
     return n_err
@@ -79,7 +79,3 @@ def _as_json(d: Any) -> dict[str, Any]:
         "suggestions": list(d.suggestions),
         "location": list(d.location),
     }
-
-
-def _plural(n: int, word: str) -> str:
-    return f"{n} {word}{'' if n == 1 else 's'}"

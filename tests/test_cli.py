@@ -345,3 +345,23 @@ def test_demo_scenario_passes_for_shipped_robots(
     )
     assert code == 0, out + err
     assert out.splitlines()[-1] == "scenario: 8 of 8 steps as expected"
+
+
+def test_other_commands_print_the_warnings_attached_to_an_error(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    erd_robots()
+    spec = tmp_path / "both.yaml"
+    spec.write_text(
+        "robotspec: 1\nname: W\nextends: pr2\nchains:\n"
+        "  spare:\n    root: torso_lift_link\n    tip: l_elbow_flex_link\n"
+        "  broken:\n    root: torso_lift_link\n    tip: l_elbow_flex_lnk\n"
+    )
+    code, out, err = run(capsys, "inspect", "chains", str(spec))
+    assert code == 1 and out == ""
+    lines = err.splitlines()
+    assert f"{spec}:10:10: error:" in lines[0] and "'l_elbow_flex_lnk'" in lines[0]
+    assert (
+        f"{spec}:6:5: warning: chains.spare: chain 'spare' has neither a manipulator nor a sensor"
+        in lines[1:]
+    )

@@ -51,8 +51,13 @@ def styled(detail: ErrorDetail, stream: TextIO) -> str:
 
 
 def print_error(err: RobotSpecError) -> None:
-    """Print every problem an error stands for, one ``file:line:col: error: message`` per line."""
-    for detail in err.details:
+    """Print every problem an error stands for, then the warnings the run attached to it.
+
+    One ``file:line:col: error: message`` per line, as ``validate`` prints them; the warnings
+    matter because one can be the cause of an error (a missing mesh package behind a body the
+    spec cannot find, say).
+    """
+    for detail in (*err.details, *(d for w in err.warnings for d in w.details)):
         sys.stderr.write(styled(detail, sys.stderr) + "\n")
 
 

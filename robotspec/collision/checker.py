@@ -198,18 +198,7 @@ class SelfCollisionChecker:
             self.world, bodies, meshes=self._meshes, on_missing_mesh=self._on_missing
         )
         geoms = model.geometries
-        by_body: dict[str, list[int]] = {}
-        for i, g in enumerate(geoms):
-            by_body.setdefault(g.body, []).append(i)
-        g1: list[int] = []
-        g2: list[int] = []
-        owner: list[int] = []
-        for k, (a, b) in enumerate(self._pairs):
-            for i in by_body.get(a, ()):
-                for j in by_body.get(b, ()):
-                    g1.append(i)
-                    g2.append(j)
-                    owner.append(k)
+        g1, g2, owner = model.pair_indices(self._pairs)
         pair_geom1 = np.array(g1, dtype=np.int64)
         pair_geom2 = np.array(g2, dtype=np.int64)
         self._compiled = _Compiled(

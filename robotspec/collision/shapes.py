@@ -98,6 +98,28 @@ class GeometryModel:
         """The geometries of one body (empty if it has none)."""
         return tuple(g for g in self.geometries if g.body == body)
 
+    def pair_indices(
+        self, pairs: Sequence[tuple[str, str]]
+    ) -> tuple[list[int], list[int], list[int]]:
+        """The geometry pairs of body ``pairs``: first and second geometry, and the body pair.
+
+        Every geometry of the first body against every geometry of the second, pair by pair in
+        the given order (the order the checker's and pinocchio's pair lists share).
+        """
+        by_body: dict[str, list[int]] = {}
+        for i, g in enumerate(self.geometries):
+            by_body.setdefault(g.body, []).append(i)
+        g1: list[int] = []
+        g2: list[int] = []
+        owner: list[int] = []
+        for k, (a, b) in enumerate(pairs):
+            for i in by_body.get(a, ()):
+                for j in by_body.get(b, ()):
+                    g1.append(i)
+                    g2.append(j)
+                    owner.append(k)
+        return g1, g2, owner
+
 
 class MeshLibrary:
     """Mesh files read into coal BVH models, each (file, scale) once.

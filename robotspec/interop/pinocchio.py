@@ -18,10 +18,8 @@ from robotspec.model.pinocchio import (
     PinocchioRobot,
     import_pinocchio,
     set_limits,
+    to_se3,
     world_to_pinocchio,
-)
-from robotspec.model.pinocchio import (
-    _se3 as se3,
 )
 
 if TYPE_CHECKING:
@@ -53,19 +51,16 @@ def robot_to_pinocchio(
             f"{g.body}_{g.element}",
             frame.parentJoint,
             frames[g.body],
-            se3(pin, joint_to_geom),
+            to_se3(pin, joint_to_geom),
             g.geometry,
         )
         index_of.append(gmodel.addGeometryObject(obj))
-    by_body: dict[str, list[int]] = {}
-    for g, gid in zip(geoms, index_of, strict=True):
-        by_body.setdefault(g.body, []).append(gid)
     pair_bodies: list[tuple[str, str]] = []
-    for a, b in checker.active_pairs:
-        for i in by_body.get(a, ()):
-            for j in by_body.get(b, ()):
-                gmodel.addCollisionPair(pin.CollisionPair(min(i, j), max(i, j)))
-                pair_bodies.append(pair_key(a, b))
+    pairs = checker.active_pairs
+    for i, j, k in zip(*checker.geometry.pair_indices(pairs), strict=True):
+        a, b = index_of[i], index_of[j]
+        gmodel.addCollisionPair(pin.CollisionPair(min(a, b), max(a, b)))
+        pair_bodies.append(pair_key(*pairs[k]))
     return PinocchioRobot(
         model=model,
         collision_model=gmodel,

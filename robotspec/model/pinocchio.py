@@ -36,7 +36,7 @@ from robotspec.errors import KinematicsError, RobotSpecError
 from robotspec.model.entities import Connection, ConnectionType
 from robotspec.model.world import World
 
-__all__ = ["PinocchioRobot", "import_pinocchio", "set_limits", "world_to_pinocchio"]
+__all__ = ["PinocchioRobot", "import_pinocchio", "set_limits", "to_se3", "world_to_pinocchio"]
 
 
 def import_pinocchio() -> Any:
@@ -116,7 +116,7 @@ def world_to_pinocchio(world: World) -> tuple[Any, dict[str, int], tuple[int, ..
                 body.name,
                 joint_of[c.child],
                 frame_of[world.bodies[c.parent].name],
-                _se3(pin, placement[c.child]),
+                to_se3(pin, placement[c.child]),
                 pin.FrameType.BODY,
             )
         )
@@ -157,7 +157,8 @@ def _leaders_first(world: World) -> list[Connection]:
     return out
 
 
-def _se3(pin: Any, m: F64) -> Any:
+def to_se3(pin: Any, m: F64) -> Any:
+    """A 4 x 4 pose as a pinocchio ``SE3`` (contiguous copies: pinocchio refuses strided views)."""
     return pin.SE3(np.ascontiguousarray(m[:3, :3]), np.ascontiguousarray(m[:3, 3]))
 
 
@@ -186,7 +187,7 @@ def _add_joints(
         axis = np.asarray(m.axis, dtype=np.float64)
         jm = _one_axis(pin, m.kind == _REVOLUTE, axis)
         name = c.name if single else c.name + c.type.dof_suffixes[_suffix_index(c, i)]
-        place = _se3(pin, origin) if i == 0 else pin.SE3.Identity()
+        place = to_se3(pin, origin) if i == 0 else pin.SE3.Identity()
         if c.mimic is not None:
             leader = dof_joint.get(m.dof)
             if leader is None:

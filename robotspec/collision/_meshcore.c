@@ -425,35 +425,37 @@ static int nodes_apart(const Node *na, const Node *nb, const double *rb, const d
     return boxes_apart(rel, t, na->h, nb->h, eps);
 }
 
-/* 1 when triangles a and b (corners, 9 doubles each) project on axis n with a gap of more than
- * eps |n| (compared squared: no square root). */
-static inline int axis_apart(const double *n, const double *a, const double *b, double eps2) {
-    double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    double a0 = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
-    double a1 = n[0] * a[3] + n[1] * a[4] + n[2] * a[5];
-    double a2 = n[0] * a[6] + n[1] * a[7] + n[2] * a[8];
-    double b0 = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
-    double b1 = n[0] * b[3] + n[1] * b[4] + n[2] * b[5];
-    double b2 = n[0] * b[6] + n[1] * b[7] + n[2] * b[8];
-    double gap = fmin(b0, fmin(b1, b2)) - fmax(a0, fmax(a1, a2));
-    double gap2 = fmin(a0, fmin(a1, a2)) - fmax(b0, fmax(b1, b2));
-    if (gap2 > gap) gap = gap2;
-    /* nn == 0 (a degenerate axis) leaves gap <= 0 or proves a real gap along no direction:
-     * gap > 0 with nn == 0 is impossible (all projections are 0). */
+/* The interval triangle t (corners, 9 doubles) projects to on axis n (not normalised). */
+static inline void span(const double *n, const double *t, double *lo, double *hi) {
+    double x0 = n[0] * t[0] + n[1] * t[1] + n[2] * t[2];
+    double x1 = n[0] * t[3] + n[1] * t[4] + n[2] * t[5];
+    double x2 = n[0] * t[6] + n[1] * t[7] + n[2] * t[8];
+    *lo = fmin(x0, fmin(x1, x2));
+    *hi = fmax(x0, fmax(x1, x2));
+}
+
+/* 1 when the spans [alo, ahi] and [blo, bhi] on an axis with |n|^2 = nn leave a gap of more than
+ * eps |n| (compared squared: no square root). A degenerate axis (nn == 0) projects everything to
+ * 0 and so never shows a gap. */
+static inline int spans_apart(double alo, double ahi, double blo, double bhi, double nn,
+                              double eps2) {
+    double gap = fmax(blo - ahi, alo - bhi);
     return gap > 0.0 && gap * gap > eps2 * nn;
 }
 
-/* A face normal: a's corners project to one value, so only b's three are computed. */
+/* 1 when triangles a and b (corners) are more than eps apart along axis n. */
+static inline int axis_apart(const double *n, const double *a, const double *b, double eps2) {
+    double alo, ahi, blo, bhi;
+    span(n, a, &alo, &ahi);
+    span(n, b, &blo, &bhi);
+    return spans_apart(alo, ahi, blo, bhi, dot3(n, n), eps2);
+}
+
+/* A face normal: a's corners project to one value, so only b's span is computed. */
 static inline int normal_apart(const double *n, const double *a, const double *b, double eps2) {
-    double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    double d = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
-    double b0 = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
-    double b1 = n[0] * b[3] + n[1] * b[4] + n[2] * b[5];
-    double b2 = n[0] * b[6] + n[1] * b[7] + n[2] * b[8];
-    double gap = fmin(b0, fmin(b1, b2)) - d;
-    double gap2 = d - fmax(b0, fmax(b1, b2));
-    if (gap2 > gap) gap = gap2;
-    return gap > 0.0 && gap * gap > eps2 * nn;
+    double d = dot3(n, a), blo, bhi;
+    span(n, b, &blo, &bhi);
+    return spans_apart(d, d, blo, bhi, dot3(n, n), eps2);
 }
 
 /* 1 when triangles fa and fb (features, one frame) are proven more than eps apart by one of the
@@ -539,15 +541,10 @@ static const double *moved_node(Scratch *m, const Tree *b, int32_t id, const dou
  * own normal, so this is the depth of that point inside the other's interval, not the width of
  * the intersection (which would be zero). */
 static inline double overlap_on(const double *n, const double *a, const double *b) {
-    double a0 = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
-    double a1 = n[0] * a[3] + n[1] * a[4] + n[2] * a[5];
-    double a2 = n[0] * a[6] + n[1] * a[7] + n[2] * a[8];
-    double b0 = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
-    double b1 = n[0] * b[3] + n[1] * b[4] + n[2] * b[5];
-    double b2 = n[0] * b[6] + n[1] * b[7] + n[2] * b[8];
-    double depth = fmin(fmax(a0, fmax(a1, a2)) - fmin(b0, fmin(b1, b2)),
-                        fmax(b0, fmax(b1, b2)) - fmin(a0, fmin(a1, a2)));
-    return depth / sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    double alo, ahi, blo, bhi;
+    span(n, a, &alo, &ahi);
+    span(n, b, &blo, &bhi);
+    return fmin(ahi - blo, bhi - alo) / sqrt(dot3(n, n));
 }
 
 /*
@@ -726,6 +723,22 @@ done:
 }
 
 /*
+ * The caller's (N, G, 4, 4) geometry poses, borrowed (no copy: the one-by-one calls run per
+ * candidate), or NULL with an exception when they are not float64, C-contiguous and G = the set's
+ * geometries.
+ */
+static PyArrayObject *geometry_poses(PyObject *pobj, const MeshSet *s, const char *who) {
+    PyArrayObject *poses = (PyArrayObject *)pobj;
+    if (!PyArray_Check(pobj) || PyArray_TYPE(poses) != NPY_DOUBLE ||
+        !PyArray_IS_C_CONTIGUOUS(poses) || PyArray_NDIM(poses) != 4 ||
+        PyArray_DIM(poses, 1) != s->n || PyArray_DIM(poses, 2) != 4 || PyArray_DIM(poses, 3) != 4) {
+        PyErr_Format(PyExc_ValueError, "%s: poses of the wrong type or shape", who);
+        return NULL;
+    }
+    return poses;
+}
+
+/*
  * apart_one(set, poses (N, G, 4, 4) float64 C-contiguous, row, i, j, eps) -> 0, 1 or 2 (as apart)
  * One candidate, for a caller that tests candidates one by one and stops early (an "any
  * collision" query). Holds the GIL: its scratch lives in the set.
@@ -737,17 +750,8 @@ static PyObject *py_apart_one(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "OOnnnd", &cap, &pobj, &row, &i, &j, &eps)) return NULL;
     const MeshSet *s = PyCapsule_GetPointer(cap, "robotspec.meshset");
     if (s == NULL) return NULL;
-    if (!PyArray_Check(pobj)) {
-        PyErr_SetString(PyExc_TypeError, "apart_one: poses must be a numpy array");
-        return NULL;
-    }
-    PyArrayObject *poses = (PyArrayObject *)pobj;
-    if (PyArray_TYPE(poses) != NPY_DOUBLE || !PyArray_IS_C_CONTIGUOUS(poses) ||
-        PyArray_NDIM(poses) != 4 || PyArray_DIM(poses, 1) != s->n || PyArray_DIM(poses, 2) != 4 ||
-        PyArray_DIM(poses, 3) != 4) {
-        PyErr_SetString(PyExc_ValueError, "apart_one: poses of the wrong type or shape");
-        return NULL;
-    }
+    PyArrayObject *poses = geometry_poses(pobj, s, "apart_one");
+    if (poses == NULL) return NULL;
     if (row < 0 || row >= PyArray_DIM(poses, 0) || i < 0 || i >= s->n || j < 0 || j >= s->n) {
         PyErr_SetString(PyExc_ValueError, "apart_one: a candidate is out of range");
         return NULL;
@@ -863,16 +867,12 @@ static PyObject *py_on_surface(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "OOnnOd", &cap, &pobj, &row, &g, &xobj, &tol)) return NULL;
     const MeshSet *s = PyCapsule_GetPointer(cap, "robotspec.meshset");
     if (s == NULL) return NULL;
-    if (!PyArray_Check(pobj) || !PyArray_Check(xobj)) {
-        PyErr_SetString(PyExc_TypeError, "on_surface: poses and point must be numpy arrays");
-        return NULL;
-    }
-    PyArrayObject *poses = (PyArrayObject *)pobj, *xa = (PyArrayObject *)xobj;
-    if (PyArray_TYPE(poses) != NPY_DOUBLE || !PyArray_IS_C_CONTIGUOUS(poses) ||
-        PyArray_NDIM(poses) != 4 || PyArray_DIM(poses, 1) != s->n || PyArray_DIM(poses, 2) != 4 ||
-        PyArray_DIM(poses, 3) != 4 || PyArray_TYPE(xa) != NPY_DOUBLE ||
-        !PyArray_IS_C_CONTIGUOUS(xa) || PyArray_SIZE(xa) != 3) {
-        PyErr_SetString(PyExc_ValueError, "on_surface: poses or point of the wrong type or shape");
+    PyArrayObject *poses = geometry_poses(pobj, s, "on_surface");
+    if (poses == NULL) return NULL;
+    PyArrayObject *xa = (PyArrayObject *)xobj;
+    if (!PyArray_Check(xobj) || PyArray_TYPE(xa) != NPY_DOUBLE || !PyArray_IS_C_CONTIGUOUS(xa) ||
+        PyArray_SIZE(xa) != 3) {
+        PyErr_SetString(PyExc_ValueError, "on_surface: point of the wrong type or shape");
         return NULL;
     }
     if (row < 0 || row >= PyArray_DIM(poses, 0) || g < 0 || g >= s->n || !(tol >= 0.0) ||

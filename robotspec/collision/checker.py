@@ -428,13 +428,17 @@ class SelfCollisionChecker:
                 for k in {*c.pair_geom1_list, *c.pair_geom2_list}
                 if geoms[k].triangles is not None and (h := _hull(geoms[k])) is not None
             }
+
+            def hulled(i: int, j: int) -> bool:
+                """The pair has a mesh, and every mesh of it has a hull."""
+                mesh = [k for k in (i, j) if geoms[k].triangles is not None]
+                return bool(mesh) and all(k in hulls for k in mesh)
+
             self._hull_fns = tuple(
                 coal.ComputeDistance(
                     hulls.get(i, geoms[i].geometry), hulls.get(j, geoms[j].geometry)
                 )
-                if (i in hulls or j in hulls)
-                and (i in hulls or geoms[i].triangles is None)
-                and (j in hulls or geoms[j].triangles is None)
+                if hulled(i, j)
                 else None
                 for i, j in zip(c.pair_geom1_list, c.pair_geom2_list, strict=True)
             )
@@ -552,13 +556,8 @@ def _mesh_trees(geoms: Sequence[CollisionGeometry], g1: list[int], g2: list[int]
     used = {k for k in (*g1, *g2) if geoms[k].triangles is not None}
     if not used:
         return None
-    try:
-        return _meshcore.mesh_set([g.triangles if k in used else None for k, g in enumerate(geoms)])
-    except ValueError as exc:  # a vertex scaled past float range: the reader checked the rest
-        bodies = sorted({geoms[k].body for k in used})
-        raise CollisionError(
-            f"a collision mesh of {', '.join(bodies)} cannot be used: {exc}", kind="mesh"
-        ) from None
+    # The triangles are finite and in range: MeshLibrary refused any mesh that is not.
+    return _meshcore.mesh_set([g.triangles if k in used else None for k, g in enumerate(geoms)])
 
 
 def _hull(geom: CollisionGeometry) -> Any:

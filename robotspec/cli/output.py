@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shlex
 import sys
 import traceback
 from collections.abc import Sequence
@@ -84,9 +85,11 @@ def run_app(app: typer.Typer, argv: Sequence[str] | None) -> int:
     except Exception as exc:  # noqa: BLE001 - a bug: say so plainly, traceback only on request
         if _verbose(args):
             traceback.print_exc()
+        rerun = shlex.join(["robotspec", "--verbose", *(a for a in args if a != "--verbose")])
         sys.stderr.write(
             f"internal error: {type(exc).__name__}: {printable(str(exc))}\n"
-            "This is a bug in robotspec; rerun with --verbose and report the traceback.\n"
+            "This is a bug in robotspec; please report it with the traceback that\n"
+            f"  {printable(rerun)}\nprints.\n"
         )
         return EXIT_INTERNAL
     return EXIT_OK

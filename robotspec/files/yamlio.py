@@ -172,65 +172,167 @@ def _check_shape(loader_type: type[yaml.SafeLoader], text: str, file: str) -> No
 
 
 def _build(
-    node: yaml.Node,
+    root: yaml.Node,
     loader: yaml.SafeLoader,
-    path: Loc,
     marks: dict[Loc, tuple[int, int]],
     key_marks: dict[Loc, tuple[int, int]],
     file: str,
-    depth: int,
     max_depth: int,
 ) -> Any:
-    if depth > max_depth:  # _check_shape refused such documents already
-        raise RobotSpecError("YAML nested too deeply", file=file, line=node.start_mark.line + 1)
-    marks[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
-    if node.tag not in _PLAIN_TAGS:
-        raise RobotSpecError(
-            f"unsupported YAML tag '{node.tag}' (only plain YAML data is read)",
-            file=file,
-            line=node.start_mark.line + 1,
-            column=node.start_mark.column + 1,
-            name=node.tag,
-        )
-    if isinstance(node, yaml.MappingNode):
-        loader.flatten_mapping(node)
-        out: dict[Any, Any] = {}
-        for key_node, value_node in node.value:
-            key = _scalar(key_node, loader, file) if isinstance(key_node, yaml.ScalarNode) else None
-            if not isinstance(key, (str, int, float, bool)) or key is None:
-                raise RobotSpecError(
-                    "mapping keys must be plain scalars",
-                    file=file,
-                    line=key_node.start_mark.line + 1,
-                    column=key_node.start_mark.column + 1,
-                )
-            if isinstance(key, bool) or not isinstance(key, str):
-                key = str(key)
-            if key in out:
-                raise RobotSpecError(
-                    f"duplicate key '{key}'",
-                    file=file,
-                    line=key_node.start_mark.line + 1,
-                    column=key_node.start_mark.column + 1,
-                    name=key,
-                )
-            child = (*path, key)
-            key_marks[child] = (key_node.start_mark.line + 1, key_node.start_mark.column + 1)
-            out[key] = _build(
-                value_node, loader, child, marks, key_marks, file, depth + 1, max_depth
+    """Plain data from a node tree, with an explicit stack (no recursion, whatever the depth)."""
+    holder: list[Any] = [None]
+    # (node, its path, depth, container to write into, index or key there)
+    work: list[tuple[yaml.Node, Loc, int, Any, Any]] = [(root, (), 0, holder, 0)]
+    while work:
+        node, path, depth, into, slot = work.pop()
+        if depth > max_depth:  # _check_shape refused such documents already
+            raise RobotSpecError("YAML nested too deeply", file=file, line=node.start_mark.line + 1)
+        marks[path] = (node.start_mark.line + 1, node.start_mark.column + 1)
+        if node.tag not in _PLAIN_TAGS:
+            raise RobotSpecError(
+                f"unsupported YAML tag '{node.tag}' (only plain YAML data is read)",
+                file=file,
+                line=node.start_mark.line + 1,
+                column=node.start_mark.column + 1,
+                name=node.tag,
             )
-        return out
-    if isinstance(node, yaml.SequenceNode):
-        return [
-            _build(item, loader, (*path, i), marks, key_marks, file, depth + 1, max_depth)
-            for i, item in enumerate(node.value)
-        ]
-    value = _scalar(node, loader, file)  # type: ignore[arg-type]
-    return value
+        if isinstance(node, yaml.MappingNode):
+            loader.flatten_mapping(node)
+            out: dict[Any, Any] = {}
+            children: list[tuple[yaml.Node, Loc, int, Any, Any]] = []
+            for key_node, value_node in node.value:
+                key = (
+                    _scalar(key_node, loader, file)
+                    if isinstance(key_node, yaml.ScalarNode)
+                    else None
+                )
+                if not isinstance(key, (str, int, float, bool)) or key is None:
+                    raise RobotSpecError(
+                        "mapping keys must be plain scalars",
+                        file=file,
+                        line=key_node.start_mark.line + 1,
+                        column=key_node.start_mark.column + 1,
+                    )
+                if isinstance(key, bool) or not isinstance(key, str):
+                    key = str(key)
+                if key in out:
+                    raise RobotSpecError(
+                        f"duplicate key '{key}'",
+                        file=file,
+                        line=key_node.start_mark.line + 1,
+                        column=key_node.start_mark.column + 1,
+                        name=key,
+                    )
+                child = (*path, key)
+                key_marks[child] = (key_node.start_mark.line + 1, key_node.start_mark.column + 1)
+                out[key] = None  # keeps the document's key order
+                children.append((value_node, child, depth + 1, out, key))
+            into[slot] = out
+            work.extend(reversed(children))
+        elif isinstance(node, yaml.SequenceNode):
+            items: list[Any] = [None] * len(node.value)
+            into[slot] = items
+            work.extend(
+                (item, (*path, i), depth + 1, items, i)
+                for i, item in reversed(list(enumerate(node.value)))
+            )
+        else:
+            into[slot] = _scalar(node, loader, file)  # type: ignore[arg-type]
+    return holder[0]
+
+
+def _compose_node(loader: yaml.SafeLoader) -> yaml.Node | None:
+    """The single document's node tree, composed from events with an explicit stack.
+
+    Why not PyYAML's composer: both its Python and its libyaml composer recurse once per
+    nesting level, so a deep document ends in a RecursionError (or kills the process) before
+    any depth check of ours could run. Events come from a parser that keeps its own stack.
+    """
+    loader.get_event()  # type: ignore[no-untyped-call]  # stream start
+    if loader.check_event(yaml.StreamEndEvent):
+        return None
+    loader.get_event()  # type: ignore[no-untyped-call]  # document start
+    anchors: dict[str, Any] = {}
+    stack: list[list[Any]] = []  # [collection node, pending mapping key or None]
+    root: yaml.Node | None = None
+    resolve: Any = loader.resolve
+    while True:
+        event: Any = loader.get_event()  # type: ignore[no-untyped-call]
+        start: Any = event.start_mark
+        end: Any = event.end_mark
+        node: Any
+        if isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
+            stack.pop()[0].end_mark = end
+            if not stack:
+                break
+            continue
+        if isinstance(event, yaml.AliasEvent):
+            if event.anchor not in anchors:
+                raise yaml.composer.ComposerError(
+                    None, None, f"found undefined alias {event.anchor!r}", start
+                )
+            node = anchors[event.anchor]
+        else:
+            anchor = event.anchor
+            if anchor is not None and anchor in anchors:
+                raise yaml.composer.ComposerError(
+                    f"found duplicate anchor {anchor!r}; first occurrence",
+                    anchors[anchor].start_mark,
+                    "second occurrence",
+                    start,
+                )
+            tag = event.tag
+            if isinstance(event, yaml.ScalarEvent):
+                if tag is None or tag == "!":
+                    tag = resolve(yaml.ScalarNode, event.value, event.implicit)
+                node = yaml.ScalarNode(tag, event.value, start, end, style=event.style)
+            else:
+                kind: Any = (
+                    yaml.SequenceNode
+                    if isinstance(event, yaml.SequenceStartEvent)
+                    else yaml.MappingNode
+                )
+                if tag is None or tag == "!":
+                    tag = resolve(kind, None, event.implicit)
+                node = kind(tag, [], start, None, flow_style=event.flow_style)
+            if anchor is not None:
+                anchors[anchor] = node
+        if not stack:
+            root = node
+        else:
+            parent = stack[-1]
+            if isinstance(parent[0], yaml.SequenceNode):
+                parent[0].value.append(node)
+            elif parent[1] is None:
+                parent[1] = node
+            else:
+                parent[0].value.append((parent[1], node))
+                parent[1] = None
+        if isinstance(node, (yaml.SequenceNode, yaml.MappingNode)) and not isinstance(
+            event, yaml.AliasEvent
+        ):
+            stack.append([node, None])
+        elif not stack:
+            break
+    loader.get_event()  # type: ignore[no-untyped-call]  # document end
+    if not loader.check_event(yaml.StreamEndEvent):
+        extra: Any = loader.get_event()  # type: ignore[no-untyped-call]
+        raise yaml.composer.ComposerError(
+            "expected a single document in the stream",
+            None if root is None else root.start_mark,
+            "but found another document",
+            extra.start_mark,
+        )
+    return root
 
 
 def load_yaml_text(text: str, file: str = "<string>") -> LocatedYaml:
-    """Parse one YAML document from ``text`` safely, keeping node positions."""
+    """Parse one YAML document from ``text`` safely, keeping node positions.
+
+    Nothing on this path recurses per nesting level (events are read with the parser's own
+    stack, nodes composed and built with explicit ones), so a deep document is refused by the
+    depth limit with its line and column, whichever parser PyYAML bundles.
+    """
     cap = limits().max_yaml_bytes
     if len(text) > cap or len(text.encode("utf-8", errors="replace")) > cap:
         raise RobotSpecError(
@@ -244,27 +346,34 @@ def load_yaml_text(text: str, file: str = "<string>") -> LocatedYaml:
     except yaml.YAMLError as fast_error:
         if _SafeComposer.__mro__[1] is yaml.SafeLoader:
             raise _yaml_error(fast_error, file) from None
-        # libyaml's messages are terser ("did not find expected ','"); the pure-Python parser
-        # says what it found instead. Errors are rare, so parse again for the better message.
-        try:
-            _compose(_PySafeComposer, text, file)
-        except yaml.YAMLError as slow_error:
-            raise _yaml_error(slow_error, file) from None
-        raise _yaml_error(fast_error, file) from None
-    except RecursionError:
-        raise RobotSpecError("YAML nested too deeply", file=file) from None
+        error = fast_error
+    # libyaml refuses some documents by itself (nesting past its own limit of 1,000 flow
+    # levels) and words its syntax errors tersely ("did not find expected ','"). The
+    # pure-Python parser runs the same shape check (our depth limit, located) and says what
+    # it found instead. Outside the except clause: whatever it raises is raised plainly.
+    try:
+        _check_shape(_PySafeComposer, text, file)
+        return _compose(_PySafeComposer, text, file)  # deeper than libyaml goes, but allowed
+    except yaml.YAMLError as slow_error:
+        error = slow_error
+    raise _yaml_error(error, file) from None
 
 
 def _compose(loader_type: type[yaml.SafeLoader], text: str, file: str) -> LocatedYaml:
     loader: yaml.SafeLoader | None = None
     try:
         loader = loader_type(text)  # the reader checks characters as it is made
-        node = loader.get_single_node()
+        node = _compose_node(loader)
         if node is None:
             return LocatedYaml(data=None, file=file)
         marks: dict[Loc, tuple[int, int]] = {}
         key_marks: dict[Loc, tuple[int, int]] = {}
-        data = _build(node, loader, (), marks, key_marks, file, 0, limits().max_yaml_depth)
+        try:
+            data = _build(node, loader, marks, key_marks, file, limits().max_yaml_depth)
+        except RecursionError:
+            # PyYAML's merge of '<<' keys recurses once per merged mapping
+            error = RobotSpecError("YAML merge keys ('<<') chained too deeply", file=file)
+            raise error from None
     finally:
         if loader is not None:
             loader.dispose()

@@ -1,0 +1,90 @@
+"""The located YAML loader gives one answer whichever parser PyYAML bundles.
+
+PyYAML wheels bundle libyaml (which refuses nesting past 1,000 levels by itself) or not; the
+loader's own depth limit, its marks and its messages must not depend on which.
+"""
+
+from __future__ import annotations
+
+import pytest
+import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from robotspec.errors import RobotSpecError
+from robotspec.files import yamlio
+
+PARSERS = ["libyaml", "python"]
+
+
+@pytest.fixture(params=PARSERS)
+def parser(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
+    if request.param == "libyaml":
+        if not hasattr(yaml, "CSafeLoader"):
+            pytest.skip("this PyYAML was built without libyaml")
+    else:
+        monkeypatch.setattr(yamlio, "_SafeComposer", yamlio._PySafeComposer)
+    return str(request.param)
+
+
+@pytest.mark.parametrize("depth", [101, 1_001, 5_000, 50_000])
+def test_deep_nesting_is_refused_at_the_limit_with_its_place(parser: str, depth: int) -> None:
+    for text in ("[" * depth, "[" * depth + "]" * depth, "a:\n" + "- " * depth + "x\n"):
+        with pytest.raises(RobotSpecError) as info:
+            yamlio.load_yaml_text(text, "deep.yaml")
+        assert "YAML nested too deeply (more than 100 levels" in str(info.value), text[:20]
+        assert info.value.file == "deep.yaml"
+
+
+def test_a_raised_limit_reads_past_libyaml_s_own(
+    parser: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("ROBOTSPEC_MAX_YAML_DEPTH", "10000")
+    loaded = yamlio.load_yaml_text("[" * 1500 + "1" + "]" * 1500, "deep.yaml")
+    inner = loaded.data
+    for _ in range(1500):
+        assert isinstance(inner, list) and len(inner) == 1
+        inner = inner[0]
+    assert inner == 1
+    assert loaded.position((0,) * 1500) == (1, 1501)
+
+
+def test_marks_aliases_merges_and_key_order(parser: str) -> None:
+    text = "b: [1, {c: &x [2, 3]}, *x]\na: {<<: {d: 1}, e: 2}\n"
+    loaded = yamlio.load_yaml_text(text, "f.yaml")
+    assert loaded.data == {"b": [1, {"c": [2, 3]}, [2, 3]], "a": {"d": 1, "e": 2}}
+    assert list(loaded.data) == ["b", "a"]
+    assert loaded.position(("b", 1, "c", 1)) == (1, 19)
+    assert loaded.key_position(("a",)) == (2, 1)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("a: 1\n---\nb: 2\n", "2:1: error: invalid YAML: but found another document"),
+        ("x: *y\n", "1:4: error: invalid YAML: found undefined alias 'y'"),
+        ("a: &z 1\nb: &z 2\n", "2:4: error: invalid YAML: second occurrence"),
+        ("a: b: c\n", "1:5: error: invalid YAML: mapping values are not allowed here"),
+    ],
+)
+def test_syntax_errors_are_located(parser: str, text: str, message: str) -> None:
+    with pytest.raises(RobotSpecError) as info:
+        yamlio.load_yaml_text(text, "f.yaml")
+    assert str(info.value) == f"f.yaml:{message}"
+
+
+json_like = st.recursive(
+    st.none() | st.booleans() | st.integers(-(2**40), 2**40) | st.text(max_size=8),
+    lambda inner: (
+        st.lists(inner, max_size=4)
+        | st.dictionaries(st.text(min_size=1, max_size=6), inner, max_size=4)
+    ),
+    max_leaves=30,
+)
+
+
+@settings(max_examples=150, deadline=None)
+@given(json_like)
+def test_the_loader_reads_what_pyyaml_reads(data: object) -> None:
+    text = yaml.safe_dump(data)
+    assert yamlio.load_yaml_text(text).data == yaml.safe_load(text)

@@ -38,6 +38,8 @@ _SAMPLES = 2048
 _GRID = 121
 _SWEEPS = 4
 _STARTS = 3
+_TIE_DECIMALS = 9  # heights equal to a nanometre are one height (see _sampled)
+_TIE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -258,7 +260,9 @@ def _sampled(
     z = chain_fk_batch(conns, q)[:, 2, 3]
     best: dict[str, tuple[float, F64]] = {}
     for sign, key in ((1.0, "low"), (-1.0, "high")):
-        order = np.argsort(sign * z)[:_STARTS]
+        # Heights equal to a nanometre are ties (a joint that does not move the body gives
+        # many): rounded and sorted stably, the witness does not hang on the last bit of BLAS.
+        order = np.argsort(np.round(sign * z, _TIE_DECIMALS), kind="stable")[:_STARTS]
         found: tuple[float, F64] | None = None
         for i in order.tolist():
             x = q[i].copy()
@@ -270,13 +274,13 @@ def _sampled(
                     trial = np.repeat(x[None], _GRID, axis=0)
                     trial[:, d] = grid
                     zz = chain_fk_batch(conns, trial)[:, 2, 3]
-                    k = int(np.argmin(sign * zz))
-                    if sign * float(zz[k]) < sign * val - 1e-12:
+                    k = int(np.argmin(np.round(sign * zz, _TIE_DECIMALS)))
+                    if sign * float(zz[k]) < sign * val - _TIE:
                         val, x = float(zz[k]), trial[k]
                         improved = True
                 if not improved:
                     break
-            if found is None or sign * val < sign * found[0]:
+            if found is None or sign * val < sign * found[0] - _TIE:
                 found = (val, x)
         assert found is not None
         best[key] = found

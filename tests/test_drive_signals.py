@@ -46,3 +46,34 @@ def test_signal_ends_a_drive_with_its_summary_and_a_whole_log(
     assert "Traceback" not in err
     rows = [json.loads(line) for line in log.read_text(encoding="utf-8").splitlines()]
     assert rows and f"wrote {len(rows)} states to" in out  # every row whole, the count told
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_inside_a_logged_state_waits_until_the_row_is_written(
+    tmp_path: Path, sig: signal.Signals
+) -> None:
+    """The race of the old log, made certain: the signal arrives while a row is being logged."""
+    import os
+
+    from robotspec.cli.driving import _Guarded, _StopSignals
+
+    written: list[int] = []
+
+    def listener(state: object) -> None:
+        os.kill(os.getpid(), sig)  # delivered at the next bytecode, inside the listener
+        written.append(1)  # the row completes all the same
+
+    with _StopSignals() as signals:
+        guarded = _Guarded(listener, signals)  # type: ignore[arg-type]
+        with pytest.raises(KeyboardInterrupt):
+            guarded(None)  # type: ignore[arg-type]
+        assert written == [1]
+        if sig == signal.SIGINT:
+            with pytest.raises(KeyboardInterrupt):  # outside a row: at once, as before
+                os.kill(os.getpid(), sig)
+                time.sleep(1)
+        else:  # a second SIGTERM would kill, as SIGTERM does
+            assert signal.getsignal(sig) == signal.SIG_DFL
+    said = "SIGTERM" if sig == signal.SIGTERM else "Ctrl-C"
+    assert signals.received == [said] * (2 if sig == signal.SIGINT else 1)
+    assert signal.getsignal(sig) is not signals._on_signal  # handlers given back

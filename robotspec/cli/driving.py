@@ -11,7 +11,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from types import FrameType
@@ -24,30 +24,70 @@ if TYPE_CHECKING:
 __all__ = ["drive_target", "run_driver"]
 
 
-@contextmanager
-def _sigterm_interrupts(received: list[str]) -> Iterator[None]:
-    """While inside, SIGTERM ends the run as Ctrl-C does (``KeyboardInterrupt``).
+class _StopSignals:
+    """Ctrl-C and SIGTERM end the run, but never inside a state's logging.
 
-    Why: the default SIGTERM kills the process on the spot, so a ``--log`` was cut mid-line and
-    no summary was printed; a run stopped by a process manager must end like one stopped by hand.
-    The served path has its own handlers (:mod:`robotspec.service.serve`). Signal handlers can
-    only be set from the main thread; elsewhere nothing is changed.
+    Why: Python raises ``KeyboardInterrupt`` between any two bytecodes, so a signal could land
+    inside the state log's listener, after a row was counted and before it was written (the
+    summary said 21 states, the log held 20), or cut a row short. Here both signals only set a
+    flag inside a critical section and raise once it is left; outside one they raise at once, as
+    before. The default SIGTERM killed the process on the spot (no summary, a log cut mid-line);
+    now a run stopped by a process manager ends like one stopped by hand. The served path has its
+    own handlers (:mod:`robotspec.service.serve`). Handlers can only be set from the main thread;
+    elsewhere nothing is changed.
     """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.getsignal(signal.SIGTERM)
 
-    def on_term(_signum: int, _frame: FrameType | None) -> None:
-        received.append("SIGTERM")
-        signal.signal(signal.SIGTERM, previous)  # a second SIGTERM is the default again
-        raise KeyboardInterrupt
+    def __init__(self) -> None:
+        self.received: list[str] = []
+        self._pending = False
+        self._depth = 0
+        self._previous: dict[int, object] = {}
 
-    signal.signal(signal.SIGTERM, on_term)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    def __enter__(self) -> _StopSignals:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._previous[sig] = signal.getsignal(sig)
+                signal.signal(sig, self._on_signal)
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        for sig, previous in self._previous.items():
+            signal.signal(sig, previous)  # type: ignore[arg-type]
+        self._previous.clear()
+
+    def _on_signal(self, signum: int, _frame: FrameType | None) -> None:
+        self.received.append("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
+        if signum == signal.SIGTERM:
+            # the first one is honoured gracefully; a second one kills, as SIGTERM does
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        if self._depth:
+            self._pending = True
+        else:
+            raise KeyboardInterrupt
+
+    @contextmanager
+    def critical(self) -> Iterator[None]:
+        """A stretch no stop signal cuts: one raised inside is raised when it is left."""
+        self._depth += 1
+        try:
+            yield
+        finally:
+            self._depth -= 1
+        if not self._depth and self._pending:
+            self._pending = False
+            raise KeyboardInterrupt
+
+
+class _Guarded:
+    """A state listener run as a critical section of :class:`_StopSignals`."""
+
+    def __init__(self, listener: Callable[[RobotState], None], signals: _StopSignals) -> None:
+        self._listener = listener
+        self._signals = signals
+
+    def __call__(self, st: RobotState) -> None:
+        with self._signals.critical():
+            self._listener(st)
 
 
 def drive_target(
@@ -106,10 +146,11 @@ def run_driver(
     scenario = load_scenario(script) if script is not None else None
     clock = SimClock() if virtual_time else RealClock()
     driver = SimRobot(info, clock=clock, update_period=1.0 / rate)
+    signals = _StopSignals()
     statelog = None
     if log is not None:
         statelog = StateLog(log, info.joint_names, len(info.chains))
-        driver.add_state_listener(statelog)
+        driver.add_state_listener(_Guarded(statelog, signals))
     tty = sys.stdout.isatty()
     status = _StatusLine(tty)
     driver.add_state_listener(status)
@@ -131,11 +172,10 @@ def run_driver(
     interrupted = False
     stopped_by = "Ctrl-C"
     wall0 = time.perf_counter()
-    terminated: list[str] = []
     try:
         with ExitStack() as guard:
             if not serve:  # the served path handles its signals itself
-                guard.enter_context(_sigterm_interrupts(terminated))
+                guard.enter_context(signals)
             driver.step()
             if serve:
                 from robotspec.service.serve import serve_driver
@@ -173,8 +213,8 @@ def run_driver(
                     driver.step()
     except KeyboardInterrupt:
         interrupted = True
-        if terminated:
-            stopped_by = terminated[0]
+        if signals.received:
+            stopped_by = signals.received[0]
     finally:
         status.clear()
         if statelog is not None:

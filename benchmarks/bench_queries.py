@@ -16,6 +16,7 @@ the two are timed interleaved, round by round, medians reported. Ratio = peer / 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import sys
 import time
@@ -194,6 +195,47 @@ def robot_rows(name: str, rounds: int, n_configs: int) -> list[Row]:
         )
     )
 
+    # The same two queries through pinocchio's broad phase (coal's dynamic AABB tree over the
+    # geometries, pinocchio 3+): the best a pinocchio user can run for one configuration. Its
+    # results are only written for the pairs the tree lets through, so they are cleared first.
+    bgdata = pin.GeometryData(gmodel)
+    broad = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(model, gmodel, bgdata)
+
+    def pin_broad_any(q: np.ndarray) -> bool:
+        return pin.computeCollisions(model, data, broad, q, True)  # type: ignore[no-any-return]
+
+    def pin_broad_all(q: np.ndarray) -> set[tuple[str, str]]:
+        for res in bgdata.collisionResults:
+            res.clear()
+        pin.computeCollisions(model, data, broad, q, False)
+        return {
+            key[b]
+            for b, res in zip(pr.pair_bodies, bgdata.collisionResults, strict=True)
+            if res.isCollision()
+        }
+
+    for q, pq in zip(qs, pqs, strict=True):
+        assert pin_broad_any(pq) == checker.in_collision(q), name
+        assert pin_broad_all(pq) == set(checker.colliding_pairs(q)), name
+    t = duel(checker.in_collision, qs, pin_broad_any, pqs, rounds)
+    rows.append(
+        Row(
+            f"{label} self-collision, any hit, vs broad phase",
+            t[0],
+            "computeCollisions(BroadPhaseManager, stop)",
+            t[1],
+        )
+    )
+    t = duel(checker.colliding_pairs, qs, pin_broad_all, pqs, rounds)
+    rows.append(
+        Row(
+            f"{label} self-collision, all pairs, vs broad phase",
+            t[0],
+            "BroadPhaseManager + pairs read",
+            t[1],
+        )
+    )
+
     def pin_dist(q: np.ndarray) -> list[tuple[float, Any, Any]]:
         pin.computeDistances(model, data, gmodel, gdata, q)
         return [
@@ -342,6 +384,35 @@ def batch_rows(samples: int, collision_configs: int, rounds: int) -> list[Row]:
             t[1] / n,
         )
     )
+    # pinocchio's own batch: computeCollisionsInParallel over a pool, one answer per
+    # configuration (any hit), on every CPU, with and without its broad phase. The checker's
+    # batch runs on one thread: these rows give pinocchio every CPU and robotspec one.
+    threads = max(1, os.cpu_count() or 1)
+    qmat = np.asfortranarray(np.array(cpqs).T)
+    pool = pin.GeometryPool(model, gmodel, threads)
+    broad_pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(model, gmodel, threads)
+
+    def pin_parallel(_: object) -> np.ndarray:
+        return np.asarray(pin.computeCollisionsInParallel(threads, pool, qmat, True))
+
+    def pin_parallel_broad(_: object) -> np.ndarray:
+        return np.asarray(pin.computeCollisionsInParallel(threads, broad_pool, qmat, True))
+
+    assert np.array_equal(pin_parallel(0), checker.in_collision_batch(cqs))
+    assert np.array_equal(pin_parallel_broad(0), checker.in_collision_batch(cqs))
+    for peer, what in (
+        (pin_parallel, "computeCollisionsInParallel (GeometryPool)"),
+        (pin_parallel_broad, "computeCollisionsInParallel (broad phase pool)"),
+    ):
+        t = duel(lambda _: checker.in_collision_batch(cqs), [0], peer, [0], rounds)
+        rows.append(
+            Row(
+                f"pr2: self-collision any hit, batch of {n}, {threads} threads (per config)",
+                t[0] / n,
+                what,
+                t[1] / n,
+            )
+        )
     return rows
 
 

@@ -37,10 +37,44 @@ from robotspec.spec.draft.naming import (
     unique,
 )
 from robotspec.spec.draft.parts import add_drive, add_sensors, add_states, add_torso
-from robotspec.spec.draft.srdf_groups import end_effector_root, group_chains
+from robotspec.spec.draft.srdf_groups import (
+    GroupJoints,
+    end_effector_root,
+    group_chains,
+    group_notes,
+)
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = ["Drafter", "draft_spec"]
+
+
+class _SubsetIndex:
+    """Answers "is another of these joint sets a strict part of this one?" without a full scan.
+
+    Why: an SRDF may hold 10^5 groups; comparing each with all others is quadratic (minutes).
+    A part of a set holds that set's least joint, so only the sets filed under one of its
+    joints are compared, and each distinct set is asked once.
+    """
+
+    def __init__(self, sets: list[frozenset[str]]) -> None:
+        self._by_least: dict[str, list[frozenset[str]]] = {}
+        self._empty = False
+        for s in dict.fromkeys(sets):
+            if s:
+                self._by_least.setdefault(min(s), []).append(s)
+            else:
+                self._empty = True
+        self._answers: dict[frozenset[str], bool] = {}
+
+    def has_strict_subset(self, target: frozenset[str]) -> bool:
+        """Whether a set of the index is a strict subset of ``target``."""
+        answer = self._answers.get(target)
+        if answer is None:
+            answer = (self._empty and bool(target)) or any(
+                s < target for j in target for s in self._by_least.get(j, ())
+            )
+            self._answers[target] = answer
+        return answer
 
 
 class Drafter:
@@ -51,6 +85,7 @@ class Drafter:
     ) -> None:
         self.world = world
         self.srdf = srdf
+        self.groups = GroupJoints(joints={})
         self.names: set[str] = set()
         root = world.root
         drive: DraftDrive | None = None
@@ -84,19 +119,21 @@ class Drafter:
         out: list[tuple[DraftChain, Limb | None]] = []
         used: set[int] = set()
         if self.srdf is not None:
-            found = group_chains(self.world, self.srdf)
-            sets = [lb.joints for lb in limbs] + [gc.joints for gc in found]
-            accepted: list[frozenset[str]] = []
+            self.groups = GroupJoints.of(self.world, self.srdf)
+            self.draft.notes.extend(group_notes(self.groups))
+            found = group_chains(self.world, self.srdf, self.groups)
+            joins = _SubsetIndex([lb.joints for lb in limbs] + [gc.joints for gc in found])
+            accepted: set[frozenset[str]] = set()
+            hands = [lb.hand for lb in limbs if lb.hand is not None]
             for gc in found:
-                if any(s < gc.joints for s in sets) or gc.joints in accepted:
+                if gc.joints in accepted or joins.has_strict_subset(gc.joints):
                     self.draft.notes.append(
                         f"SRDF group {gc.group.name!r} joins or repeats other chains; not drafted"
                     )
                     continue
-                hands = [lb.hand for lb in limbs if lb.hand is not None]
                 if any(self.world.is_ancestor(h, gc.root) for h in hands):
                     continue  # a hand's own joints (Panda's 'hand'): its manipulator has them
-                accepted.append(gc.joints)
+                accepted.add(gc.joints)
                 limb_i = next(
                     (i for i, lb in enumerate(limbs) if lb.joints & gc.joints and i not in used),
                     None,
@@ -240,7 +277,7 @@ class Drafter:
         assert self.srdf is not None
         world = self.world
         for ee in self.srdf.end_effectors:
-            start = end_effector_root(world, self.srdf, ee)
+            start = end_effector_root(world, self.srdf, ee, self.groups)
             if start is None:
                 self.draft.notes.append(f"end effector {ee.name!r}: its links are not in the URDF")
                 continue

@@ -56,6 +56,8 @@ def scalar(text: str) -> str:
 
 def comment(text: str) -> str:
     """Text safe inside a ``#`` comment: one line, no control characters."""
+    if text.isascii() and text.isprintable():
+        return text  # nothing to escape (the common case; a draft may carry 10^5 notes)
     return "".join(_escape_char(ch) if ch not in '\\"' else ch for ch in text.replace("\n", "\\n"))
 
 

@@ -54,6 +54,8 @@ _BLOCK = 512
 _HULL_TOLERANCE = 1e-10
 _HULL_GAP = 1e-5
 _ON_SURFACE = 1e-9
+#: Relative thickness below which a mesh counts as flat and gets no hull (see ``_solid``).
+_FLAT = 1e-6
 #: What the mesh core proved of a candidate (its codes), and "not asked".
 _UNKNOWN, _APART, _CROSS, _UNTRIED = 0, 1, 2, -1
 #: Candidates of a block from which mesh proofs run in one C call rather than one by one.
@@ -561,11 +563,38 @@ def _mesh_trees(geoms: Sequence[CollisionGeometry], g1: list[int], g2: list[int]
 
 
 def _hull(geom: CollisionGeometry) -> Any:
-    """The convex hull of a mesh geometry as a coal convex, or None (a flat mesh has none)."""
+    """The convex hull of a mesh geometry as a coal convex, or None (a flat mesh has none).
+
+    A mesh with no volume (a plate, a sliver, collinear or repeated points) never reaches qhull:
+    coal 3.0 does not turn qhull's refusal of a flat point set into an exception but crashes the
+    process (SIGSEGV). Such a mesh gets no hull, so its pairs use coal's mesh distance.
+    """
     model = geom.geometry
+    if getattr(model, "convex", None) is None and (
+        geom.triangles is None or not _solid(geom.triangles[0])
+    ):
+        return None
     try:
         if getattr(model, "convex", None) is None:
             model.buildConvexHull(False, "Qt")  # qhull: the hull's vertices are mesh vertices
         return model.convex
     except Exception:  # noqa: BLE001 - qhull refuses flat or degenerate point sets
         return None
+
+def _solid(vertices: F64) -> bool:
+    """Whether qhull can hull ``vertices`` (V, 3): at least four points, not (nearly) flat.
+
+    The test: the points' extent across their plane of best fit (the last principal axis) must
+    exceed ``_FLAT`` times their size (their largest extent, or their distance from the origin
+    if larger: qhull's rounding grows with the coordinates). Random near-flat point sets crash
+    qhull up to about 1e-8 and never from 1e-7 on, so ``_FLAT`` keeps a factor of ten.
+    """
+    points = np.unique(np.asarray(vertices, dtype=np.float64).reshape(-1, 3), axis=0)
+    if len(points) < 4:
+        return False
+    centred = points - points.mean(axis=0)
+    axes = np.linalg.svd(centred, full_matrices=False)[2]
+    along = centred @ axes.T
+    extent = along.max(axis=0) - along.min(axis=0)
+    size = max(float(extent[0]), float(np.abs(points).max()))
+    return bool(extent[2] > _FLAT * size)

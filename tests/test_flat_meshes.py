@@ -1,0 +1,131 @@
+"""Flat and degenerate collision meshes (issue 24, item 4): distances answer, never a crash.
+
+A plate of two triangles is common in real URDFs (a sensor's mounting plate, a caster's cover).
+Coal's qhull crashed the whole process (SIGSEGV) when the distance path asked it for the convex
+hull of such a mesh; the checker now gives a flat mesh no hull and uses coal's mesh distance.
+The command line runs in a subprocess, so a crash there fails one test instead of the run.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from robotspec.collision import CollisionRules, SelfCollisionChecker
+from robotspec.collision.checker import _solid
+from robotspec.description.urdf import load_urdf
+
+#: Degenerate point sets: (vertices, triangles), each 0.1 m across, in the mesh's frame.
+MESHES: dict[str, tuple[list[list[float]], list[list[int]]]] = {
+    "plate": ([[0, 0, 0], [0.1, 0, 0], [0.1, 0.1, 0], [0, 0.1, 0]], [[0, 1, 2], [0, 2, 3]]),
+    "sliver": (
+        [[0, 0, 0], [0.1, 0, 0], [0.05, 0.1, 0], [0.05, 0.05, 1e-10]],
+        [[0, 1, 2], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+    ),
+    "collinear": ([[0, 0, 0], [0.05, 0, 0], [0.1, 0, 0], [0.1, 0, 0]], [[0, 1, 2], [1, 2, 3]]),
+    "repeated": ([[0, 0, 0], [0, 0, 0], [0, 0, 0], [0.1, 0, 0]], [[0, 1, 3], [1, 2, 3]]),
+}
+
+#: Two meshes on prismatic joints over a box, and a second box s (x, y in [0, 0.1], z in [0.55,
+#: 0.65]): the pairs a-b (mesh, mesh), a-s and b-s (mesh, box) are checked; the base is adjacent
+#: to everything.
+URDF = """<?xml version="1.0"?>
+<robot name="flat">
+  <link name="base"><collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+  <link name="a"><collision><geometry><mesh filename="{a}"/></geometry></collision></link>
+  <link name="b"><collision><geometry><mesh filename="{b}"/></geometry></collision></link>
+  <link name="s"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <joint name="base_a" type="prismatic">
+    <parent link="base"/><child link="a"/><origin xyz="0 0 1"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <joint name="base_b" type="prismatic">
+    <parent link="base"/><child link="b"/><origin xyz="0 0 1.5"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <joint name="base_s" type="fixed">
+    <parent link="base"/><child link="s"/><origin xyz="0.05 0.05 0.6"/>
+  </joint>
+</robot>
+"""
+
+
+def _write_stl(path: Path, name: str) -> None:
+    import trimesh
+
+    vertices, faces = MESHES[name]
+    trimesh.Trimesh(np.array(vertices), np.array(faces), process=False).export(str(path))
+
+
+def _robot(tmp_path: Path, a: str, b: str) -> Path:
+    """The URDF above with mesh ``a`` on link a and ``b`` on link b (a name of ``MESHES``)."""
+    _write_stl(tmp_path / f"{a}.stl", a)
+    _write_stl(tmp_path / f"{b}.stl", b)
+    path = tmp_path / "flat.urdf"
+    path.write_text(URDF.format(a=f"{a}.stl", b=f"{b}.stl"))
+    return path
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_distances_of_a_flat_mesh_are_its_mesh_distances(tmp_path: Path, name: str) -> None:
+    world = load_urdf(_robot(tmp_path, name, "plate"))
+    checker = SelfCollisionChecker(world, CollisionRules.for_world(world))
+    assert checker.active_pairs == (("a", "b"), ("a", "s"), ("b", "s"))
+    q = world.configuration()
+    found = {(d.link1, d.link2): d for d in checker.distances(q)}
+    # Every test mesh lies in its link's plane z = 0 (to 1e-10), within x, y in [0, 0.1].
+    assert found[("a", "b")].distance == pytest.approx(0.5, abs=1e-9)
+    assert found[("a", "s")].distance == pytest.approx(0.35, abs=1e-9)
+    assert found[("b", "s")].distance == pytest.approx(0.85, abs=1e-9)
+    assert found[("b", "s")].point1[2] == pytest.approx(1.5, abs=1e-9)
+    assert found[("b", "s")].point2[2] == pytest.approx(0.65, abs=1e-9)
+    qs = np.array([q, world.configuration({"base_a": -0.3, "base_b": -0.6})])  # at 0.7 and 0.9
+    batch = checker.distances_batch(qs)
+    assert batch[0] == pytest.approx([0.5, 0.35, 0.85], abs=1e-9)
+    assert batch[1] == pytest.approx([0.2, 0.05, 0.25], abs=1e-9)
+    assert not checker.in_collision(q)
+
+
+def test_flat_mesh_collides_through_a_primitive(tmp_path: Path) -> None:
+    world = load_urdf(_robot(tmp_path, "plate", "plate"))
+    checker = SelfCollisionChecker(world, CollisionRules.for_world(world))
+    q = world.configuration({"base_a": -0.38})  # the plate at z = 0.62 cuts the box s
+    assert checker.colliding_pairs(q) == (("a", "s"),)
+    assert checker.distances_batch(q[None, :])[0, 1] <= 0.0
+
+
+def test_solid_point_sets_keep_their_hull_and_flat_ones_get_none() -> None:
+    rng = np.random.default_rng(3)
+    rotation = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    plate = np.c_[rng.uniform(0, 0.1, (50, 2)), np.zeros(50)]
+    for name, (vertices, _) in MESHES.items():
+        assert not _solid(np.array(vertices, dtype=np.float64)), name
+    assert not _solid(plate @ rotation.T)  # flat in any orientation
+    bumped = plate.copy()
+    bumped[0, 2] = 1e-9  # thinner than qhull can hull
+    assert not _solid(bumped @ rotation.T)
+    bumped[0, 2] = 1e-4
+    assert _solid(bumped @ rotation.T)
+    # Far from the origin the same bump is below qhull's rounding: flat.
+    assert not _solid(bumped @ rotation.T + 1e3)
+    cube = np.array([[x, y, z] for x in (0, 0.1) for y in (0, 0.1) for z in (0, 0.1)], dtype=float)
+    assert _solid(cube)
+
+
+def test_collisions_check_distances_command_on_a_flat_mesh(tmp_path: Path) -> None:
+    _robot(tmp_path, "plate", "sliver")
+    spec = tmp_path / "flat.yaml"
+    spec.write_text("robotspec: 1\nname: Flat\ndescription:\n  urdf: flat.urdf\nroot: base\n")
+    run = subprocess.run(
+        [sys.executable, "-m", "robotspec", "collisions", "check", str(spec), "--distances"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0, (run.returncode, run.stderr)
+    assert run.stdout.startswith("collision-free (3 pairs checked)")
+    assert "0.500000" in run.stdout and "0.350000" in run.stdout

@@ -34,7 +34,7 @@ from robotspec.description.mesh_report import MissingMesh, summarize_missing_mes
 from robotspec.description.urdf_walk import JointRecord, ShapeRecord, walk_urdf
 from robotspec.files.limits import limits
 from robotspec.files.reading import read_bounded
-from robotspec.files.xmlsafe import line_of, parse_xml_bytes
+from robotspec.files.xmlsafe import line_of, parse_xml_bytes, undeclared_prefixes
 from robotspec.model.world import Body, Connection, ConnectionType, DegreeOfFreedom, Mimic, World
 
 __all__ = ["MeshPolicy", "is_xacro", "load_urdf", "read_description_xml", "world_from_urdf_xml"]
@@ -141,6 +141,20 @@ def world_from_urdf_xml(
     raise_collected(problems)
     if missing and issues is not None:
         issues.extend(summarize_missing_meshes(missing))
+    undeclared = undeclared_prefixes(root)
+    if undeclared and issues is not None:
+        names = ", ".join(f"'{p}:'" for p in undeclared)
+        issues.append(
+            DescriptionError(
+                f"XML prefix{'es' if len(undeclared) > 1 else ''} {names} used without a "
+                "declaration (as Drake writes them); read as extensions URDF does not use",
+                file=file,
+                line=line_of(root),
+                kind="xml",
+                name=undeclared[0],
+                severity="warning",
+            )
+        )
     joints = {j.name: j for j in records.joints}
     leaders = _resolve_mimics(joints, file)
     dofs: list[DegreeOfFreedom] = []

@@ -7,7 +7,9 @@ recovering parser silently drops elements). Errors carry the file and lxml's lin
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
+from typing import Any
 
 from lxml import etree
 
@@ -15,7 +17,21 @@ from robotspec.errors import DescriptionError, RobotSpecError
 from robotspec.files.limits import env_name, limits
 from robotspec.files.reading import read_bounded, refuse_entities
 
-__all__ = ["parse_xml_bytes", "parse_xml_file", "safe_parser"]
+__all__ = [
+    "UNDECLARED_NAMESPACE",
+    "parse_xml_bytes",
+    "parse_xml_file",
+    "safe_parser",
+    "undeclared_prefixes",
+]
+
+#: The namespace URI prefix given to XML prefixes a file uses without declaring them (Drake
+#: writes ``drake:`` elements and attributes into URDFs without ``xmlns:drake``). urdfdom and
+#: pinocchio read such files; the extension elements are unknown to URDF and ignored anyway.
+UNDECLARED_NAMESPACE = "urn:robotspec:undeclared:"
+
+_UNDECLARED = re.compile(r"Namespace prefix ([A-Za-z_][\w.-]*) (?:for \S+ )?on \S+ is not defined")
+_MAX_UNDECLARED = 64  # prefixes declared for a file; more is not a robot description
 
 
 def safe_parser() -> etree.XMLParser:
@@ -84,7 +100,7 @@ def parse_xml_bytes(
         )
     refuse_entities(data, file, error_type)
     try:
-        root: etree._Element | None = etree.fromstring(data, parser=safe_parser())
+        root: etree._Element | None = _parse_declaring_prefixes(data)
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if exc.lineno and exc.lineno > 0 else None
         col = exc.offset if exc.offset and exc.offset > 0 else None
@@ -96,6 +112,75 @@ def parse_xml_bytes(
         raise error_type("empty XML document", file=file)
     _check_no_entities(root, file)
     return root
+
+
+def _parse_declaring_prefixes(data: bytes) -> etree._Element | None:
+    """Parse; where the only faults are undeclared prefixes, declare them on the root and retry.
+
+    Why: libxml2 reports every undeclared prefix and otherwise parses on, so one retry with
+    ``xmlns:PREFIX="urn:robotspec:undeclared:PREFIX"`` added to the root's start tag reads the
+    file as urdfdom does. A file with any other fault is refused with that fault (the retry's).
+    """
+    parser = safe_parser()
+    try:
+        return etree.fromstring(data, parser=parser)
+    except etree.XMLSyntaxError:
+        prefixes: dict[str, None] = {}
+        log: Any = parser.error_log  # this parse's own (the exception's may hold older ones)
+        for entry in log:
+            found = _UNDECLARED.fullmatch(entry.message)
+            if entry.type_name == "NS_ERR_UNDEFINED_NAMESPACE" and found is not None:
+                prefixes[found.group(1)] = None
+        at = _root_name_end(data)
+        if not prefixes or len(prefixes) > _MAX_UNDECLARED or at is None:
+            raise
+        declared = b"".join(
+            f' xmlns:{p}="{UNDECLARED_NAMESPACE}{p}"'.encode("ascii") for p in prefixes
+        )
+        try:
+            return etree.fromstring(data[:at] + declared + data[at:], parser=safe_parser())
+        except etree.XMLSyntaxError as retry:
+            # The declarations went onto the root's line: later columns there shift back.
+            line = data.count(b"\n", 0, at) + 1
+            column = at - data.rfind(b"\n", 0, at)
+            if retry.lineno == line and retry.offset and retry.offset > column:
+                retry.offset -= len(declared)
+            raise
+
+
+_NAME = re.compile(rb"[A-Za-z_:][\w.:-]*")
+
+
+def _root_name_end(data: bytes) -> int | None:
+    """The offset just past the root element's name in its start tag (ASCII-compatible text)."""
+    pos = 0
+    while True:
+        i = data.find(b"<", pos)
+        if i < 0:
+            return None
+        if data.startswith(b"<!--", i):
+            pos = data.find(b"-->", i + 4)
+            pos = -1 if pos < 0 else pos + 3
+        elif data.startswith(b"<?", i):
+            pos = data.find(b"?>", i + 2)
+            pos = -1 if pos < 0 else pos + 2
+        elif data.startswith(b"<!", i):
+            pos = data.find(b">", i + 2)
+            pos = -1 if pos < 0 else pos + 1
+        else:
+            name = _NAME.match(data, i + 1)
+            return None if name is None else name.end()
+        if pos < 0:
+            return None
+
+
+def undeclared_prefixes(root: etree._Element) -> list[str]:
+    """The prefixes :func:`parse_xml_bytes` declared for ``root``'s file (empty: none)."""
+    return [
+        prefix
+        for prefix, uri in (root.nsmap or {}).items()
+        if prefix and uri and uri.startswith(UNDECLARED_NAMESPACE)
+    ]
 
 
 def parse_xml_file(

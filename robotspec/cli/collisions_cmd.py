@@ -126,10 +126,45 @@ def check(
         raise typer.Exit(1)
 
 
+#: Bounds of ``--samples`` and ``--seed``: those of robotspec.collision.sampling (MAX_SAMPLES,
+#: MAX_SEED), written out so that ``--help`` does not import numpy; a test keeps them equal.
+MAX_SAMPLES = 1_000_000_000
+MAX_SEED = 2**64 - 1
+
+
+def _within(low: int, high: int, shown: str) -> Any:
+    """A callback refusing a value outside ``[low, high]``: a usage error naming the value.
+
+    Why not the option's own ``min``/``max``: their message names the bound, not the value
+    given, and a script's user needs to see which value was wrong.
+    """
+
+    def check(value: int | None) -> int | None:
+        if value is not None and not low <= value <= high:
+            raise typer.BadParameter(f"{value} is not between {low} and {shown}")
+        return value
+
+    return check
+
+
+_samples_range = _within(0, MAX_SAMPLES, f"{MAX_SAMPLES:,}")
+
 #: The sampling options that ``collisions generate`` and ``collisions audit`` share.
-SeedOpt = Annotated[int, typer.Option("--seed", help="Seed of the sampler.")]
+SeedOpt = Annotated[
+    int,
+    typer.Option(
+        "--seed", help="Seed of the sampler, 0 to 2^64-1.", callback=_within(0, MAX_SEED, "2^64-1")
+    ),
+]
 JobsOpt = Annotated[
-    int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes (default: CPUs).")
+    int | None,
+    typer.Option(
+        "--jobs",
+        "-j",
+        help="Worker processes (default: CPUs); never more than the CPUs or the blocks of "
+        "500 samples.",
+        callback=_within(1, 1_000_000, "1,000,000"),
+    ),
 ]
 ProgressOpt = Annotated[
     bool | None,
@@ -139,11 +174,25 @@ ProgressOpt = Annotated[
 ]
 
 
+def processes_text(used: int, asked: int | None) -> str:
+    """``2 processes``, and what ``--jobs`` asked for when fewer ran (the CPUs or the work)."""
+    text = f"{used} process{'' if used == 1 else 'es'}"
+    if asked is not None and asked > used:
+        text += f" (--jobs {asked}: at most the CPUs and one per block of 500 samples)"
+    return text
+
+
 @collisions_app.command("generate")
 def generate(
     spec: SpecArg,
     samples: Annotated[
-        int, typer.Option("--samples", "-n", min=0, help="Random configurations to sample.")
+        int,
+        typer.Option(
+            "--samples",
+            "-n",
+            help="Random configurations to sample (at most 10^9).",
+            callback=_samples_range,
+        ),
     ] = 10_000,
     seed: SeedOpt = 0,
     output: Annotated[
@@ -205,7 +254,7 @@ def generate(
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
     lines = [
         f"{len(matrix.disabled)} pairs disabled ({counts}); {len(matrix.checked)} stay checked; "
-        f"{matrix.samples} samples, seed {matrix.seed}, {matrix.processes} processes, "
+        f"{matrix.samples} samples, seed {matrix.seed}, {processes_text(matrix.processes, jobs)}, "
         f"{matrix.seconds:.1f} s"
     ]
     if robot.srdf is not None:
@@ -234,7 +283,10 @@ def audit(
     samples: Annotated[
         int,
         typer.Option(
-            "--samples", "-n", min=0, help="Random configurations for the regenerated matrix."
+            "--samples",
+            "-n",
+            help="Random configurations for the regenerated matrix (at most 10^9).",
+            callback=_samples_range,
         ),
     ] = 10_000,
     seed: SeedOpt = 0,

@@ -27,7 +27,7 @@ from robotspec.collision.checker import SelfCollisionChecker
 from robotspec.collision.convergence import SrdfComparison, compare_with_srdf
 from robotspec.collision.matrix import CollisionMatrix, generate_for_robot
 from robotspec.collision.rules import ADJACENT, NEVER, CollisionRules, adjacent_pairs, pair_key
-from robotspec.collision.sampling import default_configuration, random_configurations
+from robotspec.collision.sampling import RandomBlocks, check_sampling, default_configuration
 from robotspec.collision.shapes import MissingMeshPolicy
 from robotspec.errors import CollisionError
 from robotspec.model.world import World
@@ -175,13 +175,24 @@ def _witnesses(
         todo = [j for j in range(len(probe.active_pairs)) if j not in found_q]
         if not todo:
             break
-        qs = random_configurations(world, samples, rng)
-        hits = probe.collisions_batch(qs)
+        # Block by block (memory flat whatever ``samples`` is); each pair keeps the round's
+        # first candidates, as if the round were drawn at once.
+        cols = np.array(todo, dtype=np.intp)
+        kept: dict[int, list[F64]] = {}
+        for qs in RandomBlocks(world, samples, rng):
+            hits = probe.collisions_batch(qs)[:, cols]
+            for col in np.flatnonzero(hits.any(axis=0)).tolist():
+                j = todo[col]
+                rows = np.flatnonzero(hits[:, col])
+                counts[j] = counts.get(j, 0) + int(len(rows))
+                have = kept.setdefault(j, [])
+                room = _WITNESS_CANDIDATES - sum(len(a) for a in have)
+                if room > 0:
+                    have.append(qs[rows[:room]])
         for j in todo:
-            rows = np.flatnonzero(hits[:, j])
-            counts[j] = counts.get(j, 0) + int(len(rows))
-            if len(rows):
-                found_q[j] = qs[rows[:_WITNESS_CANDIDATES]]
+            counts.setdefault(j, 0)
+        for j, parts in kept.items():
+            found_q[j] = np.concatenate(parts)
     out: dict[tuple[str, str], tuple[dict[str, float], bool, int]] = {}
     for j, (a, b) in enumerate(probe.active_pairs):
         if j not in found_q:
@@ -213,6 +224,7 @@ def audit_srdf(
     "Never" verdicts come from a regenerated matrix (``samples`` random configurations, the
     generator's seed); witnesses from ``samples`` further configurations (seed ``seed + 1``).
     """
+    check_sampling(samples, seed)
     srdf = robot.srdf
     if srdf is None:
         raise CollisionError(f"robot '{robot.name}' has no SRDF to audit", kind="srdf")

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.collision.checker import SelfCollisionChecker
-from robotspec.collision.parallel import default_processes, ever_colliding_parallel
+from robotspec.collision.parallel import ever_colliding_parallel, used_processes
 from robotspec.collision.rules import (
     ADJACENT,
     ALWAYS,
@@ -39,7 +39,12 @@ from robotspec.collision.rules import (
     adjacent_pairs,
     pair_key,
 )
-from robotspec.collision.sampling import default_configuration, random_configurations
+from robotspec.collision.sampling import (
+    RandomBlocks,
+    check_sampling,
+    default_configuration,
+    random_configurations,
+)
 from robotspec.collision.shapes import MeshLibrary, MissingMeshPolicy
 from robotspec.errors import CollisionError, RobotSpecError
 from robotspec.model.world import World
@@ -92,6 +97,8 @@ class CollisionMatrix:
     samples: int
     seed: int
     always_samples: int
+    #: Worker processes the "Never" pass used: the ones asked for, at most the CPUs and the
+    #: blocks of samples (what ran, not what was asked).
     processes: int
     seconds: float
     skipped: tuple[RobotSpecError, ...] = ()
@@ -170,8 +177,7 @@ def generate_collision_matrix(
 
     ``progress(done, total)`` is called as samples complete (total = every sample drawn).
     """
-    if samples < 0:
-        raise CollisionError(f"samples must be >= 0, got {samples}", kind="config")
+    check_sampling(samples, seed)
     if not 0.0 < always_fraction <= 1.0:
         raise CollisionError(
             f"always_fraction must be in (0, 1], got {always_fraction}", kind="config"
@@ -211,7 +217,6 @@ def generate_collision_matrix(
     undecided &= ~hits
 
     rng = np.random.default_rng(seed)
-    procs = default_processes() if processes is None else max(1, processes)
     always_drawn = 0
     total = samples + ALWAYS_ROUND
     done = 0
@@ -236,7 +241,9 @@ def generate_collision_matrix(
             break
         total += ALWAYS_ROUND
 
-    qs = random_configurations(world, samples, rng)
+    # Drawn block by block as the workers ask: memory stays flat whatever ``samples`` is.
+    blocks = RandomBlocks(world, samples, rng)
+    procs = used_processes(processes, len(blocks))
     first: dict[int, int] = {}
 
     def seen(start: int, hits: NDArray[np.bool_]) -> None:
@@ -245,7 +252,7 @@ def generate_collision_matrix(
 
     ever = ever_colliding_parallel(
         checker,
-        qs,
+        blocks,
         undecided.copy(),
         processes=procs,
         on_missing_mesh=on_missing_mesh,

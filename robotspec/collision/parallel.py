@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import multiprocessing
 from collections import deque
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from multiprocessing.pool import AsyncResult
 from typing import Any
@@ -21,11 +21,12 @@ from numpy.typing import NDArray
 from robotspec.arrays import F64
 from robotspec.collision.checker import SelfCollisionChecker
 from robotspec.collision.rules import CollisionRules
+from robotspec.collision.sampling import RandomBlocks
 from robotspec.collision.shapes import MissingMeshPolicy
 from robotspec.model.kinematics import available_cpus
 from robotspec.model.world import Body, Connection, DegreeOfFreedom, World
 
-__all__ = ["CheckerInputs", "default_processes", "ever_colliding_parallel"]
+__all__ = ["CheckerInputs", "default_processes", "ever_colliding_parallel", "used_processes"]
 
 Bools = NDArray[np.bool_]
 
@@ -90,9 +91,21 @@ def default_processes() -> int:
     return available_cpus()
 
 
+def used_processes(asked: int | None, chunks: int) -> int:
+    """Workers worth starting: ``asked`` (default: the CPUs), at most the CPUs and the chunks.
+
+    Why: a worker per chunk is the most that can run at once, and more workers than CPUs only
+    share them (each forked worker also holds its own copy of what it touches). ``--jobs 64``
+    for two chunks of work starts at most two.
+    """
+    cpus = default_processes()
+    wanted = cpus if asked is None else asked
+    return max(1, min(wanted, cpus, chunks))
+
+
 def ever_colliding_parallel(
     checker: SelfCollisionChecker,
-    qs: F64,
+    qs: F64 | RandomBlocks,
     mask: Bools,
     *,
     processes: int,
@@ -110,14 +123,26 @@ def ever_colliding_parallel(
     on the number of processes or on the order chunks finish in. ``on_chunk(start, hits)`` sees
     each chunk's result in sample order (``start`` = its first sample's index), so a caller can
     tell when each pair was first seen colliding (the matrix's convergence report).
+
+    ``qs`` is an array (split in chunks of ``chunk`` rows) or :class:`RandomBlocks` (drawn block
+    by block as workers ask, so memory does not grow with the sample count). Workers are at most
+    :func:`used_processes` of ``processes``: never more than the CPUs or the chunks.
     """
     ever = np.zeros(len(checker.active_pairs), dtype=np.bool_)
-    chunks: Sequence[F64] = [qs[i : i + chunk] for i in range(0, len(qs), chunk)]
-    if processes <= 1 or len(chunks) <= 1:
-        for i, block in enumerate(chunks):
+    if isinstance(qs, np.ndarray):
+        arr = qs
+        count = -(-len(arr) // max(1, chunk))
+        chunks: Iterable[F64] = (arr[i : i + chunk] for i in range(0, len(arr), max(1, chunk)))
+    else:
+        count, chunks = len(qs), qs
+    processes = used_processes(processes, count)
+    if processes <= 1:
+        done = 0
+        for block in chunks:
             hits = checker.ever_colliding(block, pair_mask=mask & ~ever, margin=margin)
             if on_chunk is not None:
-                on_chunk(i * chunk, hits & ~ever)
+                on_chunk(done, hits & ~ever)
+            done += len(block)
             ever |= hits
             if progress is not None:
                 progress(len(block))
@@ -135,13 +160,17 @@ def ever_colliding_parallel(
         init, args = _init_worker, (CheckerInputs.of(checker, on_missing_mesh),)
     pending: deque[tuple[int, AsyncResult[Any]]] = deque()
     with ctx.Pool(processes, initializer=init, initargs=args) as pool:
-        todo = deque(chunks)
+        todo: Iterator[F64] = iter(chunks)
+        more = True
         done = 0
-        while todo or pending:
-            while todo and len(pending) < 2 * processes:
-                block = todo.popleft()
-                task = pool.apply_async(_ever_colliding_task, (block, mask & ~ever, margin))
-                pending.append((len(block), task))
+        while more or pending:
+            while more and len(pending) < 2 * processes:
+                part = next(todo, None)
+                if part is None:
+                    more = False
+                    break
+                task = pool.apply_async(_ever_colliding_task, (part, mask & ~ever, margin))
+                pending.append((len(part), task))
             size, task = pending.popleft()
             hits = task.get()
             if on_chunk is not None:

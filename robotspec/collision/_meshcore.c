@@ -327,7 +327,9 @@ static void set_free(PyObject *capsule) {
     free(s);
 }
 
-/* mesh_set([(vertices, triangles) or None, ...]) -> capsule */
+/* mesh_set([(vertices, triangles) or None, ...]) -> capsule
+ * The set is complete (trees and apart_one's scratch) before the capsule owns it, so a failure
+ * frees each allocation exactly once: by hand before the capsule exists, by its destructor after. */
 static PyObject *py_mesh_set(PyObject *self, PyObject *args) {
     PyObject *seq;
     if (!PyArg_ParseTuple(args, "O", &seq)) return NULL;
@@ -335,26 +337,39 @@ static PyObject *py_mesh_set(PyObject *self, PyObject *args) {
     if (fast == NULL) return NULL;
     Py_ssize_t n = PySequence_Fast_GET_SIZE(fast);
     MeshSet *s = calloc(1, sizeof(MeshSet));
-    if (s == NULL) {
-        Py_DECREF(fast);
-        return PyErr_NoMemory();
-    }
-    s->trees = calloc((size_t)(n > 0 ? n : 1), sizeof(Tree *));
-    PyObject *cap = PyCapsule_New(s, "robotspec.meshset", set_free);
-    if (s->trees == NULL || cap == NULL) {
-        free(s->trees);
+    Tree **trees = calloc((size_t)(n > 0 ? n : 1), sizeof(Tree *));
+    Scratch *one = calloc(1, sizeof(Scratch));
+    if (s == NULL || trees == NULL || one == NULL) {
         free(s);
-        Py_XDECREF(cap);
+        free(trees);
+        free(one);
         Py_DECREF(fast);
         return PyErr_NoMemory();
     }
+    s->trees = trees;
+    s->one = one; /* zeroed: scratch_free is safe on it before scratch_init */
     s->n = n;
+    PyObject *cap = PyCapsule_New(s, "robotspec.meshset", set_free);
+    if (cap == NULL) {
+        free(one);
+        free(trees);
+        free(s);
+        Py_DECREF(fast);
+        return NULL;
+    }
     for (Py_ssize_t i = 0; i < n; i++) {
         PyObject *item = PySequence_Fast_GET_ITEM(fast, i);
         if (item == Py_None) continue;
         PyObject *vobj, *fobj;
-        if (!PyArg_ParseTuple(item, "OO", &vobj, &fobj) ||
-            (s->trees[i] = tree_new(vobj, fobj)) == NULL) {
+        if (!PyTuple_Check(item) || PyTuple_GET_SIZE(item) != 2) {
+            PyErr_SetString(PyExc_TypeError, "mesh_set: each mesh is (vertices, triangles) or None");
+            Py_DECREF(fast);
+            Py_DECREF(cap);
+            return NULL;
+        }
+        vobj = PyTuple_GET_ITEM(item, 0);
+        fobj = PyTuple_GET_ITEM(item, 1);
+        if ((s->trees[i] = tree_new(vobj, fobj)) == NULL) {
             Py_DECREF(fast);
             Py_DECREF(cap);
             return NULL;
@@ -365,8 +380,7 @@ static PyObject *py_mesh_set(PyObject *self, PyObject *args) {
     for (Py_ssize_t i = 0; i < n; i++) {
         if (s->trees[i] != NULL && s->trees[i]->n_tri > s->most_tri) s->most_tri = s->trees[i]->n_tri;
     }
-    s->one = calloc(1, sizeof(Scratch));
-    if (s->one == NULL || scratch_init(s->one, s->most_tri) != 0) {
+    if (scratch_init(s->one, s->most_tri) != 0) {
         Py_DECREF(cap);
         return PyErr_NoMemory();
     }
@@ -722,6 +736,22 @@ done:
     return (PyObject *)out;
 }
 
+/* 1 when obj is an array the core may read in place as float64: a numpy array of native byte
+ * order, aligned and C-contiguous; else 0 with a TypeError saying which. */
+static int borrowable(PyObject *obj, const char *who, const char *what) {
+    PyArrayObject *a = (PyArrayObject *)obj;
+    if (!PyArray_Check(obj) || PyArray_TYPE(a) != NPY_DOUBLE) {
+        PyErr_Format(PyExc_TypeError, "%s: %s must be a float64 numpy array", who, what);
+        return 0;
+    }
+    if (!PyArray_ISNOTSWAPPED(a) || !PyArray_ISALIGNED(a) || !PyArray_IS_C_CONTIGUOUS(a)) {
+        PyErr_Format(PyExc_TypeError, "%s: %s must be native-order, aligned and C-contiguous",
+                     who, what);
+        return 0;
+    }
+    return 1;
+}
+
 /*
  * The caller's (N, G, 4, 4) geometry poses, borrowed (no copy: the one-by-one calls run per
  * candidate), or NULL with an exception when they are not float64, C-contiguous and G = the set's
@@ -729,10 +759,10 @@ done:
  */
 static PyArrayObject *geometry_poses(PyObject *pobj, const MeshSet *s, const char *who) {
     PyArrayObject *poses = (PyArrayObject *)pobj;
-    if (!PyArray_Check(pobj) || PyArray_TYPE(poses) != NPY_DOUBLE ||
-        !PyArray_IS_C_CONTIGUOUS(poses) || PyArray_NDIM(poses) != 4 ||
-        PyArray_DIM(poses, 1) != s->n || PyArray_DIM(poses, 2) != 4 || PyArray_DIM(poses, 3) != 4) {
-        PyErr_Format(PyExc_ValueError, "%s: poses of the wrong type or shape", who);
+    if (!borrowable(pobj, who, "poses")) return NULL;
+    if (PyArray_NDIM(poses) != 4 || PyArray_DIM(poses, 1) != s->n || PyArray_DIM(poses, 2) != 4 ||
+        PyArray_DIM(poses, 3) != 4) {
+        PyErr_Format(PyExc_ValueError, "%s: poses of the wrong shape (N, G, 4, 4)", who);
         return NULL;
     }
     return poses;
@@ -870,9 +900,9 @@ static PyObject *py_on_surface(PyObject *self, PyObject *args) {
     PyArrayObject *poses = geometry_poses(pobj, s, "on_surface");
     if (poses == NULL) return NULL;
     PyArrayObject *xa = (PyArrayObject *)xobj;
-    if (!PyArray_Check(xobj) || PyArray_TYPE(xa) != NPY_DOUBLE || !PyArray_IS_C_CONTIGUOUS(xa) ||
-        PyArray_SIZE(xa) != 3) {
-        PyErr_SetString(PyExc_ValueError, "on_surface: point of the wrong type or shape");
+    if (!borrowable(xobj, "on_surface", "point")) return NULL;
+    if (PyArray_SIZE(xa) != 3) {
+        PyErr_SetString(PyExc_ValueError, "on_surface: point of the wrong shape (3 values)");
         return NULL;
     }
     if (row < 0 || row >= PyArray_DIM(poses, 0) || g < 0 || g >= s->n || !(tol >= 0.0) ||
@@ -903,7 +933,7 @@ static PyMethodDef methods[] = {
 
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_meshcore", "Proofs that two triangle meshes are apart, in C.", -1,
-    methods,
+    methods, NULL, NULL, NULL, NULL,
 };
 
 PyMODINIT_FUNC PyInit__meshcore(void) {

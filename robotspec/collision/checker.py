@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.arrays import F64, I64
-from robotspec.collision import _meshcore
+from robotspec.collision import meshcore
 from robotspec.collision.rules import CollisionRules, pair_key
 from robotspec.collision.shapes import (
     CollisionGeometry,
@@ -33,7 +33,7 @@ from robotspec.collision.shapes import (
     import_coal,
 )
 from robotspec.errors import CollisionError, RobotSpecError
-from robotspec.model import _kincore
+from robotspec.model import kincore
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
 from robotspec.semantic.states import state_configuration
@@ -213,7 +213,7 @@ class SelfCollisionChecker:
                 for i, j in zip(g1, g2, strict=True)
             ),
             transforms=tuple(coal.Transform3s() for _ in geoms),
-            broad=_kincore.geoms(
+            broad=kincore.core().geoms(
                 np.array([g.body_index for g in geoms], dtype=np.int64),
                 np.array([g.body_T_geometry for g in geoms], dtype=np.float64).reshape(-1, 4, 4),
                 np.array([g.aabb_center for g in geoms], dtype=np.float64).reshape(-1, 3),
@@ -250,7 +250,7 @@ class SelfCollisionChecker:
         """
         kin = self.kinematics
         bodies = kin.forward(qs[0]) if qs.shape[0] == 1 else kin.forward_batch(qs)
-        rows, ks, poses = _kincore.broad(c.broad, bodies, margin, mask)
+        rows, ks, poses = kincore.core().broad(c.broad, bodies, margin, mask)
         return rows.tolist(), ks.tolist(), poses
 
     # ------------------------------------------------------------------------- queries
@@ -285,7 +285,7 @@ class SelfCollisionChecker:
         owner = c.pair_of_list
         g1s, g2s = c.pair_geom1_list, c.pair_geom2_list
         meshes, two_meshes = c.meshes, c.two_meshes
-        apart, eps = _meshcore.apart_one, margin + _APART_SLACK
+        apart, eps = meshcore.core().apart_one, margin + _APART_SLACK
         hit_rows: list[int] = []
         hit_pairs: list[int] = []
         for start in range(0, n, _BLOCK):
@@ -357,7 +357,9 @@ class SelfCollisionChecker:
         proofs = np.full(len(k), _UNTRIED, dtype=np.int64)
         if not len(at):
             return rows, ks, proofs.tolist()
-        proofs[at] = _meshcore.apart(c.meshes, poses, r[at], k[at], c.pair_geom1, c.pair_geom2, eps)
+        proofs[at] = meshcore.core().apart(
+            c.meshes, poses, r[at], k[at], c.pair_geom1, c.pair_geom2, eps
+        )
         keep = proofs != _APART
         return r[keep].tolist(), k[keep].tolist(), proofs[keep].tolist()
 
@@ -491,7 +493,7 @@ class SelfCollisionChecker:
         )
         clear, near1, near2 = res.clear, res.getNearestPoint1, res.getNearestPoint2
         hclear, hnear1, hnear2 = hres.clear, hres.getNearestPoint1, hres.getNearestPoint2
-        meshes, on_surface = c.meshes, _meshcore.on_surface
+        meshes, on_surface = c.meshes, meshcore.core().on_surface
         none = np.zeros(len(c.pair_of), dtype=np.uint8)  # poses only, no broad phase
         for start in range(0, qs.shape[0], _BLOCK):
             _, _, poses = self._broad(c, qs[start : start + _BLOCK], 0.0, none)
@@ -559,7 +561,10 @@ def _mesh_trees(geoms: Sequence[CollisionGeometry], g1: list[int], g2: list[int]
     if not used:
         return None
     # The triangles are finite and in range: MeshLibrary refused any mesh that is not.
-    return _meshcore.mesh_set([g.triangles if k in used else None for k, g in enumerate(geoms)])
+    trees: object = meshcore.core().mesh_set(
+        [g.triangles if k in used else None for k, g in enumerate(geoms)]
+    )
+    return trees
 
 
 def _hull(geom: CollisionGeometry) -> Any:

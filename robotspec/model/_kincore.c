@@ -10,13 +10,17 @@
  * live in capsules owned by the Python objects that built them.
  *
  * Poses are row-major 4x4 (numpy's layout); the last row is written as 0 0 0 1.
+ *
+ * Portable C99 (no threads, no variable-length arrays, compiler extensions only behind #if): a
+ * large batch is split over Python threads by robotspec/model/kincore.py, each slice one call
+ * that runs with the GIL released. An accelerator only: robotspec/model/_kincore_py.py gives the
+ * same answers in numpy when this file could not be built.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 #include <math.h>
-#include <pthread.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -242,6 +246,11 @@ static PyObject *py_tree(PyObject *self, PyObject *args) {
         return NULL;
     Py_ssize_t n = PyObject_Length(parent);
     if (n < 0) return NULL;
+    /* The root is output slot 0; every scratch slot is some row's child. */
+    if (n_out < 1 || n_slots < n_out || n_slots - n_out > n || n_dof < 0) {
+        PyErr_SetString(PyExc_ValueError, "tree program: slot or DOF counts out of range");
+        return NULL;
+    }
     Tree *t = calloc(1, sizeof(Tree));
     if (t == NULL) return PyErr_NoMemory();
     t->n_ops = n;
@@ -269,6 +278,36 @@ static PyObject *py_tree(PyObject *self, PyObject *args) {
             Py_DECREF(cap);
             return NULL;
         }
+        if (t->kind[k] < KIND_FIXED || t->kind[k] > KIND_PRISMATIC) {
+            PyErr_SetString(PyExc_ValueError, "tree program has a motion kind out of range");
+            Py_DECREF(cap);
+            return NULL;
+        }
+    }
+    /* Parents first: a row reads only the root or a slot an earlier row wrote (never memory
+     * that no row set). */
+    char *written = calloc((size_t)n_slots, 1);
+    if (written == NULL) {
+        Py_DECREF(cap);
+        return PyErr_NoMemory();
+    }
+    written[0] = 1;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        if (!written[t->parent[k]]) {
+            free(written);
+            PyErr_SetString(PyExc_ValueError, "tree program reads a slot before a row writes it");
+            Py_DECREF(cap);
+            return NULL;
+        }
+        written[t->child[k]] = 1;
+    }
+    Py_ssize_t unset = 1;
+    while (unset < n_out && written[unset]) unset++;
+    free(written);
+    if (unset < n_out) { /* its pose would be whatever the allocator left there */
+        PyErr_SetString(PyExc_ValueError, "tree program leaves a body's pose unset");
+        Py_DECREF(cap);
+        return NULL;
     }
     t->code = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
     t->translate = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
@@ -330,16 +369,6 @@ static PyObject *py_fk(PyObject *self, PyObject *args) {
     return (PyObject *)out;
 }
 
-/* One thread's share of a batch: samples lo .. hi, with its own scratch slots. */
-typedef struct {
-    const Tree *t;
-    const double *q;
-    double *out;
-    npy_intp lo, hi;
-    double *scratch, *stage; /* scratch slots; one sample's output, kept in cache */
-    int stream;              /* stage and stream (a caller's array), or write in place */
-} FkShare;
-
 /*
  * Why stage each sample in a small buffer when writing into a caller's array: a batch result
  * (100 MB for 10,000 PR2 samples) does not fit in any cache, and plain stores first read every
@@ -360,97 +389,103 @@ static void stream_copy(double *dst, const double *src, size_t n) {
     memcpy(dst, src, n * sizeof(double));
 }
 
-static void *fk_share(void *arg) {
-    FkShare *s = arg;
-    const size_t width = 16 * (size_t)s->t->n_out;
-    for (npy_intp i = s->lo; i < s->hi; i++) {
-        if (s->stream) {
-            tree_run(s->t, s->q + i * s->t->n_dof, s->stage, s->scratch);
-            stream_copy(s->out + i * (npy_intp)width, s->stage, width);
+/* Samples 0 .. n of q into out; scratch holds the scratch slots, stage (16-byte aligned) one
+ * sample's output when streaming. */
+static void fk_run_batch(const Tree *t, const double *q, npy_intp n, double *out, double *scratch,
+                         double *stage, int stream) {
+    const size_t width = 16 * (size_t)t->n_out;
+    for (npy_intp i = 0; i < n; i++) {
+        if (stream) {
+            tree_run(t, q + i * t->n_dof, stage, scratch);
+            stream_copy(out + i * (npy_intp)width, stage, width);
         } else {
-            tree_run(s->t, s->q + i * s->t->n_dof, s->out + i * (npy_intp)width, s->scratch);
+            tree_run(t, q + i * t->n_dof, out + i * (npy_intp)width, scratch);
         }
     }
 #if defined(__SSE2__)
-    _mm_sfence();
+    if (stream) _mm_sfence();
 #endif
-    return NULL;
+}
+
+/* The caller's out array when it is one the core may write as native float64 poses (N, B, 4, 4):
+ * TypeError for the wrong type, byte order or alignment, ValueError for the wrong shape. */
+static int check_out(PyObject *oobj, npy_intp n, Py_ssize_t n_out) {
+    PyArrayObject *out = (PyArrayObject *)oobj;
+    if (!PyArray_Check(oobj) || PyArray_TYPE(out) != NPY_DOUBLE || !PyArray_ISNOTSWAPPED(out) ||
+        !PyArray_ISALIGNED(out) || !PyArray_IS_C_CONTIGUOUS(out) || !PyArray_ISWRITEABLE(out)) {
+        PyErr_SetString(PyExc_TypeError, "out must be a writeable, aligned, native-order "
+                                         "C-contiguous float64 array (N, B, 4, 4)");
+        return -1;
+    }
+    if (PyArray_NDIM(out) != 4 || PyArray_DIM(out, 0) != n || PyArray_DIM(out, 1) != n_out ||
+        PyArray_DIM(out, 2) != 4 || PyArray_DIM(out, 3) != 4) {
+        PyErr_SetString(PyExc_ValueError, "out must be a writeable, aligned, native-order "
+                                          "C-contiguous float64 array (N, B, 4, 4)");
+        return -1;
+    }
+    return 0;
 }
 
 /*
- * fk_batch(tree, q (N, D), threads=1, out=None) -> poses (N, B, 4, 4), into out when given
- * With threads > 1 the samples are split into that many contiguous shares run in parallel (the
- * GIL released); the result does not depend on the split.
+ * fk_batch(tree, q (N, D), out=None, stream=False) -> poses (N, B, 4, 4), into out when given
+ * One loop over the samples with the GIL released, so robotspec/model/kincore.py runs slices of a
+ * batch on several Python threads at once. stream: write through a cached stage with
+ * non-temporal stores (for a caller's array, see stream_copy).
  */
 static PyObject *py_fk_batch(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj, *oobj = Py_None;
-    Py_ssize_t threads = 1;
-    if (!PyArg_ParseTuple(args, "OO|nO", &cap, &qobj, &threads, &oobj)) return NULL;
+    int stream = 0;
+    if (!PyArg_ParseTuple(args, "OO|Op", &cap, &qobj, &oobj, &stream)) return NULL;
     const Tree *t = PyCapsule_GetPointer(cap, "robotspec.tree");
     if (t == NULL) return NULL;
-    if (threads < 1 || threads > 64) {
-        PyErr_SetString(PyExc_ValueError, "threads must be between 1 and 64");
-        return NULL;
-    }
     PyArrayObject *q = as_config(qobj, 2, t->n_dof);
     if (q == NULL) return NULL;
     npy_intp n = PyArray_DIM(q, 0);
-    if (threads > n) threads = n > 0 ? n : 1;
     npy_intp dims[4] = {n, t->n_out, 4, 4};
     PyArrayObject *out;
     if (oobj == Py_None) {
         out = (PyArrayObject *)PyArray_SimpleNew(4, dims, NPY_DOUBLE);
-    } else {
-        /* The caller's array, written in place: a batch loop then reuses its pages. */
-        out = (PyArrayObject *)oobj;
-        if (!PyArray_Check(oobj) || PyArray_TYPE(out) != NPY_DOUBLE ||
-            !PyArray_IS_C_CONTIGUOUS(out) || !PyArray_ISWRITEABLE(out) ||
-            PyArray_NDIM(out) != 4 || PyArray_DIM(out, 0) != n || PyArray_DIM(out, 1) != t->n_out ||
-            PyArray_DIM(out, 2) != 4 || PyArray_DIM(out, 3) != 4) {
-            PyErr_SetString(PyExc_ValueError,
-                            "out must be a writeable C-contiguous float64 array (N, B, 4, 4)");
+        if (out == NULL) {
             Py_DECREF(q);
             return NULL;
         }
+    } else {
+        /* The caller's array, written in place: a batch loop then reuses its pages. */
+        if (check_out(oobj, n, t->n_out) != 0) {
+            Py_DECREF(q);
+            return NULL;
+        }
+        out = (PyArrayObject *)oobj;
         Py_INCREF(out);
     }
     Py_ssize_t n_scratch = t->n_slots - t->n_out;
-    /* Per thread: scratch slots, then a 16-byte aligned stage of one sample's output. */
+    /* Scratch slots, then a 16-byte aligned stage of one sample's output. */
     size_t per = 16 * (size_t)(n_scratch > 0 ? n_scratch : 1) + 16 * (size_t)t->n_out + 2;
-    double *scratch = malloc(sizeof(double) * per * (size_t)threads);
-    FkShare *shares = malloc(sizeof(FkShare) * (size_t)threads);
-    pthread_t *ids = malloc(sizeof(pthread_t) * (size_t)threads);
-    if (out == NULL || scratch == NULL || shares == NULL || ids == NULL) {
-        free(scratch);
-        free(shares);
-        free(ids);
+    double *scratch = malloc(sizeof(double) * per);
+    if (scratch == NULL) {
         Py_DECREF(q);
-        Py_XDECREF(out);
-        return out == NULL ? NULL : PyErr_NoMemory();
+        Py_DECREF(out);
+        return PyErr_NoMemory();
     }
-    for (Py_ssize_t k = 0; k < threads; k++) {
-        double *base = scratch + per * (size_t)k;
-        double *stage = base + 16 * (size_t)(n_scratch > 0 ? n_scratch : 1);
-        if (((uintptr_t)stage & 15) != 0) stage++;
-        shares[k] = (FkShare){t,     PyArray_DATA(q), PyArray_DATA(out), n * k / threads,
-                              n * (k + 1) / threads, base, stage, oobj != Py_None};
-    }
-    int started = 0;
+    double *stage = scratch + 16 * (size_t)(n_scratch > 0 ? n_scratch : 1);
+    if (((uintptr_t)stage & 15) != 0) stage++;
+    const double *qv = PyArray_DATA(q);
+    double *ov = PyArray_DATA(out);
     Py_BEGIN_ALLOW_THREADS
-    for (Py_ssize_t k = 1; k < threads; k++) {
-        if (pthread_create(&ids[k], NULL, fk_share, &shares[k]) != 0) break;
-        started++;
-    }
-    fk_share(&shares[0]);
-    for (int k = 1; k <= started; k++) pthread_join(ids[k], NULL);
-    /* A share whose thread could not start runs here. */
-    for (Py_ssize_t k = started + 1; k < threads; k++) fk_share(&shares[k]);
+    fk_run_batch(t, qv, n, ov, scratch, stage, stream);
     Py_END_ALLOW_THREADS
     free(scratch);
-    free(shares);
-    free(ids);
     Py_DECREF(q);
     return (PyObject *)out;
+}
+
+/* tree_size(tree) -> (bodies returned, degrees of freedom) */
+static PyObject *py_tree_size(PyObject *self, PyObject *args) {
+    PyObject *cap;
+    if (!PyArg_ParseTuple(args, "O", &cap)) return NULL;
+    const Tree *t = PyCapsule_GetPointer(cap, "robotspec.tree");
+    if (t == NULL) return NULL;
+    return Py_BuildValue("nn", t->n_out, t->n_dof);
 }
 
 /* ------------------------------------------------------------------------------ a chain */
@@ -488,6 +523,10 @@ static PyObject *py_chain(PyObject *self, PyObject *args) {
         return NULL;
     Py_ssize_t n = PyObject_Length(kind);
     if (n < 0) return NULL;
+    if (n_cols < 0 || n_dof < 0) {
+        PyErr_SetString(PyExc_ValueError, "chain program: column or DOF count out of range");
+        return NULL;
+    }
     Chain *c = calloc(1, sizeof(Chain));
     if (c == NULL) return PyErr_NoMemory();
     c->n = n;
@@ -855,6 +894,7 @@ static PyMethodDef methods[] = {
     {"tree", py_tree, METH_VARARGS, "Compile a tree program (see robotspec.model.program)."},
     {"fk", py_fk, METH_VARARGS, "Every output pose (B, 4, 4) of one configuration."},
     {"fk_batch", py_fk_batch, METH_VARARGS, "Every output pose (N, B, 4, 4) of a batch."},
+    {"tree_size", py_tree_size, METH_VARARGS, "(bodies, degrees of freedom) of a tree program."},
     {"chain", py_chain, METH_VARARGS, "Compile a chain program."},
     {"chain_fk", py_chain_fk, METH_VARARGS, "root_T_tip (4, 4) of one configuration."},
     {"chain_fk_batch", py_chain_fk_batch, METH_VARARGS, "root_T_tip (N, 4, 4) of a batch."},
@@ -867,6 +907,7 @@ static PyMethodDef methods[] = {
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_kincore",
     "Forward kinematics, chain Jacobians and the collision broad phase, in C.", -1, methods,
+    NULL, NULL, NULL, NULL,
 };
 
 PyMODINIT_FUNC PyInit__kincore(void) {

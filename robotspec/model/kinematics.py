@@ -21,7 +21,7 @@ import numpy as np
 
 from robotspec.arrays import F64
 from robotspec.errors import KinematicsError
-from robotspec.model import _kincore
+from robotspec.model import kincore
 from robotspec.model.world import Body, Connection, ConnectionType, World
 
 __all__ = ["ChainKinematics", "Kinematics"]
@@ -103,7 +103,7 @@ class Kinematics:
     def forward(self, q: object) -> F64:
         """``root_T_body`` for every body (B, 4, 4) at configuration ``q`` (D,)."""
         try:
-            poses: F64 = _kincore.fk(self._tree, q)
+            poses: F64 = kincore.core().fk(self._tree, q)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self.world.name, False) from None
         return poses
@@ -131,7 +131,7 @@ class Kinematics:
         if out is not None:
             _check_out(out, (n, len(self.world.bodies), 4, 4))
         try:
-            poses: F64 = _kincore.fk_batch(self._tree, arr, threads, out)
+            poses: F64 = kincore.fk_batch(self._tree, arr, threads, out)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self.world.name, True) from None
         return poses
@@ -218,7 +218,7 @@ def _tree_program(world: World) -> object:
             mul.append(m.multiplier)
             off.append(m.offset)
             src = dst
-    return _kincore.tree(
+    return kincore.core().tree(
         np.array(parent, dtype=np.int64),
         np.array(child, dtype=np.int64),
         np.array(kind, dtype=np.int64),
@@ -271,7 +271,7 @@ class ChainKinematics:
         self.dof_names: tuple[str, ...] = tuple(
             world.degrees_of_freedom[d].name for d in self.dof_indices
         )
-        self._program = _kincore.chain(
+        self._program = kincore.core().chain(
             np.array(pre, dtype=np.float64).reshape(-1, 4, 4),
             acc,
             np.array(kinds, dtype=np.int64),
@@ -287,7 +287,7 @@ class ChainKinematics:
     def fk(self, q: object) -> F64:
         """``root_T_tip`` (4, 4) for the world configuration ``q`` (D,)."""
         try:
-            pose: F64 = _kincore.chain_fk(self._program, q)
+            pose: F64 = kincore.core().chain_fk(self._program, q)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self._world_name, False) from None
         return pose
@@ -295,7 +295,7 @@ class ChainKinematics:
     def fk_batch(self, q: object) -> F64:
         """``root_T_tip`` (N, 4, 4) for each configuration of ``q`` (N, D), in one C loop."""
         try:
-            poses: F64 = _kincore.chain_fk_batch(self._program, q)
+            poses: F64 = kincore.core().chain_fk_batch(self._program, q)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self._world_name, True) from None
         return poses
@@ -307,7 +307,7 @@ class ChainKinematics:
         leader's column.
         """
         try:
-            jac: F64 = _kincore.chain_jacobian(self._program, q)
+            jac: F64 = kincore.core().chain_jacobian(self._program, q)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self._world_name, False) from None
         return jac

@@ -1,0 +1,141 @@
+"""The mesh core's entry points without its proofs: every candidate is left to coal.
+
+Why this is enough: ``_meshcore.c`` only accelerates. A pair it proves apart or crossing is one
+coal answers the same way (that is what its proofs are checked against), and a hull's closest
+point it finds on the mesh only lets the checker skip coal's exact mesh distance. So a fallback
+that proves nothing and finds no point on a surface gives every answer, from coal, the same to
+coal's tolerance, only slower on nearly touching meshes (see benchmarks/bench_fallback.py).
+
+The arguments are checked as the C core checks them (see ``_meshcore.pyi``), so a caller's
+mistake fails the same way whichever core runs; :mod:`robotspec.collision.meshcore` chooses.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+_INT32_MAX = 2**31 - 1
+
+
+@dataclass(frozen=True)
+class MeshSet:
+    """How many geometries a checker has, and which are meshes."""
+
+    n: int
+    is_mesh: tuple[bool, ...]
+
+
+def _mesh(item: object) -> None:
+    """Check one (vertices (V, 3), triangles (T >= 1, 3)) mesh as the C core does."""
+    if not isinstance(item, tuple) or len(item) != 2:
+        raise TypeError("mesh_set: each mesh is (vertices, triangles) or None")
+    v = np.asarray(item[0])
+    f = np.asarray(item[1])
+    if not np.can_cast(v.dtype, np.float64, "safe"):
+        raise TypeError(f"mesh_set: cannot read vertices of {v.dtype} as float64")
+    if not np.can_cast(f.dtype, np.int64, "safe"):
+        raise TypeError(f"mesh_set: cannot read triangles of {f.dtype} as int64")
+    if v.ndim != 2 or f.ndim != 2:
+        raise ValueError("a mesh needs vertices (V, 3) and triangles (T >= 1, 3)")
+    if v.shape[1] != 3 or f.shape[1] != 3 or not 1 <= f.shape[0] <= _INT32_MAX // 4:
+        raise ValueError("a mesh needs vertices (V, 3) and triangles (T >= 1, 3)")
+    if f.min() < 0 or f.max() >= v.shape[0]:
+        raise ValueError("a triangle refers to a vertex out of range")
+    if not np.isfinite(v[np.unique(f)]).all():
+        raise ValueError("a mesh vertex is not finite")
+
+
+def mesh_set(meshes: Any) -> object:
+    try:
+        items = list(meshes)
+    except TypeError:
+        raise TypeError("mesh_set needs a sequence") from None
+    for item in items:
+        if item is not None:
+            _mesh(item)
+    return MeshSet(len(items), tuple(item is not None for item in items))
+
+
+def _set_of(obj: object) -> MeshSet:
+    if not isinstance(obj, MeshSet):
+        raise TypeError("expected a mesh set (from mesh_set())")
+    return obj
+
+
+def _eps(eps: float) -> None:
+    if not (eps >= 1e-9 and math.isfinite(eps)):
+        raise ValueError("eps must be finite and >= 1e-9")
+
+
+def _int_array(obj: object, what: str) -> np.ndarray[Any, Any]:
+    a = np.asarray(obj)
+    if not np.can_cast(a.dtype, np.int64, "safe"):
+        raise TypeError(f"apart: cannot read {what} of {a.dtype} as int64")
+    if a.ndim != 1:
+        raise ValueError(f"apart: {what} must have 1 dimension")
+    return a.astype(np.int64)
+
+
+def apart(meshes: object, poses: Any, rows: Any, pairs: Any, g1: Any, g2: Any, eps: float) -> Any:
+    s = _set_of(meshes)
+    eps = float(eps)
+    _eps(eps)
+    p = np.asarray(poses)
+    if not np.can_cast(p.dtype, np.float64, "safe"):
+        raise TypeError(f"apart: cannot read poses of {p.dtype} as float64")
+    if p.ndim != 4:
+        raise ValueError("apart: poses must have 4 dimensions")
+    r, k = _int_array(rows, "rows"), _int_array(pairs, "pairs")
+    a, b = _int_array(g1, "g1"), _int_array(g2, "g2")
+    n, ng = p.shape[0], p.shape[1]
+    if ng != s.n or p.shape[2:] != (4, 4) or len(k) != len(r) or len(b) != len(a):
+        raise ValueError("apart: arrays of the wrong shape")
+    if len(r):
+        bad = (r < 0) | (r >= n) | (k < 0) | (k >= len(a))
+        if not bad.any():
+            i, j = a[k], b[k]
+            bad = (i < 0) | (i >= ng) | (j < 0) | (j >= ng)
+        if bad.any():
+            raise ValueError("apart: a candidate is out of range")
+    return np.zeros(len(r), dtype=np.uint8)  # nothing proven: coal decides every candidate
+
+
+def _borrowable(obj: object, who: str, what: str) -> np.ndarray[Any, Any]:
+    """The array the C core would read in place (see ``borrowable`` in ``_meshcore.c``)."""
+    if not isinstance(obj, np.ndarray) or obj.dtype.type is not np.float64:
+        raise TypeError(f"{who}: {what} must be a float64 numpy array")
+    if not (obj.dtype.isnative and obj.flags.aligned and obj.flags.c_contiguous):
+        raise TypeError(f"{who}: {what} must be native-order, aligned and C-contiguous")
+    return obj
+
+
+def _poses(obj: object, s: MeshSet, who: str) -> np.ndarray[Any, Any]:
+    p = _borrowable(obj, who, "poses")
+    if p.ndim != 4 or p.shape[1:] != (s.n, 4, 4):
+        raise ValueError(f"{who}: poses of the wrong shape (N, G, 4, 4)")
+    return p
+
+
+def apart_one(meshes: object, poses: Any, row: int, i: int, j: int, eps: float) -> int:
+    s = _set_of(meshes)
+    p = _poses(poses, s, "apart_one")
+    if not (0 <= row < p.shape[0] and 0 <= i < s.n and 0 <= j < s.n):
+        raise ValueError("apart_one: a candidate is out of range")
+    _eps(float(eps))
+    return 0
+
+
+def on_surface(meshes: object, poses: Any, row: int, g: int, point: Any, tol: float) -> bool:
+    s = _set_of(meshes)
+    p = _poses(poses, s, "on_surface")
+    x = _borrowable(point, "on_surface", "point")
+    if x.size != 3:
+        raise ValueError("on_surface: point of the wrong shape (3 values)")
+    tol = float(tol)
+    if not (0 <= row < p.shape[0] and 0 <= g < s.n and tol >= 0.0 and math.isfinite(tol)):
+        raise ValueError("on_surface: row, geometry or tolerance out of range")
+    return False  # not found: the checker asks coal for the meshes' own distance

@@ -1,0 +1,119 @@
+"""Which kinematics core runs the queries: the C accelerator or its numpy fallback.
+
+Why a choice: ``_kincore.c`` is built when the package is installed, but a user without a C
+compiler still installs robotspec (setup.py makes the build optional) and gets the same answers
+from ``_kincore_py`` (numpy), slower. ``ROBOTSPEC_NO_ACCEL=1`` chooses the fallback even when
+the C core is there (to compare, or to rule it out). The choice is made once, on the first query
+(not on import: a command that never computes a pose never loads either core), and
+:func:`accelerated` tells which it was.
+
+Every entry point is the C core's (see ``_kincore.pyi``), except that :func:`fk_batch` takes
+``threads``: the batch is split into that many slices, each one call of the core on its own
+Python thread (the C core releases the GIL while it runs, so the slices run in parallel).
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from robotspec.arrays import F64
+
+__all__ = ["NO_ACCEL_ENV", "accelerated", "accelerators_disabled", "core", "fk_batch"]
+
+#: The environment variable that turns the C accelerators off (any value but "", "0").
+NO_ACCEL_ENV = "ROBOTSPEC_NO_ACCEL"
+
+_core: ModuleType | None = None
+_lock = threading.Lock()
+
+
+def accelerators_disabled() -> bool:
+    """Whether ``ROBOTSPEC_NO_ACCEL`` asks for the pure-Python cores."""
+    return os.environ.get(NO_ACCEL_ENV, "").strip() not in ("", "0")
+
+
+def _load() -> ModuleType:
+    if not accelerators_disabled():
+        try:
+            from robotspec.model import _kincore
+        except ImportError:  # not built (no compiler at install): the fallback answers
+            pass
+        else:
+            return _kincore
+    from robotspec.model import _kincore_py
+
+    return _kincore_py
+
+
+def core() -> ModuleType:
+    """The kinematics core in use (loaded on the first call)."""
+    global _core
+    if _core is None:
+        with _lock:
+            if _core is None:
+                _core = _load()
+    return _core
+
+
+def accelerated() -> bool:
+    """Whether queries run in the C core (False: the numpy fallback)."""
+    return core().__name__.endswith("._kincore")
+
+
+def fk_batch(tree: object, q: object, threads: int = 1, out: Any = None) -> F64:
+    """Every body pose (N, B, 4, 4) of the batch ``q`` (N, D), into ``out`` when given.
+
+    With ``threads`` > 1 the samples are split into that many contiguous slices, one core call
+    each on its own thread; the result does not depend on the split. ``q`` is checked whole
+    before any slice runs, so an error leaves ``out`` untouched.
+    """
+    c = core()
+    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= 64:
+        raise ValueError(f"threads must be between 1 and 64, got {threads!r}")
+    arr = np.asarray(q) if isinstance(q, np.ndarray) else None
+    n = arr.shape[0] if arr is not None and arr.ndim == 2 else 0
+    threads = min(threads, n)
+    if threads <= 1:
+        poses: F64 = c.fk_batch(tree, q, out, out is not None)
+        return poses
+    assert arr is not None
+    n_out, n_dof = c.tree_size(tree)
+    if arr.dtype != np.float64 or not arr.dtype.isnative:
+        arr = arr.astype(np.float64)  # the core would convert it once per slice
+    arr = np.ascontiguousarray(arr)
+    if arr.shape[1] != n_dof:
+        raise ValueError("configuration has the wrong number of values")
+    if not np.isfinite(arr).all():
+        raise ValueError("configuration contains NaN or infinite values")
+    stream = out is not None
+    if stream:  # the core's checks of the caller's array, once (each slice is a view of it)
+        from robotspec.model._kincore_py import check_out
+
+        check_out(out, (n, n_out, 4, 4))
+    result: F64 = np.empty((n, n_out, 4, 4)) if out is None else out
+    errors: list[BaseException] = []
+
+    def run(lo: int, hi: int) -> None:
+        try:
+            c.fk_batch(tree, arr[lo:hi], result[lo:hi], stream)
+        except BaseException as exc:  # noqa: BLE001 - re-raised on the caller's thread
+            errors.append(exc)
+
+    cuts = [n * k // threads for k in range(threads + 1)]
+    workers = [
+        threading.Thread(target=run, args=(cuts[k], cuts[k + 1]), daemon=True)
+        for k in range(1, threads)
+    ]
+    for w in workers:
+        w.start()
+    run(cuts[0], cuts[1])
+    for w in workers:
+        w.join()
+    if errors:
+        raise errors[0]
+    return result

@@ -105,7 +105,8 @@ def test_spec_package_paths_cannot_widen_the_roots(tmp: Path) -> None:
     assert r.code == 1
     assert r.err == (
         f"a/spec.yaml:6:19: error: package path '/' lies outside the spec's folder {a}; a spec "
-        "may only name folders inside its own tree (allow this one with -P/--package-path /, "
+        "may name folders inside its own tree, or relative to it below the filesystem's "
+        "top-level and home folders (allow this one with -P/--package-path /, "
         "or ROS_PACKAGE_PATH)\n"
     )
 

@@ -40,6 +40,7 @@ def init(
     from robotspec.spec.draft import render_draft
     from robotspec.spec.draft.render import camera_presets
     from robotspec.spec.draft.run import draft_from_files
+    from robotspec.spec.load import spec_may_name
 
     if output is not None and output.exists() and not force:
         raise RobotSpecError(
@@ -60,9 +61,9 @@ def init(
             + "; check the lines marked DECIDE, then run "
             f"`robotspec validate {output}`\n"
         )
-    outside = [p for p in draft.package_paths if p.startswith("..") or Path(p).is_absolute()]
+    outside = [p for p in draft.package_paths if not spec_may_name(p, folder)]
     if outside:
-        # A spec may name package folders outside its own tree only with the user's leave.
+        # A spec may name such package folders (absolute, or too wide) only with the user's leave.
         allow = " ".join(f"-P {(folder / p).resolve()}" for p in outside)
         sys.stderr.write(
             f"note: package_paths outside the spec's folder are read only when allowed: "

@@ -162,6 +162,28 @@ def walk_up(description_folder: Path) -> tuple[list[Path], list[Path]]:
     return search, roots
 
 
+#: Folders a robot description keeps its URDF in, inside the description's own folder (whose
+#: ``meshes/`` beside it the URDF names as ``../meshes/...``), lower case.
+DESCRIPTION_SUBFOLDERS = frozenset({"urdf", "xacro"})
+
+
+def description_root(description: Path) -> list[Path]:
+    """The robot description's own folder when it is no ROS package: the one above ``urdf/``.
+
+    Why: the most common layout outside ROS is ``robot/urdf/robot.urdf`` with ``robot/meshes/``
+    named as ``../meshes/...``; the folder holding both is the description, as a package folder
+    is. Only one level: ``urdf/`` of the filesystem root or of the home folder widens nothing.
+    """
+    folder = Path(os.path.normpath(description.parent))
+    if folder.name.lower() not in DESCRIPTION_SUBFOLDERS:
+        return []
+    parent = folder.parent
+    home = Path(os.path.normpath(Path.home().absolute()))
+    if parent == home or parent.parent == parent:
+        return []
+    return [parent]
+
+
 def user_roots(
     extra_paths: Sequence[str | Path] = (),
     *,

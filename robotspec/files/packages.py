@@ -27,6 +27,7 @@ from robotspec.errors import (
 )
 from robotspec.files.package_search import (
     PACKAGE_NAME,
+    description_root,
     example_robot_data_folders,
     folder_packages,
     user_roots,
@@ -130,6 +131,8 @@ class PackageResolver:
             near, package_roots = walk_up(Path(os.path.normpath(desc.parent)))
             folders += near
             roots += [Path(os.path.normpath(desc.parent)), *package_roots]
+            if not package_roots:
+                roots += description_root(desc)
         flat: list[Path] = []
         if use_example_robot_data:
             erd = example_robot_data_folders()

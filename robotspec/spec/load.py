@@ -29,6 +29,7 @@ __all__ = [
     "json_schema_text",
     "load_spec",
     "merge_data",
+    "spec_may_name",
 ]
 
 
@@ -116,11 +117,35 @@ def _inside(path: str, folder: str) -> bool:
     return path == folder or path.startswith(folder.rstrip(os.sep) + os.sep)
 
 
-def _foreign_paths(doc: LocatedYaml, folder: Path) -> list[ForeignPath]:
-    """The document's package folders that lie outside its own folder tree (symlinks followed).
+def _too_wide(target: str) -> bool:
+    """Whether a folder is the filesystem root, a top-level folder, or the home folder (or above).
 
-    Why: allowed read roots come from the user, never from the input. A spec downloaded with a
-    robot may point inside its own tree; anything else must be allowed by the user.
+    A spec's relative ``package_paths`` may leave its tree (``../robots``: specs and robot files
+    side by side), but never name a folder that holds the whole machine or a user's files.
+    """
+    path = Path(target)
+    home = Path(os.path.realpath(Path.home()))
+    return len(path.parts) <= 2 or path == home or path in home.parents
+
+
+def spec_may_name(value: str, folder: Path, real_folder: str | None = None) -> bool:
+    """Whether a spec in ``folder`` may name the package folder ``value`` without ``-P``."""
+    target = os.path.realpath(folder / value)
+    if _inside(target, real_folder or os.path.realpath(folder)):
+        return True
+    relative = not (Path(value).is_absolute() or value.startswith("~"))
+    return relative and not _too_wide(target)
+
+
+def _foreign_paths(doc: LocatedYaml, folder: Path) -> list[ForeignPath]:
+    """The document's package folders the user must allow (symlinks followed).
+
+    Why: the spec is the user's own file, kept with their robot files: a *relative* entry
+    (``../robots``) is read as the command line's ``-P ../robots`` would be, unless it names a
+    folder too wide to be a robot's (:func:`_too_wide`). An absolute entry outside the spec's
+    own tree is the machine's layout, not the project's: the user allows it (``-P``,
+    ``ROS_PACKAGE_PATH``). What the robot's *description* files name is fenced separately, by
+    the roots these folders and the user give.
     """
     data = doc.data
     where: list[tuple[tuple[str | int, ...], Any]] = []
@@ -140,9 +165,9 @@ def _foreign_paths(doc: LocatedYaml, folder: Path) -> list[ForeignPath]:
         for i, value in enumerate(values):
             if not isinstance(value, str):
                 continue
-            target = os.path.realpath(folder / value)
-            if _inside(target, real_folder):
+            if spec_may_name(value, folder, real_folder):
                 continue
+            target = os.path.realpath(folder / value)
             line, col = doc.position((*loc, i))
             out.append(ForeignPath(value, Path(target), folder, doc.file, line, col, (*loc, i)))
     return out
@@ -167,7 +192,8 @@ def check_package_paths(loaded: LoadedSpec, package_paths: Sequence[str | Path] 
         problems.append(
             SpecError(
                 f"package path '{fp.given}' lies outside the spec's folder {fp.folder}; a spec "
-                f"may only name folders inside its own tree (allow this one with "
+                f"may name folders inside its own tree, or relative to it below the "
+                f"filesystem's top-level and home folders (allow this one with "
                 f"-P/--package-path {fp.path}, or ROS_PACKAGE_PATH)",
                 file=fp.file,
                 line=fp.line,

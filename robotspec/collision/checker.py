@@ -9,11 +9,17 @@ functor pinocchio uses) runs only for pairs whose boxes come within the margin. 
 over them.
 
 Everything is built on the first query (meshes read once), so constructing a checker is cheap.
+
+Threads: one checker may be shared by threads. What is built once (geometries, coal functors,
+trees) is built under a lock and only read afterwards; what a query writes (each geometry's coal
+transform, coal's request and result) is per thread (:class:`_Scratch`). Coal's own calls hold the
+GIL, so the functors' internal solver state is used by one call at a time.
 """
 
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, cast
@@ -90,7 +96,6 @@ class _Compiled:
     pair_geom2: I64
     pair_of: I64  # (Q,) index of the body pair each geometry pair belongs to
     collide: tuple[Any, ...]  # coal.ComputeCollision per geometry pair
-    transforms: tuple[Any, ...]  # one reusable coal.Transform3s per geometry
     broad: object  # the C core's table of geometries and pairs (_kincore.geoms)
     meshes: object | None  # box trees of the mesh geometries (_meshcore.mesh_set), if any pair
     two_meshes: list[bool]  # per geometry pair: both are meshes (so `meshes` can prove them apart)
@@ -106,11 +111,41 @@ class _Compiled:
         object.__setattr__(self, "pair_of_list", self.pair_of.tolist())
 
 
+class _Scratch:
+    """One thread's coal objects that a query writes: transforms, a request and a result.
+
+    Why per thread: a query writes every geometry's pose into its transform and then asks coal,
+    and reads coal's answer from the result after the call; a second thread writing the same
+    transforms, or clearing the same result, in between changes the first one's answer (a shared
+    checker gave wrong distances and missed collisions). Kept rather than made per query: the
+    PR2's 32 transforms cost more to create than a whole ``in_collision``.
+    """
+
+    def __init__(self, coal: Any, n_geometries: int) -> None:
+        self.transforms = tuple(coal.Transform3s() for _ in range(n_geometries))
+        self.margin = math.nan
+        self.request = coal.CollisionRequest()
+        self.result = coal.CollisionResult()
+
+    def collision(self, margin: float) -> tuple[Any, Any]:
+        """Coal's collision request for ``margin`` and the result to reuse."""
+        if margin != self.margin:
+            self.request.security_margin = margin
+            self.margin = margin
+        return self.request, self.result
+
+
 class SelfCollisionChecker:
     """Self-collision of one world under a set of rules (see :class:`CollisionRules`).
 
     ``pairs`` restricts the checked body pairs (default: the rules' active pairs); the matrix
     generator uses it to check every pair with no rules at all.
+
+    A checker may be shared by threads: every query answers as if it ran alone. The first query
+    builds the geometry (under a lock, once); each thread then writes only its own coal
+    transforms and results. Coal holds the GIL, so threads do not check faster than one thread,
+    except in the kinematics and the mesh proofs of batches (C loops without the GIL); for
+    throughput on many configurations use worker processes (``collisions generate --jobs``).
     """
 
     def __init__(
@@ -136,8 +171,10 @@ class SelfCollisionChecker:
         self._compiled: _Compiled | None = None
         self._distance_fns: tuple[Any, ...] | None = None
         self._hull_fns: tuple[Any, ...] | None = None
-        self._request: tuple[float, Any, Any] | None = None
         self._robot: AbstractRobot | None = None
+        # Built-once state is built under the lock; what queries write is per thread.
+        self._lock = threading.RLock()
+        self._local = threading.local()
 
     @classmethod
     def from_robot(
@@ -178,7 +215,9 @@ class SelfCollisionChecker:
     def kinematics(self) -> Kinematics:
         """The forward kinematics the checker uses."""
         if self._kin is None:
-            self._kin = Kinematics(self.world)
+            with self._lock:
+                if self._kin is None:
+                    self._kin = Kinematics(self.world)
         return self._kin
 
     def configuration(
@@ -192,8 +231,20 @@ class SelfCollisionChecker:
         return state_configuration(self._robot, states, values)
 
     def _build(self) -> _Compiled:
-        if self._compiled is not None:
-            return self._compiled
+        compiled = self._compiled
+        if compiled is None:
+            with self._lock:  # one thread builds (meshes read once); the others wait for it
+                compiled = self._compiled if self._compiled is not None else self._compile()
+        return compiled
+
+    def _scratch(self, c: _Compiled) -> _Scratch:
+        """This thread's transforms, request and result (made on its first query)."""
+        scratch: _Scratch | None = getattr(self._local, "scratch", None)
+        if scratch is None:
+            scratch = self._local.scratch = _Scratch(import_coal(), len(c.model.geometries))
+        return scratch
+
+    def _compile(self) -> _Compiled:
         coal = import_coal()
         bodies = sorted({b for p in self._pairs for b in p}, key=self._body_order)
         model = build_geometry_model(
@@ -212,7 +263,6 @@ class SelfCollisionChecker:
                 coal.ComputeCollision(geoms[i].geometry, geoms[j].geometry)
                 for i, j in zip(g1, g2, strict=True)
             ),
-            transforms=tuple(coal.Transform3s() for _ in geoms),
             broad=kincore.core().geoms(
                 np.array([g.body_index for g in geoms], dtype=np.int64),
                 np.array([g.body_T_geometry for g in geoms], dtype=np.float64).reshape(-1, 4, 4),
@@ -277,10 +327,11 @@ class SelfCollisionChecker:
         if not len(c.pair_of):
             return hits
         geom_mask = None if pair_mask is None else pair_mask[c.pair_of].astype(np.uint8)
-        req, res = self._requests(margin)
+        scratch = self._scratch(c)
+        req, res = scratch.collision(margin)
         clear, is_collision = res.clear, res.isCollision
         found = [False] * len(self._pairs)
-        tf = c.transforms
+        tf = scratch.transforms
         fns = c.collide
         owner = c.pair_of_list
         g1s, g2s = c.pair_geom1_list, c.pair_geom2_list
@@ -362,16 +413,6 @@ class SelfCollisionChecker:
         )
         keep = proofs != _APART
         return r[keep].tolist(), k[keep].tolist(), proofs[keep].tolist()
-
-    def _requests(self, margin: float) -> tuple[Any, Any]:
-        """A coal collision request for ``margin`` and a result to reuse (kept per checker)."""
-        cached = self._request
-        if cached is None or cached[0] != margin:
-            coal = import_coal()
-            req = coal.CollisionRequest()
-            req.security_margin = margin
-            cached = self._request = (margin, req, coal.CollisionResult())
-        return cached[1], cached[2]
 
     def in_collision(self, q: object, *, margin: float = 0.0) -> bool:
         """Whether any checked pair collides (or comes closer than ``margin``) at ``q``."""
@@ -465,15 +506,16 @@ class SelfCollisionChecker:
         """
         c = self._build()
         coal = import_coal()
-        fns = self._distance_functors(c)
-        hulls = self._hull_functors(c)
+        with self._lock:  # built by one thread, once (qhull on meshes shared by checkers)
+            fns = self._distance_functors(c)
+            hulls = self._hull_functors(c)
         npairs = len(self._pairs)
         req = coal.DistanceRequest()  # coal >= 3 always fills the nearest points
         res = coal.DistanceResult()
         hreq = coal.DistanceRequest()
         hreq.gjk_tolerance = _HULL_TOLERANCE
         hres = coal.DistanceResult()
-        tf = c.transforms
+        tf = self._scratch(c).transforms
         geoms = c.model.geometries
         # The transforms are updated in place, so each pair's functors and transforms are bound
         # once.
@@ -585,6 +627,7 @@ def _hull(geom: CollisionGeometry) -> Any:
         return model.convex
     except Exception:  # noqa: BLE001 - qhull refuses flat or degenerate point sets
         return None
+
 
 def _solid(vertices: F64) -> bool:
     """Whether qhull can hull ``vertices`` (V, 3): at least four points, not (nearly) flat.

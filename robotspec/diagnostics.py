@@ -20,7 +20,7 @@ from robotspec.errors import (
     closest_names,
 )
 
-__all__ = ["Diagnostics", "Loc", "SpecSource", "loc_text"]
+__all__ = ["Accepted", "Diagnostics", "Loc", "SpecSource", "loc_text"]
 
 Loc = tuple[str | int, ...]
 
@@ -28,6 +28,20 @@ Loc = tuple[str | int, ...]
 class _Document(Protocol):
     @property
     def file(self) -> str: ...
+
+
+class Accepted(Protocol):
+    """A spec's accepted warning (:class:`robotspec.spec.models.AcceptedWarning`)."""
+
+    @property
+    def at(self) -> str:
+        """The spec path the warning is about."""
+        ...
+
+    @property
+    def says(self) -> str:
+        """A part of its message."""
+        ...
 
 
 class SpecSource(Protocol):
@@ -165,6 +179,33 @@ class Diagnostics:
             return (rank, f, e.line or 0, e.column or 0)
 
         return sorted(problems, key=key)
+
+    def accept(self, accepted: Sequence[Accepted]) -> None:
+        """Drop the warnings the spec accepts; an acceptance that matches none is a warning.
+
+        ``accepted`` are the spec's ``accept_warnings`` entries, in order; entry ``i`` matches a
+        warning located at its spec path ``at`` (or below it) whose message contains ``says``.
+        """
+        used = [False] * len(accepted)
+        kept: list[RobotSpecError] = []
+        for warning in self.warnings:
+            where = loc_text(warning.detail.location)
+            hit = False
+            for i, entry in enumerate(accepted):
+                at = entry.at.strip()
+                inside = where == at or where.startswith((f"{at}.", f"{at}["))
+                if warning.detail.location and inside and entry.says in warning.message:
+                    used[i] = hit = True
+            if not hit:
+                kept.append(warning)
+        self.warnings = kept
+        for i, entry in enumerate(accepted):
+            if not used[i]:
+                self.warning(
+                    ("accept_warnings", i),
+                    f"no warning at '{entry.at}' says '{entry.says}' (any more?); "
+                    "remove this entry",
+                )
 
     def raise_if_failed(self, *, strict: bool = False) -> None:
         """Raise every error (and, in strict mode, every warning as an error) at once."""

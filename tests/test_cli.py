@@ -164,7 +164,8 @@ def test_strict_turns_warnings_into_errors(
     code, out, _ = run(capsys, "validate", str(spec))
     assert code == 0
     warning = (
-        f"{spec}:6:5: warning: chains.spare: chain 'spare' has neither a manipulator nor a sensor"
+        f"{spec}:6:5: warning: chains.spare: chain 'spare' has neither a manipulator nor a "
+        "sensor (not an arm? say 'kind: leg' or 'kind: chain')"
     )
     assert out.splitlines() == [warning, "1 of 1 spec valid; 0 errors, 1 warning"]
     code, out, _ = run(capsys, "validate", "--strict", str(spec))
@@ -362,6 +363,7 @@ def test_other_commands_print_the_warnings_attached_to_an_error(
     lines = err.splitlines()
     assert f"{spec}:10:10: error:" in lines[0] and "'l_elbow_flex_lnk'" in lines[0]
     assert (
-        f"{spec}:6:5: warning: chains.spare: chain 'spare' has neither a manipulator nor a sensor"
+        f"{spec}:6:5: warning: chains.spare: chain 'spare' has neither a manipulator nor a "
+        "sensor (not an arm? say 'kind: leg' or 'kind: chain')"
         in lines[1:]
     )

@@ -135,8 +135,12 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
                     )
         for i, s_name in enumerate(c.sensors):
             use_sensor(b, (*loc, "sensors", i), s_name, f"chain '{name}'", used_sensor)
-        if c.manipulator is None and not c.sensors:
-            diag.warning(loc, f"chain '{name}' has neither a manipulator nor a sensor")
+        if c.manipulator is None and not c.sensors and c.kind == "arm":
+            diag.warning(
+                loc,
+                f"chain '{name}' has neither a manipulator nor a sensor (not an arm? say "
+                "'kind: leg' or 'kind: chain')",
+            )
     for name in spec.manipulators:
         if name not in used_manip:
             diag.warning(("manipulators", name), f"manipulator '{name}' is on no chain")

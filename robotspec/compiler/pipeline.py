@@ -233,6 +233,7 @@ def compile_loaded(
     )
     robot = build_robot(build, robot_class)
     check_arm_sides(robot, loaded.spec.chains, diag)
+    diag.accept(loaded.spec.accept_warnings)
     diag.raise_if_failed(strict=strict)
     return CompileResult(
         loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))

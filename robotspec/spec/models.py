@@ -276,6 +276,31 @@ class CollisionSpec(SpecModel):
     )
 
 
+class AcceptedWarning(SpecModel):
+    """A warning the spec's author has read and accepts, with the reason (shown by ``--strict``).
+
+    Why: some warnings flag what is usually a slip but is right for this robot (a leg that
+    carries no tool, a camera fixed to a welded head). Accepting one by one, with a reason,
+    keeps ``--strict`` usable without silencing a class of warnings everywhere.
+    """
+
+    at: str = Field(
+        description="the spec path the warning is about, as the warning prints it",
+        examples=["chains.left_leg"],
+        min_length=1,
+    )
+    says: str = Field(
+        description="a part of the warning's message",
+        examples=["neither a manipulator nor a sensor"],
+        min_length=1,
+    )
+    because: str = Field(
+        description="why the warning does not apply to this robot",
+        examples=["a leg carries no tool"],
+        min_length=1,
+    )
+
+
 class RobotSpec(SpecModel):
     """A robot: its files, its root, and its semantic parts."""
 
@@ -360,6 +385,20 @@ class RobotSpec(SpecModel):
         description="robot-level named joint states",
         examples=[{"zero": {"head_pan_joint": 0.0}}],
         json_schema_extra={"unit": "rad or m (per joint)"},
+    )
+    accept_warnings: list[AcceptedWarning] = Field(
+        default_factory=list,
+        description="warnings read and accepted, one by one, each with its reason; one that "
+        "no longer occurs is itself a warning",
+        examples=[
+            [
+                {
+                    "at": "chains.left_leg",
+                    "says": "neither a manipulator nor a sensor",
+                    "because": "a leg carries no tool",
+                }
+            ]
+        ],
     )
 
     @model_validator(mode="after")

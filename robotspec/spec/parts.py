@@ -181,9 +181,10 @@ SensorSpec = Annotated[CameraSpec | GenericSensorSpec, Field(discriminator="type
 class ChainSpec(SpecModel):
     """A kinematic chain, by ``root``/``tip`` or by SRDF ``group`` name."""
 
-    kind: Literal["arm", "chain"] = Field(
+    kind: Literal["arm", "leg", "chain"] = Field(
         default="arm",
-        description="informational; a chain with a manipulator is an arm",
+        description="an arm carries a manipulator or a sensor (warned otherwise); a leg or "
+        "another chain (a lift, a tail) need not; a chain with a manipulator is an arm",
         examples=["arm"],
     )
     root: Name | None = Field(

@@ -10,7 +10,11 @@ from typing import Annotated, Any
 
 import typer
 
-from robotspec.cli.geometry import check_missing_geometry, report_skipped
+from robotspec.cli.geometry import (
+    check_missing_geometry,
+    report_skipped,
+    require_collision_geometry,
+)
 from robotspec.cli.options import (
     JsonFlag,
     PackagePath,
@@ -63,6 +67,7 @@ def check(
     from robotspec.collision import SelfCollisionChecker
 
     robot = load_robot(spec, package_path)
+    require_collision_geometry(robot, "check collisions")
     reported = check_missing_geometry(
         robot, skip=skip_missing_meshes, collision=True, command="check collisions"
     )
@@ -234,6 +239,7 @@ def generate(
     other = None if compare is None else load_srdf(compare, strict=False)
     if merge and robot.srdf is None:
         raise CollisionError(f"--merge: robot '{robot.name}' has no SRDF to merge into")
+    require_collision_geometry(robot, "generate the matrix for")
     reported = check_missing_geometry(
         robot, skip=skip_missing_meshes, collision=True, command="generate the matrix"
     )
@@ -312,6 +318,7 @@ def audit(
     from robotspec.collision.audit import audit_srdf
 
     robot = load_robot(spec, package_path)
+    require_collision_geometry(robot, "audit")
     bar = Progress(0, "audit", enabled=progress)
 
     with bar:

@@ -17,7 +17,7 @@ from robotspec.errors import ErrorDetail, RobotSpecError
 if TYPE_CHECKING:
     from robotspec.semantic import AbstractRobot
 
-__all__ = ["check_missing_geometry", "report_skipped"]
+__all__ = ["check_missing_geometry", "report_skipped", "require_collision_geometry"]
 
 
 def check_missing_geometry(
@@ -66,3 +66,42 @@ def _print(detail: ErrorDetail) -> None:
     from robotspec.cli.output import styled
 
     sys.stderr.write(styled(detail, sys.stderr) + "\n")
+
+
+def require_collision_geometry(robot: AbstractRobot, command: str) -> None:
+    """Refuse plainly when fewer than two bodies have collision geometry with a volume.
+
+    Why: without it every collision command "succeeded" with 0 pairs (or checked pairs of
+    bodies that have nothing to collide), which reads as a clean bill of health.
+    """
+    from robotspec.errors import CollisionError
+    from robotspec.model.geometry import Mesh
+
+    def solid(body: object) -> bool:
+        for shape in getattr(body, "collisions", ()):
+            g = shape.geometry
+            if isinstance(g, Mesh):
+                return True
+            size = getattr(g, "size", ())
+            dims = [*size, *(getattr(g, k) for k in ("radius", "length") if hasattr(g, k))]
+            if all(x > 0 for x in dims):
+                return True
+        return False
+
+    bodies = [b.name for b in robot.world.bodies if solid(b)]
+    source = robot.world.source
+    where = f" in {source.rsplit('/', 1)[-1]}" if source else ""
+    if not bodies:
+        raise CollisionError(
+            f"robot '{robot.name}' has no collision geometry (no <collision> element with a "
+            f"volume{where}): nothing to {command}",
+            file=source,
+            kind="collision",
+        )
+    if len(bodies) == 1:
+        raise CollisionError(
+            f"robot '{robot.name}' has collision geometry on one body only ('{bodies[0]}'"
+            f"{where}): no pair to {command}",
+            file=source,
+            kind="collision",
+        )

@@ -182,7 +182,13 @@ def _primitive(shape: Shape, coal: Any) -> tuple[Any, F64, str]:
     raise TypeError(f"not a primitive: {g!r}")  # pragma: no cover
 
 
-def _check_dimensions(shape: Shape, body: Body, file: str | None) -> None:
+def _check_dimensions(shape: Shape, body: Body, file: str | None) -> bool:
+    """Whether the element has a body; a negative or non-finite dimension is refused.
+
+    A zero dimension (a sphere of radius 0, a flat box) is common in real files (ARMAR-4 has
+    six): such an element has no volume to collide with, so it is left out (the caller lists
+    every one in a warning) rather than stopping every collision command at the first.
+    """
     g = shape.geometry
     values: Sequence[float]
     if isinstance(g, Box):
@@ -195,6 +201,8 @@ def _check_dimensions(shape: Shape, body: Body, file: str | None) -> None:
         # A negative mesh scale mirrors the mesh (Talos's right arm reuses the left arm's
         # meshes with scale 1 -1 1), as in every URDF reader; only zero flattens it.
         values = tuple(abs(v) for v in g.scale)
+    if all(math.isfinite(v) and v >= 0 for v in values) and not isinstance(g, Mesh):
+        return all(v > 0 for v in values)
     if not all(math.isfinite(v) and v > 0 for v in values):
         shown = g.scale if isinstance(g, Mesh) else values
         raise CollisionError(
@@ -205,6 +213,28 @@ def _check_dimensions(shape: Shape, body: Body, file: str | None) -> None:
             kind="link",
             name=body.name,
         )
+    return True
+
+
+def _degenerate_warning(
+    degenerate: Sequence[tuple[Body, Shape]], file: str | None
+) -> CollisionError:
+    """One warning listing every zero-sized primitive left out, at the first one's line."""
+    listed = ", ".join(
+        f"'{body.name}' ({type(shape.geometry).__name__.lower()}"
+        f"{'' if shape.line is None else f', line {shape.line}'})"
+        for body, shape in degenerate
+    )
+    n = len(degenerate)
+    return CollisionError(
+        f"{n} collision element{'s' if n != 1 else ''} of zero size left out (no volume to "
+        f"collide with): {listed}",
+        file=file,
+        line=degenerate[0][1].line,
+        kind="link",
+        name=degenerate[0][0].name,
+        severity="warning",
+    )
 
 
 def build_geometry_model(
@@ -225,11 +255,14 @@ def build_geometry_model(
     wanted = None if bodies is None else set(bodies)
     out: list[CollisionGeometry] = []
     skipped: list[RobotSpecError] = []
+    degenerate: list[tuple[Body, Shape]] = []
     for body in world.bodies:
         if not body.collisions or (wanted is not None and body.name not in wanted):
             continue
         for k, shape in enumerate(body.collisions):
-            _check_dimensions(shape, body, world.source)
+            if not _check_dimensions(shape, body, world.source):
+                degenerate.append((body, shape))
+                continue
             origin = np.asarray(shape.origin, dtype=np.float64)
             rot, trans = origin[:3, :3], origin[:3, 3]
             triangles: tuple[F64, I64] | None = None
@@ -261,6 +294,8 @@ def build_geometry_model(
                     triangles=triangles,
                 )
             )
+    if degenerate:
+        skipped.insert(0, _degenerate_warning(degenerate, world.source))
     return GeometryModel(geometries=tuple(out), skipped=tuple(skipped))
 
 

@@ -200,7 +200,7 @@ def run_driver(
                     assert isinstance(r, StepResult)
                     status.clear()
                     mark = "ok  " if r.ok else "FAIL"
-                    extra = f": {r.detail}" if r.detail else ""
+                    extra = f": {r.detail or r.note}" if r.detail or r.note else ""
                     sys.stdout.write(f"{mark} step {r.index} {r.description}{extra}\n")
 
                 results = run_scenario(driver, scenario, on_result=report)
@@ -239,9 +239,18 @@ def run_driver(
         failed = mismatch_errors(scenario, results)
         n_run = len(results)
         n_steps = len(scenario.scenario.steps)
+        slowed = [str(r.index) for r in results if r.note]
         sys.stdout.write(
             f"scenario: {n_run - len(failed)} of {n_steps} steps as expected"
-            f"{'' if n_run == n_steps else f' ({n_steps - n_run} not run)'}\n"
+            f"{'' if n_run == n_steps else f' ({n_steps - n_run} not run)'}"
+            + (
+                f"; {len(slowed)} trajector{'y' if len(slowed) == 1 else 'ies'} slowed to stay "
+                f"within the joint limits (step{'' if len(slowed) == 1 else 's'} "
+                f"{', '.join(slowed)})"
+                if slowed
+                else ""
+            )
+            + "\n"
         )
         if interrupted and n_run < n_steps:
             failed.append(

@@ -16,6 +16,7 @@ from robotspec.driver.errors import (
     OperationAbortedError,
 )
 from robotspec.driver.state import ActionStatus
+from robotspec.driver.stretch import Stretch
 from robotspec.driver.trajectory import TrajectoryInterpolator
 from robotspec.errors import DriverError
 
@@ -36,12 +37,17 @@ NEXT_TIMEOUT_S = 5.0
 
 @dataclass(frozen=True)
 class TrajectoryStatus:
-    """What ``Next()`` returns: action status, trajectory time and current waypoint."""
+    """What ``Next()`` returns: action status, trajectory time and current waypoint.
+
+    ``stretch`` (not in the robdef) says how the trajectory was slowed to stay within the joint
+    limits, None when it runs as planned: a client learns it from the first ``Next()``.
+    """
 
     action_status: ActionStatus
     trajectory_time: float = 0.0
     current_waypoint: int = 0
     seqno: int = 0
+    stretch: Stretch | None = None
 
 
 class Completion:
@@ -123,7 +129,9 @@ class TrajectoryGenerator:
             task.next_called = True
             if queued and first:
                 task.reported_queued = True
-                return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
+                return TrajectoryStatus(
+                    ActionStatus.queued, 0.0, 0, d._state_seqno, task.interp.stretch
+                )
             if task.reported_queued and not queued:
                 # It started since the client last heard "queued": say so at once.
                 task.reported_queued = False
@@ -146,13 +154,17 @@ class TrajectoryGenerator:
                 task.outcome_reported = True
                 return self._status(ActionStatus.complete)
             if task is not d._traj_active:
-                return TrajectoryStatus(ActionStatus.queued, 0.0, 0, d._state_seqno)
+                return TrajectoryStatus(
+                    ActionStatus.queued, 0.0, 0, d._state_seqno, task.interp.stretch
+                )
             task.reported_queued = False
             return self._status(ActionStatus.running)
 
     def _status(self, status: ActionStatus) -> TrajectoryStatus:
         t = self._task
-        return TrajectoryStatus(status, t.time, t.waypoint, self._driver._state_seqno)
+        return TrajectoryStatus(
+            status, t.time, t.waypoint, self._driver._state_seqno, t.interp.stretch
+        )
 
     def Abort(self) -> None:  # noqa: N802
         """Stop the robot: mode becomes ``halt``; ``Next()`` fails with OperationAborted."""

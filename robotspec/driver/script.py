@@ -34,6 +34,7 @@ from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import PayloadInfo, Pose, ToolInfo
 from robotspec.driver.sim import Fault, SimRobot
 from robotspec.driver.state import StateFlags
+from robotspec.driver.stretch import Stretch
 from robotspec.driver.trajectory import JointTrajectory, Waypoint
 from robotspec.errors import RobotSpecError, RobotSpecErrors, closest_names
 from robotspec.files.validation import validation_errors
@@ -137,6 +138,9 @@ class StepResult:
     description: str
     ok: bool
     detail: str = ""
+    #: What the step did that the run should show though it was as expected (a trajectory
+    #: slowed to stay within the joint limits).
+    note: str = ""
 
 
 @dataclass(frozen=True)
@@ -227,6 +231,7 @@ def _trajectory(driver: RobotDriver, args: dict[str, Any]) -> JointTrajectory:
                     Waypoint(
                         joint_position=tuple(float(x) for x in w["joint_position"]),
                         time_from_start=float(w["time_from_start"]),
+                        joint_velocity=tuple(float(x) for x in w.get("joint_velocity", ())),
                     )
                 )
             else:
@@ -238,8 +243,10 @@ def _trajectory(driver: RobotDriver, args: dict[str, Any]) -> JointTrajectory:
     return JointTrajectory.smooth_move(start, end, float(args.get("duration", 1.0)))
 
 
-def _do_call(driver: RobotDriver, name: str, args: dict[str, Any]) -> str | None:
-    """Perform one call; return a status name for trajectories."""
+def _do_call(
+    driver: RobotDriver, name: str, args: dict[str, Any]
+) -> tuple[str | None, Stretch | None]:
+    """Perform one call; return a status name and any stretch for trajectories."""
     wait = bool(args.get("wait", True))
     chain = int(args.get("chain", 0))
     if name == "command_mode":
@@ -265,9 +272,11 @@ def _do_call(driver: RobotDriver, name: str, args: dict[str, Any]) -> str | None
     elif name == "execute_trajectory":
         gen = driver.execute_trajectory(_trajectory(driver, args))
         status = None
+        stretch = None
         for st in gen:
             status = st.action_status.name
-        return status
+            stretch = st.stretch
+        return status, stretch
     elif name == "tool_attached":
         driver.tool_attached(chain, ToolInfo.model_validate(args["tool"]))
     elif name == "tool_detached":
@@ -277,7 +286,7 @@ def _do_call(driver: RobotDriver, name: str, args: dict[str, Any]) -> str | None
         driver.payload_attached(chain, PayloadInfo.model_validate(args["payload"]), pose)
     elif name == "payload_detached":
         driver.payload_detached(chain, str(args.get("name", "")))
-    return None
+    return None, None
 
 
 def _compare(expect: Literal["ok"] | Expect, status: str | None, exc: Exception | None) -> str:
@@ -353,11 +362,14 @@ def run_scenario(
         line = loaded.line_of(i)
         desc = _describe(step)
         detail = ""
+        note = ""
         if step.call is not None:
             exc: Exception | None = None
             status: str | None = None
             try:
-                status = _do_call(driver, step.call, step.args)
+                status, stretch = _do_call(driver, step.call, step.args)
+                if stretch is not None:
+                    note = stretch.describe(driver.joint_names)
             except RobotSpecError as e:
                 exc = e
             except (KeyError, TypeError, ValueError) as e:
@@ -374,7 +386,7 @@ def run_scenario(
             driver.step()
         elif step.check is not None:
             detail = _check(driver, step.check)
-        result = StepResult(i + 1, line, desc, not detail, detail)
+        result = StepResult(i + 1, line, desc, not detail, detail, note)
         results.append(result)
         if on_result is not None:
             on_result(result)

@@ -157,6 +157,9 @@ class RobotState:
     trajectory_time: float = 0.0
     trajectory_max_time: float = 0.0
     trajectory_current_waypoint: int = 0
+    #: How much the segment being run was slowed to stay within the joint limits (its duration
+    #: over the planned one; 1.0 as planned or with no trajectory). Not in the robdef.
+    trajectory_stretch: float = 1.0
     config_seqno: int = 1
     speed_ratio: float = 1.0
     error_message: str = ""

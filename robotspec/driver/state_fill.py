@@ -131,6 +131,7 @@ class StateFill(ModeMachine):
             trajectory_time=0.0 if task is None else task.time,
             trajectory_max_time=0.0 if task is None else task.interp.max_time,
             trajectory_current_waypoint=0 if task is None else task.waypoint,
+            trajectory_stretch=1.0 if task is None else task.interp.stretch_at(task.waypoint),
             config_seqno=self._config_seqno,
             speed_ratio=self._speed_ratio,
             error_message=self._fault_message,

@@ -45,7 +45,8 @@ class StateLog:
             header += [f"qcmd_{n}" for n in joint_names]
             for c in range(n_chains):
                 header += [f"tcp{c}_{a}" for a in ("x", "y", "z", "qw", "qx", "qy", "qz")]
-            header += ["error"]
+            # trajectory_stretch after error: columns read by position keep their place.
+            header += ["error", "trajectory_stretch"]
             self._csv.writerow(header)
 
     def __call__(self, st: RobotState) -> None:
@@ -70,6 +71,7 @@ class StateLog:
                 else:
                     row += [""] * 7
             row.append(st.error_message)
+            row.append(f"{st.trajectory_stretch:.6g}")
             self._csv.writerow(row)
             return
         rec = {
@@ -89,6 +91,8 @@ class StateLog:
             ],
             "trajectory_running": st.trajectory_running,
             "trajectory_time": st.trajectory_time,
+            "trajectory_max_time": st.trajectory_max_time,
+            "trajectory_stretch": st.trajectory_stretch,
             "error": st.error_message,
         }
         self._fh.write(json.dumps(rec) + "\n")

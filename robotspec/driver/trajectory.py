@@ -8,10 +8,18 @@ except where the reference is defective (documented in :mod:`robotspec.driver.ro
   ratio below 1 (the reference rejects at 0.4 what it accepts at 1.0);
 * NaN or infinite values are refused.
 
-Interpolation is a monotone piecewise-cubic Hermite (PCHIP) with zero velocity at both ends,
-instead of the reference's not-a-knot cubic spline. Why: PCHIP never overshoots between waypoints,
-so a trajectory whose waypoints are within the joint limits stays within them, and it starts and
-ends at rest.
+Interpolation is a piecewise-cubic Hermite through the waypoints, instead of the reference's
+not-a-knot cubic spline. Its velocity at a waypoint is the waypoint's ``joint_velocity`` (times the
+speed ratio) when the client gave one: the planner's own curve. Where none is given it is the
+monotone (PCHIP, Fritsch-Carlson) slope, as before velocities were honoured. Why PCHIP there: it
+never overshoots between waypoints, so a trajectory whose waypoints are within the joint limits
+stays within them. The curve starts and ends at rest whatever velocities the first and last
+waypoints give: the arm starts from rest and the driver holds the end (a velocity there would be a
+jump, an unbounded acceleration).
+
+Where that curve would exceed a joint's velocity or acceleration limit, the segments concerned are
+slowed just enough (:mod:`robotspec.driver.stretch`), and the interpolator reports it
+(:attr:`TrajectoryInterpolator.stretch`).
 """
 
 from __future__ import annotations
@@ -29,6 +37,7 @@ import numpy.typing as npt
 from robotspec.arrays import F64
 from robotspec.driver.commands import JointLimitArrays
 from robotspec.driver.errors import InvalidArgumentError
+from robotspec.driver.stretch import Stretch, time_scale
 
 __all__ = [
     "JointTrajectory",
@@ -124,12 +133,27 @@ class JointTrajectory:
 
 
 class TrajectoryInterpolator:
-    """Samples a checked trajectory at any time with preallocated buffers (PCHIP)."""
+    """Samples a checked trajectory at any time (cubic Hermite through the waypoints).
 
-    def __init__(self, times: F64, positions: F64) -> None:
-        self.times = times
+    Args:
+        times: waypoint times (s), increasing from 0, ``(m,)``.
+        positions: waypoint positions, ``(m, n)``.
+        velocities: the waypoints' velocities, ``(m, n)``, a row of NaN where none was given
+            (that waypoint gets the PCHIP slope); None: PCHIP everywhere.
+        limits: the joint limits the curve must stay within; None: not checked (the curve as
+            given, for tests of the interpolation itself).
+    """
+
+    def __init__(
+        self,
+        times: F64,
+        positions: F64,
+        velocities: F64 | None = None,
+        limits: JointLimitArrays | None = None,
+    ) -> None:
+        #: The waypoint times as planned (after the speed ratio), before any stretch.
+        self.planned_times = times
         self.positions = positions
-        self.max_time = float(times[-1])
         self.n_waypoints = int(times.shape[0])
         h = np.diff(times)
         delta = np.diff(positions, axis=0) / h[:, None]
@@ -147,8 +171,33 @@ class TrajectoryInterpolator:
                 hm = (w1 + w2) / (w1 / d0 + w2 / d1)
             _yield()
             d[1:-1] = np.where(same & np.isfinite(hm), hm, 0.0)
+        if velocities is not None:
+            given = ~np.isnan(velocities[:, 0])
+            d[given] = velocities[given]
+            d[0] = d[-1] = 0.0  # starts and ends at rest (see the module's docstring)
+        #: How the curve was slowed to stay within the limits; None when it was not.
+        self.stretch: Stretch | None = None
+        #: Per segment, its duration over the planned one (None when nothing was stretched).
+        self.segment_stretch: F64 | None = None
+        #: Per waypoint, its velocity over the planned one (None when nothing was stretched).
+        self.speed_scale: F64 | None = None
+        if limits is not None:
+            _yield()
+            timing = time_scale(times, positions, d, limits, pause=_yield)
+            times, d = timing.times, timing.velocities
+            self.stretch = timing.stretch
+            self.segment_stretch = timing.segment_stretch
+            self.speed_scale = timing.speed_scale
+            if timing.stretch is not None:
+                h = np.diff(times)
+        self.times = times
+        self.max_time = float(times[-1])
+        #: The curve's velocity at each waypoint, ``(m, n)`` (given ones scaled by any stretch).
+        self.velocities = d
         self._h = h
-        self._slopes = d
+        self._stretch_l: list[float] = (
+            [] if self.segment_stretch is None else _to_lists(self.segment_stretch)
+        )
         # Plain-float copies for evaluate(), which the loop calls every step.
         self._times_l: list[float] = _to_lists(times)
         self._h_l: list[float] = _to_lists(h)
@@ -157,6 +206,12 @@ class TrajectoryInterpolator:
         # the loop thread for 170 ms.
         self._segment = -1
         self._rows: tuple[list[float], list[float], list[float], list[float]] = ([], [], [], [])
+
+    def stretch_at(self, segment: int) -> float:
+        """How much segment ``segment`` was stretched (1.0: as planned)."""
+        if 0 <= segment < len(self._stretch_l):
+            return self._stretch_l[segment]
+        return 1.0
 
     def evaluate(self, t: float) -> tuple[F64, int]:
         """Position at time ``t`` (clamped to the ends; a new array) and the segment's start.
@@ -184,8 +239,8 @@ class TrajectoryInterpolator:
             self._rows = (
                 self.positions[k].tolist(),
                 self.positions[k + 1].tolist(),
-                self._slopes[k].tolist(),
-                self._slopes[k + 1].tolist(),
+                self.velocities[k].tolist(),
+                self.velocities[k + 1].tolist(),
             )
         p0, p1, m0, m1 = self._rows
         out = [p0[i] * h00 + (hh10 * m0[i] + h01 * p1[i] + hh11 * m1[i]) for i in range(len(p0))]
@@ -233,6 +288,7 @@ def load_trajectory(
     vel_finite = np.ones(m, dtype=bool)
     wp_fast = np.zeros(m, dtype=bool)
     rows: list[Sequence[float]] = []
+    given: list[tuple[int, list[float]]] = []
     vmax = limits.velocity.tolist()
     try:
         for start in range(0, m, CHUNK):
@@ -249,6 +305,8 @@ def load_trajectory(
                     wp_fast[i] = len(vs) == n and any(
                         abs(v * speed_ratio) > lim for v, lim in zip(vs, vmax, strict=True)
                     )
+                    if len(vs) == n:
+                        given.append((i, vs))
             _yield()
     except (TypeError, ValueError, OverflowError):
         raise InvalidArgumentError("Waypoint values must be numbers") from None
@@ -283,4 +341,10 @@ def load_trajectory(
     if failures:
         # A non-finite waypoint poisons its neighbours' differences: report it first.
         raise InvalidArgumentError(min(failures)[2])
-    return TrajectoryInterpolator(times, pos)
+    velocities = None
+    if given:
+        # The client's velocities are on its time axis: on the driver's (÷ speed ratio) they
+        # are faster by the ratio, as the velocity check above takes them.
+        velocities = np.full((m, n), np.nan)
+        velocities[[i for i, _ in given]] = np.array([v for _, v in given]) * speed_ratio
+    return TrajectoryInterpolator(times, pos, velocities, limits)

@@ -202,6 +202,8 @@ def test_tree_programs_that_would_corrupt_memory_are_refused(kin: ModuleType) ->
         _tree(kin, [0], [1], 3, 3)
     with pytest.raises(ValueError, match="out of range"):
         kin.chain(np.zeros((0, 4, 4)), np.eye(4), [], [], [], [], [], [], -1, 1)
+    fixed = kin.tree([0], [1], [0], np.eye(4)[None], np.zeros((1, 3)), [0], [0.0], [0.0], 2, 2, 0)
+    np.testing.assert_array_equal(kin.fk(fixed, np.zeros(0)), np.tile(np.eye(4), (2, 1, 1)))
     t = _tree(kin, [0, 1], [1, 2], 3, 3)
     assert kin.tree_size(t) == (3, 1)
     np.testing.assert_allclose(kin.fk(t, [np.pi / 2])[2][:2, :2], [[-1, 0], [0, -1]], atol=1e-15)
@@ -212,7 +214,7 @@ def test_foreign_byte_order_is_converted_or_refused(kin: ModuleType) -> None:
     q = np.array([[0.3], [-1.2]])
     want = kin.fk_batch(t, q)
     np.testing.assert_array_equal(kin.fk_batch(t, q.astype(">f8")), want)  # read as numbers
-    np.testing.assert_array_equal(kin.fk(t, q[0].astype(">f8")), want[0])
+    np.testing.assert_allclose(kin.fk(t, q[0].astype(">f8")), want[0], rtol=0, atol=1e-15)
     swapped = np.zeros(want.shape, dtype=">f8")
     with pytest.raises(TypeError, match="native-order"):
         kin.fk_batch(t, q, swapped, True)

@@ -72,35 +72,18 @@ def _config(obj: object, ndim: int, width: int) -> F64:
     return a
 
 
-def _mul34(a: F64, b: F64) -> F64:
-    """``a @ b`` of stacked 4x4 poses whose last row is 0 0 0 1, term by term as the C core.
-
-    For the broad phase's geometry poses (the C core's exact values); kinematics uses
-    ``np.matmul``, several times cheaper per call on small stacks, equal to rounding.
-    """
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    out[..., :3, :] = (
-        a[..., :3, 0:1] * b[..., 0:1, :]
-        + a[..., :3, 1:2] * b[..., 1:2, :]
-        + a[..., :3, 2:3] * b[..., 2:3, :]
-    )
-    out[..., :3, 3] += a[..., :3, 3]
-    out[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
-    return out
-
-
 def _motions(kind: I64, axis: F64, v: F64) -> F64:
-    """Each row's motion (..., R, 4, 4) at values ``v`` (..., R): a rotation, translation or 1.
+    """Each row's motion (..., R, 3, 4) at values ``v`` (..., R): a rotation, translation or 1.
 
     Every row is computed alike: a row that does not rotate gets angle 0 (the identity,
-    exactly), one that does not slide gets offset 0.
+    exactly), one that does not slide gets offset 0. Poses here drop the last row (0 0 0 1).
     """
     vr = np.where(kind == KIND_REVOLUTE, v, 0.0)
     vp = np.where(kind == KIND_PRISMATIC, v, 0.0)
     x, y, z = axis[:, 0], axis[:, 1], axis[:, 2]
     s, c = np.sin(vr), np.cos(vr)
     t = 1.0 - c
-    m = np.empty((*v.shape, 4, 4))
+    m = np.empty((*v.shape, 3, 4))
     m[..., 0, 0] = c + x * x * t
     m[..., 0, 1] = x * y * t - z * s
     m[..., 0, 2] = x * z * t + y * s
@@ -110,17 +93,39 @@ def _motions(kind: I64, axis: F64, v: F64) -> F64:
     m[..., 2, 0] = z * x * t - y * s
     m[..., 2, 1] = z * y * t + x * s
     m[..., 2, 2] = c + z * z * t
-    m[..., :3, 3] = axis * vp[..., None]
-    m[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+    m[..., 3] = axis * vp[..., None]
     return m
+
+
+def _compose(a: F64, b: F64) -> F64:
+    """``a @ b`` of stacked poses without their last row (..., 3, 4), term by term.
+
+    Why not ``np.matmul``: on a batch it is one small product per pose (tens of thousands of
+    calls inside numpy); six whole-array operations are several times cheaper.
+    """
+    out = a[..., :, 0:1] * b[..., 0:1, :]
+    out += a[..., :, 1:2] * b[..., 1:2, :]
+    out += a[..., :, 2:3] * b[..., 2:3, :]
+    out[..., 3] += a[..., 3]
+    return out
+
+
+def _full(m: F64) -> F64:
+    """Poses (..., 3, 4) with their last row 0 0 0 1 put back: (..., 4, 4)."""
+    out = np.empty((*m.shape[:-2], 4, 4))
+    out[..., :3, :] = m
+    out[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+    return out
 
 
 # -------------------------------------------------------------------------------- the tree
 @dataclass(frozen=True)
 class Tree:
-    """A tree program (see ``_kincore.c``), its rows grouped by depth in ``levels``.
+    """A tree program (see ``_kincore.c``), its rows sorted by depth.
 
-    Row k sets slot child[k] = slot parent[k] times origin[k] times the row's motion.
+    Row k sets slot child[k] = slot parent[k] times origin[k] times the row's motion. The rows
+    of one depth, ``levels`` (first, end), only read slots that shallower rows wrote, so each
+    depth is one step over every sample.
     """
 
     n_slots: int
@@ -129,12 +134,12 @@ class Tree:
     parent: I64
     child: I64
     kind: I64
-    dof: I64
+    dof: I64  # the DOF each row reads; n_dof (a column of zeros) for a fixed row
     origin: F64
     axis: F64
     mul: F64
     off: F64
-    levels: tuple[I64, ...]
+    levels: tuple[tuple[int, int], ...]
 
 
 def tree(
@@ -183,10 +188,24 @@ def tree(
         raise ValueError("tree program leaves a body's pose unset")
     if k.size and (k.min() < KIND_FIXED or k.max() > KIND_PRISMATIC):
         raise ValueError("tree program has a motion kind out of range")
-    levels = tuple(
-        np.flatnonzero(row_depth == lv) for lv in range(1, int(row_depth.max(initial=0)) + 1)
+    reads = np.where(k == KIND_FIXED, n_dof, d)  # a fixed row's DOF is never read, nor checked
+    order = np.argsort(row_depth, kind="stable")
+    ends = np.searchsorted(row_depth[order], np.arange(1, int(row_depth.max(initial=0)) + 2))
+    levels = tuple((int(lo), int(hi)) for lo, hi in zip(ends[:-1], ends[1:], strict=True))
+    return Tree(
+        n_slots,
+        n_out,
+        n_dof,
+        p[order],
+        c[order],
+        k[order],
+        reads[order],
+        o[order],
+        a[order],
+        m[order],
+        f[order],
+        levels,
     )
-    return Tree(n_slots, n_out, n_dof, p, c, k, d, o, a, m, f, levels)
 
 
 def _tree_of(obj: object) -> Tree:
@@ -204,21 +223,35 @@ def tree_size(tree: object) -> tuple[int, int]:
 def _run_tree(t: Tree, q: F64, out: F64) -> None:
     """Every output pose of the samples of ``q`` (N, D) into ``out`` (N, B, 4, 4)."""
     n = q.shape[0]
-    slots = np.empty((n, t.n_slots, 4, 4))
-    slots[:, 0] = np.eye(4)
-    v = q[:, t.dof] * t.mul + t.off
-    row = np.matmul(t.origin, _motions(t.kind, t.axis, v))
-    for rows in t.levels:
-        slots[:, t.child[rows]] = np.matmul(slots[:, t.parent[rows]], row[:, rows])
-    out[...] = slots[:, : t.n_out]
+    slots = np.empty((n, t.n_slots, 3, 4))
+    slots[:, 0] = np.eye(4)[:3]
+    row = _compose(t.origin[:, :3], _motions(t.kind, t.axis, _values(t, q)))
+    for lo, hi in t.levels:
+        slots[:, t.child[lo:hi]] = _compose(slots[:, t.parent[lo:hi]], row[:, lo:hi])
+    out[..., :3, :] = slots[:, : t.n_out]
+    out[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+
+
+def _values(t: Tree, q: F64) -> F64:
+    """Each row's motion value (N, R) for the samples of ``q`` (N, D); 0 for a fixed row."""
+    padded = np.zeros((q.shape[0], t.n_dof + 1))
+    padded[:, : t.n_dof] = q
+    v: F64 = padded[:, t.dof] * t.mul + t.off
+    return v
 
 
 def fk(tree: object, q: object) -> F64:
     t = _tree_of(tree)
     qa = _config(q, 1, t.n_dof)
-    out = np.empty((1, t.n_out, 4, 4))
-    _run_tree(t, qa[None, :], out)
-    pose: F64 = out[0]
+    # One sample: a 4x4 product per row and depth (np.matmul) costs fewer numpy calls than
+    # _compose's whole-array steps, which pay off on batches; the two agree to rounding.
+    slots = np.empty((t.n_slots, 4, 4))
+    slots[0] = np.eye(4)
+    row = np.matmul(t.origin, _full(_motions(t.kind, t.axis, _values(t, qa[None, :])[0])))
+    for lo, hi in t.levels:
+        slots[t.child[lo:hi]] = np.matmul(slots[t.parent[lo:hi]], row[lo:hi])
+    pose: F64 = slots[: t.n_out]
+    pose[:, 3] = (0.0, 0.0, 0.0, 1.0)
     return pose
 
 
@@ -325,12 +358,11 @@ def _chain_of(obj: object) -> Chain:
 def _chain_run(c: Chain, q: F64) -> F64:
     """root_T_tip (N, 4, 4) of the samples of ``q`` (N, D)."""
     v = q[:, c.dof] * c.mul + c.off
-    steps = np.matmul(c.pre, _motions(c.kind, c.axis, v))
-    t = np.broadcast_to(np.eye(4), (q.shape[0], 4, 4))
+    steps = _compose(c.pre[:, :3], _motions(c.kind, c.axis, v))
+    t = np.broadcast_to(np.eye(4)[:3], (q.shape[0], 3, 4))
     for i in range(steps.shape[1]):
-        t = np.matmul(t, steps[:, i])
-    tips: F64 = np.matmul(t, c.post)
-    return tips
+        t = _compose(t, steps[:, i])
+    return _full(_compose(t, c.post[:3]))
 
 
 def chain_fk(chain: object, q: object) -> F64:
@@ -352,7 +384,7 @@ def chain_jacobian(chain: object, q: object) -> F64:
     c = _chain_of(chain)
     qa = _config(q, 1, c.n_dof)
     n = len(c.kind)
-    motion = _motions(c.kind, c.axis, qa[c.dof] * c.mul + c.off)
+    motion = _full(_motions(c.kind, c.axis, qa[c.dof] * c.mul + c.off))
     z = np.empty((n, 3))
     p = np.empty((n, 3))
     t = np.eye(4)
@@ -456,7 +488,7 @@ def broad(geoms: object, body_poses: Any, margin: float, mask: Any) -> tuple[Any
             raise ValueError("pair mask has the wrong size")
         keep = m != 0
     bodies = bp[:, g.body]  # (N, G, 4, 4)
-    poses = _mul34(bodies, g.body_T_geom)
+    poses = _full(_compose(bodies[..., :3, :], g.body_T_geom[:, :3]))  # the C core's terms
     rot = bodies[..., :3, :3]
     c, h = g.center, g.half
     cen = rot[..., 0] * c[:, 0, None] + rot[..., 1] * c[:, 1, None] + rot[..., 2] * c[:, 2, None]

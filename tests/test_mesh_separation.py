@@ -257,12 +257,16 @@ def test_a_mesh_scaled_past_float_range_is_a_located_error(tmp_path: Path) -> No
     from robotspec.description.urdf import load_urdf
     from robotspec.errors import CollisionError
 
-    trimesh.creation.box(extents=(1e30, 1e30, 1e30)).export(str(tmp_path / "big.stl"))
+    # Scales are bounded (at most 1e6 each), so the overflow comes from the vertices: an OBJ
+    # holds float64 coordinates, 1e305 of them times 1e6 is past the float range.
+    (tmp_path / "big.obj").write_text(
+        "v 0 0 0\nv 1e305 0 0\nv 0 1e305 0\nv 0 0 1e305\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n"
+    )
     trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(str(tmp_path / "cube.stl"))
     (tmp_path / "two.urdf").write_text(
         '<robot name="two">'
         '<link name="a"><collision><geometry>'
-        '<mesh filename="big.stl" scale="1e300 1e300 1e300"/></geometry></collision></link>'
+        '<mesh filename="big.obj" scale="1e6 1e6 1e6"/></geometry></collision></link>'
         '<link name="b"><collision><geometry><mesh filename="cube.stl"/></geometry></collision>'
         '</link><joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
         '<origin xyz="3 0 0"/><axis xyz="0 0 1"/>'
@@ -272,7 +276,7 @@ def test_a_mesh_scaled_past_float_range_is_a_located_error(tmp_path: Path) -> No
     checker = SelfCollisionChecker(world, CollisionRules(bodies=("a", "b")), pairs=[("a", "b")])
     with pytest.raises(CollisionError, match=r"link 'a'.*beyond the float range") as info:
         checker.in_collision(world.configuration())
-    assert info.value.file is not None and info.value.file.endswith("big.stl")
+    assert info.value.file is not None and info.value.file.endswith("big.obj")
 
 
 def _without_hulls(checker: SelfCollisionChecker) -> SelfCollisionChecker:

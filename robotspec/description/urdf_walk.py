@@ -32,6 +32,7 @@ from robotspec.model.rotations import rpy_to_matrix
 
 __all__ = [
     "JOINT_TYPES",
+    "MESH_SCALE",
     "JointRecord",
     "LinkRecord",
     "ShapeRecord",
@@ -43,6 +44,11 @@ __all__ = [
 ]
 
 JOINT_TYPES = ("fixed", "revolute", "continuous", "prismatic", "floating", "planar")
+#: The sizes a mesh scale factor may have (its sign mirrors). Why bounds: ``1e308`` overflows
+#: every vertex to infinity and ``1e-300`` collapses a mesh to a point (every distance zero);
+#: real robots use 0.001 (millimetres to metres) to 1, and a factor of a million either way
+#: covers any unit.
+MESH_SCALE = (1e-6, 1e6)
 
 
 @dataclass(frozen=True, slots=True)
@@ -285,7 +291,15 @@ class _Walk:
             if scale is not None:
                 one = len(scale.replace(",", " ").split()) == 1
                 got = self.floats(g, "scale", 1 if one else 3, f"{what}: mesh scale")
-                if got is not None:
+                if got is not None and not all(
+                    MESH_SCALE[0] <= abs(v) <= MESH_SCALE[1] for v in got
+                ):
+                    self.error(
+                        f"{what}: mesh scale '{scale}' is out of range (each factor's size must "
+                        f"be between {MESH_SCALE[0]:g} and {MESH_SCALE[1]:g})",
+                        g,
+                    )
+                elif got is not None:
                     values = (got[0], got[0], got[0]) if one else (got[0], got[1], got[2])
         else:
             self.error(f"{what}: unknown geometry <{tag}>", g)

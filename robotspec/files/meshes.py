@@ -7,21 +7,68 @@ broken file with the same message; each caller names the error type its users ex
 from __future__ import annotations
 
 import io
+import re
+import struct
 
 import numpy as np
 import numpy.typing as npt
 
 from robotspec.errors import RobotSpecError
-from robotspec.files.limits import limits
+from robotspec.files.limits import env_name, limits
 from robotspec.files.reading import read_bounded
 
-__all__ = ["read_triangles"]
+__all__ = ["declared_triangles", "read_triangles"]
+
+_PLY_FACES = re.compile(rb"^element\s+face\s+(\d+)\s*$", re.MULTILINE)
+
+
+def declared_triangles(data: bytes, suffix: str) -> int | None:
+    """How many triangles (at least) a mesh file holds, told before it is parsed; None: unknown.
+
+    Why before: parsing costs about 500 bytes of memory per triangle whatever the file's size
+    (a 256 MB binary STL holds 5.3 million triangles), so a file over the triangle cap must be
+    refused from what it declares. A binary STL states its count in its header (bytes 80-84,
+    exact when the file's size agrees); a PLY in its ``element face`` line; an ASCII STL and an
+    OBJ are counted by their ``endfacet`` and ``f`` lines (an OBJ polygon makes at least one
+    triangle). Other formats are counted once parsed.
+    """
+    if suffix == "stl":
+        if len(data) >= 84:
+            (count,) = struct.unpack_from("<I", data, 80)
+            if len(data) == 84 + 50 * count:
+                return int(count)
+        return data.count(b"endfacet")
+    if suffix == "obj":
+        return data.count(b"\nf ") + data.count(b"\nf\t") + int(data[:2] in (b"f ", b"f\t"))
+    if suffix == "ply":
+        head, _, _ = data[:65536].partition(b"end_header")
+        found = _PLY_FACES.search(head)
+        return int(found.group(1)) if found else None
+    return None
+
+
+def _check_triangles(
+    count: int, path: str, error_type: type[RobotSpecError], *, declared: bool
+) -> None:
+    cap = limits().max_mesh_triangles
+    if count > cap:
+        says = "declares" if declared else "has"
+        raise error_type(
+            f"mesh {says} {count:,} triangles, more than {cap:,} (the cap on one mesh; "
+            f"set {env_name('max_mesh_triangles')} to raise it)",
+            file=path,
+            kind="size",
+        )
 
 
 def read_triangles(
     path: str, error_type: type[RobotSpecError] = RobotSpecError
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
-    """Vertices and faces as the file stores them (unscaled); a bad file is ``error_type``."""
+    """Vertices and faces as the file stores them (unscaled); a bad file is ``error_type``.
+
+    Two caps bound the work: ``max_mesh_bytes`` on the file and ``max_mesh_triangles`` on its
+    triangles, checked on what the file declares before it is parsed and on what was parsed.
+    """
     import trimesh
 
     suffix = path.rsplit(".", 1)[-1].lower() if "." in path else ""
@@ -37,6 +84,9 @@ def read_triangles(
         if exc.detail.kind == "file" and exc.message.startswith("file not found"):
             raise error_type("mesh file not found", file=path, kind="mesh") from None
         raise
+    declared = declared_triangles(data, suffix)
+    if declared is not None:
+        _check_triangles(declared, path, error_type, declared=True)
     try:
         mesh = trimesh.load(io.BytesIO(data), file_type=suffix, force="mesh", process=False)
     except Exception as exc:  # noqa: BLE001 - trimesh's readers raise anything on a corrupt file
@@ -47,6 +97,9 @@ def read_triangles(
     faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
     if faces.ndim != 2 or len(faces) == 0 or faces.shape[1] != 3:
         raise error_type("mesh has no triangles", file=path, kind="mesh")
+    # Checked again once parsed: a format that declares nothing (COLLADA), a polygon that made
+    # several triangles, a header that lied. Before anything larger (trees, hulls) is built.
+    _check_triangles(len(faces), path, error_type, declared=False)
     if not np.all(np.isfinite(vertices)):
         raise error_type("mesh has non-finite vertices", file=path, kind="mesh")
     return vertices, faces

@@ -21,17 +21,20 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
 from robotspec.driver.cartesian import DIRECTION_TOLERANCE_DEG
 from robotspec.driver.clock import JitteryClock, SimClock
 from robotspec.driver.commands import JointLimitArrays, RobotJointCommand
 from robotspec.driver.errors import InvalidArgumentError, OperationFailedError
+from robotspec.driver.handles import TrajectoryStatus
 from robotspec.driver.loop import JOG_ARRIVAL_SPEED, JOG_ARRIVAL_TOLERANCE
 from robotspec.driver.robot_info import RobotCapability, RobotInfo, load_robot_info
 from robotspec.driver.sim import Fault, SimRobot
-from robotspec.driver.state import CommandMode, RobotState
+from robotspec.driver.state import ActionStatus, CommandMode, RobotState
+from robotspec.driver.trajectory import JointTrajectory, Waypoint
+from tests.conftest import erd_robots
 from tests.driver_support import ROBOTINFO_DIR, RRP, robotinfo
 
 #: Relative and absolute round-off allowances.
@@ -302,6 +305,148 @@ def test_ur5e_velocity_stream_into_a_limit_brakes_in_time() -> None:
     assert ur.sim_position[0] == pytest.approx(lim.upper[0], abs=1e-3)
     assert abs(ur.sim_velocity[0]) < 1e-3
     assert max(abs(x[0]) for x in trace.v) == pytest.approx(lim.velocity[0])
+
+
+# ------------------------------------------------------------------ trajectories
+
+
+def reference_trajectory(
+    q0: np.ndarray, goal: np.ndarray, duration: float, spacing: float = 0.05
+) -> JointTrajectory:
+    """A planner's rest-to-rest trajectory: a cosine time law on a joint-space line, sampled
+    every ``spacing`` s with its exact velocities (what a time-parameterised plan carries)."""
+    m = int(math.ceil(duration / spacing)) + 1
+    t = np.linspace(0.0, duration, m)
+    w = math.pi / duration
+    s = (1 - np.cos(w * t)) / 2
+    ds = w * np.sin(w * t) / 2
+    q = q0[None, :] + s[:, None] * (goal - q0)[None, :]
+    q[-1] = goal
+    v = ds[:, None] * (goal - q0)[None, :]
+    return JointTrajectory(
+        waypoints=tuple(
+            Waypoint(tuple(q[i].tolist()), float(t[i]), tuple(v[i].tolist())) for i in range(m)
+        )
+    )
+
+
+def cosine_duration(delta: np.ndarray, lim: JointLimitArrays, accel_use: float) -> float:
+    """The duration of a cosine move over ``delta`` peaking at ``accel_use`` x the limits."""
+    # Peak acceleration |delta| (pi / T)^2 / 2, peak velocity |delta| pi / (2 T).
+    t_acc = np.sqrt(np.abs(delta) * math.pi**2 / (2 * accel_use * lim.acceleration))
+    t_vel = np.abs(delta) * math.pi / (2 * 0.9 * lim.velocity)
+    return float(max(np.max(t_acc), np.max(t_vel), 0.25))
+
+
+def run_trajectory(robot: SimRobot, traj: JointTrajectory) -> tuple[Trace, list[TrajectoryStatus]]:
+    """Execute ``traj`` in trajectory mode to the end, tracing every step, then settle."""
+    to_mode(robot, CommandMode.trajectory)
+    trace = traced(robot)
+    statuses = list(robot.execute_trajectory(traj))
+    robot.run_for(0.1)
+    return trace, statuses
+
+
+@settings(max_examples=16, deadline=None)
+@given(
+    path=st.sampled_from(files_with(RobotCapability.trajectory_command)),
+    start=st.lists(FRACTION, min_size=1, max_size=7),
+    goal=st.lists(FRACTION, min_size=1, max_size=7),
+    accel_use=st.floats(0.3, 4.0),
+    ratio=st.sampled_from([0.5, 1.0, 1.5]),
+    jitter=JITTER,
+    seed=st.integers(0, 1000),
+)
+def test_trajectories_respect_acceleration_and_limits(
+    path: Path,
+    start: list[float],
+    goal: list[float],
+    accel_use: float,
+    ratio: float,
+    jitter: float,
+    seed: int,
+) -> None:
+    # Planner trajectories with velocities, some beyond the acceleration limits (accel_use > 1,
+    # or a speed ratio above 1): every step the driver commands and the arm makes is within the
+    # limits, and the trajectory ends on its last waypoint.
+    robot = make_robot(path, jitter, seed, start)
+    lim = robot.limits
+    robot.speed_ratio = ratio
+    q0 = robot.sim_position
+    target = lim.lower + np.resize(np.array(goal), lim.count) * (lim.upper - lim.lower)
+    target = q0 + 0.5 * (target - q0)
+    duration = cosine_duration(target - q0, lim, accel_use) * max(ratio, 1.0)
+    trace, statuses = run_trajectory(robot, reference_trajectory(q0, target, duration))
+    assert statuses[-1].action_status is ActionStatus.complete
+    event("stretched" if statuses[-1].stretch is not None else "as planned")
+    if jitter == 0.0:
+        assert violations(trace, lim) == []
+    else:
+        # Under jitter, consecutive steps cover different durations: the mean velocities of two
+        # steps of a curve within a_max differ by up to a_max (dt1 + dt2) / 2, not a_max dt2 as
+        # the step-by-step profiles guarantee. The curve's own measure is the divided difference.
+        found = violations(trace, lim)
+        assert [v for v in found if "commanded acceleration" not in v] == []
+        assert curve_acceleration_violations(trace, lim) == []
+    np.testing.assert_allclose(robot.sim_position, target, atol=1e-9)
+
+
+def curve_acceleration_violations(trace: Trace, lim: JointLimitArrays) -> list[str]:
+    """Steps where the commanded positions' second divided difference exceeds ``a_max``."""
+    out = []
+    for k in range(2, len(trace.t)):
+        p0, p1, p2 = trace.pos_cmd[k - 2], trace.pos_cmd[k - 1], trace.pos_cmd[k]
+        if p0 is None or p1 is None or p2 is None:
+            continue
+        dt1, dt2 = trace.t[k - 1] - trace.t[k - 2], trace.t[k] - trace.t[k - 1]
+        acc = 2 * ((p2 - p1) / dt2 - (p1 - p0) / dt1) / (dt1 + dt2)
+        if np.any(np.abs(acc) > lim.acceleration * (1 + REL) + 1e-6):
+            out.append(f"step {k}: {np.max(np.abs(acc) / lim.acceleration):.4g} x the limit")
+    return out
+
+
+def _pr2_right_arm() -> RobotInfo:
+    erd_robots()
+    from robotspec.export.robotinfo import export_spec_chain
+
+    return export_spec_chain("pr2", "right_arm").info
+
+
+def test_an_everyday_pr2_arm_trajectory_runs_as_planned() -> None:
+    # A 7-DOF plan within the limits, velocities from its smooth reference: accepted and run
+    # unchanged, in its planned time, within the limits at every step.
+    robot = SimRobot(_pr2_right_arm(), clock=SimClock())
+    robot.step()
+    lim = robot.limits
+    q0 = robot.sim_position
+    goal = np.clip(q0 + np.array([0.5, 0.3, -0.4, -0.6, 0.8, -0.5, 1.0]), lim.lower, lim.upper)
+    duration = cosine_duration(goal - q0, lim, 0.8)
+    trace, statuses = run_trajectory(robot, reference_trajectory(q0, goal, duration))
+    assert statuses[-1].action_status is ActionStatus.complete
+    assert statuses[-1].stretch is None
+    assert statuses[-1].trajectory_time == pytest.approx(duration, abs=0.011)
+    assert violations(trace, lim) == []
+    np.testing.assert_allclose(robot.sim_position, goal, atol=1e-9)
+
+
+def test_a_pr2_arm_trajectory_planned_too_fast_is_slowed_not_refused() -> None:
+    # A quick move (0.3 s) timed for 1.6 x the acceleration limits (a planner configured with
+    # other limits): accepted, slowed where needed, reported, within the limits at every step.
+    robot = SimRobot(_pr2_right_arm(), clock=SimClock())
+    robot.step()
+    lim = robot.limits
+    q0 = robot.sim_position
+    step = np.array([1, 1, -1, -1, 1, -1, 1]) * 0.15 * lim.velocity
+    goal = np.clip(q0 + step, lim.lower, lim.upper)
+    duration = cosine_duration(goal - q0, lim, 1.6)
+    trace, statuses = run_trajectory(robot, reference_trajectory(q0, goal, duration))
+    final = statuses[-1]
+    assert final.action_status is ActionStatus.complete
+    assert final.stretch is not None and final.stretch.limit == "acceleration"
+    assert final.trajectory_time == pytest.approx(final.stretch.duration, abs=0.011)
+    assert final.stretch.duration > duration
+    assert violations(trace, lim) == []
+    np.testing.assert_allclose(robot.sim_position, goal, atol=1e-9)
 
 
 # ------------------------------------------------------------------ jogs under jitter

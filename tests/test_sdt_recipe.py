@@ -1,0 +1,156 @@
+"""The SDT mapping as data (robotspec.interop.sdt.recipe): runs without SDT installed.
+
+What each robotspec part becomes in SDT, which joints get hardware interfaces, which states
+keep an SDT kind, and that importing robotspec (or the bridge package) never imports SDT.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+from robotspec.errors import RobotSpecError
+from robotspec.interop.sdt.recipe import STATE_KINDS, RobotRecipe, robot_recipe
+from robotspec.semantic import AbstractRobot
+from tests.conftest import erd_robots, shared_path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@cache
+def _robot(name: str) -> AbstractRobot:
+    from robotspec.robots import load
+
+    paths = [shared_path("robots", "hsrb")] if name == "hsrb" else []
+    return load(name, package_paths=paths)
+
+
+def _pr2() -> AbstractRobot:
+    erd_robots()
+    return _robot("pr2")
+
+
+def test_pr2_parts_are_sdt_kinds_in_sdt_slots() -> None:
+    robot = _pr2()
+    recipe = robot_recipe(robot)
+    parts = recipe.parts()
+    assert len(parts) == 12
+    assert [s for s, _ in recipe.children] == ["mobile_base"]
+    (base,) = recipe.slot("mobile_base")
+    (torso,) = base.slot("torso")
+    assert (base.root, torso.root, torso.tip) == ("base_link", "base_link", "torso_lift_link")
+    left, right = torso.slot("arms")
+    assert (left.tip, right.tip) == (robot.left_arm.tip.name, robot.right_arm.tip.name)
+    (gripper,) = left.slot("end_effector")
+    thumb, finger = gripper.slot("fingers")
+    manipulator = robot.left_arm.manipulator
+    assert manipulator is not None
+    assert gripper.tool_frame == manipulator.tool_frame.name
+    assert thumb.root == "l_gripper_l_finger_link"  # the thumb is SDT's first finger
+    assert finger.root == "l_gripper_r_finger_link"
+    (neck,) = torso.slot("neck")
+    (kinect,) = neck.slot("sensors")
+    assert kinect.kind == "camera" and kinect.default_camera
+    assert kinect.minimal_height == robot.cameras[0].minimal_height
+
+
+def test_hardware_interfaces_are_the_controlled_joints_that_move_a_chain() -> None:
+    robot = _pr2()
+    recipe = robot_recipe(robot)
+    hardware = [j for p in recipe.parts() for j in p.hardware_joints]
+    assert len(hardware) == len(set(hardware)) == 17
+    controlled = {c.name for c in robot.controlled_connections}
+    assert set(hardware) < controlled
+    # Left without: the grippers (their own action commands them) and the laser tilt (no chain).
+    assert controlled - set(hardware) == {
+        "l_gripper_l_finger_joint",
+        "r_gripper_l_finger_joint",
+        "laser_tilt_mount_joint",
+    }
+    assert recipe.extra_hardware_joints == ()
+
+
+def test_a_mimic_leader_moves_the_chain_of_its_follower() -> None:
+    # HSRB's torso_lift_joint follows arm_lift_joint: the torso's hardware joint is the leader.
+    robot = _robot("hsrb")
+    recipe = robot_recipe(robot)
+    (base,) = recipe.slot("mobile_base")
+    (torso,) = base.slot("torso")
+    assert torso.hardware_joints == ("arm_lift_joint",)
+    assert [s.joints for s in torso.states][1] == (("arm_lift_joint", 0.34),)
+
+
+def test_states_keep_their_sdt_kind_and_the_rest_is_reported() -> None:
+    robot = _pr2()
+    recipe = robot_recipe(robot)
+    kinds = {(p.name, s.name): s.kind for p in recipe.parts() for s in p.states}
+    assert kinds[("torso", "mid")] == ("TorsoState", "MID")
+    assert kinds[("left_arm", "park")] == ("StaticJointState", "PARK")
+    assert kinds[("right_gripper", "close")] == ("GripperState", "CLOSE")
+    assert len(kinds) == len(robot.joint_states)
+    assert recipe.left_out == ()
+    erd_robots()
+    panda = robot_recipe(_robot("panda"))
+    assert "ready" not in STATE_KINDS
+    assert any("'arm.ready'" in note for note in panda.left_out)
+
+
+def test_other_chains_are_left_out_but_named_joints_keep_interfaces(tmp_path: Path) -> None:
+    erd_robots()
+    spec = tmp_path / "lift.yaml"
+    spec.write_text(
+        "robotspec: 1\nname: PR2Lift\nextends: pr2\n"
+        "chains:\n  tilt: {root: torso_lift_link, tip: laser_tilt_mount_link, kind: chain}\n"
+        "controlled_joints: [torso_lift_joint, head_pan_joint, laser_tilt_mount_joint,"
+        " l_gripper_l_finger_joint]\n",
+        encoding="utf-8",
+    )
+    from robotspec.compiler import compile_robot
+
+    recipe = robot_recipe(compile_robot(spec))
+    assert any(note.startswith("chain 'tilt'") for note in recipe.left_out)
+    # Named joints keep hardware interfaces wherever they are: on no SDT part, the robot's.
+    assert sorted(recipe.extra_hardware_joints) == [
+        "l_gripper_l_finger_joint",
+        "laser_tilt_mount_joint",
+    ]
+    on_parts = {j for p in recipe.parts() for j in p.hardware_joints}
+    assert on_parts == {"torso_lift_joint", "head_pan_joint"}
+
+
+def test_a_robot_gives_equal_recipes_and_json_keeps_them() -> None:
+    erd_robots()
+    from robotspec.robots import load
+
+    first, second = robot_recipe(load("pr2")), robot_recipe(load("pr2"))
+    assert first == second and first.digest() == second.digest()
+    again = RobotRecipe.from_json(json.loads(json.dumps(first.to_json())))
+    assert again == first and again.digest() == first.digest()
+    other = robot_recipe(_robot("tiago"))
+    assert other.digest() != first.digest()
+
+
+def test_importing_robotspec_and_the_bridge_does_not_import_sdt() -> None:
+    code = (
+        "import sys, robotspec, robotspec.interop.sdt, robotspec.interop.sdt.recipe\n"
+        "robotspec.load_robot\n"
+        "print(sorted(m for m in sys.modules if m.startswith('semantic_digital_twin')))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True
+    )
+    assert out.stdout.strip() == "[]"
+
+
+def test_without_sdt_the_bridge_says_how_to_install_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    from robotspec.interop import sdt
+
+    monkeypatch.setitem(sys.modules, "semantic_digital_twin", None)
+    monkeypatch.delitem(sys.modules, "robotspec.interop.sdt._api", raising=False)
+    with pytest.raises(RobotSpecError, match=r"pip install 'robotspec\[sdt\]'"):
+        sdt.sdt_api()

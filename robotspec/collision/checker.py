@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from robotspec.arrays import F64, I64
+from robotspec.arrays import F64, I64, real_array, real_number
 from robotspec.collision import meshcore
 from robotspec.collision.rules import CollisionRules, pair_key
 from robotspec.collision.shapes import (
@@ -38,7 +38,7 @@ from robotspec.collision.shapes import (
     build_geometry_model,
     import_coal,
 )
-from robotspec.errors import CollisionError, RobotSpecError
+from robotspec.errors import CollisionError, KinematicsError, RobotSpecError
 from robotspec.model import kincore
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
@@ -285,10 +285,31 @@ class SelfCollisionChecker:
 
     # ------------------------------------------------------------------------- geometry
     def _as_batch(self, qs: object) -> F64:
-        arr = np.asarray(qs, dtype=np.float64)
-        if arr.ndim == 1:
-            arr = arr[None, :]
-        return arr
+        """``qs`` as a checked batch (N, D) of configurations; one configuration (D,) is one row."""
+        arr = real_array(qs, "configurations", KinematicsError)
+        return self.kinematics.configuration_array(
+            arr[None, :] if arr.ndim == 1 else arr, batch=True
+        )
+
+    def _one(self, q: object, batch: str) -> F64:
+        """``q`` as a batch of one (1, D), checked; a batch is refused, naming the method for it.
+
+        Why: a single-configuration query once answered for the first row of a batch alone.
+        """
+        return self.kinematics.configuration_array(q, hint=f"SelfCollisionChecker.{batch}")[None, :]
+
+    def _pair_mask(self, pair_mask: object) -> Bools:
+        """``pair_mask`` checked: booleans, one per checked pair."""
+        want = f"pair_mask must be booleans of shape ({len(self._pairs)},), one per checked pair"
+        try:
+            mask = np.asarray(pair_mask)
+        except (ValueError, TypeError) as exc:
+            raise CollisionError(f"{want}: {exc}", kind="config") from None
+        if mask.dtype != np.bool_ or mask.shape != (len(self._pairs),):
+            raise CollisionError(
+                f"{want}, got a {mask.dtype} array of shape {mask.shape}", kind="config"
+            )
+        return mask
 
     def _broad(
         self, c: _Compiled, qs: F64, margin: float, mask: NDArray[np.uint8] | None
@@ -319,8 +340,8 @@ class SelfCollisionChecker:
         ``pair_mask`` limits the pairs tested. ``drop_found`` stops testing a pair once it has
         collided in any sample (the matrix generator only asks whether a pair *ever* collides).
         """
-        if not margin >= 0.0:
-            raise CollisionError(f"margin must be >= 0, got {margin}", kind="config")
+        margin = real_number(margin, "margin", _config_error, minimum=0.0)
+        pair_mask = None if pair_mask is None else self._pair_mask(pair_mask)
         c = self._build()
         n = qs.shape[0]
         hits = np.zeros((n, len(self._pairs)), dtype=np.bool_)
@@ -416,11 +437,13 @@ class SelfCollisionChecker:
 
     def in_collision(self, q: object, *, margin: float = 0.0) -> bool:
         """Whether any checked pair collides (or comes closer than ``margin``) at ``q``."""
-        return bool(self._scan(self._as_batch(q)[:1], margin=margin, first_only=True).any())
+        return bool(
+            self._scan(self._one(q, "in_collision_batch"), margin=margin, first_only=True).any()
+        )
 
     def colliding_pairs(self, q: object, *, margin: float = 0.0) -> tuple[tuple[str, str], ...]:
         """The checked pairs that collide (or are closer than ``margin``) at ``q``."""
-        hits = self._scan(self._as_batch(q)[:1], margin=margin)[0]
+        hits = self._scan(self._one(q, "collisions_batch"), margin=margin)[0]
         return tuple(self._pairs[i] for i in np.flatnonzero(hits))
 
     def buffer_violations(self, q: object) -> tuple[tuple[str, str], ...]:
@@ -571,7 +594,7 @@ class SelfCollisionChecker:
         """Minimum distance and closest points of every checked pair at ``q``."""
         nan: Point = (math.nan, math.nan, math.nan)
         out: list[PairDistance] = []
-        for best, near in self._distance_rows(self._as_batch(q)[:1], with_points=True):
+        for best, near in self._distance_rows(self._one(q, "distances_batch"), with_points=True):
             for (a, b), d, x in zip(self._pairs, best, near, strict=True):
                 p1, p2 = (cast(Point, tuple(x[0])), cast(Point, tuple(x[1]))) if x else (nan, nan)
                 out.append(PairDistance(a, b, d, p1, p2))
@@ -595,6 +618,10 @@ class SelfCollisionChecker:
                 f"pair '{a}' - '{b}' is not checked{why}", kind="pair", name=f"{a} {b}"
             )
         return self._pair_index[key]
+
+
+def _config_error(message: str) -> CollisionError:
+    return CollisionError(message, kind="config")
 
 
 def _mesh_trees(geoms: Sequence[CollisionGeometry], g1: list[int], g2: list[int]) -> object | None:

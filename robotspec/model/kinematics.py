@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robotspec.arrays import F64
+from robotspec.arrays import F64, finite_array, real_array
 from robotspec.errors import KinematicsError
 from robotspec.model import kincore
 from robotspec.model.world import Body, Connection, ConnectionType, World
@@ -103,7 +103,9 @@ class Kinematics:
     def forward(self, q: object) -> F64:
         """``root_T_body`` for every body (B, 4, 4) at configuration ``q`` (D,)."""
         try:
-            poses: F64 = kincore.core().fk(self._tree, q)
+            poses: F64 = kincore.core().fk(
+                self._tree, _numbers(q, self._nd, self.world.name, False)
+            )
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self.world.name, False) from None
         return poses
@@ -118,23 +120,42 @@ class Kinematics:
         otherwise). ``out``, an (N, B, 4, 4) float64 C-contiguous array, receives the poses in
         place and is returned: a caller that runs batch after batch then writes into memory that
         is already mapped (a fresh 100 MB result costs a third of the time in page faults).
+        An ``out`` that shares memory with ``q`` is refused: the poses would overwrite
+        configurations not yet read.
         """
-        try:
-            arr = np.asarray(q, dtype=np.float64)
-        except (ValueError, TypeError):
-            raise _bad_configuration(q, self._nd, self.world.name, True) from None
+        arr = real_array(q, f"configuration of {_want(self._nd, self.world.name, True)}", _error)
         n = arr.shape[0] if arr.ndim == 2 else 0
         if threads is None:
             threads = default_threads() if n >= PARALLEL_BATCH else 1
-        if not 1 <= threads <= 64:
-            raise KinematicsError(f"threads must be between 1 and 64, got {threads}")
+        if (
+            isinstance(threads, bool | np.bool_)
+            or not isinstance(threads, int | np.integer)
+            or not 1 <= threads <= 64
+        ):
+            raise KinematicsError(f"threads must be an integer between 1 and 64, got {threads!r}")
+        threads = int(threads)
         if out is not None:
             _check_out(out, (n, len(self.world.bodies), 4, 4))
+            if _overlap(out, arr):
+                # The core writes each sample's poses while later samples are still to be read.
+                raise KinematicsError(
+                    "out must not share memory with the configurations q: writing the poses "
+                    "would overwrite configurations not yet read; pass a separate array"
+                )
         try:
             poses: F64 = kincore.fk_batch(self._tree, arr, threads, out)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self.world.name, True) from None
         return poses
+
+    def configuration_array(self, q: object, *, batch: bool = False, hint: str = "") -> F64:
+        """``q`` as a checked float64 configuration (D,) or, with ``batch``, batch (N, D).
+
+        For callers that read ``q`` before the core does (the collision checker): a wrong type,
+        shape or value is a KinematicsError that says which. ``hint`` ends the message when a
+        batch is given where one configuration is expected (the method that takes the batch).
+        """
+        return _checked_configuration(q, self._nd, self.world.name, batch, hint)
 
     def pose(self, q: object, body: str, relative_to: str | None = None) -> F64:
         """The pose of ``body`` in the frame of ``relative_to`` (default: the world root).
@@ -161,17 +182,50 @@ class Kinematics:
         return chain
 
 
-def _bad_configuration(q: object, nd: int, world: str, batch: bool) -> KinematicsError:
-    """The error for a configuration the C core refused: what is wrong with it, in words."""
+def _error(message: str) -> KinematicsError:
+    return KinematicsError(message)
+
+
+def _want(nd: int, world: str, batch: bool) -> str:
     shape = "(N, D)" if batch else "(D,)"
-    want = f"shape {shape} with D = {nd} degrees of freedom of world '{world}'"
-    try:
-        arr = np.asarray(q, dtype=np.float64)
-    except (ValueError, TypeError) as exc:
-        return KinematicsError(f"configuration must be numbers of {want}: {exc}")
+    return f"shape {shape} with D = {nd} degrees of freedom of world '{world}'"
+
+
+def _numbers(q: object, nd: int, world: str, batch: bool) -> object:
+    """``q`` for the core: a float64 array as it is, anything else only if float64 holds it.
+
+    The core checks the shape and values; anything but a float64 array is converted here, and
+    refused by its dtype when float64 would change it (complex, longdouble, strings, objects).
+    Why here: the numpy fallback reads a list as float64 whatever it holds (strings included),
+    so the dtype is checked once for both cores; it costs nothing on a float64 array.
+    """
+    if isinstance(q, np.ndarray) and q.dtype == np.float64:
+        return q
+    return real_array(q, f"configuration of {_want(nd, world, batch)}", _error)
+
+
+def _checked_configuration(q: object, nd: int, world: str, batch: bool, hint: str = "") -> F64:
+    """``q`` as float64 of the right shape, finite; else the KinematicsError that says why."""
+    want = _want(nd, world, batch)
+    arr = real_array(q, f"configuration of {want}", _error)
     if arr.ndim != (2 if batch else 1) or arr.shape[-1] != nd:
-        return KinematicsError(f"configuration must have {want}, got {arr.shape}")
-    return KinematicsError("configuration contains NaN or infinite values")
+        more = f"; for a batch of configurations use {hint}" if hint and arr.ndim == 2 else ""
+        raise KinematicsError(f"configuration must have {want}, got {arr.shape}{more}")
+    return finite_array(arr, "configuration", _error)
+
+
+def _bad_configuration(q: object, nd: int, world: str, batch: bool) -> KinematicsError:
+    """The error for a configuration the core refused: what is wrong with it, in words."""
+    try:
+        _checked_configuration(q, nd, world, batch)
+    except KinematicsError as exc:
+        return exc
+    return KinematicsError(f"configuration of {_want(nd, world, batch)} refused by the core")
+
+
+def _overlap(a: F64, b: F64) -> bool:
+    """Whether two arrays share memory (bounds first, then numpy's exact test: a few strides)."""
+    return bool(np.may_share_memory(a, b) and np.shares_memory(a, b))
 
 
 def _tree_program(world: World) -> object:
@@ -287,7 +341,9 @@ class ChainKinematics:
     def fk(self, q: object) -> F64:
         """``root_T_tip`` (4, 4) for the world configuration ``q`` (D,)."""
         try:
-            pose: F64 = kincore.core().chain_fk(self._program, q)
+            pose: F64 = kincore.core().chain_fk(
+                self._program, _numbers(q, self._nd, self._world_name, False)
+            )
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self._world_name, False) from None
         return pose
@@ -295,7 +351,9 @@ class ChainKinematics:
     def fk_batch(self, q: object) -> F64:
         """``root_T_tip`` (N, 4, 4) for each configuration of ``q`` (N, D), in one C loop."""
         try:
-            poses: F64 = kincore.core().chain_fk_batch(self._program, q)
+            poses: F64 = kincore.core().chain_fk_batch(
+                self._program, _numbers(q, self._nd, self._world_name, True)
+            )
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self._world_name, True) from None
         return poses
@@ -307,7 +365,9 @@ class ChainKinematics:
         leader's column.
         """
         try:
-            jac: F64 = kincore.core().chain_jacobian(self._program, q)
+            jac: F64 = kincore.core().chain_jacobian(
+                self._program, _numbers(q, self._nd, self._world_name, False)
+            )
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self._world_name, False) from None
         return jac

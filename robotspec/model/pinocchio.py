@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from robotspec.arrays import F64
+from robotspec.arrays import F64, finite_array, real_array
 from robotspec.errors import KinematicsError, RobotSpecError
 from robotspec.model.entities import Connection, ConnectionType
 from robotspec.model.world import World
@@ -74,11 +74,12 @@ class PinocchioRobot:
 
     def configuration(self, q: object) -> F64:
         """The pinocchio configuration of a robotspec configuration ``q`` (same length)."""
-        arr = np.asarray(q, dtype=np.float64)
+        arr = real_array(q, "configuration", KinematicsError)  # complex refused, not truncated
         if arr.shape != (len(self.q_index),):
             raise KinematicsError(
                 f"configuration must have shape ({len(self.q_index)},), got {arr.shape}"
             )
+        finite_array(arr, "configuration", KinematicsError)
         if self.q_index == tuple(range(len(self.q_index))):
             return arr
         return arr[list(self.q_index)]

@@ -2,13 +2,23 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from robotspec.cli.options import OutputFile, PackagePath, SpecArg, write_file, write_output
+from robotspec.cli.options import (
+    Force,
+    OutputFile,
+    PackagePath,
+    SpecArg,
+    refuse_existing,
+    refuse_link,
+    write_file,
+    write_output,
+)
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
@@ -25,6 +35,7 @@ def robotinfo(
         str, typer.Option("--chain", "-c", help="The chain to export (see `inspect chains`).")
     ],
     output: OutputFile = None,
+    force: Force = False,
     package_path: PackagePath = None,
 ) -> None:
     """A Robot Raconteur RobotInfo YAML of one chain: H/P kinematics, limits, flange pose.
@@ -35,6 +46,8 @@ def robotinfo(
     from robotspec.driver.export import dump_robot_info_yaml
     from robotspec.export.robotinfo import export_spec_chain
 
+    if output is not None and not force:
+        refuse_existing(output)  # before the work, as the write refuses it again
     ex = export_spec_chain(spec, chain, package_path)
     header = (
         f"RobotInfo of chain '{chain}' of {spec}, exported by robotspec.\n"
@@ -43,7 +56,7 @@ def robotinfo(
     text = dump_robot_info_yaml(ex.info, header=header)
     for note in ex.notes:
         sys.stderr.write(f"note: {note}\n")
-    if not write_output(text, output):
+    if not write_output(text, output, force=force):
         return
     sys.stderr.write(
         f"wrote {output} ({len(ex.info.joint_info)} joints, chain "
@@ -55,6 +68,7 @@ def robotinfo(
 def srdf(
     spec: SpecArg,
     output: OutputFile = None,
+    force: Force = False,
     package_path: PackagePath = None,
 ) -> None:
     """A MoveIt SRDF of the compiled robot: a group per chain, end effectors, group states.
@@ -65,9 +79,11 @@ def srdf(
     from robotspec.compiler import compile_robot
     from robotspec.export.srdf import srdf_from_robot, write_srdf
 
+    if output is not None and not force:
+        refuse_existing(output)
     robot = compile_robot(spec, package_paths=package_path or ())
     exported = srdf_from_robot(robot)
-    if not write_output(write_srdf(exported), output):
+    if not write_output(write_srdf(exported), output, force=force):
         return
     sys.stderr.write(
         f"wrote {output}: {len(exported.groups)} groups, {len(exported.end_effectors)} end "
@@ -80,6 +96,7 @@ def srdf(
 def urdf(
     spec: SpecArg,
     output: OutputFile = None,
+    force: Force = False,
     package_path: PackagePath = None,
 ) -> None:
     """One URDF of the robot: a composed robot's parts joined, welds as fixed joints.
@@ -91,14 +108,38 @@ def urdf(
     from robotspec.export.urdf import joined_urdf, urdf_text
     from robotspec.spec.load import load_spec
 
+    if output is not None and not force:
+        refuse_existing(output)
     loaded = load_spec(resolve_spec(spec))
     tree = joined_urdf(loaded, package_paths=package_path or ())
     text = urdf_text(tree, comment=f"{loaded.spec.name}: exported by robotspec from {spec}")
-    if not write_output(text, output):
+    if not write_output(text, output, force=force):
         return
     links = sum(1 for _ in tree.iterfind("link"))
     joints = sum(1 for _ in tree.iterfind("joint"))
     sys.stderr.write(f"wrote {output}: {links} links, {joints} joints\n")
+
+
+def _plain_name(value: str | None) -> str | None:
+    """``--name`` must be a file stem: no folder, no ``..``, nothing a file name cannot hold.
+
+    Why: the stem is joined to ``--output``; ``--name ../../x`` wrote outside it.
+    """
+    if value is None:
+        return None
+    seps = {"/", "\\", os.sep, *([os.altsep] if os.altsep else [])}
+    bad = (
+        not value.strip()
+        or ".." in value
+        or value == "."
+        or any(sep in value for sep in seps)
+        or any(ord(ch) < 0x20 or ord(ch) == 0x7F for ch in value)
+    )
+    if bad:
+        raise typer.BadParameter(
+            f"{value!r} is not a plain file name (no folders, no '..', no control characters)"
+        )
+    return value
 
 
 @export_app.command("bundle")
@@ -108,21 +149,33 @@ def bundle_cmd(
         Path, typer.Option("--output", "-o", help="Folder to write NAME.urdf/.srdf/.yaml into.")
     ],
     name: Annotated[
-        str | None, typer.Option("--name", help="File stem (default: the spec's file stem).")
+        str | None,
+        typer.Option(
+            "--name",
+            help="File stem (default: the spec's file stem); a plain name, no folders.",
+            callback=_plain_name,
+        ),
     ] = None,
+    force: Force = False,
     package_path: PackagePath = None,
 ) -> None:
     """URDF + SRDF + a flat spec naming them: the same robot without the source files.
 
     `robotspec validate FOLDER/NAME.yaml` then compiles to the same robot (a composed one too).
+    Existing files are kept unless --force; a symbolic link is never written through.
     """
     from robotspec.compiler import check_spec, resolve_spec
     from robotspec.export.urdf import bundle
 
     path = resolve_spec(spec)
-    result = check_spec(path, package_paths=package_path or ())
     stem = name or path.stem
+    targets = [output / f"{stem}{suffix}" for suffix in (".urdf", ".srdf", ".yaml")]
+    for target in targets:  # all three before any is written: no half-written bundle
+        refuse_link(target)
+        if not force:
+            refuse_existing(target)
+    result = check_spec(path, package_paths=package_path or ())
     out = bundle(result, name=stem, package_paths=package_path or ())
-    for suffix, text in ((".urdf", out.urdf), (".srdf", out.srdf), (".yaml", out.spec)):
-        write_file(output / f"{stem}{suffix}", text)
+    for target, text in zip(targets, (out.urdf, out.srdf, out.spec), strict=True):
+        write_file(target, text, force=force)
     sys.stderr.write(f"wrote {output}/{stem}.urdf, .srdf and .yaml\n")

@@ -57,27 +57,90 @@ OutputFile = Annotated[
 ]
 
 
-def write_output(text: str, output: Path | None) -> bool:
-    """Write ``text`` to ``output``, or to stdout when it is None; True if a file was written."""
+def write_output(text: str, output: Path | None, *, force: bool = True) -> bool:
+    """Write ``text`` to ``output``, or to stdout when it is None; True if a file was written.
+
+    ``force=False``: an existing ``output`` is an error (the command's ``--force`` lifts it).
+    """
     if output is None:
         sys.stdout.write(text)
         return False
-    write_file(output, text)
+    write_file(output, text, force=force)
     return True
 
 
-def write_file(path: Path, text: str) -> None:
-    """Write a file the user named; a folder that is missing or read-only is their error."""
+Force = Annotated[bool, typer.Option("--force", help="Overwrite existing files.")]
+
+
+def refuse_existing(path: Path) -> None:
+    """An error if ``path`` exists (a link too, even a dangling one): nothing is overwritten."""
     from robotspec.errors import RobotSpecError
 
+    if path.is_symlink() or path.exists():
+        raise RobotSpecError(
+            "the file exists; pass --force to overwrite it", file=str(path), kind="output"
+        )
+
+
+def refuse_link(path: Path, *, raced: bool = False) -> None:
+    """An error if ``path`` is a symbolic link (``raced``: the open met one, made since)."""
+    from robotspec.errors import RobotSpecError
+
+    if raced or path.is_symlink():
+        raise RobotSpecError(
+            "is a symbolic link; robotspec does not write through links (remove it or name "
+            "another file)",
+            file=str(path),
+            kind="output",
+        )
+
+
+def write_file(path: Path, text: str, *, force: bool = True) -> None:
+    """Write a file the user named; a folder that is missing or read-only is their error.
+
+    Never through a symbolic link: a link planted in an output folder (``robot.urdf`` pointing
+    at ``~/.bashrc``) would otherwise have its target overwritten, so the last part of the path
+    is opened with ``O_NOFOLLOW`` and a link is refused. Nor into anything but a regular file (a
+    FIFO would block). Without ``force`` an existing file is refused (``O_EXCL``), atomically.
+    """
+    import errno
+    import stat
+
+    from robotspec.errors import RobotSpecError
+
+    shown = str(path)
+    refuse_link(path)  # also where the system has no O_NOFOLLOW
+    flags = os.O_WRONLY | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+    flags |= os.O_TRUNC if force else os.O_EXCL
     try:
         if path.parent != Path(""):
             path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
+        fd = os.open(path, flags, 0o666)
+    except OSError as exc:
+        if exc.errno == errno.EEXIST:
+            refuse_existing(path)
+        if exc.errno == errno.ELOOP:
+            refuse_link(path, raced=True)
+        raise RobotSpecError(
+            f"cannot write file: {exc.strerror or exc}", file=shown, kind="file"
+        ) from None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise RobotSpecError(
+                "is not a regular file (a device, FIFO or socket); robotspec writes only files",
+                file=shown,
+                kind="output",
+            )
+        data = text.encode("utf-8")
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view) :]
     except OSError as exc:
         raise RobotSpecError(
-            f"cannot write file: {exc.strerror or exc}", file=str(path), kind="file"
+            f"cannot write file: {exc.strerror or exc}", file=shown, kind="file"
         ) from None
+    finally:
+        os.close(fd)
 
 
 JsonFlag = Annotated[bool, typer.Option("--json", help="Print JSON instead of a table.")]

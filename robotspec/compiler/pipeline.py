@@ -17,12 +17,13 @@ from typing import Any
 from robotspec.compiler.arm_sides import check_arm_sides
 from robotspec.compiler.build import Build, build_robot
 from robotspec.description.srdf import Srdf
-from robotspec.diagnostics import Diagnostics
+from robotspec.diagnostics import Diagnostics, Loc
 from robotspec.errors import RobotSpecError
 from robotspec.model.world import ConnectionType, World
 from robotspec.semantic import AbstractRobot
 from robotspec.shipped import package_data
 from robotspec.spec.load import LoadedSpec
+from robotspec.spec.models import RobotSpec
 
 __all__ = ["CompileResult", "compile_loaded", "load_camera_presets"]
 
@@ -87,6 +88,8 @@ def _prepare_world(
         frames.append((name, f.parent, f.pose()))
     if frames:
         world = world.add_frames(frames)
+    if add_drive and spec.drive is not None and spec.drive.joints is not None:
+        return _urdf_drive(spec, world, diag)
     if not add_drive or world.parent_connection(world.root) is not None:
         return world
     drive = spec.drive
@@ -106,13 +109,70 @@ def _prepare_world(
         kind = ConnectionType.FLOATING if drive.type == "floating" else ConnectionType.PLANAR
         parent = drive.parent_frame
         joint = drive.joint or f"{parent}_T_{world.root.name}"
-        return world.with_base_connection(joint, parent, kind)
+        try:
+            return world.with_base_connection(joint, parent, kind)
+        except RobotSpecError as exc:
+            at = "parent_frame" if exc.detail.kind == "link" else "joint"
+            hint = (
+                "; if the URDF models the base's motion itself, name its x, y and theta joints "
+                "in drive.joints"
+                if at == "parent_frame"
+                else ""
+            )
+            diag.error(("drive", at), exc.message + hint, name=exc.detail.name)
+            return world
     if vj is not None:
         kind = {"planar": ConnectionType.PLANAR, "floating": ConnectionType.FLOATING}.get(
             vj.type, ConnectionType.FIXED
         )
-        return world.with_base_connection(vj.name, vj.parent_frame, kind)
+        try:
+            return world.with_base_connection(vj.name, vj.parent_frame, kind)
+        except RobotSpecError as exc:
+            srdf_file = getattr(srdf, "file", None)
+            diag.add(
+                exc.located(file=srdf_file, line=getattr(vj, "line", None)), ("description", "srdf")
+            )
+            return world
     return world
+
+
+def _urdf_drive(spec: RobotSpec, world: World, diag: Diagnostics) -> World:
+    """The drive made of the URDF's own x, y and theta joints (``drive.joints``)."""
+    from robotspec.model.planar_drive import collapse_planar_joints
+
+    drive = spec.drive
+    assert drive is not None and drive.joints is not None
+    loc: Loc = ("drive", "joints")
+    if drive.type not in ("omni", "differential"):
+        diag.error(
+            ("drive", "type"),
+            f"a drive of URDF joints is planar: omni or differential, not {drive.type}",
+        )
+        return world
+    missing = [(i, n) for i, n in enumerate(drive.joints) if not world.has_connection(n)]
+    for i, name in missing:
+        diag.not_found((*loc, i), "joint", name, world.connection_names, _file_name(world))
+    if missing:
+        return world
+    theta = world.get_connection_by_name(drive.joints[2])
+    child = world.bodies[theta.child].name
+    if spec.root_link != child:
+        diag.error(
+            ("root",),
+            f"the drive's theta joint '{theta.name}' moves '{child}': that is the robot's "
+            f"root, not '{spec.root_link}'",
+            name=spec.root_link,
+        )
+        return world
+    try:
+        return collapse_planar_joints(world, drive.joints, drive.joint)
+    except RobotSpecError as exc:
+        diag.add(exc, loc)
+        return world
+
+
+def _file_name(world: World) -> str:
+    return (world.source or world.name).rsplit("/", 1)[-1]
 
 
 def _check_srdf(

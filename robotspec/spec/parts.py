@@ -46,6 +46,13 @@ class DriveSpec(SpecModel):
     parent_frame: Name = Field(
         default="odom", description="the frame the base moves in", examples=["odom_combined"]
     )
+    joints: tuple[Name, Name, Name] | None = Field(
+        default=None,
+        description="the URDF's own base joints, x, y and theta (prismatic along x, along y, "
+        "revolute about z), made one planar drive connection named `joint`; the robot's root "
+        "is the theta joint's child",
+        examples=[["odom_x", "odom_y", "odom_theta"]],
+    )
 
 
 class FingerSpec(SpecModel):

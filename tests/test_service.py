@@ -159,9 +159,13 @@ def test_trajectory_runs_to_completion_through_next(served: Served) -> None:
     traj = served.trajectory(delta, 0.6)
     adv = r.advanced_robot_state.Connect()
     seen_running: list[bool] = []
-    adv.WireValueChanged += lambda _w, value, _ts: seen_running.append(
-        bool(value.robot_state_flags & int(StateFlags.trajectory_running))
-    )
+    max_times: list[float] = []
+
+    def on_state(_w: Any, value: Any, _ts: Any) -> None:
+        seen_running.append(bool(value.robot_state_flags & int(StateFlags.trajectory_running)))
+        max_times.append(float(value.trajectory_max_time))
+
+    adv.WireValueChanged += on_state
     try:
         gen = r.execute_trajectory(traj)
         statuses = []
@@ -169,7 +173,10 @@ def test_trajectory_runs_to_completion_through_next(served: Served) -> None:
             for _ in range(10):
                 statuses.append(gen.Next())
         assert statuses[-1].action_status == 3  # complete
-        assert statuses[-1].trajectory_time == pytest.approx(0.6, abs=1e-6)
+        # The curve through these smoothstep samples asks 1.6 x the slide's acceleration limit
+        # near its ends: the driver slows it (issue 24), and the client sees the time it runs.
+        assert statuses[-1].trajectory_time == pytest.approx(max(max_times), abs=1e-6)
+        assert 0.6 < max(max_times) < 0.7
         assert statuses[-1].current_waypoint == len(traj.waypoints) - 1
         assert any(seen_running)
     finally:

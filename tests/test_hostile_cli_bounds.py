@@ -8,6 +8,7 @@ sample at once (a MemoryError). Each is now a usage error naming the value, or b
 from __future__ import annotations
 
 import tracemalloc
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -135,3 +136,15 @@ def test_memory_does_not_grow_with_the_sample_count(arm: AbstractRobot) -> None:
         tracemalloc.stop()
     assert matrix.samples == 500_000
     assert peak < 4 * 1024 * 1024, peak
+
+
+def test_a_trillion_samples_is_a_usage_error_under_a_memory_fence(tmp_path: Path) -> None:
+    # Before: every sample drawn at once, a MemoryError (an internal error, exit 3).
+    from tests.test_hostile import run_cli
+
+    (tmp_path / "work").mkdir()
+    r = run_cli(tmp_path, "collisions", "generate", str(ARM), "-n", str(10**12), "--seed", "-1")
+    assert r.code == 2, r.err
+    assert "Invalid value for '--samples' / '-n': 1000000000000 is not between" in " ".join(
+        r.err.replace("\u2502", " ").split()
+    )

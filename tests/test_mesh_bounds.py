@@ -188,3 +188,23 @@ def test_sane_mesh_scales_are_kept(
     _binary_stl(tmp_path / "m.stl", 2)
     spec = _robot(tmp_path, "m.stl", scale)
     assert run_app(app, ["validate", str(spec)]) == 0, capsys.readouterr()
+
+
+def test_five_million_declared_triangles_are_refused_under_a_memory_fence(tmp_path: Path) -> None:
+    # The reported crash: a binary STL of 5 * 10^6 triangles was a MemoryError (parsing costs
+    # about 500 bytes per triangle). A sparse file of that size, run under the hostile runner's
+    # address-space limit, is refused from its header with the file named.
+    from tests.test_hostile import run_cli
+
+    (tmp_path / "work").mkdir()
+    n = 5_000_000
+    with (tmp_path / "m.stl").open("wb") as f:
+        f.write(b"\0" * 80 + struct.pack("<I", n))
+        f.truncate(84 + 50 * n)
+    spec = _robot(tmp_path, "m.stl")
+    r = run_cli(tmp_path, "collisions", "check", str(spec))
+    assert r.code == 1, r.err
+    assert r.err.startswith(
+        f"{tmp_path / 'm.stl'}: error: link 'a': mesh declares 5,000,000 triangles, more than "
+        "1,000,000 (the cap on one mesh; set ROBOTSPEC_MAX_MESH_TRIANGLES to raise it)"
+    )

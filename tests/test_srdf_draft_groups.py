@@ -161,3 +161,18 @@ def test_virtual_joint_in_a_group_is_not_a_problem(tmp_path: Path) -> None:
     sets = GroupJoints.of(desc.world, desc.srdf)
     assert sets.joints == {"all": frozenset({"j1"})}
     assert sets.problems == {}
+
+
+def test_deep_nesting_under_the_hostile_runner(tmp_path: Path) -> None:
+    # The same 1,500-deep file in a subprocess under the memory and CPU fences (the reported
+    # RecursionError was an internal error, exit 3).
+    from tests.test_hostile import run_cli
+
+    (tmp_path / "work").mkdir()
+    _urdf(tmp_path)
+    groups = [f'<group name="g{i}"><group name="g{i + 1}"/></group>\n' for i in range(1_499)]
+    groups.append('<group name="g1499"><chain base_link="base" tip_link="l3"/></group>\n')
+    srdf = _srdf(tmp_path, groups)
+    r = run_cli(tmp_path, "init", str(tmp_path / "r.urdf"), "--srdf", str(srdf))
+    assert r.code == 0, r.err
+    assert "  g0:  # from the SRDF group 'g0'" in r.out

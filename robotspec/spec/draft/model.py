@@ -84,6 +84,10 @@ class DraftCamera:
     body: str
     optical: bool
     decide: list[str] = field(default_factory=list)
+    #: A camera model of ``templates/cameras.yaml``; when set, no angles are written.
+    preset: str | None = None
+    #: Chosen angles (horizontal, vertical, rad); None writes the placeholder, marked DECIDE.
+    field_of_view: tuple[float, float] | None = None
 
 
 @dataclass

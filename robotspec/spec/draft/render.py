@@ -154,7 +154,7 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
             xyz = ", ".join(_num(v) for v in f.xyz)
             out.append(
                 f"    {scalar(f.name)}: {{parent: {scalar(f.parent)}, xyz: [{xyz}]}}"
-                f"  # DECIDE: {comment(f.reason)}"
+                + (f"  # DECIDE: {comment(f.reason)}" if f.reason else "")
             )
     out.append(f"root: {scalar(d.root)}")
     if d.drive is not None:
@@ -193,10 +193,16 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
             else:
                 out.append(f"    body: {scalar(cam.body)}")
                 out.append("    forward_facing_axis: [1, 0, 0]  # a body frame: looks along +x")
-            out.append(
-                f"    field_of_view: {{horizontal: {h}, vertical: {v}}}"
-                f"  # DECIDE: the camera's angles{offer}"
-            )
+            if cam.preset is not None:
+                out.append(f"    preset: {scalar(cam.preset)}")
+            elif cam.field_of_view is not None:
+                fh, fv = (_num(a) for a in cam.field_of_view)
+                out.append(f"    field_of_view: {{horizontal: {fh}, vertical: {fv}}}")
+            else:
+                out.append(
+                    f"    field_of_view: {{horizontal: {h}, vertical: {v}}}"
+                    f"  # DECIDE: the camera's angles{offer}"
+                )
     if d.states:
         out.append("states:")
         for name, values in d.states.items():

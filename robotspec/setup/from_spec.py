@@ -1,0 +1,224 @@
+"""A spec read back into a draft, so the assistant edits a spec a person (or ``init``) wrote.
+
+Why marks by position: a DECIDE mark is a comment, which the spec's data does not hold, but its
+loader knows the line of every node; a mark on the line of a part is that part's open question.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from robotspec.errors import RobotSpecError, RobotSpecErrors, SpecError
+from robotspec.model.world import World
+from robotspec.spec.draft.model import (
+    Draft,
+    DraftCamera,
+    DraftChain,
+    DraftDrive,
+    DraftFinger,
+    DraftFrame,
+    DraftManipulator,
+)
+from robotspec.spec.draft.render import PLACEHOLDER_FOV
+from robotspec.spec.load import LoadedSpec
+
+__all__ = ["draft_of_spec"]
+
+_MARK = "# DECIDE:"
+_FROM = "# from "
+
+
+class _Marks:
+    """The DECIDE mark and the ``# from`` note on the line of a spec node."""
+
+    def __init__(self, loaded: LoadedSpec) -> None:
+        self.loaded = loaded
+        self.lines = loaded.file.read_text(encoding="utf-8").splitlines()
+
+    def _line(self, loc: tuple[str | int, ...]) -> str:
+        doc = self.loaded.documents[0]
+        line = doc.key_marks.get(loc, doc.marks.get(loc, (None, None)))[0]
+        return self.lines[line - 1] if line is not None and 0 < line <= len(self.lines) else ""
+
+    def decide(self, loc: tuple[str | int, ...]) -> list[str]:
+        text = self._line(loc)
+        at = text.find(_MARK)
+        return [text[at + len(_MARK) :].strip()] if at >= 0 else []
+
+    def notes(self) -> list[str]:
+        """The ``# Note:`` lines of the header (a draft's notes)."""
+        out: list[str] = []
+        for text in self.lines:
+            if not text.startswith("#"):
+                break
+            if text.startswith("# Note: "):
+                out.append(text.removeprefix("# Note: ").removesuffix("."))
+        return out
+
+    def ends(self, loc: tuple[str | int, ...]) -> tuple[str, str]:
+        """The ``# root -> tip`` comment a draft writes after a ``group:``."""
+        text = self._line(loc)
+        at = text.find("#")
+        root, sep, tip = text[at + 1 :].partition(" -> ") if at >= 0 else ("", "", "")
+        return (root.strip(), tip.strip()) if sep else ("", "")
+
+    def source(self, loc: tuple[str | int, ...]) -> str:
+        text = self._line(loc)
+        at = text.find(_FROM)
+        if at < 0:
+            return "the spec"
+        rest = text[at + len(_FROM) :]
+        return rest.split("  # DECIDE:")[0].strip()
+
+
+def _refuse(loaded: LoadedSpec, loc: tuple[str | int, ...], what: str) -> SpecError:
+    file, line, col = loaded.position(loc)
+    return SpecError(
+        f"robotspec setup cannot edit {what} yet; edit this spec in a text editor",
+        file=file,
+        line=line,
+        column=col,
+        kind="spec",
+        location=loc,
+    )
+
+
+def _rebase(ref: str, loaded: LoadedSpec, folder: Path | None) -> str:
+    """A file reference of the spec as the saved spec in ``folder`` must write it."""
+    from robotspec.spec.draft.paths import relative_path
+
+    if folder is None or "://" in ref or Path(ref).is_absolute():
+        return ref
+    return relative_path(loaded.folder / ref, folder)
+
+
+def draft_of_spec(
+    ref: str, *, package_paths: Sequence[str | Path] = (), folder: Path | None = None
+) -> tuple[Draft, World, dict[str, Any]]:
+    """The draft a spec amounts to, the robot's tree, and the top-level keys kept as read."""
+    from robotspec.compiler import resolve_spec
+    from robotspec.description.load import load_description
+    from robotspec.setup.source import KEPT_KEYS
+    from robotspec.spec.load import load_spec
+
+    loaded = load_spec(resolve_spec(ref))
+    spec = loaded.spec
+    refused: list[RobotSpecError] = []
+    for key in ("parts", "extends"):
+        if getattr(spec, key):
+            refused.append(_refuse(loaded, (key,), f"'{key}:' (a composed robot)"))
+    if spec.description is not None and spec.description.xacro_args:
+        refused.append(_refuse(loaded, ("description", "xacro_args"), "xacro_args"))
+    for name, f in spec.files.frames.items() if spec.description is not None else ():
+        if f.rpy is not None or f.quaternion is not None:
+            refused.append(_refuse(loaded, ("description", "frames", name), "a rotated frame"))
+    for name, s in spec.sensors.items():
+        if s.type != "camera":
+            refused.append(_refuse(loaded, ("sensors", name), "a generic sensor"))
+        elif s.forward_facing_axis not in (None, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)):
+            refused.append(_refuse(loaded, ("sensors", name), "a camera facing that axis"))
+        elif s.minimal_height is not None or s.maximal_height is not None or s.default:
+            refused.append(_refuse(loaded, ("sensors", name), "camera heights or default"))
+    if refused:
+        raise refused[0] if len(refused) == 1 else RobotSpecErrors(refused)
+    marks = _Marks(loaded)
+    files = spec.files
+    paths = [*(_rebase(p, loaded, None) for p in files.package_paths), *map(str, package_paths)]
+    absolute = [p if Path(p).is_absolute() else str(loaded.folder / p) for p in paths]
+    desc = load_description(
+        files.urdf, package_paths=absolute, meshes="keep", base_folder=loaded.folder
+    )
+    world = desc.world
+    draft = Draft(
+        name=spec.name,
+        urdf=_rebase(files.urdf, loaded, folder),
+        srdf=None if files.srdf is None else _rebase(files.srdf, loaded, folder),
+        root=spec.root_link,
+        drive=None,
+        chains=[],
+        manipulators=[],
+        cameras=[],
+        package_paths=[_rebase(p, loaded, folder) for p in files.package_paths],
+        states={k: dict(v) for k, v in spec.states.items()},
+        notes=marks.notes(),
+    )
+    if spec.drive is not None:
+        d = spec.drive
+        draft.drive = DraftDrive(
+            type=d.type,
+            joint=d.joint,
+            parent_frame=d.parent_frame if d.type != "fixed" else None,
+            source=marks.source(("drive",)),
+            decide=next(iter(marks.decide(("drive",))), None),
+        )
+    for name, f in files.frames.items():
+        loc: tuple[str | int, ...] = ("description", "frames", name)
+        draft.frames.append(DraftFrame(name, f.parent, f.xyz, (marks.decide(loc) or [""])[0]))
+    for key in ("torso", "neck"):
+        part = getattr(spec, key)
+        if part is None:
+            continue
+        c = DraftChain(
+            name=key,
+            root=part.root,
+            tip=part.tip,
+            source=marks.source((key,)),
+            role=key,
+            decide=marks.decide((key,)),
+            states={k: dict(v) for k, v in part.states.items()},
+        )
+        if key == "neck":
+            c.yaw_body, c.pitch_body, c.sensors = part.yaw_body, part.pitch_body, [*part.sensors]
+        setattr(draft, key, c)
+    for name, ch in spec.chains.items():
+        ends = marks.ends(("chains", name, "group")) if ch.group else ("", "")
+        draft.chains.append(
+            DraftChain(
+                name=name,
+                root=ch.root or ends[0],
+                tip=ch.tip or ends[1],
+                source=marks.source(("chains", name)),
+                role=ch.kind if ch.kind != "chain" else "chain",
+                group=ch.group,
+                decide=marks.decide(("chains", name)),
+                manipulator=ch.manipulator,
+                sensors=[*ch.sensors],
+                states={k: dict(v) for k, v in ch.states.items()},
+                side=ch.side,
+            )
+        )
+    for name, m in spec.manipulators.items():
+        dm = DraftManipulator(
+            name=name,
+            root=m.root,
+            tool_frame=m.tool_frame,
+            source=marks.source(("manipulators", name)),
+            decide=marks.decide(("manipulators", name)),
+            states={k: dict(v) for k, v in m.states.items()},
+            front_facing=m.front_facing_orientation,
+        )
+        if m.type == "parallel_gripper":
+            dm.finger = DraftFinger(m.finger.root, m.finger.tip)
+            dm.thumb = DraftFinger(m.thumb.root, m.thumb.tip)
+        draft.manipulators.append(dm)
+    for name, s in spec.sensors.items():
+        if s.type != "camera":  # pragma: no cover - refused above
+            continue
+        fov = s.field_of_view
+        angles = None if fov is None else (fov.horizontal, fov.vertical)
+        placeholder = angles == PLACEHOLDER_FOV and marks.decide(("sensors", name, "field_of_view"))
+        draft.cameras.append(
+            DraftCamera(
+                name=name,
+                body=s.body,
+                optical=s.forward_facing_axis != (1.0, 0.0, 0.0),
+                decide=marks.decide(("sensors", name)),
+                preset=s.preset,
+                field_of_view=None if placeholder else angles,
+            )
+        )
+    raw = loaded.documents[0].data
+    kept = {k: raw[k] for k in KEPT_KEYS if isinstance(raw, dict) and k in raw}
+    return draft, world, kept

@@ -1,0 +1,548 @@
+"""The assistant's editable state: one draft, one lock, a validation after every change.
+
+Why one object shared by every browser tab: two tabs on one server must see one state, and a
+change from one must never interleave with another's; each mutation works on a copy under the
+lock, validates the text it would save, and only then becomes the state (so a change that fails
+halfway leaves nothing behind). Listeners hear of each new state (the page redraws on them).
+"""
+
+from __future__ import annotations
+
+import copy
+import threading
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from robotspec.errors import RobotSpecError
+from robotspec.model.world import World
+from robotspec.setup.questions import (
+    BODY_FRAME,
+    DRIVES,
+    FACINGS,
+    KEEP,
+    OPTICAL,
+    REMOVE,
+    ROLES,
+    Question,
+    questions_of,
+)
+from robotspec.setup.save import spec_text, write_spec
+from robotspec.setup.source import Source, open_source
+from robotspec.setup.tree import chain_joints, joint_range, subtree_joints
+from robotspec.setup.validation import Validation, validate_text
+from robotspec.spec.draft.model import (
+    Draft,
+    DraftCamera,
+    DraftChain,
+    DraftDrive,
+    DraftFinger,
+    DraftManipulator,
+)
+
+__all__ = ["SetupError", "SetupSession", "Snapshot"]
+
+_HISTORY = 50
+
+
+class SetupError(RobotSpecError):
+    """A change the assistant cannot make (an unknown part, a link not in the robot)."""
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """One state of the session: its text, its validation, its open questions."""
+
+    version: int
+    text: str
+    validation: Validation
+    questions: tuple[Question, ...]
+    saved: bool
+
+
+def _chain(draft: Draft, part: str) -> DraftChain:
+    if part in ("torso", "neck"):
+        c = getattr(draft, part)
+        if c is None:
+            raise SetupError(f"the robot has no {part}; add one first", kind="part", name=part)
+        return c  # type: ignore[no-any-return]
+    name = part.removeprefix("chains.")
+    for c in draft.chains:
+        if c.name == name:
+            return c
+    raise SetupError(f"no chain '{name}'", kind="chain", name=name)
+
+
+def _manipulator(draft: Draft, part: str) -> DraftManipulator:
+    name = part.removeprefix("manipulators.")
+    for m in draft.manipulators:
+        if m.name == name:
+            return m
+    raise SetupError(f"no manipulator '{name}'", kind="manipulator", name=name)
+
+
+def _camera(draft: Draft, part: str) -> DraftCamera:
+    name = part.removeprefix("sensors.")
+    for c in draft.cameras:
+        if c.name == name:
+            return c
+    raise SetupError(f"no camera '{name}'", kind="sensor", name=name)
+
+
+def _facing(axis: tuple[float, float, float]) -> tuple[float, float, float, float]:
+    import numpy as np
+
+    from robotspec.spec.draft.hands import facing_quaternion
+
+    q = facing_quaternion(np.array(axis, dtype=np.float64))
+    return (0.0, 0.0, 0.0, 1.0) if q is None else q
+
+
+class SetupSession:
+    """A draft being turned into a valid spec, and where it will be saved."""
+
+    def __init__(
+        self, source: Source, output: Path, *, package_paths: Sequence[str | Path] = ()
+    ) -> None:
+        self.source = source
+        self.world: World = source.world
+        self.output = output
+        self.package_paths = tuple(package_paths)
+        self._lock = threading.RLock()
+        self._draft = copy.deepcopy(source.draft)
+        self._history: list[Draft] = []
+        self._listeners: list[Callable[[Snapshot], None]] = []
+        self._version = 0
+        self._saved_text: str | None = None
+        self._snapshot = self._make_snapshot(self._draft)
+
+    @classmethod
+    def open(
+        cls,
+        ref: str,
+        *,
+        output: Path,
+        srdf: str | None = None,
+        package_paths: Sequence[str | Path] = (),
+    ) -> SetupSession:
+        """A session on a URDF (drafted) or a spec (read back); errors as init/validate raise."""
+        source = open_source(ref, srdf=srdf, output=output, package_paths=package_paths)
+        return cls(source, output, package_paths=package_paths)
+
+    # ------------------------------------------------------------------ reading
+    @property
+    def snapshot(self) -> Snapshot:
+        """The current state (a value: it never changes under the caller)."""
+        return self._snapshot
+
+    @property
+    def validation(self) -> Validation:
+        """What validate says of the current text."""
+        return self._snapshot.validation
+
+    def draft(self) -> Draft:
+        """A copy of the current draft."""
+        with self._lock:
+            return copy.deepcopy(self._draft)
+
+    def parts(self) -> tuple[str, ...]:
+        """Every editable part: drive, torso, neck, chains.X, manipulators.X, sensors.X."""
+        d = self._draft
+        out = ["drive"]
+        out += [k for k in ("torso", "neck") if getattr(d, k) is not None]
+        out += [f"chains.{c.name}" for c in d.chains]
+        out += [f"manipulators.{m.name}" for m in d.manipulators]
+        out += [f"sensors.{c.name}" for c in d.cameras]
+        return tuple(out)
+
+    def part_joints(self, part: str) -> tuple[str, ...]:
+        """The joints a part's states name: a chain's from root to tip, a hand's below its root."""
+        with self._lock:
+            d = self._draft
+            if part == "robot":
+                return tuple(
+                    c.name for c in self.world.connections if c.is_active and not c.is_mimic
+                )
+            if part.startswith("manipulators."):
+                return subtree_joints(self.world, _manipulator(d, part).root)
+            c = _chain(d, part)
+            if c.group is not None and not c.root:
+                return ()
+            return chain_joints(self.world, c.root, c.tip)
+
+    def part_states(self, part: str) -> dict[str, dict[str, float]]:
+        """A part's named states (``robot``: the spec's top-level ``states``)."""
+        with self._lock:
+            return copy.deepcopy(self._states_of(self._draft, part))
+
+    def joint_range(self, joint: str) -> tuple[float, float]:
+        """The range a state's slider spans (the joint's limits)."""
+        return joint_range(self.world, joint)
+
+    def subscribe(self, listener: Callable[[Snapshot], None]) -> None:
+        """Call ``listener`` with every new state (from the thread that made it)."""
+        with self._lock:
+            self._listeners.append(listener)
+
+    # ------------------------------------------------------------------ the one way to change
+    def _make_snapshot(self, draft: Draft) -> Snapshot:
+        text = spec_text(draft, self.source.kept, self.source.presets)
+        validation = validate_text(text, self.output, package_paths=self.package_paths)
+        return Snapshot(
+            self._version,
+            text,
+            validation,
+            questions_of(draft, self.source.presets),
+            saved=text == self._saved_text,
+        )
+
+    def edit(self, change: Callable[[Draft], None]) -> Validation:
+        """Apply ``change`` to a copy of the draft, validate it, make it the state."""
+        with self._lock:
+            new = copy.deepcopy(self._draft)
+            change(new)
+            self._version += 1
+            snap = self._make_snapshot(new)
+            self._history = [*self._history[-_HISTORY + 1 :], self._draft]
+            self._draft, self._snapshot = new, snap
+            listeners = list(self._listeners)
+        for listener in listeners:
+            listener(snap)
+        return snap.validation
+
+    def undo(self) -> Validation:
+        """Go back one change (nothing happens when there is none)."""
+        with self._lock:
+            if not self._history:
+                return self.validation
+            previous = self._history.pop()
+            self._version += 1
+            snap = self._make_snapshot(previous)
+            self._draft, self._snapshot = previous, snap
+            listeners = list(self._listeners)
+        for listener in listeners:
+            listener(snap)
+        return snap.validation
+
+    # ------------------------------------------------------------------ changes
+    def _link(self, name: str, what: str) -> str:
+        if not self.world.has_body(name):
+            from robotspec.errors import closest_names
+
+            near = closest_names(name, self.world.body_names)
+            raise SetupError(
+                f"{what}: no link '{name}' in the robot", kind="link", name=name, suggestions=near
+            )
+        return name
+
+    def set_chain(
+        self,
+        part: str,
+        *,
+        root: str | None = None,
+        tip: str | None = None,
+        kind: str | None = None,
+        side: str | None = "",
+    ) -> Validation:
+        """Change a chain (or the torso, the neck): its root, tip, kind, side; answers its mark."""
+        if root is not None:
+            self._link(root, "root")
+        if tip is not None:
+            self._link(tip, "tip")
+        if kind is not None and kind not in ROLES:
+            raise SetupError(f"a chain's kind is arm, leg or chain, not '{kind}'", kind="kind")
+        if side not in ("", None, "left", "right"):
+            raise SetupError(f"a side is left or right, not '{side}'", kind="side")
+
+        def change(d: Draft) -> None:
+            c = _chain(d, part)
+            if root is not None or tip is not None:
+                if c.group is not None:  # an SRDF group written as root/tip from now on
+                    c.group = None
+                c.root = root if root is not None else c.root
+                c.tip = tip if tip is not None else c.tip
+                c.decide.clear()
+            if kind is not None:
+                c.role = kind
+                c.decide.clear()
+            if side != "":
+                c.side = side
+
+        return self.edit(change)
+
+    def add_chain(self, name: str, root: str, tip: str, kind: str = "arm") -> Validation:
+        """A new chain (``torso`` and ``neck`` make those parts)."""
+        self._link(root, "root")
+        self._link(tip, "tip")
+
+        def change(d: Draft) -> None:
+            if name in ("torso", "neck"):
+                if getattr(d, name) is not None:
+                    raise SetupError(f"the robot has a {name} already", kind="part", name=name)
+                setattr(d, name, DraftChain(name, root, tip, "robotspec setup", role=name))
+                return
+            if any(c.name == name for c in d.chains):
+                raise SetupError(f"a chain '{name}' exists already", kind="chain", name=name)
+            d.chains.append(DraftChain(name, root, tip, "robotspec setup", role=kind))
+
+        return self.edit(change)
+
+    def remove(self, part: str) -> Validation:
+        """Drop a part; references to it (a chain's manipulator, a neck's sensors) go too."""
+
+        def change(d: Draft) -> None:
+            kind, _, name = part.partition(".")
+            if part in ("torso", "neck"):
+                _chain(d, part)
+                setattr(d, part, None)
+            elif kind == "chains":
+                d.chains.remove(_chain(d, part))
+            elif kind == "manipulators":
+                d.manipulators.remove(_manipulator(d, part))
+                for c in d.chains:
+                    if c.manipulator == name:
+                        c.manipulator = None
+            elif kind == "sensors":
+                d.cameras.remove(_camera(d, part))
+                for holder in [*d.chains, d.neck]:
+                    if holder is not None and name in holder.sensors:
+                        holder.sensors.remove(name)
+            elif kind == "frames":
+                frame = next((f for f in d.frames if f.name == name), None)
+                if frame is None:
+                    raise SetupError(f"no frame '{name}'", kind="frame", name=name)
+                d.frames.remove(frame)
+                for m in d.manipulators:
+                    if m.tool_frame == name:
+                        m.tool_frame = frame.parent
+            else:
+                raise SetupError(f"no part '{part}'", kind="part", name=part)
+
+        return self.edit(change)
+
+    def set_manipulator(
+        self,
+        part: str,
+        *,
+        root: str | None = None,
+        tool_frame: str | None = None,
+        thumb: tuple[str, str] | None = None,
+        finger: tuple[str, str] | None = None,
+        generic: bool = False,
+        facing: tuple[float, float, float] | None = None,
+    ) -> Validation:
+        """Change a hand: its root, tool frame, fingers (root, tip), or the way it faces."""
+        for link, what in ((root, "root"), (tool_frame, "tool frame")):
+            if link is not None:
+                self._link(link, what)
+        for pair, what in ((thumb, "thumb"), (finger, "finger")):
+            for link in pair or ():
+                self._link(link, what)
+
+        def change(d: Draft) -> None:
+            m = _manipulator(d, part)
+            m.root = root if root is not None else m.root
+            m.tool_frame = tool_frame if tool_frame is not None else m.tool_frame
+            if thumb is not None:
+                m.thumb = DraftFinger(*thumb)
+            if finger is not None:
+                m.finger = DraftFinger(*finger)
+            if generic:
+                m.thumb = m.finger = None
+            if facing is not None:
+                m.front_facing = _facing(facing)
+            m.decide.clear()
+
+        return self.edit(change)
+
+    def add_manipulator(
+        self, name: str, root: str, tool_frame: str, chain: str | None = None
+    ) -> Validation:
+        """A new generic hand, optionally carried by a chain (``chains.X``)."""
+        self._link(root, "root")
+        self._link(tool_frame, "tool frame")
+
+        def change(d: Draft) -> None:
+            if any(m.name == name for m in d.manipulators):
+                raise SetupError(f"a manipulator '{name}' exists", kind="manipulator", name=name)
+            d.manipulators.append(DraftManipulator(name, root, tool_frame, "robotspec setup"))
+            if chain is not None:
+                _chain(d, chain).manipulator = name
+
+        return self.edit(change)
+
+    def set_camera(
+        self,
+        part: str,
+        *,
+        body: str | None = None,
+        preset: str | None = None,
+        field_of_view: tuple[float, float] | None = None,
+        optical: bool | None = None,
+    ) -> Validation:
+        """Change a camera: its body, preset or angles (rad), which way its frame looks."""
+        if body is not None:
+            self._link(body, "camera body")
+        if preset is not None and preset not in self.source.presets:
+            raise SetupError(
+                f"no camera preset '{preset}'; there are {', '.join(self.source.presets)}",
+                kind="preset",
+                name=preset,
+            )
+
+        def change(d: Draft) -> None:
+            c = _camera(d, part)
+            c.body = body if body is not None else c.body
+            if preset is not None:
+                c.preset, c.field_of_view = preset, None
+            if field_of_view is not None:
+                c.preset, c.field_of_view = None, (float(field_of_view[0]), float(field_of_view[1]))
+            if optical is not None:
+                c.optical = optical
+                c.decide.clear()
+            if body is not None:
+                c.decide.clear()
+
+        return self.edit(change)
+
+    def add_camera(self, name: str, body: str, *, optical: bool = True) -> Validation:
+        """A new camera on ``body`` (its angles still to decide)."""
+        self._link(body, "camera body")
+
+        def change(d: Draft) -> None:
+            if any(c.name == name for c in d.cameras):
+                raise SetupError(f"a camera '{name}' exists", kind="sensor", name=name)
+            d.cameras.append(DraftCamera(name, body, optical))
+
+        return self.edit(change)
+
+    def set_drive(self, kind: str) -> Validation:
+        """How the base moves: fixed, omni, differential or floating."""
+        if kind not in DRIVES:
+            raise SetupError(f"a drive is {', '.join(DRIVES)}, not '{kind}'", kind="drive")
+
+        def change(d: Draft) -> None:
+            old = d.drive
+            if kind == "fixed":
+                d.drive = DraftDrive("fixed", source="robotspec setup")
+            else:
+                joint = old.joint if old is not None else None
+                frame = old.parent_frame if old is not None and old.parent_frame else "odom"
+                d.drive = DraftDrive(kind, joint, frame, source="robotspec setup")
+
+        return self.edit(change)
+
+    def _states_of(self, d: Draft, part: str) -> dict[str, dict[str, float]]:
+        if part == "robot":
+            return d.states
+        if part.startswith("manipulators."):
+            return _manipulator(d, part).states
+        return _chain(d, part).states
+
+    def set_state(self, part: str, name: str, values: Mapping[str, float]) -> Validation:
+        """A named state of a part (``robot`` for the spec's own ``states``), joint by joint."""
+        if not name.strip():
+            raise SetupError("a state needs a name", kind="state")
+        clean: dict[str, float] = {}
+        for joint, value in values.items():
+            if not self.world.has_connection(joint):
+                raise SetupError(f"no joint '{joint}' in the robot", kind="joint", name=joint)
+            clean[joint] = round(float(value), 6)
+
+        def change(d: Draft) -> None:
+            self._states_of(d, part)[name] = clean
+
+        return self.edit(change)
+
+    def remove_state(self, part: str, name: str) -> Validation:
+        """Drop a named state."""
+
+        def change(d: Draft) -> None:
+            states = self._states_of(d, part)
+            if name not in states:
+                raise SetupError(f"no state '{name}' on {part}", kind="state", name=name)
+            del states[name]
+
+        return self.edit(change)
+
+    def answer(self, question: str, choice: str = KEEP) -> Validation:
+        """Answer an open question: keep the guess, or apply one of its alternatives."""
+        with self._lock:
+            q = next((q for q in self._snapshot.questions if q.id == question), None)
+        if q is None:
+            raise SetupError(f"no open question '{question}'", kind="question", name=question)
+        if choice not in q.choices:
+            raise SetupError(
+                f"'{choice}' is not a choice of {question}: {', '.join(q.choices)}",
+                kind="choice",
+                name=choice,
+            )
+        if choice == REMOVE:
+            return self.remove(q.part)
+        if choice.startswith("drive: "):
+            return self.set_drive(choice.removeprefix("drive: "))
+        if choice.startswith("preset: "):
+            return self.set_camera(q.part, preset=choice.removeprefix("preset: "))
+        if choice in FACINGS:
+            return self.set_manipulator(q.part, facing=FACINGS[choice])
+        if choice == "make it generic":
+            return self.set_manipulator(q.part, generic=True)
+        if choice in (OPTICAL, BODY_FRAME):
+            return self.set_camera(q.part, optical=choice == OPTICAL)
+        for role, words in ROLES.items():
+            if choice == f"make it {words}":
+                return self.set_chain(q.part, kind=role)
+        return self.edit(lambda d: _keep(d, q))
+
+    # ------------------------------------------------------------------ saving
+    def save(self, path: Path | None = None) -> Path:
+        """Write the spec if validate accepts it; refuse (listing the errors) if not."""
+        with self._lock:
+            snap = self._snapshot
+            target = path or self.output
+            if not snap.validation.valid:
+                shown = "; ".join(p.render(str(target)) for p in snap.validation.errors[:5])
+                raise SetupError(
+                    f"not saved: the spec has {len(snap.validation.errors)} error(s): {shown}",
+                    file=str(target),
+                    kind="spec",
+                )
+            if target.resolve().parent != self.output.resolve().parent:
+                check = validate_text(snap.text, target, package_paths=self.package_paths)
+                if not check.valid:
+                    raise SetupError(
+                        "not saved: the spec's relative paths do not resolve from that folder",
+                        file=str(target),
+                        kind="spec",
+                    )
+            write_spec(target, snap.text)
+            self._saved_text = snap.text
+            self._snapshot = Snapshot(
+                snap.version, snap.text, snap.validation, snap.questions, saved=True
+            )
+            listeners = list(self._listeners)
+            saved = self._snapshot
+        for listener in listeners:
+            listener(saved)
+        return target
+
+
+def _keep(d: Draft, q: Question) -> None:
+    """Keep a guess: its DECIDE mark goes, nothing else changes."""
+    kind, _, name = q.part.partition(".")
+    if q.id.endswith(".field_of_view"):
+        from robotspec.spec.draft.render import PLACEHOLDER_FOV
+
+        _camera(d, q.part).field_of_view = PLACEHOLDER_FOV
+    elif q.part == "drive" and d.drive is not None:
+        d.drive.decide = None
+    elif q.part in ("torso", "neck") or kind == "chains":
+        _chain(d, q.part).decide.clear()
+    elif kind == "manipulators":
+        _manipulator(d, q.part).decide.clear()
+    elif kind == "sensors":
+        _camera(d, q.part).decide.clear()
+    elif kind == "frames":
+        for f in d.frames:
+            if f.name == name:
+                f.reason = ""

@@ -1,0 +1,76 @@
+"""What the assistant starts from: a URDF (drafted as ``init`` does) or a spec (read back).
+
+A spec is read back into the draft's form, its DECIDE marks found at their parts.
+
+Why one form for both: the assistant edits a :class:`~robotspec.spec.draft.Draft` and saves it
+with the draft's writer, so the comments a draft carries survive and an answered DECIDE mark is
+simply a reason no longer there. A spec using what a draft cannot hold (``parts:``, ``extends:``,
+generic sensors, frames with a rotation) is refused with a located error rather than saved with
+parts of it lost; top-level settings the assistant does not edit (``collision``,
+``velocity_limits``, ...) are kept as read.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from robotspec.model.world import World
+from robotspec.spec.draft.model import Draft
+
+__all__ = ["KEPT_KEYS", "Source", "is_spec_file", "open_source"]
+
+#: Top-level spec keys the assistant keeps as read (it does not edit them).
+KEPT_KEYS = (
+    "velocity_limits",
+    "controlled_joints",
+    "collision",
+    "import_srdf_group_states",
+    "accept_warnings",
+)
+
+
+@dataclass(frozen=True)
+class Source:
+    """A draft to edit, the robot's kinematic tree, and what of the input is kept as read."""
+
+    draft: Draft
+    world: World
+    origin: str
+    kept: dict[str, Any] = field(default_factory=dict)
+    presets: tuple[str, ...] = ()
+
+
+def is_spec_file(ref: str) -> bool:
+    """Whether ``ref`` names a spec (a YAML file, a shipped robot) rather than a URDF or xacro."""
+    from robotspec.shipped import shipped_spec_files
+
+    if ref.lower().endswith((".yaml", ".yml")):
+        return True
+    return not Path(ref).exists() and ref.lower() in shipped_spec_files()
+
+
+def open_source(
+    ref: str,
+    *,
+    srdf: str | None = None,
+    output: Path,
+    package_paths: Sequence[str | Path] = (),
+) -> Source:
+    """Open ``ref`` for editing; its problems raise the errors ``init`` or ``validate`` raise."""
+    from robotspec.spec.draft.render import camera_presets
+
+    presets = camera_presets()
+    if is_spec_file(ref):
+        from robotspec.setup.from_spec import draft_of_spec
+
+        folder = output.resolve().parent
+        draft, world, kept = draft_of_spec(ref, package_paths=package_paths, folder=folder)
+        return Source(draft, world, ref, kept, presets)
+    from robotspec.spec.draft.run import draft_from_files
+
+    folder = output.resolve().parent
+    draft, desc = draft_from_files(ref, srdf, folder=folder, package_paths=package_paths)
+    return Source(draft, desc.world, ref, {}, presets)

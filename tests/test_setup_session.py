@@ -1,0 +1,172 @@
+"""The setup assistant's session, without a browser: questions, edits, validation, saving.
+
+On example-robot-data's robots: the xArm7 (a URDF alone, every part guessed) and the PR2 (URDF
+and SRDF, cameras whose angles are open). What is saved must be what ``robotspec validate``
+accepts, with the draft's comments kept and the answered DECIDE marks gone.
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import pytest
+
+from robotspec.cli.app import main
+from robotspec.compiler import check_spec
+from robotspec.errors import DescriptionError, RobotSpecError, SpecError
+from robotspec.setup import SetupSession
+from robotspec.setup.questions import KEEP
+from robotspec.setup.session import SetupError
+from robotspec.setup.validation import part_of
+from tests.conftest import erd_robots
+
+
+def _xarm(tmp_path: Path) -> SetupSession:
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    return SetupSession.open(str(urdf), output=tmp_path / "xarm.yaml")
+
+
+def _pr2(tmp_path: Path) -> SetupSession:
+    pr2 = erd_robots() / "pr2_description"
+    return SetupSession.open(
+        str(pr2 / "urdf" / "pr2.urdf"),
+        srdf=str(pr2 / "srdf" / "pr2.srdf"),
+        output=tmp_path / "out" / "pr2.yaml",
+    )
+
+
+def _validate_exit(path: Path) -> int:
+    with pytest.raises(SystemExit) as exc:
+        main(["validate", str(path)])
+    return int(exc.value.code or 0)
+
+
+def test_part_of_maps_spec_locations_to_parts() -> None:
+    assert part_of(("chains", "left_arm", "tip")) == "chains.left_arm"
+    assert part_of(("torso", "root")) == "torso"
+    assert part_of(("description", "frames", "tcp", "parent")) == "frames.tcp"
+    assert part_of(("sensors", "cam")) == "sensors.cam"
+    assert part_of(()) == "robot"
+
+
+def test_xarm_questions_answered_and_saved_validate(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    s = _xarm(tmp_path)
+    assert s.validation.valid  # a draft validates as written
+    ids = [q.id for q in s.snapshot.questions]
+    assert ids == ["drive", "chains.arm", "manipulators.tool"]
+    q = s.snapshot.questions[2]
+    assert q.guess.endswith("tool frame link_eef") and "tool faces +z" in q.alternatives
+    assert "which way does the tool face" in q.reason
+    s.answer("drive")
+    s.answer("chains.arm", KEEP)
+    v = s.answer("manipulators.tool", "tool faces +z")
+    assert v.valid and not s.snapshot.questions
+    v = s.set_state("chains.arm", "park", dict.fromkeys(s.part_joints("chains.arm"), 0.0))
+    assert v.valid and len(s.part_joints("chains.arm")) == 7
+    path = s.save()
+    text = path.read_text()
+    assert "DECIDE: " not in text.split("delete the mark.")[1]
+    assert "# from the URDF tree" in text  # the draft's comments are kept
+    assert "front_facing_orientation: [0, 0.7071068, 0, 0.7071068]" in text
+    assert "park: {joint1: 0" in text
+    assert _validate_exit(path) == 0
+    assert "1 of 1 spec valid; 0 errors, 0 warnings" in capsys.readouterr().out
+    assert s.snapshot.saved
+
+
+def test_a_change_that_breaks_the_spec_shows_the_validators_message(tmp_path: Path) -> None:
+    s = _xarm(tmp_path)
+    v = s.set_chain("chains.arm", tip="link_eef")
+    assert not v.valid
+    (err,) = v.at("chains.arm")
+    assert "not below the chain's tip 'link_eef'" in err.message and err.line is not None
+    with pytest.raises(SetupError, match="not saved: the spec has 1 error"):
+        s.save()
+    assert not (tmp_path / "xarm.yaml").exists()
+    assert s.undo().valid  # back to the draft
+    assert s.set_chain("chains.arm", tip="link7").valid
+
+
+def test_picks_of_unknown_names_are_refused_with_the_nearest_links(tmp_path: Path) -> None:
+    s = _xarm(tmp_path)
+    before = s.snapshot.version
+    with pytest.raises(SetupError) as exc:
+        s.set_manipulator("manipulators.tool", tool_frame="link_ef")
+    assert "link_eef" in exc.value.suggestions
+    with pytest.raises(SetupError, match="no chain 'leg'"):
+        s.set_chain("chains.leg", tip="link3")
+    with pytest.raises(SetupError, match="not a choice"):
+        s.answer("drive", "drive: hover")
+    with pytest.raises(SetupError, match="no joint"):
+        s.set_state("chains.arm", "x", {"nope": 1.0})
+    assert s.snapshot.version == before  # nothing changed
+
+
+def test_pr2_cameras_presets_states_and_round_trip(tmp_path: Path) -> None:
+    s = _pr2(tmp_path)
+    qs = s.snapshot.questions
+    assert sum(q.id.endswith(".field_of_view") for q in qs) == 5
+    for q in qs:
+        s.answer(q.id, "preset: kinect_v1" if q.id.endswith("field_of_view") else KEEP)
+    s.set_state("torso", "low", {"torso_lift_joint": 0.0})
+    s.set_state("torso", "high", {"torso_lift_joint": 0.3})
+    joints = s.part_joints("manipulators.left_eef")
+    assert joints == ("l_gripper_l_finger_joint",)
+    lo, hi = s.joint_range(joints[0])
+    assert s.set_state("manipulators.left_eef", "open", {joints[0]: hi}).valid
+    v = s.set_state("manipulators.left_eef", "close", {joints[0]: lo})
+    assert v.valid and not s.snapshot.questions
+    path = s.save()
+    text = path.read_text()
+    assert text.count("preset: kinect_v1") == 5 and "# Note: SRDF group" in text
+    check_spec(path)  # validate accepts the file as written
+    # The saved spec opened again is the same spec, and saves to the same text.
+    again = SetupSession.open(str(path), output=tmp_path / "again" / "pr2.yaml")
+    assert again.validation.valid and not again.snapshot.questions
+    assert again.save().read_text() == text
+
+
+def test_a_spec_keeps_its_marks_and_what_setup_does_not_edit(tmp_path: Path) -> None:
+    s = _xarm(tmp_path)
+    s.answer("drive")
+    spec = tmp_path / "xarm.yaml"
+    text = s.snapshot.text + "collision: {buffer_distance: 0.02}\n"
+    spec.write_text(text)
+    again = SetupSession.open(str(spec), output=tmp_path / "b" / "xarm.yaml")
+    assert [q.id for q in again.snapshot.questions] == ["chains.arm", "manipulators.tool"]
+    assert again.validation.valid
+    assert "collision:\n  buffer_distance: 0.02" in again.snapshot.text
+
+
+def test_files_it_cannot_read_get_the_clis_located_errors(tmp_path: Path) -> None:
+    with pytest.raises(DescriptionError, match="file not found"):
+        SetupSession.open(str(tmp_path / "nope.urdf"), output=tmp_path / "x.yaml")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("robotspec: 1\nname: [\n")
+    with pytest.raises(RobotSpecError) as exc:
+        SetupSession.open(str(bad), output=tmp_path / "x.yaml")
+    assert exc.value.file is not None and exc.value.file.endswith("bad.yaml")
+    # A shipped spec using what a draft cannot hold is refused where it uses it.
+    erd_robots()
+    with pytest.raises(SpecError, match="cannot edit") as refused:
+        SetupSession.open("pr2", output=tmp_path / "pr2.yaml")
+    assert refused.value.line is not None
+
+
+def test_two_threads_editing_see_one_state(tmp_path: Path) -> None:
+    s = _xarm(tmp_path)
+    seen: list[int] = []
+    s.subscribe(lambda snap: seen.append(snap.version))
+
+    def work(k: int) -> None:
+        for i in range(3):
+            s.set_state("robot", f"s{k}_{i}", {"joint1": 0.1 * i})
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert sorted(seen) == list(range(1, 7)) and s.snapshot.version == 6
+    assert len(s.part_states("robot")) == 6 and s.validation.valid

@@ -1,0 +1,123 @@
+"""What a user without the C accelerators pays: the numpy fallbacks against the C cores, one run.
+
+Run: ``python benchmarks/bench_fallback.py [--robot pr2] [--batch 2000] [--samples 2000] [--json]``
+(needs the dev extra: example-robot-data, coal; and the C cores built, to compare with).
+
+Ours is the public API on the pure-Python cores (``robotspec/model/_kincore_py.py``,
+``robotspec/collision/_meshcore_py.py``: what ``ROBOTSPEC_NO_ACCEL=1`` or an install without a
+compiler runs); the peer is the same call on the C cores (``_kincore.c``, ``_meshcore.c``). Both
+sides are built separately in this process, their answers compared before anything is timed, and
+timed in turns (rows.median_times). Ratio = C time / fallback time: the fraction of the
+accelerated speed a user without a compiler gets. The collision matrix (the ``robotspec
+collisions generate`` path) runs in this process (``processes=1``) on each side once.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+from rows import Row, add_json_flag, median_times, print_rows
+
+
+@contextmanager
+def using(kin: ModuleType, mesh: ModuleType) -> Iterator[None]:
+    """Run with the given cores (the dispatch's choice, restored after)."""
+    from robotspec.collision import meshcore
+    from robotspec.model import kincore
+
+    saved = kincore._core, meshcore._core
+    kincore._core, meshcore._core = kin, mesh
+    try:
+        yield
+    finally:
+        kincore._core, meshcore._core = saved
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--robot", default="pr2", help="a shipped robot (example-robot-data)")
+    parser.add_argument("--batch", type=int, default=2000, help="configurations per FK batch")
+    parser.add_argument("--samples", type=int, default=2000, help="collision matrix samples")
+    parser.add_argument("--rounds", type=int, default=15, help="timing rounds (medians)")
+    add_json_flag(parser)
+    args = parser.parse_args()
+
+    from robotspec.collision import SelfCollisionChecker, random_configurations
+    from robotspec.collision import _meshcore as mesh_c
+    from robotspec.collision import _meshcore_py as mesh_py
+    from robotspec.collision.matrix import generate_for_robot
+    from robotspec.compiler import compile_robot
+    from robotspec.model import _kincore as kin_c
+    from robotspec.model import _kincore_py as kin_py
+    from robotspec.model.kinematics import Kinematics
+
+    robot = compile_robot(args.robot)
+    world = robot.world
+    c, py = (kin_c, mesh_c), (kin_py, mesh_py)
+    sides: dict[str, Any] = {}
+    for name, cores in (("c", c), ("py", py)):
+        with using(*cores):
+            sides[name] = (Kinematics(world), SelfCollisionChecker.from_robot(robot))
+    qs = np.asarray(random_configurations(world, max(args.batch, 64), seed=0))
+    batch = qs[: args.batch]
+    chain_sem = max(robot.manipulator_chains, key=lambda ch: len(ch.active_connections))
+    root, tip = chain_sem.root.name, chain_sem.tip.name
+    label = f"{args.robot}:"
+
+    def on(
+        name: str, fn: Callable[[Kinematics, SelfCollisionChecker], object], reps: int = 1
+    ) -> Callable[[], object]:
+        """``fn`` on one side, ``reps`` times in one go (the core switch stays out of the time)."""
+        cores = c if name == "c" else py
+        kin, checker = sides[name]
+
+        def run() -> object:
+            with using(*cores):
+                for _ in range(reps - 1):
+                    fn(kin, checker)
+                return fn(kin, checker)
+
+        return run
+
+    cases: list[tuple[str, Callable[[Kinematics, SelfCollisionChecker], Any], float, int]] = [
+        (f"FK all {len(world.bodies)} bodies", lambda k, _: k.forward(qs[0]), 1e-12, 100),
+        (f"pose of one frame ({tip})", lambda k, _: k.pose(qs[0], tip), 1e-12, 100),
+        (f"Jacobian {root} -> {tip}", lambda k, _: k.chain(root, tip).jacobian(qs[0]), 1e-12, 100),
+        (f"FK batch of {len(batch)}", lambda k, _: k.forward_batch(batch), 1e-12, 1),
+        ("in_collision (one configuration)", lambda _, ch: ch.in_collision(qs[1]), 0.0, 10),
+        ("collisions_batch of 64", lambda _, ch: ch.collisions_batch(qs[:64]), 0.0, 1),
+    ]
+    rows: list[Row] = []
+    for what, fn, tol, reps in cases:
+        ours, peer = on("py", fn), on("c", fn)
+        np.testing.assert_allclose(np.asarray(ours()), np.asarray(peer()), rtol=0, atol=tol)
+        t_ours, t_peer = median_times([on("py", fn, reps), on("c", fn, reps)], args.rounds)
+        rows.append(Row(f"{label} {what}", t_ours / reps, "C accelerators", t_peer / reps))
+
+    # The `robotspec collisions generate` path, once a side (seconds each).
+    matrices, times = {}, {}
+    for name in ("c", "py"):
+        with using(*(c if name == "c" else py)):
+            t = time.perf_counter()
+            matrices[name] = generate_for_robot(robot, samples=args.samples, seed=0, processes=1)
+            times[name] = time.perf_counter() - t
+    assert matrices["c"].disabled_pairs() == matrices["py"].disabled_pairs()
+    rows.append(
+        Row(
+            f"{label} collision matrix, {args.samples} samples",
+            times["py"],
+            "C accelerators (processes=1)",
+            times["c"],
+        )
+    )
+    print_rows(rows, args.json)
+
+
+if __name__ == "__main__":
+    main()

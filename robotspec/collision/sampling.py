@@ -86,7 +86,8 @@ class RandomBlocks:
     Why: drawing every sample at once costs ``n * D * 8`` bytes (a MemoryError for ``n = 10**12``);
     blocks keep memory bounded whatever ``n`` is. The values are those of
     ``random_configurations(world, n, rng)``: a generator fills an array in order, so blocks
-    drawn one after another from one generator continue the same stream.
+    drawn one after another from one generator continue the same stream. Iterate once: a second
+    pass continues the generator (other values).
     """
 
     def __init__(self, world: World, n: int, rng: np.random.Generator, size: int = BLOCK) -> None:

@@ -23,12 +23,13 @@ Each over-limit segment first gets the scale that a pure time scaling needs,
 ``σ = 1 / sqrt(max(a / a_max, (v / v_max)²))``, at both its waypoints. Where neighbouring scales
 then differ too much (a dense trajectory cannot change speed within one 10 ms segment), the
 faster waypoint is slowed, by bisection, just enough for the ramp between them to be within the
-limits; that may spread the slowing over the neighbouring segments, one more each round, until
-every segment is within the limits. The result: only the segments that need it, and the ramps
-into and out of them, are slowed. Should that not settle within :data:`MAX_ROUNDS` rounds, the
-whole trajectory is slowed by the one factor its worst segment needs (a pure time scaling,
-within the limits by construction). Either way the slowing is reported (:class:`Stretch`), never
-silent, and a trajectory is never refused for it.
+limits (to :data:`_SLACK`); that may spread the slowing over the neighbouring segments, one more
+each round, until every segment is within the limits. Each round evaluates only the segments
+beside a waypoint the last round changed, all at once (numpy). The result: only the segments
+that need it, and the ramps into and out of them, are slowed. Should that not settle within
+:data:`MAX_ROUNDS` rounds, the whole trajectory is slowed by the one factor its worst segment
+needs (a pure time scaling, within the limits by construction). Either way the slowing is
+reported (:class:`Stretch`), never silent, and a trajectory is never refused for it.
 
 A slowed segment may also not leave the joint position limits (a ramp bends the curve a little);
 the curve the client gave may not either (:func:`time_scale` refuses one that does by more than
@@ -68,6 +69,9 @@ MAX_ROUNDS = 60
 _BISECTIONS = 12
 #: The pure time scaling aims this much below the limit, so it is within it after round-off.
 _MARGIN = 1e-9
+#: A slowed waypoint leaves its ramp this much (relative) below the limit. Why: then the small
+#: changes its neighbours make in later rounds do not push it back over; it saves most rounds, for
+#: at most a thousandth of acceleration left unused on a ramp.
 _SLACK = 1e-3
 
 

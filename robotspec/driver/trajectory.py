@@ -255,8 +255,12 @@ def load_trajectory(
 ) -> TrajectoryInterpolator:
     """Check ``traj`` against the robot and build its interpolator, on times ÷ ``speed_ratio``.
 
+    The interpolator follows the waypoints' velocities (times ``speed_ratio``) and is slowed
+    where it would exceed the velocity or acceleration limits (its ``stretch`` says how much).
+
     Raises:
-        InvalidArgumentError: with the reference's message for the first failed check.
+        InvalidArgumentError: with the reference's message for the first failed check; or when
+            the curve through the given velocities leaves the position limits between waypoints.
     """
     n = len(joint_names)
     if traj.joint_names and tuple(traj.joint_names) != tuple(joint_names):

@@ -40,7 +40,7 @@ def check_arm_sides(
         return
     sides = [declared.get(a.name) for a in arms]
     try:
-        arm_sides(robot.world, robot.root, arms, sides)
+        arm_sides(robot.world, robot.root, arms, sides, left=robot.left_axis)
     except KinematicsError as exc:
         bad = exc.name if exc.name is not None else arms[0].name
         if any(sides):
@@ -51,8 +51,8 @@ def check_arm_sides(
     if not any(sides):
         return
     a, b = arms
-    ya = lateral_offset(robot.world, robot.root, a)
-    yb = lateral_offset(robot.world, robot.root, b)
+    ya = lateral_offset(robot.world, robot.root, a, robot.left_axis)
+    yb = lateral_offset(robot.world, robot.root, b, robot.left_axis)
     left_by_position = a if ya > yb else b
     named = next(arm for arm, side in zip(arms, sides, strict=True) if side is not None)
     side = declared[named.name]

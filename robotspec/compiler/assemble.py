@@ -6,11 +6,13 @@ Nothing here checks anything; :func:`robotspec.compiler.build.build_robot` only 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TypedDict
 
 from robotspec.compiler.context import Build
 from robotspec.compiler.parts import CameraValues
+from robotspec.model.geometry import UNIT_TOL
 from robotspec.model.world import Body, World
 from robotspec.semantic import (
     AbstractRobot,
@@ -132,6 +134,7 @@ def assemble(b: Build, r: Resolved, robot_class: type[AbstractRobot]) -> Abstrac
         ),
         srdf=b.srdf,
         drive_type=drive_type(b),
+        forward_axis=forward_axis(b),
         controlled_joint_names=None
         if spec.controlled_joints is None
         else tuple(spec.controlled_joints),
@@ -211,3 +214,28 @@ def drive_type(b: Build) -> str:
     if parent is None or parent.is_fixed:
         return "fixed"
     return {"planar": "omni", "floating": "floating"}.get(parent.type.value, parent.type.value)
+
+
+def forward_axis(b: Build) -> tuple[float, float, float]:
+    """The spec's ``forward`` (checked by :func:`check_forward`), unit length; default +x."""
+    f = b.spec.forward
+    if f is None:
+        return (1.0, 0.0, 0.0)
+    n = math.sqrt(sum(x * x for x in f)) or 1.0
+    return (f[0] / n, f[1] / n, f[2] / n)
+
+
+def check_forward(b: Build) -> None:
+    """The robot's forward axis must be a horizontal unit vector of its root's frame."""
+    f = b.spec.forward
+    if f is None:
+        return
+    n = math.sqrt(sum(x * x for x in f))
+    if abs(n - 1.0) > UNIT_TOL:
+        b.diag.error(("forward",), f"must be a unit vector, its length is {n:.4g}")
+    elif abs(f[2]) > UNIT_TOL:
+        b.diag.error(
+            ("forward",),
+            f"must be horizontal (z = 0) in the root's frame: the robot faces along the "
+            f"ground, not {list(f)}",
+        )

@@ -7,7 +7,7 @@ second pass (``assemble``) create the semantic parts, so no half-built robot eve
 
 from __future__ import annotations
 
-from robotspec.compiler.assemble import Resolved, assemble
+from robotspec.compiler.assemble import Resolved, assemble, check_forward
 from robotspec.compiler.context import Build, moved_by, subtree_joints
 from robotspec.compiler.joints import check_states, check_velocity, srdf_state_values
 from robotspec.compiler.kinematic_checks import KinematicInputs, check_kinematics
@@ -33,6 +33,7 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
     diag = b.diag
     root = b.body(("root",), spec.root)
     b.robot_root = root
+    check_forward(b)
     robot_joints: list[Connection] = []
     if root is not None:
         robot_joints = subtree_joints(b.world, root)

@@ -80,8 +80,15 @@ def render_scene(scene: RobotScene, q: F64, options: RenderOptions | None = None
     segments = scene.overlays(q, poses) if opts.overlays else ()
     pts = [verts] + [np.array([s.start, s.end]) for s in segments]
     legend_w = _legend_width(scene.legend, opts) if opts.legend else 0
+    robot = scene.robot
+    facing = poses[robot.root.index][:3, :3] @ np.asarray(robot.forward_axis)
     camera = ViewCamera.fit(
-        opts.view, np.concatenate(pts), opts.width, opts.height, left_reserve=legend_w
+        opts.view,
+        np.concatenate(pts),
+        opts.width,
+        opts.height,
+        left_reserve=legend_w,
+        facing=(float(facing[0]), float(facing[1]), float(facing[2])),
     )
     s = max(1, int(opts.supersample))
     big = camera.scaled(s)

@@ -35,13 +35,22 @@ VIEWS: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] 
 _FRAGMENT_CHUNK = 3_000_000
 
 
-def view_axes(view: str) -> F64:
-    """Rows right, up and forward (into the screen) of a named view, world frame (3, 3)."""
+def view_axes(view: str, facing: tuple[float, float, float] = (1.0, 0.0, 0.0)) -> F64:
+    """Rows right, up and forward (into the screen) of a named view, world frame (3, 3).
+
+    ``facing`` is the direction the robot faces in the world (horizontal): the views are
+    turned about the vertical so that "front" looks at the robot's face whichever way it was
+    modelled.
+    """
     if view not in VIEWS:
         from robotspec.errors import NotFoundError
 
         raise NotFoundError("view", view, VIEWS)
-    fwd_t, up_t = VIEWS[view]
+    fx, fy = facing[0], facing[1]
+    n = float(np.hypot(fx, fy)) or 1.0
+    c, s = fx / n, fy / n
+    turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    fwd_t, up_t = (turn @ np.asarray(v) for v in VIEWS[view])
     fwd = np.asarray(fwd_t) / np.linalg.norm(fwd_t)
     up = np.asarray(up_t) - fwd * float(np.dot(up_t, fwd))
     up /= np.linalg.norm(up)
@@ -89,12 +98,13 @@ class ViewCamera:
         *,
         margin: float = 0.05,
         left_reserve: int = 0,
+        facing: tuple[float, float, float] = (1.0, 0.0, 0.0),
     ) -> ViewCamera:
         """The camera of ``view`` that shows every point with ``margin`` around them.
 
         ``left_reserve`` pixels on the left stay free (for the legend).
         """
-        axes = view_axes(view)
+        axes = view_axes(view, facing)
         c = np.asarray(points, dtype=np.float64).reshape(-1, 3) @ axes.T
         if len(c) == 0:
             c = np.zeros((1, 3))

@@ -65,6 +65,8 @@ class AbstractRobot:
     disabled_collision_bodies: set[str] = field(default_factory=set, kw_only=True)
     srdf: Srdf | None = field(default=None, kw_only=True, repr=False)
     drive_type: str = field(default="fixed", kw_only=True)
+    #: The direction the robot faces in its root's frame (a horizontal unit vector; REP 103: +x).
+    forward_axis: tuple[float, float, float] = field(default=(1.0, 0.0, 0.0), kw_only=True)
     controlled_joint_names: tuple[str, ...] | None = field(default=None, kw_only=True)
     _sides: tuple[tuple[int, ...], tuple[KinematicChain, KinematicChain]] | None = field(
         default=None, init=False, repr=False
@@ -149,8 +151,17 @@ class AbstractRobot:
         key = tuple(id(a) for a in arms)
         if self._sides is None or self._sides[0] != key:
             declared = [getattr(a, "side", None) for a in arms]
-            self._sides = (key, arm_sides(self.world, self.root, arms, declared))
+            self._sides = (
+                key,
+                arm_sides(self.world, self.root, arms, declared, left=self.left_axis),
+            )
         return self._sides[1]
+
+    @property
+    def left_axis(self) -> tuple[float, float, float]:
+        """The robot's left in its root's frame: up (+z) cross :attr:`forward_axis`."""
+        fx, fy, _ = self.forward_axis
+        return (-fy, fx, 0.0)
 
     @property
     def cameras(self) -> list[Camera]:

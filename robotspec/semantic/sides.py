@@ -29,19 +29,33 @@ Side = Literal["left", "right"]
 SIDE_TOLERANCE = 1e-6
 
 
-def lateral_offset(world: World, root: Body, chain: KinematicChain) -> float:
-    """Mean y (m) of the chain's bodies below its root, in ``root``'s frame, default pose."""
+def lateral_offset(
+    world: World,
+    root: Body,
+    chain: KinematicChain,
+    left: tuple[float, float, float] = (0.0, 1.0, 0.0),
+) -> float:
+    """Mean offset (m) of the chain's bodies below its root along the robot's ``left``.
+
+    In ``root``'s frame, default pose; ``left`` is +y for a robot facing +x (REP 103).
+    """
     from robotspec.model.kinematics import Kinematics
 
     kin = Kinematics(world)
     q = world.default_configuration()
     bodies = [b for b in chain.bodies if b.name != chain.root.name] or [chain.tip]
-    ys = [float(kin.pose(q, b.name, relative_to=root.name)[1, 3]) for b in bodies]
+    axis = np.asarray(left, dtype=np.float64)
+    ys = [float(kin.pose(q, b.name, relative_to=root.name)[:3, 3] @ axis) for b in bodies]
     return float(np.mean(ys))
 
 
 def arm_sides(
-    world: World, root: Body, arms: Sequence[KinematicChain], declared: Sequence[Side | None]
+    world: World,
+    root: Body,
+    arms: Sequence[KinematicChain],
+    declared: Sequence[Side | None],
+    *,
+    left: tuple[float, float, float] = (0.0, 1.0, 0.0),
 ) -> tuple[KinematicChain, KinematicChain]:
     """(left, right) of exactly two arms: declared sides first, else position from ``root``.
 
@@ -68,11 +82,11 @@ def arm_sides(
         if da == "left" or db == "right":
             return a, b
         return b, a
-    ya, yb = lateral_offset(world, root, a), lateral_offset(world, root, b)
+    ya, yb = lateral_offset(world, root, a, left), lateral_offset(world, root, b, left)
     if abs(ya - yb) < SIDE_TOLERANCE:
         raise KinematicsError(
-            f"arms '{a.name}' and '{b.name}' lie side by side on the x axis of '{root.name}' "
-            "in the default pose; declare 'side: left' on one chain in the spec",
+            f"arms '{a.name}' and '{b.name}' lie side by side on the forward axis of "
+            f"'{root.name}' in the default pose; declare 'side: left' on one chain in the spec",
             kind="chain",
             name=a.name,
         )

@@ -329,6 +329,13 @@ class RobotSpec(SpecModel):
         description="the robot's root link (composed robots: the base part's)",
         examples=["base_footprint"],
     )
+    forward: tuple[float, float, float] | None = Field(
+        default=None,
+        description="the direction the robot faces, a horizontal unit vector in its root "
+        "link's frame (default +x, REP 103); a robot modelled facing -y says [0, -1, 0]: its "
+        "left is then +x, and render's front view looks at its face",
+        examples=[[0, -1, 0]],
+    )
     drive: DriveSpec | None = Field(
         default=None,
         description="how the base moves (default: from the SRDF's virtual joint)",

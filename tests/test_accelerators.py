@@ -9,10 +9,12 @@ way, and every command must run when the compiled modules cannot be imported at 
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from types import ModuleType
 from typing import Any, TypeVar
 
@@ -254,6 +256,46 @@ def test_mesh_arguments_are_checked_alike(mesh: ModuleType) -> None:
     with pytest.raises(ValueError, match="out of range"):
         mesh.mesh_set([(v, f + 4)])
     assert mesh.apart(s, poses, [0], [0], [0], [1], 1e-5).dtype == np.uint8
+
+
+_FAILING_CALLOC = r"""
+#include <stdlib.h>
+#include <string.h>
+/* calloc, except that (12347, sizeof(void *)) fails: mesh_set's table of 12347 trees. */
+void *calloc(size_t n, size_t size) {
+    if (n == 12347 && size == sizeof(void *)) return NULL;
+    if (size != 0 && n > (size_t)-1 / size) return NULL;
+    void *p = malloc(n * size);
+    if (p != NULL) memset(p, 0, n * size);
+    return p;
+}
+"""
+
+
+def test_mesh_set_survives_a_failed_allocation(mesh_c: ModuleType, tmp_path: Path) -> None:
+    """An allocation failure is a MemoryError (it freed the set twice: a crash)."""
+    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    if not sys.platform.startswith("linux") or cc is None:
+        pytest.skip("needs Linux (LD_PRELOAD) and a C compiler to inject the failure")
+    (tmp_path / "shim.c").write_text(_FAILING_CALLOC)
+    shim = tmp_path / "shim.so"
+    subprocess.run([cc, "-shared", "-fPIC", "-o", str(shim), str(tmp_path / "shim.c")], check=True)
+    code = (
+        "from robotspec.collision import _meshcore\n"
+        "try:\n"
+        "    _meshcore.mesh_set([None] * 12347)\n"
+        "except MemoryError:\n"
+        "    print('MemoryError')\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "LD_PRELOAD": str(shim)},
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "MemoryError"
 
 
 def test_a_batch_split_over_threads_checks_everything_first() -> None:

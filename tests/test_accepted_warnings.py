@@ -1,4 +1,4 @@
-"""Warnings a correct spec can silence: by saying what a chain is, or accepting one with a reason."""
+"""Warnings a correct spec can silence: by saying what a chain is, or accepting one."""
 
 from __future__ import annotations
 

@@ -364,6 +364,5 @@ def test_other_commands_print_the_warnings_attached_to_an_error(
     assert f"{spec}:10:10: error:" in lines[0] and "'l_elbow_flex_lnk'" in lines[0]
     assert (
         f"{spec}:6:5: warning: chains.spare: chain 'spare' has neither a manipulator nor a "
-        "sensor (not an arm? say 'kind: leg' or 'kind: chain')"
-        in lines[1:]
+        "sensor (not an arm? say 'kind: leg' or 'kind: chain')" in lines[1:]
     )

@@ -24,6 +24,7 @@ import pytest
 from robotspec import robots
 from robotspec.collision import SelfCollisionChecker, meshcore, random_configurations
 from robotspec.collision import _meshcore_py as mesh_py
+from robotspec.errors import KinematicsError
 from robotspec.model import _kincore_py as kin_py
 from robotspec.model import kincore
 from robotspec.model.kinematics import Kinematics
@@ -310,6 +311,11 @@ def test_a_batch_split_over_threads_checks_everything_first() -> None:
     assert (out == 7.0).all()  # no slice ran
     with pytest.raises(ValueError, match="threads"):
         kincore.fk_batch(k._tree, qs, 65)
+    # The public call names the array at fault (not the configuration the core was given).
+    buf = np.zeros(out.size * 8 + 1, dtype=np.uint8)
+    for bad in (out.astype(">f8"), buf[1:].view(np.float64).reshape(out.shape)):
+        with pytest.raises(KinematicsError, match="out must be a writeable, aligned"):
+            k.forward_batch(np.zeros_like(qs), out=bad)
 
 
 # ---------------------------------------------------------------------- without the C cores

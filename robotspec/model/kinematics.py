@@ -396,6 +396,7 @@ def _check_out(out: object, shape: tuple[int, ...]) -> None:
         and out.dtype == np.float64
         and out.shape == shape
         and out.flags.c_contiguous
+        and out.flags.aligned
         and out.flags.writeable
     )
     if not ok:
@@ -405,5 +406,6 @@ def _check_out(out: object, shape: tuple[int, ...]) -> None:
             else type(out).__name__
         )
         raise KinematicsError(
-            f"out must be a writeable C-contiguous float64 array of shape {shape}, got {got}"
+            f"out must be a writeable, aligned C-contiguous float64 array of shape {shape}, "
+            f"got {got}"
         )

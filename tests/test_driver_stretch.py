@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import bisect
 import json
+import math
 from pathlib import Path
 from unittest.mock import patch
 
@@ -424,3 +425,27 @@ def test_cli_summary_names_the_slowed_trajectories(
         "scenario: 2 of 2 steps as expected; 1 trajectory slowed to stay within the joint "
         "limits (step 2)"
     )
+
+
+def test_scenario_waypoints_may_carry_velocities(tmp_path: Path) -> None:
+    script = tmp_path / "s.yaml"
+    rows = []
+    for i in range(6):  # 0.1 -> 0.35 rad on the base, cosine law over 0.5 s
+        t = 0.1 * i
+        q = 0.1 + 0.125 * (1 - math.cos(math.pi * t / 0.5))
+        v = 0.125 * math.pi / 0.5 * math.sin(math.pi * t / 0.5)
+        rows.append(
+            f"    - {{time_from_start: {t:.1f}, joint_position: [{q!r}, 0, 0], "
+            f"joint_velocity: [{v!r}, 0, 0]}}\n"
+        )
+    script.write_text(
+        "- call: command_mode\n  args: {mode: trajectory}\n"
+        "- call: execute_trajectory\n  args:\n    waypoints:\n"
+        + "".join(rows)
+        + "  expect: {status: complete}\n"
+        "- check: {joint_position: [0.35, 0.0, 0.0]}\n"
+    )
+    robot = SimRobot(load_robot_info(RRP), clock=SimClock(), initial_position=[0.1, 0.0, 0.0])
+    robot.step()
+    results = run_scenario(robot, load_scenario(script))
+    assert [(r.ok, r.note) for r in results] == [(True, ""), (True, ""), (True, "")]

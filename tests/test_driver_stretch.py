@@ -212,7 +212,7 @@ def check_curve(
         assert st_.segments == int(np.sum(interp.segment_stretch > 1 + 1e-12)) >= 1
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(case=waypoint_sets())
 def test_curve_stays_within_the_limits_through_the_waypoints(
     case: tuple[JointLimitArrays, JointTrajectory, float, F64 | None],

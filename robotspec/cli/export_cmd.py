@@ -166,6 +166,8 @@ def bundle_cmd(
     """
     from robotspec.compiler import check_spec, resolve_spec
     from robotspec.export.urdf import bundle
+    from robotspec.cli.output import plural
+    from robotspec.files.meshes import read_mesh_bytes
 
     path = resolve_spec(spec)
     stem = name or path.stem
@@ -176,6 +178,14 @@ def bundle_cmd(
             refuse_existing(target)
     result = check_spec(path, package_paths=package_path or ())
     out = bundle(result, name=stem, package_paths=package_path or ())
+    copies = [(output / target, source) for target, source in out.meshes]
+    for target, _ in copies:
+        refuse_link(target)
+        if not force:
+            refuse_existing(target)
     for target, text in zip(targets, (out.urdf, out.srdf, out.spec), strict=True):
         write_file(target, text, force=force)
-    sys.stderr.write(f"wrote {output}/{stem}.urdf, .srdf and .yaml\n")
+    for target, source in copies:
+        write_file(target, read_mesh_bytes(source), force=force)
+    carried = f" and {plural(len(copies), 'mesh file')} in {stem}_meshes/" if copies else ""
+    sys.stderr.write(f"wrote {output}/{stem}.urdf, .srdf and .yaml{carried}\n")

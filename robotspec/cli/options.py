@@ -95,7 +95,7 @@ def refuse_link(path: Path, *, raced: bool = False) -> None:
         )
 
 
-def write_file(path: Path, text: str, *, force: bool = True) -> None:
+def write_file(path: Path, text: str | bytes, *, force: bool = True) -> None:
     """Write a file the user named; a folder that is missing or read-only is their error.
 
     Never through a symbolic link: a link planted in an output folder (``robot.urdf`` pointing
@@ -131,7 +131,7 @@ def write_file(path: Path, text: str, *, force: bool = True) -> None:
                 file=shown,
                 kind="output",
             )
-        data = text.encode("utf-8")
+        data = text.encode("utf-8") if isinstance(text, str) else text
         view = memoryview(data)
         while view:
             view = view[os.write(fd, view) :]

@@ -17,6 +17,7 @@ from typing import Any
 from lxml import etree
 
 from robotspec.compiler import CompileResult
+from robotspec.model.geometry import Mesh
 from robotspec.spec.load import LoadedSpec, check_package_paths, load_spec
 
 __all__ = ["Bundle", "bundle", "joined_urdf", "urdf_text"]
@@ -51,11 +52,49 @@ def urdf_text(tree: etree._Element, *, comment: str) -> str:
 
 @dataclass(frozen=True)
 class Bundle:
-    """The three texts of an exported robot."""
+    """The three texts of an exported robot, and the mesh files it carries along.
+
+    ``meshes`` maps a path relative to the bundle's folder to the file it copies: the meshes
+    the description named by a path of the user's machine (``../meshes/base.stl``), which the
+    bundle names relative to itself so that it works wherever it is copied. ``package://``
+    meshes stay as they are: the package is the way other tools find them too.
+    """
 
     urdf: str
     srdf: str
     spec: str
+    meshes: tuple[tuple[str, Path], ...] = ()
+
+
+def _carry_meshes(
+    tree: etree._Element, folder: str, allowed: set[Path]
+) -> tuple[tuple[str, Path], ...]:
+    """Point the tree's file-path meshes into ``folder`` (relative); what to copy where.
+
+    Only files the compiled robot resolved (inside the allowed folders, ``allowed``) are
+    carried: a description naming ``/home/me/.ssh/id_rsa`` as a mesh was warned about when the
+    robot was read and must not ride along into a bundle. One copy per source file; two
+    sources with one name get numbered names.
+    """
+    copies: dict[Path, str] = {}
+    taken: set[str] = set()
+    for el in tree.iter("mesh"):
+        given = el.get("filename")
+        if not given or "://" in given and not given.startswith("file://"):
+            continue
+        source = Path(given.removeprefix("file://")).resolve()
+        if source not in allowed:
+            continue
+        if source not in copies:
+            stem, suffix = source.stem, source.suffix
+            name, n = f"{stem}{suffix}", 1
+            while name.lower() in taken:
+                n += 1
+                name = f"{stem}_{n}{suffix}"
+            taken.add(name.lower())
+            copies[source] = f"{folder}/{name}"
+        el.set("filename", copies[source])
+    return tuple((target, source) for source, target in copies.items())
 
 
 def _flat_spec_data(result: CompileResult, urdf_name: str, srdf_name: str) -> dict[str, Any]:
@@ -95,6 +134,13 @@ def bundle(
     source = result.loaded.file
     # result.loaded is the flat spec (parts already joined); the tree comes from the source.
     tree = joined_urdf(load_spec(source), package_paths=package_paths)
+    resolved = {
+        Path(shape.geometry.path).resolve()
+        for body in robot.world.bodies
+        for shape in (*body.visuals, *body.collisions)
+        if isinstance(shape.geometry, Mesh) and shape.geometry.path is not None
+    }
+    meshes = _carry_meshes(tree, f"{name}_meshes", resolved)
     urdf = urdf_text(tree, comment=f"{robot.name}: exported by robotspec from {source.name}")
     srdf = write_srdf(srdf_from_robot(robot))
     data = _flat_spec_data(result, f"{name}.urdf", f"{name}.srdf")
@@ -105,4 +151,4 @@ def bundle(
     spec = head + yaml.safe_dump(
         data, sort_keys=False, allow_unicode=True, width=100, default_flow_style=None
     )
-    return Bundle(urdf=urdf, srdf=srdf, spec=spec)
+    return Bundle(urdf=urdf, srdf=srdf, spec=spec, meshes=meshes)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import io
 import re
 import struct
+from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
@@ -17,7 +18,7 @@ from robotspec.errors import RobotSpecError
 from robotspec.files.limits import env_name, limits
 from robotspec.files.reading import read_bounded
 
-__all__ = ["declared_triangles", "read_triangles"]
+__all__ = ["declared_triangles", "read_mesh_bytes", "read_triangles"]
 
 _PLY_FACES = re.compile(rb"^element\s+face\s+(\d+)\s*$", re.MULTILINE)
 
@@ -59,6 +60,13 @@ def _check_triangles(
             file=path,
             kind="size",
         )
+
+
+def read_mesh_bytes(path: str | Path) -> bytes:
+    """A mesh file's bytes, bounded by ``max_mesh_bytes`` (to copy it, as ``export bundle``)."""
+    return read_bounded(
+        path, cap=limits().max_mesh_bytes, cap_name="max_mesh_bytes", what="a mesh file"
+    )
 
 
 def read_triangles(

@@ -164,9 +164,9 @@ def bundle_cmd(
     `robotspec validate FOLDER/NAME.yaml` then compiles to the same robot (a composed one too).
     Existing files are kept unless --force; a symbolic link is never written through.
     """
+    from robotspec.cli.output import plural
     from robotspec.compiler import check_spec, resolve_spec
     from robotspec.export.urdf import bundle
-    from robotspec.cli.output import plural
     from robotspec.files.meshes import read_mesh_bytes
 
     path = resolve_spec(spec)

@@ -1,9 +1,13 @@
-"""Flat and degenerate collision meshes (issue 24, item 4): distances answer, never a crash.
+"""Flat and degenerate collision meshes (issue 24, item 4): right answers, never a crash.
 
 A plate of two triangles is common in real URDFs (a sensor's mounting plate, a caster's cover).
 Coal's qhull crashed the whole process (SIGSEGV) when the distance path asked it for the convex
 hull of such a mesh; the checker now gives a flat mesh no hull and uses coal's mesh distance.
 The command line runs in a subprocess, so a crash there fails one test instead of the run.
+
+Triangles without area (needles, points) are left out of every mesh: with one of them, coal's
+distance from the mesh to any sphere read minus the radius. A mesh with no triangle of any area
+is refused, naming its link and file.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import pytest
 from robotspec.collision import CollisionRules, SelfCollisionChecker
 from robotspec.collision.checker import _solid
 from robotspec.description.urdf import load_urdf
+from robotspec.errors import CollisionError
 
 #: Degenerate point sets: (vertices, triangles), each 0.1 m across, in the mesh's frame.
 MESHES: dict[str, tuple[list[list[float]], list[list[int]]]] = {
@@ -25,6 +30,10 @@ MESHES: dict[str, tuple[list[list[float]], list[list[int]]]] = {
     "sliver": (
         [[0, 0, 0], [0.1, 0, 0], [0.05, 0.1, 0], [0.05, 0.05, 1e-10]],
         [[0, 1, 2], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+    ),
+    "needled": (  # the plate, and a needle along its edge
+        [[0, 0, 0], [0.1, 0, 0], [0.1, 0.1, 0], [0, 0.1, 0], [0.05, 0, 0]],
+        [[0, 1, 2], [0, 2, 3], [0, 4, 1]],
     ),
     "collinear": ([[0, 0, 0], [0.05, 0, 0], [0.1, 0, 0], [0.1, 0, 0]], [[0, 1, 2], [1, 2, 3]]),
     "repeated": ([[0, 0, 0], [0, 0, 0], [0, 0, 0], [0.1, 0, 0]], [[0, 1, 3], [1, 2, 3]]),
@@ -70,7 +79,11 @@ def _robot(tmp_path: Path, a: str, b: str) -> Path:
     return path
 
 
-@pytest.mark.parametrize("name", sorted(MESHES))
+#: Meshes with no triangle of any area.
+NO_AREA = ("collinear", "repeated")
+
+
+@pytest.mark.parametrize("name", ["needled", "plate", "sliver"])
 def test_distances_of_a_flat_mesh_are_its_mesh_distances(tmp_path: Path, name: str) -> None:
     world = load_urdf(_robot(tmp_path, name, "plate"))
     checker = SelfCollisionChecker(world, CollisionRules.for_world(world))
@@ -90,6 +103,65 @@ def test_distances_of_a_flat_mesh_are_its_mesh_distances(tmp_path: Path, name: s
     assert not checker.in_collision(q)
 
 
+@pytest.mark.parametrize("name", NO_AREA)
+def test_a_mesh_without_area_is_refused_naming_link_and_file(tmp_path: Path, name: str) -> None:
+    world = load_urdf(_robot(tmp_path, name, "plate"))
+    checker = SelfCollisionChecker(world, CollisionRules.for_world(world))
+    with pytest.raises(CollisionError, match=r"link 'a': mesh has no triangle with an area") as err:
+        checker.distances(world.configuration())
+    assert err.value.file is not None and err.value.file.endswith(f"{name}.stl")
+    skipping = SelfCollisionChecker(world, CollisionRules.for_world(world), on_missing_mesh="skip")
+    assert skipping.distances_batch(world.configuration()[None, :])[0] == pytest.approx(
+        [np.inf, np.inf, 0.85], abs=1e-9
+    )
+    assert len(skipping.skipped) == 1 and skipping.skipped[0].severity == "warning"
+
+
+def test_needle_triangles_do_not_spoil_sphere_queries(tmp_path: Path) -> None:
+    """A plate and a cube, each with needles, and a ball near each (a ball over the plate moves).
+
+    The flat plate has no hull, so its distance is coal's mesh distance; the ball by the cube's
+    corner is inside the cube's bounding box, so coal's narrow phase decides its collision.
+    """
+    import trimesh
+
+    _write_stl(tmp_path / "needled.stl", "needled")
+    cube = trimesh.creation.box(extents=(0.1, 0.1, 0.1))  # each coordinate in [-0.05, 0.05]
+    top = [[0.05, 0.05, 0.05], [0.05, 0.0, 0.05], [0.05, 0.025, 0.05]]
+    faces = np.vstack([cube.faces, [[8, 10, 9], [8, 8, 9]]])  # needles on the top face
+    mesh = trimesh.Trimesh(np.vstack([cube.vertices, top]), faces, process=False)
+    mesh.export(str(tmp_path / "cube.stl"))
+    (tmp_path / "balls.urdf").write_text(
+        """<robot name="balls">
+  <link name="plate"><collision><geometry><mesh filename="needled.stl"/></geometry></collision>
+  </link>
+  <link name="cube"><collision><geometry><mesh filename="cube.stl"/></geometry></collision></link>
+  <link name="ball"><collision><geometry><sphere radius="0.05"/></geometry></collision></link>
+  <link name="corner"><collision><geometry><sphere radius="0.05"/></geometry></collision></link>
+  <joint name="plate_cube" type="fixed">
+    <parent link="plate"/><child link="cube"/><origin xyz="1 0 0"/>
+  </joint>
+  <joint name="drop" type="prismatic">
+    <parent link="plate"/><child link="ball"/><origin xyz="0.05 0.05 0.07"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <joint name="cube_corner" type="fixed">
+    <parent link="cube"/><child link="corner"/><origin xyz="0.09 0.09 0.09"/>
+  </joint>
+</robot>"""
+    )
+    world = load_urdf(tmp_path / "balls.urdf")
+    pairs = [("plate", "ball"), ("cube", "corner")]
+    checker = SelfCollisionChecker(world, CollisionRules.for_world(world), pairs=pairs)
+    corner = 3**0.5 * 0.04 - 0.05  # from (0.09, 0.09, 0.09) to the cube's corner, less the radius
+    qs = np.array([[0.0], [-0.03]])  # the ball 2 cm over the plate, then 1 cm through it
+    got = checker.distances_batch(qs)
+    assert got == pytest.approx(np.array([[0.02, corner], [-0.01, corner]]), abs=1e-6)
+    assert checker.collisions_batch(qs).tolist() == [[False, False], [True, False]]
+    kept = [len(g.triangles[1]) for g in checker.geometry.geometries if g.triangles is not None]
+    assert kept == [2, 12]  # the needles left out
+
+
 def test_flat_mesh_collides_through_a_primitive(tmp_path: Path) -> None:
     world = load_urdf(_robot(tmp_path, "plate", "plate"))
     checker = SelfCollisionChecker(world, CollisionRules.for_world(world))
@@ -104,6 +176,7 @@ def test_solid_point_sets_keep_their_hull_and_flat_ones_get_none() -> None:
     plate = np.c_[rng.uniform(0, 0.1, (50, 2)), np.zeros(50)]
     for name, (vertices, _) in MESHES.items():
         assert not _solid(np.array(vertices, dtype=np.float64)), name
+    assert NO_AREA
     assert not _solid(plate @ rotation.T)  # flat in any orientation
     bumped = plate.copy()
     bumped[0, 2] = 1e-9  # thinner than qhull can hull

@@ -30,7 +30,7 @@ _CHUNK = 256
 
 
 # ----------------------------------------------------------------------------------- helpers
-def _array(obj: object, dtype: type[np.generic], what: str) -> np.ndarray[Any, Any]:
+def as_array(obj: object, dtype: type[np.generic], what: str) -> np.ndarray[Any, Any]:
     """``obj`` as a native-order array of ``dtype``; TypeError when it cannot safely be one.
 
     Python numbers are converted as the C core's ``PyArray_FROMANY`` converts them; an array
@@ -47,7 +47,7 @@ def _array(obj: object, dtype: type[np.generic], what: str) -> np.ndarray[Any, A
 
 
 def _sized(obj: object, dtype: type[np.generic], want: int, what: str) -> np.ndarray[Any, Any]:
-    a = _array(obj, dtype, what)
+    a = as_array(obj, dtype, what)
     if a.size != want:
         raise ValueError(f"{what}: expected {want} values, got {a.size}")
     return a.reshape(-1).copy()
@@ -62,7 +62,7 @@ def _count(value: object, what: str) -> int:
 
 def _config(obj: object, ndim: int, width: int) -> F64:
     """A configuration (ndim 1) or batch (ndim 2) of ``width`` finite values, as float64."""
-    a = _array(obj, np.float64, "configuration")
+    a = as_array(obj, np.float64, "configuration")
     if a.ndim != ndim:
         raise ValueError(f"configuration must have {ndim} dimension(s), got {a.ndim}")
     if a.shape[-1] != width:
@@ -480,7 +480,7 @@ def broad(geoms: object, body_poses: Any, margin: float, mask: Any) -> tuple[Any
         raise TypeError("expected a geometry table (from geoms())")
     g = geoms
     margin = float(margin)
-    bp = _array(body_poses, np.float64, "body poses")
+    bp = as_array(body_poses, np.float64, "body poses")
     if bp.ndim not in (3, 4):
         raise ValueError("body poses must have 3 or 4 dimensions")
     if bp.ndim == 3:
@@ -489,7 +489,7 @@ def broad(geoms: object, body_poses: Any, margin: float, mask: Any) -> tuple[Any
         raise ValueError("body poses have the wrong shape")
     keep = np.ones(len(g.g1), dtype=np.bool_)
     if mask is not None:
-        m = _array(mask, np.uint8, "pair mask")
+        m = as_array(mask, np.uint8, "pair mask")
         if m.ndim != 1:
             raise ValueError("pair mask must have 1 dimension")
         if m.size != len(g.g1):

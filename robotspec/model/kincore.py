@@ -75,25 +75,22 @@ def fk_batch(tree: object, q: object, threads: int = 1, out: Any = None) -> F64:
     c = core()
     if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= 64:
         raise ValueError(f"threads must be between 1 and 64, got {threads!r}")
-    arr = np.asarray(q) if isinstance(q, np.ndarray) else None
-    n = arr.shape[0] if arr is not None and arr.ndim == 2 else 0
+    n = q.shape[0] if isinstance(q, np.ndarray) and q.ndim == 2 else 0
     threads = min(threads, n)
     if threads <= 1:
         poses: F64 = c.fk_batch(tree, q, out, out is not None)
         return poses
-    assert arr is not None
+    from robotspec.model._kincore_py import as_array, check_out
+
     n_out, n_dof = c.tree_size(tree)
-    if arr.dtype != np.float64 or not arr.dtype.isnative:
-        arr = arr.astype(np.float64)  # the core would convert it once per slice
-    arr = np.ascontiguousarray(arr)
+    # Converted once here (native, contiguous float64), not once per slice by the core.
+    arr = np.ascontiguousarray(as_array(q, np.float64, "configuration"))
     if arr.shape[1] != n_dof:
         raise ValueError("configuration has the wrong number of values")
     if not np.isfinite(arr).all():
         raise ValueError("configuration contains NaN or infinite values")
     stream = out is not None
     if stream:  # the core's checks of the caller's array, once (each slice is a view of it)
-        from robotspec.model._kincore_py import check_out
-
         check_out(out, (n, n_out, 4, 4))
     result: F64 = np.empty((n, n_out, 4, 4)) if out is None else out
     errors: list[BaseException] = []

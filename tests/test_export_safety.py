@@ -138,3 +138,22 @@ def test_write_file_writes_new_files_exactly(tmp_path: Path) -> None:
         write_file(target, "again", force=False)
     write_file(target, "again", force=True)
     assert target.read_text() == "again"
+
+
+def test_render_never_writes_through_a_link(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from tests.conftest import erd_robots
+
+    erd_robots()
+    target = tmp_path / "victim.txt"
+    target.write_text("keep me")
+    link = tmp_path / "robot.png"
+    link.symlink_to(target)
+    code, text = _run(capsys, "render", "ur5", "-o", str(link), "--size", "64x48")
+    assert code == 1 and "symbolic link" in text
+    assert target.read_text() == "keep me"
+    out = tmp_path / "real.png"
+    code, text = _run(capsys, "render", "ur5", "-o", str(out), "--size", "64x48")
+    assert code == 0, text
+    assert out.read_bytes().startswith(b"\x89PNG")

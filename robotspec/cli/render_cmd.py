@@ -17,6 +17,7 @@ from robotspec.cli.options import (
     StateOpt,
     joint_values,
     load_robot,
+    write_file,
 )
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
@@ -67,7 +68,7 @@ def render(
     picture = render_scene(
         scene, config, RenderOptions(width=width, height=height, view=view, title=title)
     )
-    picture.save(output)
+    write_file(output, picture.png())  # never through a link planted at the output path
     sys.stdout.write(f"wrote {output} ({width}x{height}, {view} view)\n")
 
 

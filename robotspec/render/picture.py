@@ -51,6 +51,17 @@ class Picture:
 
     def save(self, path: Path) -> None:
         """Write the image as PNG; the view and scale go into its text chunks."""
+        try:
+            path.write_bytes(self.png())
+        except OSError as exc:
+            raise RobotSpecError(
+                f"cannot write image: {exc.strerror or exc}", file=str(path), kind="file"
+            ) from None
+
+    def png(self) -> bytes:
+        """The image as PNG bytes, the view and scale in its text chunks."""
+        import io
+
         from PIL import Image, PngImagePlugin
 
         info = PngImagePlugin.PngInfo()
@@ -60,12 +71,9 @@ class Picture:
         info.add_text(
             "robotspec:legend", "; ".join(f"{e.name}=#{_hex(e.colour)}" for e in self.legend)
         )
-        try:
-            Image.fromarray(self.image, "RGB").save(path, format="PNG", pnginfo=info)
-        except OSError as exc:
-            raise RobotSpecError(
-                f"cannot write image: {exc.strerror or exc}", file=str(path), kind="file"
-            ) from None
+        buffer = io.BytesIO()
+        Image.fromarray(self.image, "RGB").save(buffer, format="PNG", pnginfo=info)
+        return buffer.getvalue()
 
 
 def _hex(c: tuple[int, int, int]) -> str:

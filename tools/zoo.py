@@ -22,6 +22,10 @@ import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from tools.draft_score import RobotScore, Truth
 
 __all__ = [
     "COMMAND",
@@ -81,6 +85,8 @@ class ZooRow:
     draft: str = ""  # the draft's text
     #: For shipped robots: (hand-written chains the draft got right, hand-written chains, missed).
     compared: tuple[int, int, list[str]] | None = None
+    #: For robots with a ground truth (``tests/data/draft_truth``): the draft scored against it.
+    score: RobotScore | None = None
 
 
 def erd_robots_folder() -> Path | None:
@@ -164,7 +170,24 @@ def zoo_row(entry: ZooEntry, folder: Path) -> ZooRow:
     shipped = next((s for s, n in SHIPPED_COMPARED.items() if n == entry.name), None)
     if shipped is not None:
         row.compared = compare_with_shipped(shipped, draft, world, desc.srdf)
+    truth = _truths().get(entry.name)
+    if truth is not None:
+        from tools.draft_score import score_draft
+
+        row.score = score_draft(truth, draft, world, row.valid)
     return row
+
+
+_TRUTHS: dict[str, Truth] = {}
+
+
+def _truths() -> dict[str, Truth]:
+    """The ground truths by robot, read once."""
+    from tools.draft_score import load_truths
+
+    if not _TRUTHS:
+        _TRUTHS.update({t.robot: t for t in load_truths()})
+    return _TRUTHS
 
 
 def compare_with_shipped(
@@ -255,6 +278,21 @@ def zoo_page(rows: Sequence[ZooRow]) -> str:
             got, of, missed = r.compared
             lines.append(f"| {spec} | {r.entry.name} | {got} / {of} | {', '.join(missed) or '-'} |")
         lines += ["", f"In all: {right} of {total} hand-written chains drafted right.", ""]
+    scored = [r.score for r in rows if r.score is not None]
+    if scored:
+        from tools.draft_score import score_lines
+
+        lines += [
+            "## The draft against ground truth",
+            "",
+            "Robots robotspec ships no spec for, with what an expert's spec of each holds written",
+            "by hand (`tests/data/draft_truth/`), scored by `python tools/draft_score.py`: each",
+            "item of the truth, and each item the draft adds that the truth lacks, counts once",
+            "(see the tool's docstring for what is right).",
+            "",
+            *score_lines(scored),
+            "",
+        ]
     lines += [
         "## Every robot",
         "",
@@ -320,4 +358,5 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # ``tools`` as a package
     sys.exit(main())

@@ -1,0 +1,222 @@
+"""How close ``robotspec init``'s drafts come to what an expert writes, robot by robot.
+
+Why: "the draft validates" says nothing about whether its arm ends at the wrist or its gripper
+is one. Ground truth written by hand for robots of example-robot-data that robotspec ships no
+spec for (``tests/data/draft_truth/*.yaml``: the chains, tool frames, grippers, cameras, torso,
+neck and drive an expert's spec has) is compared with the draft of the same files, by category::
+
+    python tools/draft_score.py      # the per-robot table and the totals
+
+The robot zoo (``tools/zoo.py``) publishes the same table in ``docs/robot-zoo.md``.
+
+How an item is counted: every item of the truth, plus every item the draft adds that the truth
+does not have (an extra chain, camera or parallel gripper is wrong), is one; it is right when
+the draft has it:
+
+* chains: same kind (arm or leg) and the same actuated joints (fixed links at the ends do not
+  count);
+* tool frames: a drafted manipulator has the truth's tool frame, or, where the truth says the
+  URDF lacks one (``{parent: LINK}``), a frame the draft proposes on that link;
+* grippers: a drafted parallel gripper whose finger tips are the truth's two;
+* cameras: a camera on the truth's frame;
+* torso, neck: the same actuated joints (present in either); drive: the same type (and the
+  same base joints, when the truth names them).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "CATEGORIES",
+    "TRUTH",
+    "RobotScore",
+    "Truth",
+    "load_truths",
+    "main",
+    "score_draft",
+    "score_lines",
+]
+
+#: The ground truth files.
+TRUTH = Path(__file__).resolve().parents[1] / "tests" / "data" / "draft_truth"
+#: The categories, in the table's order.
+CATEGORIES = ("valid", "chains", "tool frames", "grippers", "cameras", "torso/neck/drive")
+
+
+@dataclass(frozen=True)
+class Truth:
+    """One robot's ground truth: its zoo name and what its expert spec holds."""
+
+    file: str
+    robot: str
+    data: dict[str, Any]
+
+
+def load_truths(folder: Path = TRUTH) -> list[Truth]:
+    """Every ground truth file of ``folder``, by file name."""
+    import yaml
+
+    out = []
+    for path in sorted(folder.glob("*.yaml")):
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        if not isinstance(data, dict) or not isinstance(data.get("robot"), str):
+            raise ValueError(f"{path}: a ground truth needs 'robot: <package>/<urdf stem>'")
+        out.append(Truth(path.stem, data["robot"], data))
+    return out
+
+
+@dataclass
+class RobotScore:
+    """Per category: (right, counted) and what was wrong."""
+
+    robot: str
+    counts: dict[str, tuple[int, int]] = field(default_factory=dict)
+    wrong: list[str] = field(default_factory=list)
+
+    def add(self, category: str, right: bool, what: str) -> None:
+        """Count one item of ``category``; ``what`` says what was wrong when it is not right."""
+        got, of = self.counts.get(category, (0, 0))
+        self.counts[category] = (got + int(right), of + 1)
+        if not right:
+            self.wrong.append(f"{category}: {what}")
+
+
+def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> RobotScore:
+    """The draft of ``truth``'s robot against it (see the module docstring)."""
+    from robotspec.model.world import World
+    from robotspec.spec.draft.model import Draft
+
+    assert isinstance(draft, Draft) and isinstance(world, World)
+    t = truth.data
+    s = RobotScore(truth.robot)
+    s.add("valid", valid, "the draft does not validate as written")
+
+    def joints(root: str, tip: str) -> frozenset[str]:
+        conns = world.compute_chain_of_connections(root, tip)
+        return frozenset(c.name for c in conns if c.is_active)
+
+    # Chains: kind and joints.
+    drafted = [(c.role, c.joints, c.name) for c in draft.chains]
+    matched: set[int] = set()
+    for name, c in (t.get("chains") or {}).items():
+        want = (c.get("kind", "arm"), joints(c["root"], c["tip"]))
+        hit = next((i for i, d in enumerate(drafted) if i not in matched and d[:2] == want), None)
+        if hit is not None:
+            matched.add(hit)
+        s.add("chains", hit is not None, f"{name} ({c['root']} -> {c['tip']}) not drafted")
+    for i, (_, _, name) in enumerate(drafted):
+        if i not in matched:
+            s.add("chains", False, f"drafted {name}, not a chain of the truth")
+    # Tool frames and grippers.
+    frames = {f.name: f.parent for f in draft.frames}
+    grippers = [m for m in draft.manipulators if m.is_gripper]
+    used: set[str] = set()
+    for name, m in (t.get("manipulators") or {}).items():
+        tool = m.get("tool_frame")
+        if isinstance(tool, dict):
+            ok = any(frames.get(d.tool_frame) == tool["parent"] for d in draft.manipulators)
+            shown = f"a new frame on {tool['parent']}"
+        else:
+            ok = any(d.tool_frame == tool for d in draft.manipulators)
+            shown = str(tool)
+        s.add("tool frames", ok, f"{name}: {shown}")
+        if m.get("type") == "parallel_gripper":
+            tips = frozenset(m["fingers"])
+            hit_g = next(
+                (
+                    g
+                    for g in grippers
+                    if g.name not in used
+                    and g.thumb is not None
+                    and g.finger is not None
+                    and frozenset((g.thumb.tip, g.finger.tip)) == tips
+                ),
+                None,
+            )
+            if hit_g is not None:
+                used.add(hit_g.name)
+            s.add("grippers", hit_g is not None, f"{name}: fingers {sorted(tips)}")
+    for g in grippers:
+        if g.name not in used:
+            s.add("grippers", False, f"drafted {g.name} as a parallel gripper, not one")
+    # Cameras.
+    want_cams = list(t.get("cameras") or [])
+    have_cams = [c.body for c in draft.cameras]
+    for body in want_cams:
+        s.add("cameras", body in have_cams, f"{body} not a camera")
+    for body in have_cams:
+        if body not in want_cams:
+            s.add("cameras", False, f"drafted {body}, not a camera of the truth")
+    # Torso, neck, drive.
+    for key in ("torso", "neck"):
+        want_part = t.get(key)
+        have_part = getattr(draft, key)
+        if want_part is None and have_part is None:
+            continue
+        want_j = None if want_part is None else joints(want_part["root"], want_part["tip"])
+        have_j = None if have_part is None else have_part.joints
+        s.add("torso/neck/drive", want_j == have_j, f"{key}: {sorted(have_j or [])}")
+    drive = t.get("drive") or {"type": "fixed"}
+    d = draft.drive
+    ok = d is not None and d.type == drive["type"]
+    if ok and "joints" in drive:
+        ok = list(getattr(d, "joints", None) or []) == list(drive["joints"])
+    s.add("torso/neck/drive", ok, f"drive: {d.type if d is not None else None}")
+    return s
+
+
+def _pct(got: int, of: int) -> str:
+    return f"{got}/{of} ({round(100 * got / of)} %)" if of else "-"
+
+
+def score_lines(scores: Sequence[RobotScore]) -> list[str]:
+    """The Markdown table: one row per robot, the totals by category, and what was wrong."""
+    head = "| robot | " + " | ".join(CATEGORIES) + " |"
+    lines = [head, "| --- |" + " --- |" * len(CATEGORIES)]
+    totals = {c: [0, 0] for c in CATEGORIES}
+    for s in scores:
+        cells = []
+        for c in CATEGORIES:
+            got, of = s.counts.get(c, (0, 0))
+            totals[c][0] += got
+            totals[c][1] += of
+            cells.append(f"{got}/{of}" if of else "-")
+        lines.append(f"| {s.robot} | " + " | ".join(cells) + " |")
+    lines.append("| **all** | " + " | ".join(_pct(*totals[c]) for c in CATEGORIES) + " |")
+    wrong = [(s.robot, w) for s in scores for w in s.wrong]
+    if wrong:
+        lines += ["", "Wrong:", ""]
+        lines += [f"- {robot}: {w}".replace("|", "\\|") for robot, w in wrong]
+    return lines
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python tools/draft_score.py``: draft every robot with a ground truth, print the table."""
+    import tempfile
+
+    from tools.zoo import erd_robots_folder, zoo_entries, zoo_row
+
+    del argv
+    robots = erd_robots_folder()
+    if robots is None:
+        sys.stderr.write("example-robot-data is not installed: pip install 'robotspec[data]'\n")
+        return 2
+    entries = {e.name: e for e in zoo_entries(robots)}
+    scores = []
+    with tempfile.TemporaryDirectory(prefix="robotspec-score-") as tmp:
+        for truth in load_truths():
+            row = zoo_row(entries[truth.robot], Path(tmp))
+            if row.score is not None:
+                scores.append(row.score)
+    sys.stdout.write("\n".join(score_lines(scores)) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    sys.exit(main())

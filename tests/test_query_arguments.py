@@ -304,6 +304,39 @@ def test_pr2_in_collision_of_a_batch(tmp_path: Path) -> None:
     kin = Kinematics(pr2.world)
     with pytest.raises(KinematicsError, match="complex128"):
         kin.forward_batch(qs.astype(np.complex128))
+    # One state's name is that state, not its letters ('p' was not found).
+    np.testing.assert_array_equal(checker.configuration("park"), checker.configuration(["park"]))
+    with pytest.raises(CollisionError, match="joint 'r_elbow_flex_joint': value must be finite"):
+        checker.configuration((), {"r_elbow_flex_joint": np.inf})
+    with pytest.raises(CollisionError, match="value must be a real number, got str"):
+        checker.configuration((), {"r_elbow_flex_joint": "-1"})  # type: ignore[dict-item]
+
+
+def test_configurations_by_name_and_chain_ends_say_what_is_wrong(
+    checker: SelfCollisionChecker,
+) -> None:
+    world, kin = checker.world, checker.kinematics
+    assert world.configuration({"slide": -1}).tolist() == [-1.0, 0.0]
+    for value, match in (
+        ("a", "value of 'slide' must be a real number, got str"),
+        (1j, "value of 'slide' must be a real number, got complex"),
+        (np.inf, "value of 'slide' must be finite, got inf"),
+    ):
+        with pytest.raises(KinematicsError, match=match):
+            world.configuration({"slide": value})  # type: ignore[dict-item]
+    with pytest.raises(KinematicsError, match="values must be a mapping"):
+        world.configuration([0.0, 0.0])  # type: ignore[arg-type]
+    for bad in (5, None):
+        with pytest.raises(KinematicsError, match="a chain end must be a body name"):
+            kin.pose(FREE, bad)  # type: ignore[arg-type]
+        with pytest.raises(KinematicsError, match="a chain end must be a body name"):
+            kin.chain("base", bad)  # type: ignore[arg-type]
+    with pytest.raises(CollisionError, match="on_missing_mesh must be 'error' or 'skip'"):
+        SelfCollisionChecker(
+            world,
+            checker.rules,
+            on_missing_mesh="ignore",  # type: ignore[arg-type]
+        )
 
 
 def test_pinocchio_configuration_refuses_what_float64_cannot_hold() -> None:

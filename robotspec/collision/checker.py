@@ -166,6 +166,11 @@ class SelfCollisionChecker:
         )
         self._pair_index = {pair_key(a, b): i for i, (a, b) in enumerate(self._pairs)}
         self._meshes = meshes if meshes is not None else MeshLibrary()
+        if on_missing_mesh not in ("error", "skip"):  # any other word read as "skip"
+            raise CollisionError(
+                f"on_missing_mesh must be 'error' or 'skip', got {on_missing_mesh!r}",
+                kind="config",
+            )
         self._on_missing = on_missing_mesh
         self._kin: Kinematics | None = None
         self._compiled: _Compiled | None = None

@@ -173,6 +173,9 @@ class Kinematics:
 
     def chain(self, root: Body | str, tip: Body | str) -> ChainKinematics:
         """Kinematics of the root-to-tip chain (cached per pair)."""
+        for end in (root, tip):
+            if not isinstance(end, str | Body):
+                raise KinematicsError(f"a chain end must be a body name, got {type(end).__name__}")
         r = self.world.get_body_by_name(root) if isinstance(root, str) else root
         t = self.world.get_body_by_name(tip) if isinstance(tip, str) else tip
         key = (r.index, t.index)

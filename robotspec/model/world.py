@@ -18,6 +18,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from robotspec.arrays import real_number
 from robotspec.errors import (
     DescriptionError,
     DuplicateNameError,
@@ -472,10 +473,20 @@ class World:
         return q
 
     def configuration(self, values: Mapping[str, float] | None = None) -> np.ndarray:
-        """A configuration vector: the default pose, with ``values`` set by DOF name."""
+        """A configuration vector: the default pose, with ``values`` set by DOF name.
+
+        A value must be a finite real number: a string, a complex number or an infinity is a
+        KinematicsError naming the DOF (not numpy's bare error, nor a vector every query
+        refuses later).
+        """
         q = self.default_configuration()
+        if values is not None and not isinstance(values, Mapping):
+            raise KinematicsError(
+                f"values must be a mapping of DOF names to numbers, got {type(values).__name__}"
+            )
         for name, v in (values or {}).items():
-            q[self.get_degree_of_freedom_by_name(name).index] = v
+            index = self.get_degree_of_freedom_by_name(name).index
+            q[index] = real_number(v, f"value of '{name}'", KinematicsError)
         return q
 
     def __repr__(self) -> str:

@@ -8,13 +8,12 @@ pictures and the live view all start from here, over the world's one default pos
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robotspec.arrays import F64
+from robotspec.arrays import F64, real_number
 from robotspec.errors import CollisionError, NotFoundError
 
 if TYPE_CHECKING:
@@ -39,13 +38,18 @@ def state_configuration(
     """
     world = robot.world
     q = world.default_configuration() if base is None else np.array(base, dtype=np.float64)
+    if isinstance(states, str):  # one state's name, not its letters one by one
+        states = (states,)
     for name in states:
         for joint, value in _state_values(robot, name).items():
             q[_dof_index(world, joint)] = value
     for joint, value in (values or {}).items():
-        if not math.isfinite(value):
-            raise CollisionError(f"joint '{joint}': value {value} is not finite", name=joint)
-        q[_dof_index(world, joint)] = value
+        index = _dof_index(world, joint)
+
+        def error(message: str, joint: str = joint) -> CollisionError:
+            return CollisionError(message, name=joint)
+
+        q[index] = real_number(value, f"joint '{joint}': value", error)
     return q
 
 

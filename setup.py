@@ -34,12 +34,14 @@ class OptionalBuildExt(build_ext):
     """
 
     def run(self) -> None:
+        """Build every extension; any failure (say, no compiler at all) only warns."""
         try:
             super().run()
         except Exception as exc:  # noqa: BLE001 - any build failure leaves the fallbacks
             self._skipped("the C accelerators", exc)
 
     def build_extension(self, ext: Extension) -> None:
+        """Build one extension with its compiler's flags; a failure only warns."""
         if self.compiler is not None and self.compiler.compiler_type == "msvc":
             ext.extra_compile_args = ["/O2"]
         else:
@@ -51,10 +53,9 @@ class OptionalBuildExt(build_ext):
 
     @staticmethod
     def _skipped(what: str, exc: BaseException) -> None:
-        print(
+        sys.stderr.write(
             f"warning: robotspec: could not build {what} ({type(exc).__name__}: {exc}); "
-            "installing without it: every query still works, in numpy (slower)",
-            file=sys.stderr,
+            "installing without it: every query still works, in numpy (slower)\n"
         )
 
 

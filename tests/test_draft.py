@@ -50,9 +50,9 @@ def test_baxter_without_srdf_has_two_arms_grippers_neck(tmp_path: Path) -> None:
     grippers = {m.name: m for m in d.manipulators}
     right = grippers["right_gripper"]
     assert right.is_gripper and right.root == "right_gripper_base_link"
-    # The thumb is the driven finger; the other one mimics it.
-    assert right.thumb is not None and right.thumb.tip == "r_gripper_l_finger"
-    assert right.finger is not None and right.finger.tip == "r_gripper_r_finger"
+    # The thumb is the driven finger; the other one mimics it. Each ends at its fixed tip link.
+    assert right.thumb is not None and right.thumb.tip == "r_gripper_l_finger_tip"
+    assert right.finger is not None and right.finger.tip == "r_gripper_r_finger_tip"
     # Baxter's tool frame hangs on a joint named 'right_endpoint': found by its joint's name.
     assert right.tool_frame == "right_gripper"
     assert grippers["left_gripper"].tool_frame == "left_gripper"

@@ -18,6 +18,7 @@ from robotspec.spec.draft.hands import (
     facing_quaternion,
     find_gripper,
     find_tool_frame,
+    hand_center,
     hand_joints,
 )
 from robotspec.spec.draft.limbs import Limb, find_limbs
@@ -197,9 +198,13 @@ class Drafter:
             if not world.is_ancestor(world.bodies[lb.segment.joints[0].child], tip)
             for b in world.subtree(world.bodies[lb.segment.joints[0].child])
         )
-        tool = find_tool_frame(tree, top, others)
-        if tool is None and top is not tip:
-            tool = find_tool_frame(tree, tip, others)
+        prefer = None if gripper is None else gripper.root
+        tool = find_tool_frame(tree, top, others, prefer)
+        # A tool frame above the hand (a flange, a wrist F/T sensor) only when the hand has no
+        # tips to put one between.
+        tipless = hand is None or hand_center(tree, top) is None
+        if tool is None and top is not tip and gripper is None and tipless:
+            tool = find_tool_frame(tree, tip, others, prefer)
             if tool is not None:
                 decide.append(f"the only named tool frame is above the hand: root '{tip.name}'")
                 top = tip
@@ -220,6 +225,14 @@ class Drafter:
                 gripper.root.name,
                 xyz,
                 "the URDF has no tool frame: between the finger tips in the default pose",
+            )
+        elif hand is not None and (center := hand_center(tree, top)) is not None:
+            tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))
+            frame = DraftFrame(
+                tool_name,
+                top.name,
+                center,
+                "the URDF has no tool frame: between the hand's tips in the default pose",
             )
         else:
             tool_name = top.name

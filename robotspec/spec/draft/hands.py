@@ -17,10 +17,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from robotspec.model.entities import Body
+from robotspec.spec.draft.limbs import FINGER_WORDS, HAND_WORDS, is_named
 from robotspec.spec.draft.model import DraftFinger
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["Gripper", "facing_quaternion", "find_gripper", "find_tool_frame", "hand_joints"]
+__all__ = [
+    "Gripper",
+    "facing_quaternion",
+    "find_gripper",
+    "find_tool_frame",
+    "hand_center",
+    "hand_joints",
+]
 
 #: How tool frames are usually named, best first: (substring of the name, or a whole word).
 TOOL_HINTS: tuple[str, ...] = (
@@ -28,6 +36,7 @@ TOOL_HINTS: tuple[str, ...] = (
     "tcp",
     "grasping_frame",
     "grasp_frame",
+    "gripper_frame",
     "grasp",
     "tool0",
     "end_effector",
@@ -64,13 +73,59 @@ def _finger_tip(tree: Tree, branch: Body) -> Body:
     Geometry first: PR2's xacro hangs a bare frame on a prismatic joint below the finger tip.
     """
     world = tree.world
-    moved = [
-        b
-        for b in world.subtree(branch)
-        if (c := world.parent_connection(b)) is not None and not c.is_fixed
-    ]
-    solid = [b for b in moved if b.collisions or b.visuals]
+    inside = world.subtree(branch)
+    moved = [b for b in inside if (c := world.parent_connection(b)) is not None and not c.is_fixed]
+    # A fixed tip link with geometry is the finger's tip (Baxter's 'r_gripper_l_finger_tip').
+    solid = [b for b in inside if b.collisions or b.visuals]
     return max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
+
+
+def _dofs(tree: Tree, branch: Body) -> set[int]:
+    """The degrees of freedom that move a branch (a mimic joint moves its leader's)."""
+    world = tree.world
+    return {d for b in world.subtree(branch) if (c := world.parent_connection(b)) for d in c.dofs}
+
+
+def _jaws(tree: Tree, hand: Body) -> Gripper | None:
+    """Two jaws in series below ``hand``, the second hanging on the first (a WSG-50's).
+
+    Such a gripper has no split into two branches: the run from the hand passes through both
+    jaw joints (prismatic or revolute, each carrying geometry) and ends there.
+    """
+    world = tree.world
+    body = hand
+    passed = []
+    while True:
+        kids = tree.moving_children(body)
+        if len(kids) != 1:
+            break
+        body = kids[0]
+        c = world.parent_connection(body)
+        if c is not None and not c.is_fixed:
+            passed.append(c)
+    if kids or len(passed) != 2:
+        return None
+    j1, j2 = passed
+    jaw1, jaw2 = world.bodies[j1.child], world.bodies[j2.child]
+    if j1.type != j2.type or not (_own_geometry(jaw1) and _own_geometry(jaw2)):
+        return None
+    named = any(is_named(b.name, FINGER_WORDS | HAND_WORDS) for b in (jaw1, jaw2))
+    if j1.type.value != "prismatic" and not named:
+        return None  # two revolute links in series are a pendulum, not jaws
+    root = world.bodies[j1.parent]
+    decide = None if j2.is_mimic else "both jaws are driven; the upper one is taken for the thumb"
+    return Gripper(
+        root=root,
+        thumb=DraftFinger(root.name, jaw1.name),
+        finger=DraftFinger(jaw1.name, jaw2.name),
+        thumb_tip=jaw1,
+        finger_tip=jaw2,
+        decide=decide,
+    )
+
+
+def _own_geometry(body: Body) -> bool:
+    return bool(body.collisions or body.visuals)
 
 
 def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | None:
@@ -112,7 +167,12 @@ def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | N
 
 
 def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
-    """A parallel gripper at or below ``hand``, or ``None`` and why not."""
+    """A parallel gripper at or below ``hand``, or ``None`` and why not.
+
+    Two branches that no joint couples, one of which splits again into two coupled fingers
+    (Interbotix's: the gripper motor's horn beside the finger carriage), are not the fingers:
+    the coupled pair below is.
+    """
     world = tree.world
     body = hand
     while True:
@@ -121,6 +181,15 @@ def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
             break
         body = kids[0]
     branches = [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
+    if len(branches) == 2 and not _dofs(tree, branches[0]) & _dofs(tree, branches[1]):
+        for k in branches:
+            deeper, _ = find_gripper(tree, k)
+            if deeper is not None and deeper.decide is None:
+                return deeper, "two coupled finger branches"
+    if not branches:
+        jaws = _jaws(tree, hand)
+        if jaws is not None:
+            return jaws, "two jaws, one hanging on the other"
     sides = _sides(tree, body, branches)
     if sides is None:
         if not branches:
@@ -166,10 +235,18 @@ def _matches(hint: str, name: str) -> bool:
     return hint in words(name)
 
 
-def find_tool_frame(tree: Tree, top: Body, exclude: frozenset[int] = frozenset()) -> Body | None:
-    """The best-named tool frame in ``top``'s subtree (``exclude``: bodies of other parts)."""
+def find_tool_frame(
+    tree: Tree, top: Body, exclude: frozenset[int] = frozenset(), prefer: Body | None = None
+) -> Body | None:
+    """The best-named tool frame in ``top``'s subtree (``exclude``: bodies of other parts).
+
+    Of equally named frames, one hanging from ``prefer`` (where the fingers split) wins: the
+    TCP sits between the fingers, the flange above them (Interbotix's 'ee_gripper_link' beside
+    'ee_arm_link').
+    """
     world = tree.world
     candidates = [b for b in world.subtree(top) if b.index not in exclude]
+    near = set() if prefer is None else {b.index for b in world.subtree(prefer)}
     joint = {b.index: world.parent_connection(b) for b in candidates}
     for hint in TOOL_HINTS:
         # The link's name, or its joint's (Baxter's 'right_gripper' hangs on 'right_endpoint').
@@ -180,8 +257,26 @@ def find_tool_frame(tree: Tree, top: Body, exclude: frozenset[int] = frozenset()
             or ((c := joint[b.index]) is not None and c.is_fixed and _matches(hint, c.name))
         ]
         if hits:
-            return min(hits, key=lambda b: (world.depth(b), b.index))
+            return min(hits, key=lambda b: (b.index not in near, world.depth(b), b.index))
     return None
+
+
+def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:
+    """Between a hand's finger tips in the default pose, in ``top``'s frame (``None``: no tips).
+
+    The tips are the leaves with geometry below ``top``; a tool frame proposed there is a guess.
+    """
+    world = tree.world
+    tips = [
+        b
+        for b in world.subtree(top)
+        if b is not top and not world.child_bodies(b) and _own_geometry(b)
+    ]
+    if not tips:
+        return None
+    mid = np.mean([tree.poses[b.index][:3, 3] for b in tips], axis=0)
+    local = np.linalg.inv(tree.poses[top.index]) @ np.append(mid, 1.0)
+    return (round(float(local[0]), 4), round(float(local[1]), 4), round(float(local[2]), 4))
 
 
 def hand_joints(tree: Tree, top: Body) -> frozenset[str]:

@@ -80,10 +80,43 @@ def is_named(name: str, vocabulary: frozenset[str]) -> bool:
     return bool(words(name) & vocabulary) or any(w in low for w in vocabulary & INNER_WORDS)
 
 
+def hand_cut(tree: Tree, seg: Segment) -> int | None:
+    """Where the hand starts in a run: the first body named as a hand below which only fingers move.
+
+    Why not the first body named as a hand: wrists are often named after the hand they turn
+    (GR1T2's ``l_hand_yaw``, ``l_hand_roll``, ``l_hand_pitch``); a joint below the cut that moves
+    a link not named as a finger or jaw is still the arm's.
+    """
+    world = tree.world
+    for i, b in enumerate(seg.bodies):
+        if i == 0 or not words(b.name) & HAND_WORDS:
+            continue
+        below = [world.parent_connection(k) for k in seg.bodies[i + 1 :]]
+        if all(c is None or c.is_fixed or _hand_joint(tree, c) for c in below):
+            return i
+    return None
+
+
+#: Words of a wrist's links and joints (an arm's), even when they are named after the hand.
+AXIS_WORDS = frozenset({"yaw", "roll", "pitch", "wrist", "flex", "rotate", "rotation"})
+
+
+def _hand_joint(tree: Tree, c: Connection) -> bool:
+    """Whether a joint below a hand-named link moves the hand's own parts (a finger, a jaw)."""
+    child = tree.world.bodies[c.child].name
+    if is_named(child, FINGER_WORDS):
+        return True
+    named = words(child) | words(c.name)
+    return bool(named & HAND_WORDS) and not named & (AXIS_WORDS | ARM_WORDS)
+
+
 def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     world = tree.world
-    cut = next((i for i, b in enumerate(seg.bodies) if i > 0 and words(b.name) & HAND_WORDS), None)
-    bodies = seg.bodies[:cut]
+    cut = hand_cut(tree, seg)
+    # The joint that moves the hand is the arm's last (a wrist roll turning 'gripper_link').
+    into_hand = None if cut is None else world.parent_connection(seg.bodies[cut])
+    upto = None if cut is None else cut + int(into_hand is not None and not into_hand.is_fixed)
+    bodies = seg.bodies[:upto]
     moving: list[Connection] = []
     for b in bodies:
         c = world.parent_connection(b)
@@ -92,7 +125,7 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     actuated = [c for c in moving if c.is_active]
     if len(actuated) < MIN_LIMB_JOINTS or _named(bodies, FINGER_WORDS):
         return None
-    reach = tree.length(seg, cut)
+    reach = tree.length(seg, upto)
     if reach < MIN_LIMB_LENGTH:
         return None
     # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.

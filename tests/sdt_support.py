@@ -27,7 +27,7 @@ from __future__ import annotations
 import importlib.util
 import os
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -48,7 +48,17 @@ def require_sdt() -> None:
         sys.path.append(str(STAND_INS))
 
 
-def stand_in_cylinder(folder: Path) -> None:
+@pytest.fixture(scope="session")
+def sdt(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """SDT importable with its stand-ins; generated classes' recipes kept in a temporary folder."""
+    require_sdt()
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("ROBOTSPEC_SDT_CLASSES", str(tmp_path_factory.mktemp("sdt-classes")))
+        stand_in_cylinder(tmp_path_factory.mktemp("sdt-cylinder"), mp)
+        yield
+
+
+def stand_in_cylinder(folder: Path, mp: pytest.MonkeyPatch) -> None:
     """SDT's cylinder shape from a unit cylinder written to ``folder`` (see the docstring)."""
     import trimesh
     from semantic_digital_twin.collision_checking import pybullet_collision_detector as pcd
@@ -62,7 +72,7 @@ def stand_in_cylinder(folder: Path) -> None:
         scaling = bullet.Vector3(diameter, diameter, height) * 0.996  # as SDT's own
         return bullet.load_convex_shape(str(mesh), single_shape=True, scaling=scaling)
 
-    pcd.create_cylinder_shape = create_cylinder_shape
+    mp.setattr(pcd, "create_cylinder_shape", create_cylinder_shape)
 
 
 def package_path(folders: Iterable[Path]) -> str:

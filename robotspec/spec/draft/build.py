@@ -21,7 +21,15 @@ from robotspec.spec.draft.hands import (
     hand_center,
     hand_joints,
 )
-from robotspec.spec.draft.limbs import Limb, find_limbs
+from robotspec.spec.draft.limbs import (
+    FINGER_WORDS,
+    HAND_WORDS,
+    MAX_HAND_SPAN,
+    Limb,
+    find_limbs,
+    hand_span,
+    is_named,
+)
 from robotspec.spec.draft.model import (
     Draft,
     DraftChain,
@@ -30,6 +38,7 @@ from robotspec.spec.draft.model import (
     DraftManipulator,
 )
 from robotspec.spec.draft.naming import (
+    facing,
     join,
     named_side,
     role_by_name,
@@ -100,8 +109,21 @@ class Drafter:
                 drive = DraftDrive(
                     kind, vj.name, vj.parent_frame, f"the SRDF's virtual joint '{vj.name}'"
                 )
+        elif (base := base_joints(world)) is not None:
+            # The URDF moves its base itself (LoCoBot): those joints are the drive, not an arm's
+            # or a neck's, and the robot starts below them.
+            root = world.bodies[world.get_connection_by_name(base[2]).child]
+            wheels = [c for c in world.connections if "wheel" in words(c.name) and c.is_active]
+            kind = "differential" if len(wheels) == 2 else "omni"
+            drive = DraftDrive(
+                kind,
+                source="the URDF's base joints",
+                decide=f"the URDF's x, y, theta joints move the base; {kind}?",
+                joints=base,
+            )
         self.tree = Tree(world, root)
         self.limbs = find_limbs(self.tree)
+        self.forward, forward_why = facing(self.tree, self.limbs)
         self.draft = Draft(
             name=name,
             urdf=urdf,
@@ -112,6 +134,8 @@ class Drafter:
             manipulators=[],
             cameras=[],
         )
+        if forward_why is not None:
+            self.draft.forward, self.draft.forward_decide = self.forward, forward_why
 
     # ------------------------------------------------------------------------------ chains
     def chains(self) -> list[tuple[DraftChain, Limb | None]]:
@@ -158,7 +182,7 @@ class Drafter:
             group = [lb for lb in rest if lb.kind == kind]
             if not group:
                 continue
-            labels, by_name = side_labels(self.tree, group)
+            labels, by_name = side_labels(self.tree, group, self.forward)
             for lb, label in zip(group, labels, strict=True):
                 c = DraftChain(
                     unique(join(label, kind), self.names),
@@ -275,6 +299,9 @@ class Drafter:
                 tree.poses[gripper.thumb_tip.index][:3, 3]
                 + tree.poses[gripper.finger_tip.index][:3, 3]
             ) / 2
+        elif frame is not None:  # a proposed frame: from the hand's root out to it
+            ref = tree.poses[tool.index][:3, 3]
+            target = (tree.poses[tool.index] @ np.append(np.asarray(frame.xyz), 1.0))[:3]
         else:
             ref, target = tree.poses[tip.index][:3, 3], tree.poses[tool.index][:3, 3]
         axis = rot.T @ (target - ref)
@@ -284,6 +311,34 @@ class Drafter:
         else:
             m.front_facing = q
             m.decide.append("front_facing_orientation: grasping along the hand's reach")
+
+    def lone_hand(self) -> DraftManipulator | None:
+        """A hand or a gripper alone (no arm): one manipulator rooted at the robot's root.
+
+        Why not nothing: a hand's URDF (Allegro's, a WSG-50's) is a part that specs compose onto
+        an arm; its spec is its manipulator, fingers and tool frame. It is a hand when its
+        fingers make a parallel gripper, or when two or more short moving branches leave its
+        root, or when its links are named as a hand's.
+        """
+        tree, world = self.tree, self.world
+        root = tree.root
+        gripper, _ = find_gripper(tree, root)
+        # Fingers have phalanges: a branch of one joint (a rotor, a wheel) is not one.
+        branches = [
+            k
+            for k in tree.moving_children(root)
+            if sum(1 for b in world.subtree(k) if not _fixed_above(world, b)) >= 2
+        ]
+        named = any(is_named(b.name, HAND_WORDS | FINGER_WORDS) for b in world.subtree(root))
+        small = hand_span(tree, root) <= MAX_HAND_SPAN
+        if gripper is None and not (len(branches) >= 2 and (small or named)):
+            return None
+        holder = DraftChain("hand", root.name, root.name, "the URDF tree")
+        m = self.manipulator(holder, None, "gripper" if gripper else "hand", start=root)
+        if m is not None:
+            m.decide.insert(0, "a hand alone (no arm): rooted at the robot's root")
+            self.draft.lone_hand = m.name
+        return m
 
     def end_effectors(self, chains: list[tuple[DraftChain, Limb | None]]) -> None:
         """SRDF end effectors become the manipulators of the chains they hang from."""
@@ -328,6 +383,39 @@ class Drafter:
                 m.source = f"the SRDF end effector '{ee.name}' ({m.source})"
 
 
+def base_joints(world: World) -> tuple[str, str, str] | None:
+    """The URDF's own planar base: prismatic x, prismatic y, revolute z below its root, if so.
+
+    Proven by the compiler's own check (``collapse_planar_joints``), so a drafted
+    ``drive.joints`` always validates.
+    """
+    from robotspec.errors import RobotSpecError
+    from robotspec.model.planar_drive import collapse_planar_joints
+
+    body = world.root
+    found: list[str] = []
+    while len(found) < 3:
+        kids = world.child_bodies(body)
+        moving = [k for k in kids if (c := world.parent_connection(k)) and not c.is_fixed]
+        if len(moving) != 1:
+            return None
+        body = moving[0]
+        c = world.parent_connection(body)
+        assert c is not None
+        found.append(c.name)
+    joints = (found[0], found[1], found[2])
+    try:
+        collapse_planar_joints(world, joints)
+    except RobotSpecError:
+        return None
+    return joints
+
+
+def _fixed_above(world: World, body: Body) -> bool:
+    c = world.parent_connection(body)
+    return c is None or c.is_fixed
+
+
 def draft_spec(
     world: World, *, urdf_ref: str, srdf: Srdf | None, srdf_ref: str | None, name: str
 ) -> Draft:
@@ -350,6 +438,8 @@ def draft_spec(
         else:
             word = "tool"
         d.manipulator(c, lb, join(side, word) if side else word)
+    if not d.draft.chains and not d.draft.manipulators:
+        d.lone_hand()
     add_sensors(d)
     add_torso(d)
     add_drive(d)

@@ -16,7 +16,7 @@ import numpy as np
 from robotspec.model.entities import Body, Connection
 from robotspec.spec.draft.tree import Segment, Tree, words
 
-__all__ = ["Limb", "find_limbs"]
+__all__ = ["Limb", "find_limbs", "hand_cut", "hand_span", "is_named"]
 
 HAND_WORDS = frozenset({"gripper", "hand", "palm", "eef", "jaw", "claw", "effector"})
 FINGER_WORDS = frozenset(
@@ -57,7 +57,7 @@ class Limb:
     why: str
 
 
-def _span(tree: Tree, body: Body) -> float:
+def hand_span(tree: Tree, body: Body) -> float:
     """How far the subtree of ``body`` reaches from it in the default pose (m)."""
     here = tree.position(body)
     return max(
@@ -138,11 +138,13 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     if cut is not None:
         hand = seg.bodies[cut]
     elif len(tree.moving_children(seg.end)) >= 2:
-        if _span(tree, seg.end) > MAX_HAND_SPAN:
+        if hand_span(tree, seg.end) > MAX_HAND_SPAN:
             return None  # limbs branch off here: a trunk (simple_humanoid's waist), not an arm
         hand = seg.end
     if hand is None and _named(bodies, HEAD_WORDS) and not _named(bodies, ARM_WORDS):
         return None  # a head (see sensors.find_neck)
+    if hand is None and len(actuated) <= 3 and _pan_tilt(tree, seg):
+        return None  # a pan/tilt unit pointing cameras: a neck (see sensors.find_neck)
     joints = frozenset(c.name for c in actuated)
     z_tip, z_root = tree.position(tip)[2], tree.position(root)[2]
     legs_named = _count(bodies, LEG_WORDS) > _count(bodies, ARM_WORDS)
@@ -153,6 +155,21 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     ends = f"a hand at '{hand.name}'" if hand is not None else "the end of the branch"
     why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"
     return Limb("arm", root, tip, hand, joints, seg, why)
+
+
+#: Words of a camera's frames (a run carrying one and nothing else is a neck, not an arm).
+LOOK_WORDS = frozenset({"camera", "cam", "optical", "rgb", "rgbd", "depth", "stereo", "kinect"})
+
+
+def _pan_tilt(tree: Tree, seg: Segment) -> bool:
+    """Whether a run's joints all turn (no lift) and its end carries a camera frame and no limb."""
+    world = tree.world
+    if any(c.type.value not in ("revolute", "continuous") for c in seg.joints):
+        return False
+    below = world.subtree(seg.end)
+    if tree.moving_children(seg.end):
+        return False
+    return any(words(b.name) & LOOK_WORDS for b in below)
 
 
 def find_limbs(tree: Tree) -> list[Limb]:

@@ -109,6 +109,8 @@ class DraftDrive:
     parent_frame: str | None = None
     source: str = ""
     decide: str | None = None
+    #: The URDF's own base joints (x, y, theta) made the drive (``drive.joints``), if any.
+    joints: tuple[str, str, str] | None = None
 
 
 @dataclass
@@ -129,6 +131,12 @@ class Draft:
     notes: list[str] = field(default_factory=list)
     package_paths: list[str] = field(default_factory=list)
     states: dict[str, JointState] = field(default_factory=dict)
+    #: The manipulator of a hand or gripper drafted alone (no arm carries it), if one was.
+    lone_hand: str | None = None
+    #: The direction the robot faces in its root frame, when the draft thinks it is not +x.
+    forward: tuple[float, float, float] | None = None
+    #: Why ``forward`` was drafted (a guess: written as a DECIDE mark).
+    forward_decide: str | None = None
 
     @property
     def arms(self) -> list[DraftChain]:

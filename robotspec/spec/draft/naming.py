@@ -11,7 +11,7 @@ import numpy as np
 from robotspec.spec.draft.limbs import LEG_WORDS, Limb, is_named
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["join", "named_side", "role_by_name", "side_labels", "side_of", "unique"]
+__all__ = ["facing", "join", "named_side", "role_by_name", "side_labels", "side_of", "unique"]
 
 
 def unique(name: str, taken: set[str]) -> str:
@@ -36,21 +36,64 @@ def _mean_position(tree: Tree, limb: Limb) -> np.ndarray:
     return mean
 
 
-def side_labels(tree: Tree, limbs: list[Limb]) -> tuple[list[str], bool]:
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+def facing(tree: Tree, limbs: list[Limb]) -> tuple[tuple[float, float, float], str | None]:
+    """The direction the robot faces, and why when it is not +x (REP 103's default).
+
+    Evidence: limbs named left and right (``l_arm``, ``LegR``) lie to the robot's left and
+    right; their offset, left minus right, is the robot's left (``up x forward``), so the robot
+    faces ``left x up``. Snapped to the root's axes; +x unless the names say otherwise
+    (ARMAR-4 and Stretch are modelled facing -y).
+    """
+    lateral = np.zeros(3)
+    for kind in ("arm", "leg"):
+        named: dict[str, list[np.ndarray]] = {"left": [], "right": []}
+        for lb in limbs:
+            side = named_side(lb)
+            if lb.kind == kind and side is not None:
+                named[side].append(_mean_position(tree, lb))
+        if named["left"] and named["right"]:
+            lateral += np.mean(named["left"], axis=0) - np.mean(named["right"], axis=0)
+    lateral[2] = 0.0
+    norm = float(np.linalg.norm(lateral))
+    if norm < 0.02:
+        return (1.0, 0.0, 0.0), None
+    axis = int(np.argmax(np.abs(lateral)))
+    if abs(lateral[axis]) < 0.8 * norm:
+        return (1.0, 0.0, 0.0), None  # diagonal: no clear evidence
+    left = np.zeros(3)
+    left[axis] = 1.0 if lateral[axis] > 0 else -1.0
+    fwd = np.cross(left, _UP)
+    out = (float(fwd[0]) + 0.0, float(fwd[1]) + 0.0, float(fwd[2]) + 0.0)
+    if out == (1.0, 0.0, 0.0):
+        return out, None
+    names = "xyz"
+    sign = "+" if left[axis] > 0 else "-"
+    return out, f"its left and right limbs lie along {sign}{names[axis]}: it faces this way"
+
+
+def side_labels(
+    tree: Tree, limbs: list[Limb], forward: tuple[float, float, float] = (1.0, 0.0, 0.0)
+) -> tuple[list[str], bool]:
     """Labels by position in the default pose, and whether they came from names instead.
 
-    ``left``/``right`` for two limbs (left: +y of the root, as the compiler decides), ``front``/
-    ``hind`` too for four legs; when the pose cannot tell two limbs apart, ``left``/``right`` from
-    their links' names (and the draft then declares ``side:``); else numbers.
+    ``left``/``right`` for two limbs (left: the robot's left, ``up x forward``, +y of the root
+    for a robot facing +x, as the compiler decides), ``front``/``hind`` too for four legs; when
+    the pose cannot tell two limbs apart, ``left``/``right`` from their links' names (and the
+    draft then declares ``side:``); else numbers.
     """
     if len(limbs) == 1:
         return [""], False
+    ahead = np.asarray(forward, dtype=np.float64)
+    left = np.cross(_UP, ahead)
     pos = [_mean_position(tree, lb) for lb in limbs]
-    ys = [float(p[1]) for p in pos]
+    ys = [float(p @ left) for p in pos]
     if len(limbs) == 2 and abs(ys[0] - ys[1]) >= SIDE_TOLERANCE:
         return (["left", "right"] if ys[0] > ys[1] else ["right", "left"]), False
     if len(limbs) == 4:
-        xs = [float(p[0]) for p in pos]
+        xs = [float(p @ ahead) for p in pos]
         mx, my = sum(xs) / 4, sum(ys) / 4
         labels = [
             ("front" if x > mx else "hind") + ("_left" if y > my else "_right")

@@ -102,9 +102,10 @@ def _chain_body(out: list[str], c: DraftChain, indent: str) -> None:
     else:
         out.append(f"{indent}root: {scalar(c.root)}")
         out.append(f"{indent}tip: {scalar(c.tip)}")
-    if c.role in ("leg", "chain"):
-        what = "a leg" if c.role == "leg" else "no hand found"
-        out.append(f"{indent}kind: chain  # {what}")
+    if c.role == "leg":
+        out.append(f"{indent}kind: leg")
+    elif c.role == "chain":
+        out.append(f"{indent}kind: chain  # no hand found")
     if c.side is not None:
         out.append(f"{indent}side: {c.side}")
     if c.yaw_body is not None:
@@ -157,6 +158,9 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
                 + (f"  # DECIDE: {comment(f.reason)}" if f.reason else "")
             )
     out.append(f"root: {scalar(d.root)}")
+    if d.forward is not None:
+        fwd = ", ".join(_num(v) for v in d.forward)
+        out.append(f"forward: [{fwd}]" + _decide([d.forward_decide or "the robot's facing"]))
     if d.drive is not None:
         dr = d.drive
         parts = [f"type: {dr.type}"]
@@ -164,6 +168,8 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
             parts.append(f"joint: {scalar(dr.joint)}")
         if dr.parent_frame is not None:
             parts.append(f"parent_frame: {scalar(dr.parent_frame)}")
+        if dr.joints is not None:
+            parts.append("joints: [" + ", ".join(scalar(j) for j in dr.joints) + "]")
         why = _decide([dr.decide]) if dr.decide else f"  # from {comment(dr.source)}"
         out.append("drive: {" + ", ".join(parts) + "}" + why)
     for key, part in (("torso", d.torso), ("neck", d.neck)):
@@ -175,6 +181,8 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
         for c in d.chains:
             out.append(f"  {scalar(c.name)}:  # from {comment(c.source)}{_decide(c.decide)}")
             _chain_body(out, c, "    ")
+    elif d.lone_hand is not None:
+        out.append(f"chains: {{}}  # a hand alone: {comment(d.lone_hand)} is on no chain")
     else:
         out.append("chains: {}  # DECIDE: no arm or leg found; add root/tip pairs")
     if d.manipulators:
@@ -184,7 +192,12 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
     if d.cameras:
         out.append("sensors:")
         h, v = PLACEHOLDER_FOV
-        offer = f" or a preset ({', '.join(presets)})" if presets else " or a preset"
+        # A preset replaces the whole line (``preset: NAME``); it is not a field_of_view value.
+        offer = (
+            f"; or replace this line with 'preset: NAME' ({', '.join(presets)})"
+            if presets
+            else "; or replace this line with 'preset: NAME'"
+        )
         for cam in d.cameras:
             out.append(f"  {scalar(cam.name)}:{_decide(cam.decide)}")
             out.append("    type: camera")
@@ -207,4 +220,9 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
         out.append("states:")
         for name, values in d.states.items():
             out.append(f"  {scalar(name)}: {_flow(values)}")
+    if d.lone_hand is not None:
+        out.append("accept_warnings:")
+        out.append(f"  - at: {scalar('manipulators.' + d.lone_hand)}")
+        out.append("    says: is on no chain")
+        out.append("    because: a hand alone; the arm it is mounted on carries it")
     return "\n".join(out) + "\n"

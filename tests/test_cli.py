@@ -295,7 +295,7 @@ def test_init_talos_humanoid(capsys: pytest.CaptureFixture[str], tmp_path: Path)
     assert isinstance(chains, dict)
     # The SRDF's groups (joints plus a chain): arms and legs, in the SRDF's names.
     assert sorted(chains) == ["l_arm", "l_leg", "r_arm", "r_leg"]
-    assert chains["l_leg"]["kind"] == "chain"
+    assert chains["l_leg"]["kind"] == "leg"  # a leg, as the spec says (no tool warning)
     assert data["torso"]["root"] == "base_link"  # type: ignore[index]
     assert data["torso"]["states"] == {  # type: ignore[index]
         "half_sitting": {"torso_1_joint": 0, "torso_2_joint": 0.006761}

@@ -257,7 +257,16 @@ def find_tool_frame(
             or ((c := joint[b.index]) is not None and c.is_fixed and _matches(hint, c.name))
         ]
         if hits:
-            return min(hits, key=lambda b: (b.index not in near, world.depth(b), b.index))
+            # A TCP is a frame (a leaf), not a link carrying fingers ('fingers_link' on 'ee_bar').
+            return min(
+                hits,
+                key=lambda b: (
+                    b.index not in near,
+                    bool(world.child_bodies(b)),
+                    world.depth(b),
+                    b.index,
+                ),
+            )
     return None
 
 

@@ -6,6 +6,8 @@ is +y); when the pose cannot tell (shoulders at one point), from the limbs' own 
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from robotspec.spec.draft.limbs import LEG_WORDS, Limb, is_named
@@ -119,13 +121,18 @@ def role_by_name(group: str) -> str:
 def named_side(limb: Limb) -> str | None:
     """``left`` or ``right`` when the limb's links say so (``left_hand``, ``l_wrist``)."""
     for b in limb.segment.bodies:
-        w = words(b.name)
-        first = next(iter(sorted(w)), "")
-        if "left" in w or b.name.lower().startswith("l_") or first == "l":
-            return "left"
-        if "right" in w or b.name.lower().startswith("r_") or first == "r":
-            return "right"
+        for w in ordered_words(b.name):
+            if w in ("left", "l"):
+                return "left"
+            if w in ("right", "r"):
+                return "right"
     return None
+
+
+def ordered_words(name: str) -> list[str]:
+    """The words of a name in order (``LegL_Hip1`` -> leg, l, hip, 1; ``l_wrist`` -> l, wrist)."""
+    spaced = re.sub(r"(?<=[a-z])(?=[A-Z])", "_", name)
+    return [w for w in re.split(r"[^a-z0-9]+|(?<=[a-z])(?=[0-9])", spaced.lower()) if w]
 
 
 def join(label: str, noun: str) -> str:

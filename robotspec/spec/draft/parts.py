@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from robotspec.model.entities import Body
 from robotspec.model.world import World
+from robotspec.spec.draft.limbs import HEAD_WORDS
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
 from robotspec.spec.draft.naming import unique
 from robotspec.spec.draft.sensors import find_cameras, find_neck
@@ -64,6 +65,8 @@ def add_sensors(d: Drafter) -> None:
                 continue
             kept.append(chain)
         draft.chains = kept
+    else:
+        _add_head(d, tops)
     for cam in draft.cameras:
         if cam.body in carried:
             continue
@@ -72,6 +75,44 @@ def add_sensors(d: Drafter) -> None:
         if holders:
             best = max(holders, key=lambda c: world.depth(c.tip))
             best.sensors.append(cam.name)
+
+
+def _add_head(d: Drafter, limb_tops: list[Body]) -> None:
+    """A head that carries no camera frame (GR1T2's): a chain of its own, not a neck.
+
+    A neck must carry a camera; a head whose URDF has none is still a part a person moves, so
+    it is drafted as ``kind: chain`` with the reason, to become the neck once a camera frame is
+    added.
+    """
+    tree, world = d.tree, d.world
+    for seg in tree.segments:
+        if tree.moving_children(seg.end) or not seg.joints:
+            continue
+        if not 1 <= len(seg.joints) <= 4:
+            continue
+        if any(c.type.value not in ("revolute", "continuous") for c in seg.joints):
+            continue
+        if not any(words(b.name) & HEAD_WORDS for b in seg.bodies):
+            continue
+        if any(world.is_ancestor(top, seg.start) for top in limb_tops):
+            continue
+        joints = frozenset(c.name for c in seg.joints if c.is_active)
+        if not joints or any(c.joints & joints for c in d.draft.chains):
+            continue
+        first, last = seg.joints[0], seg.joints[-1]
+        head = DraftChain(
+            unique("head", d.names),
+            world.bodies[first.parent].name,
+            world.bodies[last.child].name,
+            "the URDF tree",
+            role="chain",
+            joints=joints,
+        )
+        head.decide.append(
+            f"a head of {len(seg.joints)} joint(s) without a camera frame: a neck once one is added"
+        )
+        d.draft.chains.append(head)
+        return
 
 
 def add_torso(d: Drafter) -> None:

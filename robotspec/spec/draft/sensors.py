@@ -85,19 +85,44 @@ def find_cameras(tree: Tree) -> list[CameraFound]:
             continue
         if optical or (w & CAMERA_WORDS and not world.child_bodies(b)):
             found.append(CameraFound(_stem(b.name) or b.name, b, optical))
-    # One per device: drop a camera whose name extends another's on the same rigid body.
+    # One per device: drop a camera whose name extends another's on the same rigid body, or
+    # is extended by it. Optical frames first: 'camera_link' and its child
+    # 'camera_color_optical_frame' are one camera, on the optical frame; of a device's
+    # channels, the colour one.
     kept: list[CameraFound] = []
-    for cam in sorted(found, key=lambda c: (len(c.name), not c.optical, c.body.index)):
+    order = sorted(
+        found,
+        key=lambda c: (not c.optical, len(c.name), not words(c.name) & _COLOUR, c.body.index),
+    )
+    for cam in order:
         carrier = _rigid_root(tree, cam.body)
+        device = _device(cam.name)
         dup = any(
             _rigid_root(tree, k.body) is carrier
-            and (cam.name == k.name or cam.name.startswith(k.name + "_"))
+            and (
+                cam.name == k.name
+                or cam.name.startswith(k.name + "_")
+                or k.name.startswith(cam.name + "_")
+                or _device(k.name) == device
+            )
             for k in kept
         )
         if not dup:
             kept.append(cam)
     kept.sort(key=lambda c: c.body.index)
     return kept
+
+
+#: Words naming a channel of a camera device (one device: one camera, on its colour channel).
+_CHANNELS = frozenset({"color", "colour", "rgb", "depth", "ir", "infra", "infra1", "infra2"})
+_COLOUR = frozenset({"color", "colour", "rgb"})
+
+
+def _device(name: str) -> str:
+    """A camera's device: its name without channel words (``head_cam_depth`` -> ``head_cam``)."""
+    parts = [p for p in re.split(r"[^A-Za-z0-9]+", name.lower()) if p]
+    kept = [p for p in parts if p not in _CHANNELS]
+    return "_".join(kept) or name
 
 
 def _rigid_root(tree: Tree, body: Body) -> Body:

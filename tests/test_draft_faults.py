@@ -386,3 +386,35 @@ def test_the_field_of_view_hint_is_followed_by_replacing_the_line(tmp_path: Path
     spec = tmp_path / "followed.yaml"
     spec.write_text(followed)
     assert check_spec(spec).robot is not None
+
+
+def test_an_end_effector_whose_group_is_the_arm_is_that_arms_hand(tmp_path: Path) -> None:
+    # Alex's SRDF: end effector 'left_arm_end_effector' has the arm's own group and a parent link
+    # the URDF lacks; it was hung on the spine (then made the torso), leaving it on no chain and
+    # the gripper drafted twice.
+    urdf = tmp_path / "robot.urdf"
+    urdf.write_text(_urdf("wx250s", "base_link", WX250S))
+    srdf = tmp_path / "robot.srdf"
+    srdf.write_text(
+        '<robot name="wx250s"><group name="arm"><chain base_link="base_link"'
+        ' tip_link="gripper_link"/></group>'
+        '<end_effector name="arm_end_effector" parent_link="gripper" group="arm"/></robot>'
+    )
+    draft, _ = draft_from_files(str(urdf), str(srdf), folder=tmp_path)
+    spec = tmp_path / "draft.yaml"
+    spec.write_text(render_draft(draft))
+    assert check_spec(spec).robot is not None
+    (arm,) = draft.chains
+    (hand,) = draft.manipulators
+    assert arm.manipulator == hand.name == "arm_end_effector"
+    assert hand.is_gripper and hand.tool_frame == "ee_gripper_link"
+
+
+def test_a_camera_named_by_its_model_is_a_camera(tmp_path: Path) -> None:
+    # G1's head RealSense is 'd435_link': its words split into 'd' and '435'.
+    joints = [
+        J("j1", "revolute", "base_link", "link_1", "0 0 0.1"),
+        J("d435_joint", "fixed", "base_link", "d435_link", "0.1 0 0.5"),
+    ]
+    d, _ = _draft(tmp_path, _urdf("robot", "base_link", joints))
+    assert [(c.body, c.optical) for c in d.cameras] == [("d435_link", False)]

@@ -345,7 +345,15 @@ class Drafter:
         assert self.srdf is not None
         world = self.world
         for ee in self.srdf.end_effectors:
-            start = end_effector_root(world, self.srdf, ee, self.groups)
+            # An end effector whose group is an arm's own (Alex's 'left_arm_end_effector', group
+            # 'left_arm') is that arm's hand, not something hanging below the arm's root.
+            arm = next(((c, lb) for c, lb in chains if c.srdf_group == ee.group), None)
+            start: Body | None
+            if arm is not None:
+                arm_hand = arm[1].hand if arm[1] is not None else None
+                start = arm_hand or world.get_body_by_name(arm[0].tip)
+            else:
+                start = end_effector_root(world, self.srdf, ee, self.groups)
             if start is None:
                 self.draft.notes.append(f"end effector {ee.name!r}: its links are not in the URDF")
                 continue
@@ -358,7 +366,8 @@ class Drafter:
             named = [
                 o for o in owners if ee.parent_group is not None and o[0].name == ee.parent_group
             ]
-            pick = named or sorted(owners, key=lambda o: -world.depth(o[0].tip))
+            pick = [arm] if arm is not None else named
+            pick = pick or sorted(owners, key=lambda o: -world.depth(o[0].tip))
             if not pick:
                 self.draft.notes.append(f"end effector {ee.name!r} is on no drafted chain")
                 continue

@@ -75,7 +75,8 @@ def find_cameras(tree: Tree) -> list[CameraFound]:
     for b in world.bodies:
         if b.index not in tree.inside or b is tree.root:
             continue
-        w = words(b.name)
+        # Whole tokens too: 'd435_link' splits into 'd' and '435' as words.
+        w = words(b.name) | set(re.split(r"[^a-z0-9]+", b.name.lower()))
         if w & NOT_CAMERA_WORDS:
             continue
         optical = is_optical(tree, b)

@@ -170,3 +170,22 @@ def test_two_threads_editing_see_one_state(tmp_path: Path) -> None:
         t.join()
     assert sorted(seen) == list(range(1, 7)) and s.snapshot.version == 6
     assert len(s.part_states("robot")) == 6 and s.validation.valid
+
+
+def test_the_setup_command_reports_bad_input_like_the_cli(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    pytest.importorskip("viser")
+    with pytest.raises(SystemExit) as exc:
+        main(["setup", str(tmp_path / "nope.urdf"), "-o", str(tmp_path / "x.yaml")])
+    assert exc.value.code == 1
+    err = capsys.readouterr().err
+    assert "nope.urdf: error: file not found" in err and "Traceback" not in err
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    existing = tmp_path / "xarm.yaml"
+    existing.write_text("name: mine\n")
+    with pytest.raises(SystemExit) as exc:
+        main(["setup", str(urdf), "-o", str(existing)])
+    assert exc.value.code == 1
+    assert "robotspec setup" in capsys.readouterr().err and existing.read_text() == "name: mine\n"
+    with pytest.raises(SystemExit) as exc:
+        main(["setup", str(urdf), "--port", "70000"])
+    assert exc.value.code == 2

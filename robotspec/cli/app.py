@@ -18,6 +18,7 @@ from robotspec.cli import (
     misc_cmd,
     output,
     render_cmd,
+    setup_cmd,
     validate_cmd,
 )
 
@@ -47,6 +48,7 @@ for _module in (  # in the order a user meets them: check, look, start, write, d
     validate_cmd,
     inspect_cmd,
     init_cmd,
+    setup_cmd,
     misc_cmd,
     export_cmd,
     collisions_cmd,

@@ -37,6 +37,7 @@ __all__ = [
     "Segment",
     "build_scene",
     "camera_basis",
+    "colour_parts",
     "drive_segments",
     "frustum_corners",
 ]
@@ -137,15 +138,11 @@ def default_q(robot: AbstractRobot) -> F64:
     return robot.world.default_configuration()
 
 
-def build_scene(
-    robot: AbstractRobot,
-    *,
-    library: TriangleLibrary | None = None,
-    on_missing_mesh: MissingMeshPolicy = "error",
-    collision: bool = False,
-) -> RobotScene:
-    """Colour every visual element of the robot (or its collision elements) by its part."""
-    lib = library if library is not None else TriangleLibrary()
+def colour_parts(robot: AbstractRobot) -> tuple[dict[str, RGB], dict[str, str], list[LegendEntry]]:
+    """Each body's colour and part (chains, then hands tinted), and the legend of both.
+
+    Shared by the scene and the setup assistant, which recolours the robot as its parts change.
+    """
     world = robot.world
     colours: dict[str, RGB] = {}
     groups: dict[str, str] = {}
@@ -178,6 +175,20 @@ def build_scene(
         legend.append(
             LegendEntry(f"drive ({robot.drive.type.value}) axes", DRIVE_COLOUR, "overlay")
         )
+    return colours, groups, legend
+
+
+def build_scene(
+    robot: AbstractRobot,
+    *,
+    library: TriangleLibrary | None = None,
+    on_missing_mesh: MissingMeshPolicy = "error",
+    collision: bool = False,
+) -> RobotScene:
+    """Colour every visual element of the robot (or its collision elements) by its part."""
+    lib = library if library is not None else TriangleLibrary()
+    world = robot.world
+    colours, groups, legend = colour_parts(robot)
     parts: list[Part] = []
     skipped: list[RobotSpecError] = []
     for body in world.bodies:

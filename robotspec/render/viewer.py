@@ -80,7 +80,8 @@ class RobotViewer:
     """A viser server showing one robot; sliders, a state menu and collision toggles.
 
     Starts serving on construction; :meth:`stop` ends it. ``port=0`` picks a free port, and a
-    taken port moves to the next free one (``url`` tells which).
+    taken port moves to the next free one (``url`` tells which). ``controls=False`` serves the
+    robot without the viewer's panel (the setup assistant brings its own).
     """
 
     def __init__(
@@ -91,8 +92,10 @@ class RobotViewer:
         host: str = "127.0.0.1",
         port: int = 8080,
         on_missing_mesh: MissingMeshPolicy = "error",
+        controls: bool = True,
     ) -> None:
         self.robot = robot
+        self._controls = controls
         library = TriangleLibrary()
         self.scene: RobotScene = build_scene(
             robot, library=library, on_missing_mesh=on_missing_mesh
@@ -120,7 +123,10 @@ class RobotViewer:
         self.port = int(self.server.get_port())
         self._nodes: dict[int, Any] = {}
         self._collision_meshes: dict[str, list[Any]] = {}
+        #: Each body's visual mesh handles (the setup assistant recolours and clicks them).
+        self.visual_meshes: dict[str, list[Any]] = {}
         self._sliders: dict[int, Any] = {}
+        self._show_pairs: Any = None
         self._build()
         self.update(self.q)
 
@@ -153,7 +159,7 @@ class RobotViewer:
         for k, part in enumerate(self.scene.parts):
             self._node(part.body_index)
             t = part.triangles
-            s.add_mesh_simple(
+            handle = s.add_mesh_simple(
                 f"/robot/{part.body}/visual_{k}",
                 t.vertices,
                 t.faces,
@@ -161,6 +167,7 @@ class RobotViewer:
                 flat_shading=True,
                 side="double",
             )
+            self.visual_meshes.setdefault(part.body, []).append(handle)
         for k, part in enumerate(self.collision_scene.parts):
             self._node(part.body_index)
             t = part.triangles
@@ -208,7 +215,8 @@ class RobotViewer:
                 thickness=4.0,
                 thickness_units="screen",
             )
-        self._build_gui(world)
+        if self._controls:
+            self._build_gui(world)
 
     def _build_gui(self, world: Any) -> None:
         gui = self.server.gui
@@ -285,7 +293,7 @@ class RobotViewer:
                 pose = poses[idx]
                 node.position = tuple(float(v) for v in pose[:3, 3])
                 node.wxyz = _wxyz(pose[:3, :3])
-        if self._show_pairs.value:
+        if self._show_pairs is not None and self._show_pairs.value:
             self._refresh_pairs(q)
 
     def _apply_state(self, name: str) -> None:

@@ -432,6 +432,10 @@ class SetupSession:
 
         return self.edit(change)
 
+    def set_srdf(self, ref: str | None) -> Validation:
+        """The SRDF the spec names (a path relative to the spec, or a ``package://`` URI)."""
+        return self.edit(lambda d: setattr(d, "srdf", ref))
+
     def _states_of(self, d: Draft, part: str) -> dict[str, dict[str, float]]:
         if part == "robot":
             return d.states

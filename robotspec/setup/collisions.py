@@ -1,0 +1,80 @@
+"""The self-collision matrix and its audit, run from the assistant on the spec being edited.
+
+Why the Setup Assistant's way: MoveIt's assistant regenerates ``disable_collisions`` into the
+robot's SRDF (its groups and states kept) and the spec then names that SRDF. The file is written
+beside the spec (``<spec>.srdf``) so the spec refers to it by a relative path; the audit then
+reads what each entry of it does.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from robotspec.setup.session import SetupError, SetupSession
+
+if TYPE_CHECKING:
+    from robotspec.semantic import AbstractRobot
+
+__all__ = ["MatrixResult", "audit_session", "generate_matrix"]
+
+Progress = Callable[[int, int], None]
+
+
+@dataclass(frozen=True)
+class MatrixResult:
+    """Where the SRDF went and the summary ``collisions generate`` prints."""
+
+    srdf: Path
+    summary: str
+
+
+def _robot(session: SetupSession) -> AbstractRobot:
+    robot = session.validation.robot
+    if robot is None:
+        raise SetupError("the spec has errors; fix them before the collision matrix", kind="spec")
+    if not robot.bodies_with_collisions:
+        raise SetupError(f"robot '{robot.name}' has no collision geometry", kind="robot")
+    return robot
+
+
+def generate_matrix(
+    session: SetupSession, *, samples: int = 10_000, seed: int = 0, progress: Progress | None = None
+) -> MatrixResult:
+    """Generate the matrix, write ``<spec>.srdf`` (the robot's SRDF with it), name it."""
+    from robotspec.collision import generate_for_robot
+    from robotspec.export.srdf import write_srdf
+    from robotspec.setup.save import write_spec
+
+    robot = _robot(session)
+    matrix = generate_for_robot(
+        robot, samples=samples, seed=seed, processes=1, progress=progress, on_missing_mesh="skip"
+    )
+    srdf = matrix.to_srdf(robot.srdf, merge=False) if robot.srdf else matrix.to_srdf()
+    path = session.output.with_suffix(".srdf")
+    write_spec(path, write_srdf(srdf))
+    session.set_srdf(path.name)
+    counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
+    summary = (
+        f"{len(matrix.disabled)} pairs disabled ({counts}); {len(matrix.checked)} stay checked; "
+        f"{matrix.samples} samples, seed {matrix.seed}, {matrix.seconds:.1f} s; wrote {path.name}"
+    )
+    return MatrixResult(path, summary)
+
+
+def audit_session(
+    session: SetupSession, *, samples: int = 10_000, seed: int = 0, progress: Progress | None = None
+) -> tuple[bool, str]:
+    """What each ``disable_collisions`` entry of the spec's SRDF does: (all right, the report)."""
+    from robotspec.cli.audit_report import audit_text
+    from robotspec.collision.audit import audit_srdf
+
+    robot = _robot(session)
+    if robot.srdf is None:
+        raise SetupError("the spec names no SRDF; generate the collision matrix first", kind="srdf")
+    result = audit_srdf(
+        robot, samples=samples, seed=seed, processes=1, progress=progress, on_missing_mesh="skip"
+    )
+    return not result.wrong, audit_text(result, str(session.output), False)

@@ -1,0 +1,107 @@
+"""The setup page without a browser: its controls act on the session, and nothing a page sends
+ends the server (the browser test, tests/test_setup_browser.py, drives the same page for real).
+"""
+
+from __future__ import annotations
+
+import time
+import urllib.request
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from robotspec.compiler import check_spec
+from tests.conftest import erd_robots
+
+
+class _Person:
+    """A GUI event from a browser (the page ignores events the server caused itself)."""
+
+    client = object()
+
+
+@pytest.fixture
+def page(tmp_path: Path) -> Any:
+    pytest.importorskip("viser")
+    from robotspec.setup import SetupSession
+    from robotspec.setup.page import SetupPage
+
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    session = SetupSession.open(str(urdf), output=tmp_path / "xarm.yaml")
+    p = SetupPage(session, port=0)
+    yield p
+    p.stop()
+
+
+def test_the_page_serves_and_its_controls_edit_the_spec(page: Any, tmp_path: Path) -> None:
+    from robotspec.setup.page import SELECTED_COLOUR
+
+    with urllib.request.urlopen(page.url, timeout=10) as resp:
+        assert resp.status == 200
+    s = page.session
+    assert "3 open questions" in page._status.content and "link_eef" in page._tree.content
+    page.select("link_eef")
+    assert page._link.value == "link_eef" and "(in tool)" in page.last_message
+    assert page.viewer.visual_meshes["link7"][0].color != SELECTED_COLOUR
+    page.select("link7")
+    assert tuple(page.viewer.visual_meshes["link7"][0].color) == SELECTED_COLOUR
+    page._part.value = "chains.arm"
+    page._select_part("chains.arm")
+    assert page._f_chain.visible and not page._f_hand.visible
+    page.select("link_eef")
+    page._set_chain(tip=page._pick())
+    assert "the spec is now invalid" in page.last_message and "not below" in page.last_message
+    assert "✖ invalid" in page._status.content and "chains.arm" in page._problems.content
+    page._after(s.undo(), "undone")
+    assert "✔ valid" in page._status.content
+    for q in s.snapshot.questions:
+        s.answer(q.id)
+    assert page._questions_shown == () and "0 open questions" in page._status.content
+    page._state_part.value = "manipulators.tool"
+    page._show_sliders()
+    assert "moves no joint" in page._state_info.content
+    page._state_part.value = "chains.arm"
+    page._show_sliders()
+    page._slide_to(0.5)
+    page._state_name.value = "park"
+    page._save_state()
+    assert "park" in s.part_states("chains.arm")
+    page._saved_states.value = "park"
+    page._show_state()
+    page._save()
+    assert "accepts it" in page.last_message
+    check_spec(tmp_path / "xarm.yaml")
+
+
+def test_no_input_ends_the_server(page: Any) -> None:
+    guarded = page._guarded(lambda _e: page.select("no_such_link"))
+    guarded(_Person())
+    assert "no link 'no_such_link'" in page.last_message.replace("&#x27;", "'")
+    page._guarded(lambda _e: 1 / 0)(_Person())
+    assert "internal error" in page.last_message and "ZeroDivisionError" in page.last_message
+    page._guarded(lambda _e: page._set_hand(tool=True))(_Person())
+    assert "choose a manipulator as the part first (not drive)" in page.last_message
+    page._part.value = "manipulators.tool"
+    page._guarded(lambda _e: page._set_hand(tool=True))(_Person())  # nothing picked yet
+    assert "pick a link first" in page.last_message
+    page.say("")
+    page._guarded(lambda _e: page.select("nope"))(type("Server", (), {"client": None})())
+    assert page.last_message == ""  # values the server sets itself are not a person's input
+    with urllib.request.urlopen(page.url, timeout=10) as resp:
+        assert resp.status == 200
+
+
+def test_collision_matrix_and_audit_from_the_page(page: Any, tmp_path: Path) -> None:
+    page._samples.value = 200
+    page._collisions("generate")
+    end = time.monotonic() + 60
+    while page._busy and time.monotonic() < end:
+        time.sleep(0.05)
+    assert "pairs disabled" in page._collision_text.content and page._progress.value == 100.0
+    assert (tmp_path / "xarm.srdf").is_file() and page.session.draft().srdf == "xarm.srdf"
+    page._collisions("audit")
+    while page._busy and time.monotonic() < end:
+        time.sleep(0.05)
+    assert "every entry is right" in page._collision_text.content
+    assert page.session.validation.valid

@@ -24,6 +24,7 @@ DIMENSIONLESS = {
     "front_facing_orientation",
     "front_facing_axis",
     "forward_facing_axis",
+    "forward",
 }
 UNITS = {"m", "rad", "rad/s or m/s", "rad or m (per joint)"}
 

@@ -260,3 +260,17 @@ def test_a_drafted_robot_without_srdf(tmp_path: Path, capsys: pytest.CaptureFixt
     assert isinstance(sdt_robot.drive, DifferentialDrive)
     assert sdt_robot.validate()
     assert len(_parts(sdt_robot, "Arm")) == len(robot.arms) == 1
+
+
+def test_an_unwritable_class_store_warns_and_the_robot_still_builds(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from robotspec.interop.sdt import SdtBridgeWarning, to_sdt
+
+    robot, built = _robot("pr2")
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("")
+    monkeypatch.setenv("ROBOTSPEC_SDT_CLASSES", str(blocker))
+    with pytest.warns(SdtBridgeWarning, match="could not be stored"):
+        again = to_sdt(robot)
+    assert type(again) is type(built)

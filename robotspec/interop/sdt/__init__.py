@@ -63,7 +63,15 @@ def to_sdt(robot: AbstractRobot) -> Any:
     for note in recipe.left_out:
         warnings.warn(f"{robot.name}: {note}", SdtBridgeWarning, stacklevel=2)
     cls = robot_class(recipe)
-    remember(recipe)
+    try:
+        remember(recipe)
+    except OSError as exc:  # this process works without it; a fresh one cannot rebuild
+        warnings.warn(
+            f"{robot.name}: the recipe of its SDT classes could not be stored ({exc}); another "
+            "process will not find them (set ROBOTSPEC_SDT_CLASSES to a writable folder)",
+            SdtBridgeWarning,
+            stacklevel=2,
+        )
     world = sdt_world(robot.world, drive=robot.drive_type)
     sdt_robot = cls.from_world(world)  # type: ignore[attr-defined]
     if recipe.extra_hardware_joints:

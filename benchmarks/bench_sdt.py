@@ -1,0 +1,119 @@
+"""``to_sdt`` on the PR2 against SDT's own hand-written PR2 on the same files: import, load, build.
+
+Each side is measured the same way. *Import*: a new process that imports what each side needs
+(robotspec's compiler and the bridge with SDT, or SDT's URDF parser and PR2 class). *Load*:
+robotspec compiles example-robot-data's PR2 and its spec; SDT parses the same URDF (its parser,
+meshes found through ROS_PACKAGE_PATH) and adds the omni drive, as SDT's tests do. *Build*:
+``to_sdt`` (an SDT world from robotspec's model, the generated classes, SDT's ``from_world``)
+against SDT's ``PR2.from_world`` on its parsed world (without its collision rules: the SRDF they
+read is missing from SDT's wheel). ``to_sdt`` builds its SDT world itself, so its build does what
+SDT's load and build do together; the last row adds load and build up. The first load of a
+robot also spends SDT's mesh decomposition, cached afterwards; a warm-up round takes it out.
+SDT's worlds accumulate in its global symbol graph, so every figure grows with the number of
+worlds built in one process: keep ``--repeat`` small.
+
+Run: ``python benchmarks/bench_sdt.py [--repeat N]`` in the SDT environment (the ``sdt`` extra
+and example-robot-data; without giskardpy, tests/sdt_stand_ins supplies its one helper).
+Prints medians.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from rows import Row, add_json_flag, erd_share, median_times, print_rows
+
+STAND_INS = Path(__file__).resolve().parents[1] / "tests" / "sdt_stand_ins"
+
+
+def _new_process(code: str, repeat: int) -> float:
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([*sys.path[1:], str(STAND_INS)]))
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        subprocess.run([sys.executable, "-c", code], check=True, env=env, capture_output=True)
+        times.append(time.perf_counter() - t)
+    return sorted(times)[len(times) // 2]
+
+
+def _sdt_world(urdf: Path) -> Any:
+    from semantic_digital_twin.adapters.urdf import URDFParser
+    from semantic_digital_twin.datastructures.prefixed_name import PrefixedName
+    from semantic_digital_twin.world_description.connections import OmniDrive
+    from semantic_digital_twin.world_description.world_entity import Body
+
+    world = URDFParser.from_file(str(urdf)).parse()
+    with world.modify_world():
+        base = world.root
+        odom = Body(name=PrefixedName("odom_combined"))
+        world.add_kinematic_structure_entity(odom)
+        world.add_connection(OmniDrive.create_with_dofs(parent=odom, child=base, world=world))
+    return world
+
+
+def _build_times(robot: Any, world: Any, cls: Any, repeat: int) -> tuple[float, float]:
+    """Medians of ``to_sdt(robot)`` and of ``cls.from_world`` on a fresh parsed world (untimed).
+
+    SDT's ``from_world`` adds the robot to the world it is given, so each call needs a new
+    world; its parsing is not part of the figure.
+    """
+    from robotspec.interop.sdt import to_sdt
+
+    ours, theirs = [], []
+    for _ in range(repeat + 1):  # the first round is the warm-up
+        t = time.perf_counter()
+        to_sdt(robot)
+        ours.append(time.perf_counter() - t)
+        w = world()
+        t = time.perf_counter()
+        cls.from_world(w)
+        theirs.append(time.perf_counter() - t)
+    return statistics.median(ours[1:]), statistics.median(theirs[1:])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--repeat", type=int, default=5)
+    add_json_flag(parser)
+    args = parser.parse_args()
+    if importlib.util.find_spec("giskardpy") is None:
+        sys.path.append(str(STAND_INS))
+    share = erd_share()
+    os.environ["ROS_PACKAGE_PATH"] = str(share)  # SDT takes an entry named after the package
+    urdf = share / "robots/pr2_description/urdf/pr2.urdf"
+
+    ours_import = _new_process(
+        "import robotspec.robots, robotspec.compiler, robotspec.interop.sdt._api", args.repeat
+    )
+    sdt_import = _new_process(
+        "import semantic_digital_twin.adapters.urdf, semantic_digital_twin.robots.pr2",
+        args.repeat,
+    )
+
+    from semantic_digital_twin.robots.pr2 import PR2 as SDT_PR2
+
+    from robotspec.robots import PR2
+
+    SDT_PR2._setup_collision_rules = lambda self: None  # type: ignore[method-assign]
+    robot = PR2.load()
+    load = median_times([PR2.load, lambda: _sdt_world(urdf)], args.repeat)
+    build = _build_times(robot, lambda: _sdt_world(urdf), SDT_PR2, args.repeat)
+    rows = [
+        Row("PR2: import (new process)", ours_import, "SDT: import", sdt_import),
+        Row("PR2: load (compile the spec)", load[0], "SDT: load (parse URDF, drive)", load[1]),
+        Row("PR2: build (to_sdt)", build[0], "SDT: build (PR2.from_world)", build[1]),
+        Row("PR2: load + build", load[0] + build[0], "SDT: load + build", load[1] + build[1]),
+    ]
+    print_rows(rows, args.json)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,95 @@
+"""SDT's hand-written PR2 class read back into a spec (robotspec.interop.sdt.migrate).
+
+The spec must say what SDT's class says, and robotspec's checks must find the class's defects:
+compiled, it fails on exactly the camera heights SDT made up; with FK's heights it compiles, and
+``to_sdt`` of it gives SDT's own PR2 back part for part.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from robotspec.errors import RobotSpecError
+from robotspec.interop.sdt.summary import summarize
+from tests.conftest import erd_robots
+from tests.sdt_support import hand_written, package_path, sdt, sdt_world_from_urdf  # noqa: F401
+
+pytestmark = pytest.mark.usefixtures("sdt")
+
+
+def _pr2_files(monkeypatch: pytest.MonkeyPatch) -> tuple[Path, Path]:
+    share = erd_robots().parent
+    monkeypatch.setenv("ROS_PACKAGE_PATH", package_path([share]))
+    folder = share / "robots/pr2_description"
+    return folder / "urdf/pr2.urdf", folder / "srdf/pr2.srdf"
+
+
+def _write(spec: dict[str, Any], path: Path) -> Path:
+    path.write_text(yaml.safe_dump(spec, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def test_sdts_pr2_class_becomes_a_spec_that_gives_it_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from semantic_digital_twin.robots.pr2 import PR2 as HAND_WRITTEN
+
+    from robotspec.compiler import check_spec, compile_robot
+    from robotspec.interop.sdt import to_sdt
+    from robotspec.interop.sdt.migrate import spec_from_sdt
+    from robotspec.robots import PR2
+
+    urdf, srdf = _pr2_files(monkeypatch)
+    world = sdt_world_from_urdf(urdf, odom="odom_combined")
+    migration = spec_from_sdt(HAND_WRITTEN, world, urdf=str(urdf), srdf=str(srdf))
+    spec = migration.spec
+    assert set(spec["chains"]) == {"left_arm", "right_arm"}
+    assert spec["chains"]["left_arm"]["side"] == "left"
+    assert spec["manipulators"]["left_gripper"]["thumb"]["root"] == "l_gripper_l_finger_link"
+    assert len(spec["controlled_joints"]) == 17
+    assert spec["velocity_limits"]["default"] == 1.0
+    # SDT's gripper states set the two mimics of one joint to opposite values: noted, and the
+    # one inside the joint's limits kept, on the joint they follow.
+    assert len(migration.notes) == 2 and all("disagreeing" in n for n in migration.notes)
+    assert spec["manipulators"]["left_gripper"]["states"]["open"] == {
+        "l_gripper_l_finger_joint": 0.548
+    }
+
+    # Compiled, the one defect of SDT's class robotspec refuses: heights FK never reaches.
+    with pytest.raises(RobotSpecError, match="minimal_height: FK puts") as err:
+        check_spec(_write(spec, tmp_path / "pr2.yaml"))
+    assert len(err.value.details) == 1
+    (camera,) = spec["sensors"].values()
+    (kinect,) = PR2.load().cameras
+    camera["minimal_height"], camera["maximal_height"] = (
+        kinect.minimal_height,
+        kinect.maximal_height,
+    )
+    robot = compile_robot(_write(spec, tmp_path / "pr2.yaml"))
+
+    ours = summarize(to_sdt(robot))
+    theirs = summarize(
+        hand_written(HAND_WRITTEN, sdt_world_from_urdf(urdf, odom="odom_combined"), monkeypatch)
+    )
+    assert [p for p in ours.parts if p.kind != "Camera"] == [
+        p for p in theirs.parts if p.kind != "Camera"
+    ]
+    (ours_cam,) = [p for p in ours.parts if p.kind == "Camera"]
+    (their_cam,) = [p for p in theirs.parts if p.kind == "Camera"]
+    assert ours_cam.heights == (kinect.minimal_height, kinect.maximal_height)
+    assert ours_cam.field_of_view == their_cam.field_of_view and ours_cam.axis == their_cam.axis
+    assert ours.hardware_joints == theirs.hardware_joints
+    assert ours.velocity_limits == theirs.velocity_limits
+    assert (ours.left_arm, ours.right_arm) == (theirs.left_arm, theirs.right_arm)
+
+
+def test_only_an_sdt_robot_class_migrates() -> None:
+    from robotspec.interop.sdt.migrate import spec_from_sdt
+    from robotspec.robots import PR2
+
+    with pytest.raises(RobotSpecError, match="not an SDT robot class"):
+        spec_from_sdt(PR2, None, urdf="pr2.urdf")

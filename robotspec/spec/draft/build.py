@@ -237,6 +237,8 @@ class Drafter:
         frame: DraftFrame | None = None
         if tool is not None:
             tool_name = tool.name
+            if not decide:  # (above the hand: said already)
+                decide.append(f"the tool frame '{tool.name}' by its name")
         elif gripper is not None:
             tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))
             mid = (tree.poses[gripper.thumb_tip.index] + tree.poses[gripper.finger_tip.index])[

@@ -28,15 +28,12 @@ from rows import Row, add_json_flag, median_times, print_rows
 @contextmanager
 def using(kin: ModuleType, mesh: ModuleType) -> Iterator[None]:
     """Run with the given cores (the dispatch's choice, restored after)."""
+    from robotspec.accel import using as use_cores
     from robotspec.collision import meshcore
     from robotspec.model import kincore
 
-    saved = kincore._core, meshcore._core
-    kincore._core, meshcore._core = kin, mesh
-    try:
+    with use_cores((kincore.CHOICE, kin), (meshcore.CHOICE, mesh)):
         yield
-    finally:
-        kincore._core, meshcore._core = saved
 
 
 def main() -> None:

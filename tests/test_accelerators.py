@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from robotspec import robots
+from robotspec.accel import using
 from robotspec.collision import SelfCollisionChecker, meshcore, random_configurations
 from robotspec.collision import _meshcore_py as mesh_py
 from robotspec.errors import KinematicsError
@@ -53,12 +54,8 @@ def mesh_c() -> ModuleType:
 @contextmanager
 def _using(kin: ModuleType, mesh: ModuleType) -> Iterator[None]:
     """Run with the given cores (the dispatch's choice, restored after)."""
-    saved = kincore._core, meshcore._core
-    kincore._core, meshcore._core = kin, mesh
-    try:
+    with using((kincore.CHOICE, kin), (meshcore.CHOICE, mesh)):
         yield
-    finally:
-        kincore._core, meshcore._core = saved
 
 
 class _Both:

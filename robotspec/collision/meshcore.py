@@ -9,40 +9,21 @@ checker's first query.
 
 from __future__ import annotations
 
-import threading
 from types import ModuleType
 
-from robotspec.model.kincore import accelerators_disabled
+from robotspec.accel import CoreChoice
 
-__all__ = ["accelerated", "core"]
+__all__ = ["CHOICE", "accelerated", "core"]
 
-_core: ModuleType | None = None
-_lock = threading.Lock()
-
-
-def _load() -> ModuleType:
-    if not accelerators_disabled():
-        try:
-            from robotspec.collision import _meshcore
-        except ImportError:  # not built (no compiler at install): coal answers alone
-            pass
-        else:
-            return _meshcore
-    from robotspec.collision import _meshcore_py
-
-    return _meshcore_py
+#: The C mesh proofs and the fallback that proves nothing.
+CHOICE = CoreChoice("robotspec.collision._meshcore", "robotspec.collision._meshcore_py")
 
 
 def core() -> ModuleType:
     """The mesh core in use (loaded on the first call)."""
-    global _core
-    if _core is None:
-        with _lock:
-            if _core is None:
-                _core = _load()
-    return _core
+    return CHOICE.core()
 
 
 def accelerated() -> bool:
     """Whether mesh pairs are proven apart in C first (False: coal tests every candidate)."""
-    return core().__name__.endswith("._meshcore")
+    return CHOICE.accelerated()

@@ -14,55 +14,36 @@ Python thread (the C core releases the GIL while it runs, so the slices run in p
 
 from __future__ import annotations
 
-import os
 import threading
 from types import ModuleType
 from typing import Any
 
 import numpy as np
 
+from robotspec.accel import NO_ACCEL_ENV, CoreChoice, accelerators_disabled
 from robotspec.arrays import F64
 
-__all__ = ["NO_ACCEL_ENV", "accelerated", "accelerators_disabled", "core", "fk_batch"]
+__all__ = [
+    "CHOICE",
+    "NO_ACCEL_ENV",
+    "accelerated",
+    "accelerators_disabled",
+    "core",
+    "fk_batch",
+]
 
-#: The environment variable that turns the C accelerators off (any value but "", "0").
-NO_ACCEL_ENV = "ROBOTSPEC_NO_ACCEL"
-
-_core: ModuleType | None = None
-_lock = threading.Lock()
-
-
-def accelerators_disabled() -> bool:
-    """Whether ``ROBOTSPEC_NO_ACCEL`` asks for the pure-Python cores."""
-    return os.environ.get(NO_ACCEL_ENV, "").strip() not in ("", "0")
-
-
-def _load() -> ModuleType:
-    if not accelerators_disabled():
-        try:
-            from robotspec.model import _kincore
-        except ImportError:  # not built (no compiler at install): the fallback answers
-            pass
-        else:
-            return _kincore
-    from robotspec.model import _kincore_py
-
-    return _kincore_py
+#: The C kinematics core and its numpy fallback.
+CHOICE = CoreChoice("robotspec.model._kincore", "robotspec.model._kincore_py")
 
 
 def core() -> ModuleType:
     """The kinematics core in use (loaded on the first call)."""
-    global _core
-    if _core is None:
-        with _lock:
-            if _core is None:
-                _core = _load()
-    return _core
+    return CHOICE.core()
 
 
 def accelerated() -> bool:
     """Whether queries run in the C core (False: the numpy fallback)."""
-    return core().__name__.endswith("._kincore")
+    return CHOICE.accelerated()
 
 
 def fk_batch(tree: object, q: object, threads: int = 1, out: Any = None) -> F64:

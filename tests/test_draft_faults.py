@@ -418,3 +418,25 @@ def test_a_camera_named_by_its_model_is_a_camera(tmp_path: Path) -> None:
     ]
     d, _ = _draft(tmp_path, _urdf("robot", "base_link", joints))
     assert [(c.body, c.optical) for c in d.cameras] == [("d435_link", False)]
+
+
+def test_a_robot_whose_head_camera_looks_along_minus_y_faces_minus_y(tmp_path: Path) -> None:
+    # Stretch-like: no limb names a side, but the head's optical frame looks along -y; the arm
+    # at +x is then the left one (up x forward).
+    joints = [
+        J("mast_joint", "fixed", "base_link", "mast_link", "0 0 1.0", rpy="0 0 -1.5707963"),
+        J("camera_optical_joint", "fixed", "mast_link", "camera_optical_frame", "0.05 0 0.3",
+          rpy=OPTICAL_RPY, bare=True),
+    ]  # fmt: skip
+    for tag, x in (("a", 0.2), ("b", -0.2)):
+        parent = "base_link"
+        for i in range(3):
+            child = f"arm_{tag}_link_{i}"
+            xyz = f"{x} 0 0.8" if i == 0 else f"{x} 0 0"
+            joints.append(J(f"arm_{tag}_joint_{i}", "revolute", parent, child, xyz, "0 1 0"))
+            parent = child
+    d, text = _draft(tmp_path, _urdf("stretchy", "base_link", joints))
+    assert d.forward == (0.0, -1.0, 0.0)
+    assert "DECIDE" in _line(text, "forward:")
+    arms = {c.name: c.tip for c in d.chains}
+    assert arms == {"left_arm": "arm_a_link_2", "right_arm": "arm_b_link_2"}

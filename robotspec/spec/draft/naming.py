@@ -61,7 +61,7 @@ def facing(tree: Tree, limbs: list[Limb]) -> tuple[tuple[float, float, float], s
     lateral[2] = 0.0
     norm = float(np.linalg.norm(lateral))
     if norm < 0.02:
-        return (1.0, 0.0, 0.0), None
+        return _looking(tree, limbs)
     axis = int(np.argmax(np.abs(lateral)))
     if abs(lateral[axis]) < 0.8 * norm:
         return (1.0, 0.0, 0.0), None  # diagonal: no clear evidence
@@ -74,6 +74,39 @@ def facing(tree: Tree, limbs: list[Limb]) -> tuple[tuple[float, float, float], s
     names = "xyz"
     sign = "+" if left[axis] > 0 else "-"
     return out, f"its left and right limbs lie along {sign}{names[axis]}: it faces this way"
+
+
+def _looking(tree: Tree, limbs: list[Limb]) -> tuple[tuple[float, float, float], str | None]:
+    """The facing from the optical frames on the body and head (not on a limb), if they agree.
+
+    A robot looks where it faces; only frames optical by their rotation count (a body frame's
+    axis is a guess of its own), and only when every such camera looks, in the default pose,
+    mostly horizontally along one axis of the root.
+    """
+    from robotspec.spec.draft.sensors import find_cameras
+
+    world = tree.world
+    tops = [world.bodies[lb.segment.joints[0].child] for lb in limbs if lb.segment.joints]
+    seen: set[tuple[int, int]] = set()
+    for cam in find_cameras(tree):
+        if not cam.optical or any(world.is_ancestor(t, cam.body) for t in tops):
+            continue
+        view = (tree._root_inv @ tree.poses[cam.body.index])[:3, 2]
+        view = np.array([view[0], view[1], 0.0])
+        norm = float(np.linalg.norm(view))
+        axis = int(np.argmax(np.abs(view)))
+        if norm < 0.5 or abs(view[axis]) < 0.8 * norm:
+            return (1.0, 0.0, 0.0), None
+        seen.add((axis, 1 if view[axis] > 0 else -1))
+    if len(seen) != 1:
+        return (1.0, 0.0, 0.0), None
+    ((axis, sign),) = seen
+    out = [0.0, 0.0, 0.0]
+    out[axis] = float(sign)
+    if out == [1.0, 0.0, 0.0]:
+        return (1.0, 0.0, 0.0), None
+    where = f"{'+' if sign > 0 else '-'}{'xyz'[axis]}"
+    return (out[0], out[1], out[2]), f"its head's cameras look along {where}: it faces this way"
 
 
 def side_labels(

@@ -91,7 +91,7 @@ def _looking(tree: Tree, limbs: list[Limb]) -> tuple[tuple[float, float, float],
     for cam in find_cameras(tree):
         if not cam.optical or any(world.is_ancestor(t, cam.body) for t in tops):
             continue
-        view = (tree._root_inv @ tree.poses[cam.body.index])[:3, 2]
+        view = tree.pose(cam.body)[:3, 2]
         view = np.array([view[0], view[1], 0.0])
         norm = float(np.linalg.norm(view))
         axis = int(np.argmax(np.abs(view)))

@@ -98,6 +98,11 @@ class Tree:
         p: np.ndarray = (self._root_inv @ self.poses[b.index])[:3, 3]
         return p
 
+    def pose(self, body: Body) -> np.ndarray:
+        """Where ``body`` is and how it is turned in the default pose, in the root's frame (4x4)."""
+        p: np.ndarray = self._root_inv @ self.poses[body.index]
+        return p
+
     def axis_in_root(self, c: Connection) -> np.ndarray:
         """A joint's axis in the root frame, in the default pose."""
         rot = (self._root_inv @ self.poses[c.child])[:3, :3]

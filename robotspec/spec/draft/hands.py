@@ -166,7 +166,7 @@ def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | N
     return sides if all(len(side) == 2 for side in sides) else None
 
 
-def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
+def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | None, str]:
     """A parallel gripper at or below ``hand``, or ``None`` and why not.
 
     Two branches that no joint couples, one of which splits again into two coupled fingers
@@ -181,9 +181,10 @@ def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
             break
         body = kids[0]
     branches = [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
-    if len(branches) == 2 and not _dofs(tree, branches[0]) & _dofs(tree, branches[1]):
+    uncoupled = len(branches) == 2 and not _dofs(tree, branches[0]) & _dofs(tree, branches[1])
+    if uncoupled and _depth < 2:  # a horn beside a carriage is one level; never a deep search
         for k in branches:
-            deeper, _ = find_gripper(tree, k)
+            deeper, _ = find_gripper(tree, k, _depth + 1)
             if deeper is not None and deeper.decide is None:
                 return deeper, "two coupled finger branches"
     if not branches:
@@ -229,10 +230,15 @@ def find_gripper(tree: Tree, hand: Body) -> tuple[Gripper | None, str]:
     return gripper, "two finger branches"
 
 
-def _matches(hint: str, name: str) -> bool:
+def _matches(hint: str, name: tuple[str, set[str]]) -> bool:
+    """Whether a name (lower-cased, and its words) holds a hint: inside it, or as a word."""
     if "_" in hint or len(hint) > 4:
-        return hint in name.lower()
-    return hint in words(name)
+        return hint in name[0]
+    return hint in name[1]
+
+
+def _named_as(name: str) -> tuple[str, set[str]]:
+    return name.lower(), words(name)
 
 
 def find_tool_frame(
@@ -247,15 +253,15 @@ def find_tool_frame(
     world = tree.world
     candidates = [b for b in world.subtree(top) if b.index not in exclude]
     near = set() if prefer is None else {b.index for b in world.subtree(prefer)}
-    joint = {b.index: world.parent_connection(b) for b in candidates}
+    # The link's name, or its fixed joint's (Baxter's 'right_gripper' hangs on 'right_endpoint').
+    names: dict[int, list[tuple[str, set[str]]]] = {}
+    for b in candidates:
+        c = world.parent_connection(b)
+        names[b.index] = [_named_as(b.name)]
+        if c is not None and c.is_fixed:
+            names[b.index].append(_named_as(c.name))
     for hint in TOOL_HINTS:
-        # The link's name, or its joint's (Baxter's 'right_gripper' hangs on 'right_endpoint').
-        hits = [
-            b
-            for b in candidates
-            if _matches(hint, b.name)
-            or ((c := joint[b.index]) is not None and c.is_fixed and _matches(hint, c.name))
-        ]
+        hits = [b for b in candidates if any(_matches(hint, n) for n in names[b.index])]
         if hits:
             # A TCP is a frame (a leaf), not a link carrying fingers ('fingers_link' on 'ee_bar').
             return min(

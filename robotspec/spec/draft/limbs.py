@@ -88,11 +88,15 @@ def hand_cut(tree: Tree, seg: Segment) -> int | None:
     a link not named as a finger or jaw is still the arm's.
     """
     world = tree.world
-    for i, b in enumerate(seg.bodies):
-        if i == 0 or not words(b.name) & HAND_WORDS:
-            continue
-        below = [world.parent_connection(k) for k in seg.bodies[i + 1 :]]
-        if all(c is None or c.is_fixed or _hand_joint(tree, c) for c in below):
+    # From the bottom up: the lowest index below which every joint is the hand's (linear).
+    first_hand_only = len(seg.bodies)
+    for i in range(len(seg.bodies) - 1, 0, -1):
+        c = world.parent_connection(seg.bodies[i])
+        if c is not None and not c.is_fixed and not _hand_joint(tree, c):
+            break
+        first_hand_only = i
+    for i in range(max(first_hand_only - 1, 1), len(seg.bodies)):
+        if words(seg.bodies[i].name) & HAND_WORDS:
             return i
     return None
 
@@ -166,10 +170,9 @@ def _pan_tilt(tree: Tree, seg: Segment) -> bool:
     world = tree.world
     if any(c.type.value not in ("revolute", "continuous") for c in seg.joints):
         return False
-    below = world.subtree(seg.end)
     if tree.moving_children(seg.end):
         return False
-    return any(words(b.name) & LOOK_WORDS for b in below)
+    return any(words(b.name) & LOOK_WORDS for b in world.subtree(seg.end))
 
 
 def find_limbs(tree: Tree) -> list[Limb]:

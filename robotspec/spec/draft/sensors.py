@@ -69,7 +69,13 @@ def _stem(name: str) -> str:
 
 
 def find_cameras(tree: Tree) -> list[CameraFound]:
-    """One camera per device, in tree order."""
+    """One camera per device, in tree order (found once per tree: the facing asks too)."""
+    if "cameras" not in tree.memo:
+        tree.memo["cameras"] = _find_cameras(tree)
+    return list(tree.memo["cameras"])
+
+
+def _find_cameras(tree: Tree) -> list[CameraFound]:
     world = tree.world
     found: list[CameraFound] = []
     for b in world.bodies:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -73,6 +74,8 @@ class Tree:
         self.poses = Kinematics(world).forward(world.default_configuration())
         self._root_inv = np.linalg.inv(self.poses[root.index])
         self.segments = self._segments()
+        #: What detectors found once and ask again (the cameras), by name.
+        self.memo: dict[str, Any] = {}
 
     # ------------------------------------------------------------------------------ queries
     def parent_joint(self, body: Body) -> Connection | None:

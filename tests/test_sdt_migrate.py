@@ -15,7 +15,7 @@ import yaml
 
 from robotspec.errors import RobotSpecError
 from robotspec.interop.sdt.summary import summarize
-from tests.conftest import erd_robots
+from tests.conftest import erd_robots, shared_path
 from tests.sdt_support import hand_written, package_path, sdt, sdt_world_from_urdf  # noqa: F401
 
 pytestmark = pytest.mark.usefixtures("sdt")
@@ -93,3 +93,59 @@ def test_only_an_sdt_robot_class_migrates() -> None:
 
     with pytest.raises(RobotSpecError, match="not an SDT robot class"):
         spec_from_sdt(PR2, None, urdf="pr2.urdf")
+
+
+def test_the_migrate_command_writes_a_spec_validate_checks(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+
+    urdf, srdf = _pr2_files(monkeypatch)
+    out = tmp_path / "pr2.yaml"
+    argv = ["migrate", "sdt", "semantic_digital_twin.robots.pr2:PR2", "--urdf", str(urdf)]
+    assert run_app(app, [*argv, "--srdf", str(srdf), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert err.count("note: ") == 2 and f"wrote {out}" in err
+    assert out.read_text(encoding="utf-8").count("# NOTE: ") == 2
+    assert run_app(app, ["validate", str(out)]) == 1
+    assert "minimal_height: FK puts" in capsys.readouterr().out  # validate reports on stdout
+    assert run_app(app, [*argv, "-o", str(out)]) == 1  # exists, no --force
+    assert "pass --force" in capsys.readouterr().err
+
+
+def test_a_class_that_names_a_missing_body_is_a_located_error(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # SDT's HSRB class names the IAI tool frame, which no upstream HSR URDF has.
+    from robotspec.interop.sdt.migrate import migrate_files
+
+    folder = shared_path("robots", "hsrb")
+    with pytest.raises(RobotSpecError, match="SDT's class HSRB cannot be built") as err:
+        migrate_files(
+            "semantic_digital_twin.robots.hsrb:HSRB",
+            str(folder / "hsrb4s.urdf"),
+            folder=folder,
+            package_paths=[folder],
+        )
+    assert "hand_gripper_tool_frame" in str(err.value)
+
+
+def test_sdts_missing_cylinder_mesh_is_named_not_a_crash(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Without the tests' stand-in, SDT's collision sync loads resources/obj/cylinder.obj from
+    # SDT's wheel, which lacks it: the bridge says so instead of crashing.
+    from semantic_digital_twin.collision_checking import pybullet_collision_detector as pcd
+
+    from robotspec.interop.sdt import to_sdt
+    from robotspec.robots import HSRB
+
+    folder = shared_path("robots", "hsrb")
+    missing = str(folder.parent / "absent" / "resources" / "obj" / "cylinder.obj")
+    bullet = pcd.bullet
+
+    def create_cylinder_shape(diameter: float, height: float) -> Any:
+        return bullet.load_convex_shape(missing, single_shape=True)
+
+    monkeypatch.setattr(pcd, "create_cylinder_shape", create_cylinder_shape)
+    with pytest.raises(RobotSpecError, match="wheel lacks its resources/ folder"):
+        to_sdt(HSRB.load(package_paths=[folder]))

@@ -154,3 +154,18 @@ def test_without_sdt_the_bridge_says_how_to_install_it(monkeypatch: pytest.Monke
     monkeypatch.delitem(sys.modules, "robotspec.interop.sdt._api", raising=False)
     with pytest.raises(RobotSpecError, match=r"pip install 'robotspec\[sdt\]'"):
         sdt.sdt_api()
+
+
+def test_without_sdt_the_migrate_command_says_how_to_install_it(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import importlib.util
+
+    if importlib.util.find_spec("semantic_digital_twin") is not None:
+        pytest.skip("SDT is installed here; tests/test_sdt_migrate.py runs the command")
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+
+    argv = ["migrate", "sdt", "semantic_digital_twin.robots.pr2:PR2", "--urdf", "pr2.urdf"]
+    assert run_app(app, argv) == 1
+    assert "pip install 'robotspec[sdt]'" in capsys.readouterr().err

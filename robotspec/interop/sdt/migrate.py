@@ -14,13 +14,16 @@ limits only tighten), a state of a kind robotspec has no name for.
 
 from __future__ import annotations
 
+import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from robotspec.errors import RobotSpecError
 
-__all__ = ["Migration", "spec_from_sdt"]
+__all__ = ["Migration", "import_class", "migrate_files", "render", "spec_from_sdt"]
 
 
 @dataclass(frozen=True)
@@ -131,7 +134,15 @@ def spec_from_sdt(
             kind="class",
         )
     notes: list[str] = []
-    robot, before = _build(cls, world)
+    try:
+        robot, before = _build(cls, world)
+    except Exception as exc:  # SDT's own lookups (a body its class names, a part it expects)
+        raise RobotSpecError(
+            f"SDT's class {cls.__name__} cannot be built on this robot's world: "
+            f"{type(exc).__name__}: {exc}",
+            kind="class",
+            name=cls.__name__,
+        ) from exc
     left = robot.get_left_arm_if_specified()
     right = robot.get_right_arm_if_specified()
     spec: dict[str, Any] = {"robotspec": 1, "name": name or cls.__name__}
@@ -239,3 +250,69 @@ def _drop_empty(data: Any) -> Any:
     if isinstance(data, dict):
         return {k: _drop_empty(v) for k, v in data.items() if v not in ({}, [], None)}
     return data
+
+
+# --------------------------------------------------------------------------- from files
+def import_class(target: str) -> type:
+    """``package.module:Class`` imported (the command's ``MODULE:CLASS``)."""
+    import importlib
+
+    module, _, name = target.partition(":")
+    if not module or not name:
+        raise RobotSpecError(
+            f"'{target}' is not MODULE:CLASS (e.g. semantic_digital_twin.robots.pr2:PR2)",
+            kind="class",
+            name=target,
+        )
+    try:
+        found = getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError) as exc:
+        raise RobotSpecError(f"cannot import '{target}': {exc}", kind="class", name=target) from exc
+    if not isinstance(found, type):
+        raise RobotSpecError(f"'{target}' is not a class", kind="class", name=target)
+    return found
+
+
+def migrate_files(
+    target: str,
+    urdf: str,
+    *,
+    srdf: str | None = None,
+    folder: Path,
+    package_paths: Sequence[str | Path] = (),
+) -> Migration:
+    """SDT class ``target`` (``MODULE:CLASS``) on the robot of ``urdf``, as a spec.
+
+    The URDF (or xacro) is read by robotspec (package paths, a joint's default axis) and handed
+    to SDT as a world built from robotspec's model, so SDT's parser and its package resolver
+    are not needed. The spec names the files relative to ``folder``, where it will be written.
+    """
+    from robotspec.description.load import load_description
+    from robotspec.interop.sdt import sdt_api
+    from robotspec.interop.sdt.world import sdt_world
+
+    sdt_api()  # SDT missing: say how to install it, before its class cannot be imported
+    cls = import_class(target)
+    world = load_description(urdf, package_paths=package_paths, base_folder=Path.cwd()).world
+    sdt = sdt_world(world, drive="fixed")
+
+    def named(file: str) -> str:
+        if "://" in file:
+            return file
+        path = Path(file).resolve()
+        return os.path.relpath(path, folder) if path.is_relative_to(folder) else str(path)
+
+    return spec_from_sdt(cls, sdt, urdf=named(urdf), srdf=None if srdf is None else named(srdf))
+
+
+def render(migration: Migration, *, source: str) -> str:
+    """The spec as YAML, headed by where it came from and what it could not say."""
+    import yaml
+
+    head = [
+        "# yaml-language-server: $schema=robotspec.schema.json",
+        f"# Migrated from SDT's robot class {source} by `robotspec migrate sdt`.",
+        "# Run `robotspec validate` on it: it checks what the class only assumed.",
+        *(f"# NOTE: {n}" for n in migration.notes),
+    ]
+    return "\n".join(head) + "\n" + yaml.safe_dump(migration.spec, sort_keys=False)

@@ -94,6 +94,25 @@ def sdt_world(world: World, *, drive: str, prefix: str | None = None) -> Any:
 
     out = sdt.World()
     out.name = prefix
+    try:
+        _fill(sdt, out, world, drive, pname)
+    except RuntimeError as exc:
+        if "resources" not in str(exc):
+            raise
+        # SDT's wheel lacks its resources/ folder; its Bullet collision sync loads
+        # resources/obj/cylinder.obj for every cylinder of a world (docs/sdt.md).
+        raise RobotSpecError(
+            f"SDT cannot build this world: {str(exc).strip()}; SDT 26.7's wheel lacks its "
+            "resources/ folder (install SDT from its source, or put a unit cylinder mesh, "
+            "diameter 1 and height 1, at that path)",
+            kind="dependency",
+            name="semantic_digital_twin",
+        ) from exc
+    return out
+
+
+def _fill(sdt: Any, out: Any, world: World, drive: str, pname: Any) -> None:
+    """Bodies, degrees of freedom and joints of ``world`` into the SDT world ``out``."""
     with out.modify_world():
         bodies = []
         for b in world.bodies:
@@ -148,7 +167,6 @@ def sdt_world(world: World, *, drive: str, prefix: str | None = None) -> Any:
                         raw_dof=dofs[index],
                     )
                 )
-    return out
 
 
 def _base_joint(

@@ -7,6 +7,12 @@ the kinematic tree (arms, legs, parallel grippers, tool frames, cameras, neck, t
 each guess with a ``# DECIDE:`` comment and its reason, and is valid as written, so ``robotspec
 validate`` works from the start.
 
+What an expert would sign: arms end at the wrist whatever the hand's shape (the hand gets its
+own manipulator, with its fingers), a hand or gripper alone is drafted as one, base joints are
+the drive (``drive.joints``) and pan/tilt heads with cameras necks, never arms; sides follow the
+way the robot faces (``forward:`` drafted when its limbs or cameras say it is not +x). How close
+the drafts come is measured against hand-written ground truth by ``tools/draft_score.py``.
+
 One module per job: ``tree`` (segments and the default pose), ``limbs`` (arms, legs), ``hands``
 (grippers, tool frames), ``sensors`` (cameras, neck), ``srdf_groups`` (what the SRDF says),
 ``build`` (joining them), ``render`` (YAML that survives any name), ``paths`` (portable file

@@ -273,7 +273,7 @@ class Drafter:
         m = DraftManipulator(unique(name, self.names), top.name, tool_name, "", decide)
         if gripper is not None:
             m.thumb, m.finger = gripper.thumb, gripper.finger
-            m.source = f"two finger branches below '{gripper.root.name}'"
+            m.source = f"{gripper.found} below '{gripper.root.name}'"
             if gripper.decide:
                 decide.append(gripper.decide)
         else:

@@ -6,7 +6,11 @@ finger driven by its own joint; the finger is the one that mimics it (PR2, Panda
 both are driven or both mimic, the left one (seen from the gripper) is taken for the thumb, and
 the draft says so.
 
-Tool frames are searched only in the manipulator's own subtree, so two arms never share one.
+Two jaws in series, the second hanging on the first (a WSG-50's), are a parallel gripper too; a
+branch beside the finger carriage that no joint couples to it (a motor's horn) is not a finger.
+
+Tool frames are searched only in the manipulator's own subtree, so two arms never share one; a
+hand without one gets a frame proposed between its tips.
 """
 
 from __future__ import annotations
@@ -61,6 +65,8 @@ class Gripper:
     thumb_tip: Body
     finger_tip: Body
     decide: str | None
+    #: How its fingers were found, for the draft's ``# from`` note.
+    found: str = "two finger branches"
 
 
 def _has_geometry(tree: Tree, body: Body) -> bool:
@@ -121,6 +127,7 @@ def _jaws(tree: Tree, hand: Body) -> Gripper | None:
         thumb_tip=jaw1,
         finger_tip=jaw2,
         decide=decide,
+        found="two jaws, one hanging on the other,",
     )
 
 

@@ -3,8 +3,9 @@
 An arm is a serial run of at least three actuated joints from a branching point of the tree to a
 hand (or to the end of the run); a leg is the same run ending on the ground. What is not a limb:
 fingers (short runs inside a hand, or runs whose links are named as fingers), and runs shorter
-than a forearm. The hand starts at the first link named as a hand (``gripper``, ``hand``,
-``palm``) or where the run splits into fingers; its joints do not belong to the arm.
+than a forearm, pan/tilt runs pointing cameras (necks). The hand starts at the first link named
+as a hand (``gripper``, ``hand``, ``palm``) below which only fingers or jaws move, or where the
+run splits into fingers; the joint turning it is the arm's last, the joints below it the hand's.
 """
 
 from __future__ import annotations

@@ -189,3 +189,23 @@ def test_the_setup_command_reports_bad_input_like_the_cli(tmp_path: Path, capsys
     with pytest.raises(SystemExit) as exc:
         main(["setup", str(urdf), "--port", "70000"])
     assert exc.value.code == 2
+
+
+def test_the_robots_facing_is_set_and_read_back(tmp_path: Path) -> None:
+    s = _xarm(tmp_path)
+    with pytest.raises(SetupError, match="unit vector"):
+        s.set_forward((1.0, 1.0, 0.0))
+    v = s.set_forward((0.0, -1.0, 0.0))
+    assert v.valid and "forward: [0, -1, 0]\n" in s.snapshot.text  # decided: no DECIDE mark
+    spec = s.save()
+    again = SetupSession.open(str(spec), output=tmp_path / "b" / "xarm.yaml")
+    assert again.draft().forward == (0.0, -1.0, 0.0)
+    assert "forward" not in [q.id for q in again.snapshot.questions]
+    # A drafted facing is a question; keeping it removes its mark.
+    marked = spec.read_text().replace("forward: [0, -1, 0]", "forward: [0, -1, 0]  # DECIDE: why")
+    spec.write_text(marked)
+    third = SetupSession.open(str(spec), output=tmp_path / "c" / "xarm.yaml")
+    (q,) = [q for q in third.snapshot.questions if q.id == "forward"]
+    assert q.reason == "why" and "faces +x" in q.alternatives
+    assert third.answer("forward", "faces +y").valid
+    assert "forward: [0, 1, 0]\n" in third.snapshot.text

@@ -144,6 +144,10 @@ def draft_of_spec(
         states={k: dict(v) for k, v in spec.states.items()},
         notes=marks.notes(),
     )
+    forward = getattr(spec, "forward", None)
+    if forward is not None:
+        draft.forward = (float(forward[0]), float(forward[1]), float(forward[2]))
+        draft.forward_decide = next(iter(marks.decide(("forward",))), "")
     if spec.drive is not None:
         d = spec.drive
         draft.drive = DraftDrive(

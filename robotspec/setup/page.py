@@ -26,7 +26,7 @@ import numpy as np
 from robotspec.errors import RobotSpecError
 from robotspec.render.scene import GREY, colour_parts
 from robotspec.render.viewer import RobotViewer
-from robotspec.setup.questions import FACINGS, Question
+from robotspec.setup.questions import FACINGS, FORWARDS, Question
 from robotspec.setup.session import SetupSession, Snapshot
 from robotspec.setup.tree import TreeRow, tree_rows
 from robotspec.setup.validation import Problem, Validation
@@ -212,6 +212,8 @@ class SetupPage:
             self._drive.on_update(
                 self._guarded(lambda _e: self._after(s.set_drive(self._drive.value), "drive set"))
             )
+            self._forward = gui.add_dropdown("robot", tuple(FORWARDS))
+            self._forward.on_update(self._guarded(lambda _e: self._set_forward()))
         self._button(gui, "remove this part", self._remove_part)
         with gui.add_folder("add a part", expand_by_default=False):
             self._new_name = gui.add_text("name", "")
@@ -390,8 +392,11 @@ class SetupPage:
             lines.append(f"camera on **{cam.body}**, {what}")
             self._preset.value = cam.preset or _NO_PRESET
         elif kind == "drive" and d.drive is not None:
-            lines.append(f"base: **{d.drive.type}**")
+            facing = next((k for k, v in FORWARDS.items() if v == (d.forward or (1, 0, 0))), None)
+            lines.append(f"base: **{d.drive.type}**; the robot {facing or d.forward}")
             self._drive.value = d.drive.type
+            if facing is not None:
+                self._forward.value = facing
         lines += [_problem_line(p) for p in self.session.validation.at(part)]
         self._part_info.content = "  \n".join(lines)
 
@@ -457,6 +462,12 @@ class SetupPage:
         if optical:
             kw["optical"] = str(self._optical.value).startswith("+z")
         self._after(self.session.set_camera(part, **kw), f"{part} changed")
+
+    def _set_forward(self) -> None:
+        choice = str(self._forward.value)
+        axis = FORWARDS[choice]
+        v = self.session.set_forward(None if axis == (1.0, 0.0, 0.0) else axis)
+        self._after(v, f"the robot {choice}")
 
     def _remove_part(self) -> None:
         part = self._part_name()

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from robotspec.spec.draft.model import Draft
 
-__all__ = ["FACINGS", "KEEP", "REMOVE", "Question", "questions_of"]
+__all__ = ["FACINGS", "FORWARDS", "KEEP", "REMOVE", "Question", "questions_of"]
 
 #: The choice that keeps the guess; always a question's first.
 KEEP = "keep the guess"
@@ -27,6 +27,13 @@ FACINGS: dict[str, tuple[float, float, float]] = {
     "tool faces -z": (0.0, 0.0, -1.0),
 }
 DRIVES = ("fixed", "omni", "differential", "floating")
+#: The robot's facing (``forward:``, in its root link's frame) by name; +x is the default.
+FORWARDS: dict[str, tuple[float, float, float]] = {
+    "faces +x": (1.0, 0.0, 0.0),
+    "faces -x": (-1.0, 0.0, 0.0),
+    "faces +y": (0.0, 1.0, 0.0),
+    "faces -y": (0.0, -1.0, 0.0),
+}
 ROLES = {"arm": "an arm", "leg": "a leg", "chain": "another chain (a lift, a tail)"}
 OPTICAL = "an optical frame: looks along +z"
 BODY_FRAME = "a body frame: looks along +x"
@@ -72,6 +79,10 @@ def questions_of(draft: Draft, presets: tuple[str, ...] = ()) -> tuple[Question,
             part = f"frames.{f.name}"
             guess = f"a frame on {f.parent} at {list(f.xyz)}"
             out.append(Question(part, part, guess, (KEEP, REMOVE), f.reason))
+    if draft.forward is not None and draft.forward_decide != "":
+        guess = f"faces {list(draft.forward)} in {draft.root}'s frame"
+        reason = draft.forward_decide or "the robot's facing"
+        out.append(Question("forward", "forward", guess, (KEEP, *FORWARDS), reason))
     d = draft.drive
     if d is not None and d.decide:
         others = tuple(f"drive: {t}" for t in DRIVES if t != d.type)

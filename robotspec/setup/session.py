@@ -20,6 +20,7 @@ from robotspec.setup.questions import (
     BODY_FRAME,
     DRIVES,
     FACINGS,
+    FORWARDS,
     KEEP,
     OPTICAL,
     REMOVE,
@@ -432,6 +433,17 @@ class SetupSession:
 
         return self.edit(change)
 
+    def set_forward(self, axis: tuple[float, float, float] | None) -> Validation:
+        """Which way the robot faces in its root link's frame (None: +x, the default)."""
+        if axis is not None and (len(axis) != 3 or abs(sum(v * v for v in axis) - 1.0) > 1e-6):
+            raise SetupError(f"the facing is a unit vector, not {list(axis)}", kind="forward")
+
+        def change(d: Draft) -> None:
+            d.forward = None if axis is None else (float(axis[0]), float(axis[1]), float(axis[2]))
+            d.forward_decide = None if axis is None else ""
+
+        return self.edit(change)
+
     def set_srdf(self, ref: str | None) -> Validation:
         """The SRDF the spec names (a path relative to the spec, or a ``package://`` URI)."""
         return self.edit(lambda d: setattr(d, "srdf", ref))
@@ -487,6 +499,8 @@ class SetupSession:
             return self.set_drive(choice.removeprefix("drive: "))
         if choice.startswith("preset: "):
             return self.set_camera(q.part, preset=choice.removeprefix("preset: "))
+        if choice in FORWARDS:
+            return self.set_forward(FORWARDS[choice])
         if choice in FACINGS:
             return self.set_manipulator(q.part, facing=FACINGS[choice])
         if choice == "make it generic":
@@ -538,6 +552,8 @@ def _keep(d: Draft, q: Question) -> None:
         from robotspec.spec.draft.render import PLACEHOLDER_FOV
 
         _camera(d, q.part).field_of_view = PLACEHOLDER_FOV
+    elif q.part == "forward":
+        d.forward_decide = ""
     elif q.part == "drive" and d.drive is not None:
         d.drive.decide = None
     elif q.part in ("torso", "neck") or kind == "chains":

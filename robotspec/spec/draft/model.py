@@ -135,7 +135,7 @@ class Draft:
     lone_hand: str | None = None
     #: The direction the robot faces in its root frame, when the draft thinks it is not +x.
     forward: tuple[float, float, float] | None = None
-    #: Why ``forward`` was drafted (a guess: written as a DECIDE mark).
+    #: Why ``forward`` was drafted (a guess: written as a DECIDE mark); "" once a person decided.
     forward_decide: str | None = None
 
     @property

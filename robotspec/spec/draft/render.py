@@ -160,7 +160,9 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
     out.append(f"root: {scalar(d.root)}")
     if d.forward is not None:
         fwd = ", ".join(_num(v) for v in d.forward)
-        out.append(f"forward: [{fwd}]" + _decide([d.forward_decide or "the robot's facing"]))
+        # forward_decide "" is a facing a person decided (robotspec setup): no mark.
+        why = "" if d.forward_decide == "" else _decide([d.forward_decide or "the robot's facing"])
+        out.append(f"forward: [{fwd}]" + why)
     if d.drive is not None:
         dr = d.drive
         parts = [f"type: {dr.type}"]

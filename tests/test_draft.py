@@ -398,3 +398,24 @@ def test_a_one_motor_hand_with_a_thumb_is_not_a_gripper(tmp_path: Path) -> None:
         "romeo_description/urdf/romeo.urdf", "romeo_description/srdf/romeo.srdf", tmp_path
     )
     assert not any(m.is_gripper for m in d.manipulators)
+
+
+def test_legs_coded_fore_and_hind_say_which_way_the_robot_faces(tmp_path: Path) -> None:
+    # example-robot-data's quadruped: 2-joint legs coded FL/FR/BL/BR, its front legs at +y.
+    d, text = _draft("quadruped_description/urdf/quadruped.urdf", None, tmp_path)
+    assert d.forward == (0.0, 1.0, 0.0) and "DECIDE" in text.split("forward:")[1].split("\n")[0]
+    legs = {c.name: c.tip for c in d.chains}
+    assert legs == {
+        "front_left_leg": "FL_shank",
+        "front_right_leg": "FR_shank",
+        "hind_left_leg": "BL_shank",
+        "hind_right_leg": "BR_shank",
+    }
+    assert d.drive is not None and d.drive.type == "floating"
+
+
+def test_a_leg_the_srdf_leaves_out_is_named_by_its_code(tmp_path: Path) -> None:
+    d, _ = _draft(
+        "hyq_description/robots/hyq_no_sensors.urdf", "hyq_description/srdf/hyq.srdf", tmp_path
+    )
+    assert sorted(c.name for c in d.chains) == ["lf_leg", "lh_leg", "rf_leg", "rh_leg"]

@@ -20,7 +20,8 @@ the draft has it:
 * grippers: a drafted parallel gripper whose finger tips are the truth's two;
 * cameras: a camera on the truth's frame;
 * torso, neck: the same actuated joints (present in either); drive: the same type (and the
-  same base joints, when the truth names them).
+  same base joints, when the truth names them); forward: the same facing (when either says
+  it is not +x).
 """
 
 from __future__ import annotations
@@ -161,6 +162,10 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         want_j = None if want_part is None else joints(want_part["root"], want_part["tip"])
         have_j = None if have_part is None else have_part.joints
         s.add("torso/neck/drive", want_j == have_j, f"{key}: {sorted(have_j or [])}")
+    want_fwd = tuple(float(v) for v in t.get("forward") or (1.0, 0.0, 0.0))
+    have_fwd = draft.forward or (1.0, 0.0, 0.0)
+    if want_fwd != (1.0, 0.0, 0.0) or have_fwd != (1.0, 0.0, 0.0):
+        s.add("torso/neck/drive", want_fwd == have_fwd, f"forward: {list(have_fwd)}")
     drive = t.get("drive") or {"type": "fixed"}
     d = draft.drive
     ok = d is not None and d.type == drive["type"]

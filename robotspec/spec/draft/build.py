@@ -40,7 +40,9 @@ from robotspec.spec.draft.model import (
 from robotspec.spec.draft.naming import (
     facing,
     join,
+    leg_code,
     named_side,
+    ordered_words,
     role_by_name,
     side_labels,
     side_of,
@@ -184,6 +186,10 @@ class Drafter:
                 continue
             labels, by_name = side_labels(self.tree, group, self.forward)
             for lb, label in zip(group, labels, strict=True):
+                if not label and any(leg_code(lb)):
+                    # One leg left over by the SRDF's groups (HyQ's): its code, as theirs.
+                    label = ordered_words(lb.segment.bodies[0].name)[0]
+                    label = label if kind == "leg" else ""
                 c = DraftChain(
                     unique(join(label, kind), self.names),
                     lb.root.name,

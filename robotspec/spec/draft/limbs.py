@@ -128,7 +128,9 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
         if c is not None and not c.is_fixed:
             moving.append(c)
     actuated = [c for c in moving if c.is_active]
-    if len(actuated) < MIN_LIMB_JOINTS or _named(bodies, FINGER_WORDS):
+    # Two joints make a leg when its links say so (Solo-8's hip and knee: 'FL_upperleg').
+    fewest = MIN_LIMB_JOINTS - int(_count(bodies, LEG_WORDS) >= 2)
+    if len(actuated) < fewest or _named(bodies, FINGER_WORDS):
         return None
     reach = tree.length(seg, upto)
     if reach < MIN_LIMB_LENGTH:

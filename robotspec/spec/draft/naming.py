@@ -13,7 +13,17 @@ import numpy as np
 from robotspec.spec.draft.limbs import LEG_WORDS, Limb, is_named
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["facing", "join", "named_side", "role_by_name", "side_labels", "side_of", "unique"]
+__all__ = [
+    "facing",
+    "join",
+    "leg_code",
+    "named_side",
+    "ordered_words",
+    "role_by_name",
+    "side_labels",
+    "side_of",
+    "unique",
+]
 
 
 def unique(name: str, taken: set[str]) -> str:
@@ -49,6 +59,9 @@ def facing(tree: Tree, limbs: list[Limb]) -> tuple[tuple[float, float, float], s
     faces ``left x up``. Snapped to the root's axes; +x unless the names say otherwise
     (ARMAR-4 and Stretch are modelled facing -y).
     """
+    ahead = _ahead_by_codes(tree, limbs)
+    if ahead is not None:
+        return ahead
     lateral = np.zeros(3)
     for kind in ("arm", "leg"):
         named: dict[str, list[np.ndarray]] = {"left": [], "right": []}
@@ -74,6 +87,49 @@ def facing(tree: Tree, limbs: list[Limb]) -> tuple[tuple[float, float, float], s
     names = "xyz"
     sign = "+" if left[axis] > 0 else "-"
     return out, f"its left and right limbs lie along {sign}{names[axis]}: it faces this way"
+
+
+def leg_code(limb: Limb) -> tuple[str | None, str | None]:
+    """Fore or hind, and left or right, from a leg's code (``FL_``, ``lh_``, ``RR_``, ``BL_``).
+
+    Codes put the end first (Solo's ``HL``, Unitree's ``RL``: rear left, a quadruped's ``BL``)
+    or the side first (ANYmal's and HyQ's ``LH``).
+    """
+    first = ordered_words(limb.segment.bodies[0].name)[:1]
+    code = first[0] if first else ""
+    if len(code) != 2 or limb.kind != "leg":
+        return None, None
+    end, side = code[0], code[1]
+    if end in "lr" and side in "fh":
+        end, side = side, end
+    if end not in "fhbr" or side not in "lr":
+        return None, None
+    return ("fore" if end == "f" else "hind"), ("left" if side == "l" else "right")
+
+
+def _ahead_by_codes(
+    tree: Tree, limbs: list[Limb]
+) -> tuple[tuple[float, float, float], str | None] | None:
+    """The facing from legs coded fore and hind: from the hind legs towards the fore ones."""
+    ends: dict[str, list[np.ndarray]] = {"fore": [], "hind": []}
+    for lb in limbs:
+        end, _ = leg_code(lb)
+        if end is not None:
+            ends[end].append(_mean_position(tree, lb))
+    if not (ends["fore"] and ends["hind"]):
+        return None
+    toward = np.mean(ends["fore"], axis=0) - np.mean(ends["hind"], axis=0)
+    toward[2] = 0.0
+    norm = float(np.linalg.norm(toward))
+    axis = int(np.argmax(np.abs(toward)))
+    if norm < 0.02 or abs(toward[axis]) < 0.8 * norm:
+        return None
+    out = [0.0, 0.0, 0.0]
+    out[axis] = 1.0 if toward[axis] > 0 else -1.0
+    if out == [1.0, 0.0, 0.0]:
+        return (1.0, 0.0, 0.0), None
+    where = f"{'+' if out[axis] > 0 else '-'}{'xyz'[axis]}"
+    return (out[0], out[1], out[2]), f"its fore legs lie along {where} of its hind legs"
 
 
 def _looking(tree: Tree, limbs: list[Limb]) -> tuple[tuple[float, float, float], str | None]:

@@ -440,3 +440,14 @@ def test_a_robot_whose_head_camera_looks_along_minus_y_faces_minus_y(tmp_path: P
     assert "DECIDE" in _line(text, "forward:")
     arms = {c.name: c.tip for c in d.chains}
     assert arms == {"left_arm": "arm_a_link_2", "right_arm": "arm_b_link_2"}
+
+
+def test_a_camera_link_rigid_with_an_optical_frame_is_that_cameras_body(tmp_path: Path) -> None:
+    # Go1's 'camera_laserscan_link_left' beside 'camera_optical_left': one camera, the optical.
+    joints = [
+        J("j1", "revolute", "base_link", "head", "0 0 0.3"),
+        J("a", "fixed", "head", "camera_optical_left", "0.1 0 0", rpy=OPTICAL_RPY, bare=True),
+        J("b", "fixed", "head", "camera_laserscan_link_left", "0.1 0 0.01", bare=True),
+    ]
+    d, _ = _draft(tmp_path, _urdf("robot", "base_link", joints))
+    assert [(c.body, c.optical) for c in d.cameras] == [("camera_optical_left", True)]

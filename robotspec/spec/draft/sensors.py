@@ -114,6 +114,9 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             )
             for k in kept
         )
+        # A body frame named as a camera, rigid with an optical frame, is that camera's link.
+        optical_here = any(k.optical and _rigid_root(tree, k.body) is carrier for k in kept)
+        dup = dup or (not cam.optical and optical_here)
         if not dup:
             kept.append(cam)
     kept.sort(key=lambda c: c.body.index)

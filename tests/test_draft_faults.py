@@ -451,3 +451,15 @@ def test_a_camera_link_rigid_with_an_optical_frame_is_that_cameras_body(tmp_path
     ]
     d, _ = _draft(tmp_path, _urdf("robot", "base_link", joints))
     assert [(c.body, c.optical) for c in d.cameras] == [("camera_optical_left", True)]
+
+
+def test_a_turned_camera_frame_looking_ahead_along_z_looks_along_z(tmp_path: Path) -> None:
+    # Baxter's 'head_camera_link': not REP 103's rotation, but its z axis points ahead.
+    joints = [
+        J("head_pan", "revolute", "base_link", "head", "0 0 0.6"),
+        J("cam", "fixed", "head", "head_camera_link", "0.1 0 0.05", rpy="0 1.5707963 0"),
+    ]
+    d, text = _draft(tmp_path, _urdf("robot", "base_link", joints))
+    (cam,) = d.cameras
+    assert cam.body == "head_camera_link" and cam.looks_along_z and not cam.optical
+    assert "forward_facing_axis: [0, 0, 1]" in text

@@ -88,6 +88,8 @@ class DraftCamera:
     preset: str | None = None
     #: Chosen angles (horizontal, vertical, rad); None writes the placeholder, marked DECIDE.
     field_of_view: tuple[float, float] | None = None
+    #: A body frame (not optical) that looks along its z axis (written ``[0, 0, 1]``).
+    looks_along_z: bool = False
 
 
 @dataclass

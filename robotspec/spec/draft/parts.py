@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from robotspec.model.entities import Body
 from robotspec.model.world import World
 from robotspec.spec.draft.limbs import HEAD_WORDS
@@ -33,7 +35,14 @@ def add_sensors(d: Drafter) -> None:
     for seen in found:
         cam = DraftCamera(unique(seen.name, d.names), seen.body.name, seen.optical)
         if not seen.optical:
-            cam.decide.append("named as a camera, but not rotated as an optical frame")
+            if _looks_along_z(d, seen.body):
+                cam.looks_along_z = True
+                cam.decide.append(
+                    "named as a camera, not rotated as an optical frame; its z axis, not its x,"
+                    " points the way the robot faces"
+                )
+            else:
+                cam.decide.append("named as a camera, but not rotated as an optical frame")
         draft.cameras.append(cam)
         name_of[cam.body] = cam.name
     tops = [_first_moving(world, c) for c in draft.chains if c.role in ("arm", "leg")]
@@ -75,6 +84,24 @@ def add_sensors(d: Drafter) -> None:
         if holders:
             best = max(holders, key=lambda c: world.depth(c.tip))
             best.sensors.append(cam.name)
+
+
+def _looks_along_z(d: Drafter, body: Body) -> bool:
+    """Whether a camera's body frame, turned on its joint, looks along its z axis (Baxter's).
+
+    Only for a frame off the limbs (a head's, the body's), rotated from its parent, whose z axis
+    points the way the robot faces in the default pose and whose x axis does not.
+    """
+    world = d.world
+    c = world.parent_connection(body)
+    if c is None or not c.is_fixed or np.allclose(c.origin[:3, :3], np.eye(3), atol=1e-6):
+        return False
+    if any(world.is_ancestor(world.bodies[lb.segment.joints[0].child], body) for lb in d.limbs):
+        return False
+    rot = d.tree.pose(body)[:3, :3]
+    ahead = np.asarray(d.forward, dtype=np.float64)
+    along_x, along_z = float(rot[:, 0] @ ahead), float(rot[:, 2] @ ahead)
+    return along_z > 0.7 and along_x < 0.5
 
 
 def _add_head(d: Drafter, limb_tops: list[Body]) -> None:

@@ -205,6 +205,9 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
             out.append("    type: camera")
             if cam.optical:
                 out.append(f"    body: {scalar(cam.body)}  # an optical frame: looks along +z")
+            elif cam.looks_along_z:
+                out.append(f"    body: {scalar(cam.body)}")
+                out.append("    forward_facing_axis: [0, 0, 1]  # a body frame looking along +z")
             else:
                 out.append(f"    body: {scalar(cam.body)}")
                 out.append("    forward_facing_axis: [1, 0, 0]  # a body frame: looks along +x")

@@ -182,3 +182,36 @@ def test_pr2_states_differ_only_where_listed(monkeypatch: pytest.MonkeyPatch) ->
     changed = {j: (sdts[j], mine[j]) for j in sdts if sdts[j] != mine[j]}
     assert changed == {"l_forearm_roll_joint": (4.2, 1.28803)}
     assert set(differ) == set(grippers)
+
+
+def test_hsrb_states_are_sdts_once_mimic_joints_are_read_as_their_leaders(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # SDT's HSRB sets its torso states on torso_lift_joint and its gripper states on the two
+    # proximal joints too, all mimics; read as the joints they follow, they are robotspec's,
+    # but for the torso's mid and high, which SDT 26.7 moved (docs/sdt.md).
+    robot, ours = _ours("hsrb")
+    theirs = _theirs("hsrb", monkeypatch)
+    world = robot.world
+    assert set(ours.joint_states) == set(theirs.joint_states)
+    moved = {
+        "Torso:base_link:torso_lift_link:MID": {"arm_lift_joint": 0.32},
+        "Torso:base_link:torso_lift_link:HIGH": {"arm_lift_joint": 0.64},
+    }
+    for key, values in theirs.joint_states.items():
+        resolved: dict[str, set[float]] = {}
+        for joint, value in values.items():
+            mimic = world.get_connection_by_name(joint).mimic
+            if mimic is None:
+                resolved.setdefault(joint, set()).add(round(value, 9))
+            else:
+                leader = (value - mimic.offset) / mimic.multiplier
+                resolved.setdefault(mimic.leader, set()).add(round(leader, 9))
+        assert all(len(v) == 1 for v in resolved.values()), (key, resolved)
+        sdts = {j: v.pop() for j, v in resolved.items()}
+        mine = {j: round(v, 9) for j, v in ours.joint_states[key].items()}
+        assert sdts == moved.get(key, mine), key
+    assert {k: ours.joint_states[k] for k in moved} == {
+        "Torso:base_link:torso_lift_link:MID": {"arm_lift_joint": 0.34},
+        "Torso:base_link:torso_lift_link:HIGH": {"arm_lift_joint": 0.68},
+    }

@@ -416,8 +416,11 @@ def test_a_camera_named_by_its_model_is_a_camera(tmp_path: Path) -> None:
         J("j1", "revolute", "base_link", "link_1", "0 0 0.1"),
         J("d435_joint", "fixed", "base_link", "d435_link", "0.1 0 0.5"),
     ]
-    d, _ = _draft(tmp_path, _urdf("robot", "base_link", joints))
+    d, text = _draft(tmp_path, _urdf("robot", "base_link", joints))
     assert [(c.body, c.optical) for c in d.cameras] == [("d435_link", False)]
+    # Its model names a shipped preset: drafted, marked DECIDE on the camera's line.
+    assert d.cameras[0].preset == "realsense_d435" and "preset: realsense_d435" in text
+    assert "DECIDE" in _line(text, f"{d.cameras[0].name}:")
 
 
 def test_a_robot_whose_head_camera_looks_along_minus_y_faces_minus_y(tmp_path: Path) -> None:

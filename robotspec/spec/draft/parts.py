@@ -7,6 +7,7 @@ rides on the chain it hangs from, a named state belongs to every part whose join
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -43,6 +44,10 @@ def add_sensors(d: Drafter) -> None:
                 )
             else:
                 cam.decide.append("named as a camera, but not rotated as an optical frame")
+        model = _model_preset(seen.body.name)
+        if model is not None:
+            cam.preset = model
+            cam.decide.append(f"preset '{model}' by the frame's name")
         draft.cameras.append(cam)
         name_of[cam.body] = cam.name
     tops = [_first_moving(world, c) for c in draft.chains if c.role in ("arm", "leg")]
@@ -84,6 +89,21 @@ def add_sensors(d: Drafter) -> None:
         if holders:
             best = max(holders, key=lambda c: world.depth(c.tip))
             best.sensors.append(cam.name)
+
+
+#: Camera models a frame's name can say, and the preset of ``templates/cameras.yaml`` for each.
+_MODELS = {"d435": "realsense_d435", "xtion": "xtion_pro_live", "kinect": "kinect_v1"}
+
+
+def _model_preset(name: str) -> str | None:
+    """The preset of the camera model a frame is named after (G1's 'd435_link'), if shipped."""
+    from robotspec.spec.draft.render import camera_presets
+
+    tokens = set(re.split(r"[^a-z0-9]+", name.lower())) | words(name)
+    for word, preset in _MODELS.items():
+        if word in tokens and preset in camera_presets():
+            return preset
+    return None
 
 
 def _looks_along_z(d: Drafter, body: Body) -> bool:

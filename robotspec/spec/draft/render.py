@@ -8,6 +8,7 @@ comments is escaped the same way, so no name can end a comment and start a key.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 import unicodedata
@@ -61,6 +62,7 @@ def comment(text: str) -> str:
     return "".join(_escape_char(ch) if ch not in '\\"' else ch for ch in text.replace("\n", "\\n"))
 
 
+@functools.cache
 def camera_presets() -> tuple[str, ...]:
     """Names of the camera models a spec's ``preset:`` may name (``templates/cameras.yaml``).
 

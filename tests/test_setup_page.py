@@ -105,3 +105,35 @@ def test_collision_matrix_and_audit_from_the_page(page: Any, tmp_path: Path) -> 
         time.sleep(0.05)
     assert "every entry is right" in page._collision_text.content
     assert page.session.validation.valid
+
+
+def test_parts_added_changed_and_removed_from_the_page(page: Any) -> None:
+    s = page.session
+    page.select("link7")
+    page._new_kind.value = "camera"
+    page._new_name.value = "wrist_cam"
+    page._add_part()
+    assert page._part.value == "sensors.wrist_cam" and page._f_camera.visible
+    assert "sensors.wrist_cam.field_of_view" in [q.id for q in s.snapshot.questions]
+    page._preset.value = s.source.presets[0]
+    page._set_camera(preset=True)
+    assert s.draft().cameras[0].preset == s.source.presets[0]
+    page._fov.value = (1.2, 0.9)
+    page._set_camera(fov=True)
+    assert s.draft().cameras[0].field_of_view == (1.2, 0.9) and s.validation.valid
+    page._new_kind.value = "leg"
+    page._new_name.value = "tail"
+    page._add_part()  # root and tip at the picked link: validate says what is wrong
+    assert "the spec is now invalid" in page.last_message and "chains.tail" in s.parts()
+    page._remove_part()
+    assert "chains.tail" not in s.parts() and s.validation.valid
+    page._part.value = "drive"
+    page._select_part("drive")
+    page._drive.value = "omni"
+    page._guarded(lambda _e: page._after(s.set_drive(str(page._drive.value)), "set"))(_Person())
+    assert s.draft().drive.type == "omni"
+    page._forward.value = "faces -y"
+    page._set_forward()
+    assert s.draft().forward == (0.0, -1.0, 0.0) and "faces -y" in page._part_info.content
+    page._guarded(lambda _e: page._remove_part())(_Person())
+    assert "cannot be removed" in page.last_message

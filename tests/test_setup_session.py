@@ -209,3 +209,16 @@ def test_the_robots_facing_is_set_and_read_back(tmp_path: Path) -> None:
     assert q.reason == "why" and "faces +x" in q.alternatives
     assert third.answer("forward", "faces +y").valid
     assert "forward: [0, 1, 0]\n" in third.snapshot.text
+
+
+def test_tiago_a_camera_model_guessed_by_name_is_a_question(tmp_path: Path) -> None:
+    urdf = erd_robots() / "tiago_description" / "robots" / "tiago.urdf"
+    s = SetupSession.open(str(urdf), output=tmp_path / "tiago.yaml")
+    cams = [q for q in s.snapshot.questions if q.part.startswith("sensors.")]
+    assert cams and all("preset: kinect_v1" in q.alternatives for q in cams)
+    for q in s.snapshot.questions:
+        s.answer(q.id, "preset: kinect_v1" if q in cams else KEEP)
+    assert not s.snapshot.questions and s.validation.valid
+    text = s.save().read_text()
+    assert "preset: kinect_v1" in text and "DECIDE: " not in text.split("delete the mark.")[1]
+    check_spec(tmp_path / "tiago.yaml")

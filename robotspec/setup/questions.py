@@ -101,7 +101,12 @@ def questions_of(draft: Draft, presets: tuple[str, ...] = ()) -> tuple[Question,
         if cam.decide:
             other = BODY_FRAME if cam.optical else OPTICAL
             guess = OPTICAL if cam.optical else BODY_FRAME
-            out.append(Question(part, part, guess, (KEEP, other, REMOVE), "; ".join(cam.decide)))
+            models: tuple[str, ...] = ()
+            if cam.preset is not None:  # a model guessed from the frame's name
+                guess += f", preset {cam.preset}"
+                models = tuple(f"preset: {p}" for p in presets if p != cam.preset)
+            choices = (KEEP, other, *models, REMOVE)
+            out.append(Question(part, part, guess, choices, "; ".join(cam.decide)))
         if cam.preset is None and cam.field_of_view is None:
             choices = (KEEP, *(f"preset: {p}" for p in presets))
             out.append(

@@ -400,9 +400,7 @@ class SetupSession:
                 c.preset, c.field_of_view = None, (float(field_of_view[0]), float(field_of_view[1]))
             if optical is not None:
                 c.optical = optical
-                c.decide.clear()
-            if body is not None:
-                c.decide.clear()
+            c.decide.clear()  # a person decided this camera: its question is answered
 
         return self.edit(change)
 

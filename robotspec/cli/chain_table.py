@@ -42,13 +42,15 @@ def _chain_row(robot: AbstractRobot, c: KinematicChain) -> dict[str, Any]:
 
 
 def print_chains(robot: AbstractRobot, *, as_json: bool = False) -> None:
-    """Print the robot's chains (fingers of parallel grippers too) as a table or JSON."""
-    from robotspec.semantic import ParallelGripper
+    """Print the robot's chains (fingers of grippers and hands too) as a table or JSON."""
+    from robotspec.semantic import Hand, ParallelGripper
 
     items = [_chain_row(robot, c) for c in robot.all_chains]
     for m in robot.manipulators:
         if isinstance(m, ParallelGripper):
             items += [_chain_row(robot, m.thumb), _chain_row(robot, m.finger)]
+        elif isinstance(m, Hand):
+            items += [_chain_row(robot, f) for f in m.all_fingers]
     rows = [
         [
             i["name"],

@@ -36,20 +36,28 @@ def manipulators(
     spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = None
 ) -> None:
     """Manipulators: root, tool frame, front-facing orientation and axis, fingers, states."""
-    from robotspec.semantic import ParallelGripper
+    from robotspec.semantic import Hand, ParallelGripper
 
     robot = load_robot(spec, package_path)
     items = []
     for m in robot.manipulators:
         item: dict[str, Any] = {
             "name": m.name,
-            "type": "parallel_gripper" if isinstance(m, ParallelGripper) else "generic",
+            "type": "parallel_gripper"
+            if isinstance(m, ParallelGripper)
+            else "hand"
+            if isinstance(m, Hand)
+            else "generic",
             "root": m.root.name,
             "tool_frame": m.tool_frame.name,
             "front_facing_orientation": list(m.front_facing_orientation),
             "front_facing_axis": list(m.front_facing_axis),
-            "thumb": m.thumb.tip.name if isinstance(m, ParallelGripper) else None,
-            "finger": m.finger.tip.name if isinstance(m, ParallelGripper) else None,
+            "thumb": m.thumb.tip.name if isinstance(m, (ParallelGripper, Hand)) else None,
+            "finger": m.finger.tip.name
+            if isinstance(m, ParallelGripper)
+            else ", ".join(f.tip.name for f in m.fingers.values())
+            if isinstance(m, Hand)
+            else None,
             "states": sorted(m.states),
         }
         items.append(item)

@@ -23,6 +23,7 @@ from robotspec.semantic import (
     Finger,
     GenericManipulator,
     GenericSensor,
+    Hand,
     JointState,
     KinematicChain,
     Manipulator,
@@ -32,7 +33,7 @@ from robotspec.semantic import (
     Torso,
     front_facing_axis_of,
 )
-from robotspec.spec.models import CameraSpec, FingerSpec, ParallelGripperSpec
+from robotspec.spec.models import CameraSpec, FingerSpec, HandSpec, ParallelGripperSpec
 
 __all__ = ["Resolved", "assemble", "drive_type"]
 
@@ -116,6 +117,12 @@ def _manipulators(b: Build, r: Resolved) -> dict[str, Manipulator]:
             thumb = _finger(w, f"{name}_thumb", spec.thumb)
             finger = _finger(w, f"{name}_finger", spec.finger)
             out[name] = ParallelGripper(**common, finger=finger, thumb=thumb)
+        elif isinstance(spec, HandSpec):
+            out[name] = Hand(
+                **common,
+                thumb=_finger(w, f"{name}_thumb", spec.thumb),
+                fingers={k: _finger(w, f"{name}_{k}", f) for k, f in spec.fingers.items()},
+            )
         else:
             out[name] = GenericManipulator(**common)
     return out

@@ -21,7 +21,7 @@ from robotspec.compiler.heights import HeightRange, chain_fk_batch, height_range
 from robotspec.compiler.parts import CameraValues
 from robotspec.diagnostics import Loc
 from robotspec.model.world import Body
-from robotspec.spec.models import CameraSpec, ParallelGripperSpec
+from robotspec.spec.models import CameraSpec, FingerSpec, HandSpec, ParallelGripperSpec
 
 __all__ = ["HEIGHT_TOL", "KinematicInputs", "check_kinematics"]
 
@@ -78,14 +78,20 @@ def _immobile_parts(b: Build, r: KinematicInputs) -> None:
         arm = c.kind == "arm" or c.manipulator is not None
         parts.append((("chains", name), f"chain '{name}'", ends, arm))
     for name, m in spec.manipulators.items():
-        if not isinstance(m, ParallelGripperSpec):
-            continue
-        for role in ("thumb", "finger"):
-            f = getattr(m, role)
+        fingers: list[tuple[Loc, str, FingerSpec]] = []
+        if isinstance(m, ParallelGripperSpec):
+            fingers = [(("manipulators", name, r), r, getattr(m, r)) for r in ("thumb", "finger")]
+        elif isinstance(m, HandSpec):
+            fingers = [(("manipulators", name, "thumb"), "thumb", m.thumb)]
+            fingers += [
+                (("manipulators", name, "fingers", k), f"finger '{k}'", f)
+                for k, f in m.fingers.items()
+            ]
+        for floc, role, f in fingers:
             if b.world.has_body(f.root) and b.world.has_body(f.tip):
                 ends = (b.world.get_body_by_name(f.root), b.world.get_body_by_name(f.tip))
                 if ends[0].index != ends[1].index and b.world.is_ancestor(*ends):
-                    parts.append((("manipulators", name, role), f"{role} of '{name}'", ends, False))
+                    parts.append((floc, f"{role} of '{name}'", ends, False))
     for loc, what, (root, tip), must_move in parts:
         if root.index == tip.index:
             continue

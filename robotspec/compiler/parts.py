@@ -19,6 +19,7 @@ from robotspec.spec.models import (
     ChainSpec,
     FingerSpec,
     GenericManipulatorSpec,
+    HandSpec,
     ParallelGripperSpec,
 )
 
@@ -26,7 +27,7 @@ __all__ = ["CameraValues", "camera_values", "chain_ends", "check_manipulator", "
 
 
 def check_manipulator(
-    b: Build, name: str, m: ParallelGripperSpec | GenericManipulatorSpec
+    b: Build, name: str, m: ParallelGripperSpec | HandSpec | GenericManipulatorSpec
 ) -> tuple[Body, Body] | None:
     """Root, tool frame, fingers and axis of one manipulator; its (root, tool) when found."""
     loc: Loc = ("manipulators", name)
@@ -75,6 +76,8 @@ def check_manipulator(
             b.chain_ok(floc, f"{role} of '{name}'", froot, ftip)
         if m.finger.root == m.thumb.root and m.finger.tip == m.thumb.tip:
             b.diag.error((*loc, "thumb"), "finger and thumb are the same chain")
+    elif isinstance(m, HandSpec):
+        _check_hand(b, name, m, root)
     if root is None or tool is None:
         return None
     allowed = moved_by(b.world, subtree_joints(b.world, root))
@@ -82,6 +85,47 @@ def check_manipulator(
         name, check_states(b, (*loc, "states"), f"manipulator '{name}'", m.states, allowed)
     )
     return root, tool
+
+
+def _check_hand(b: Build, name: str, m: HandSpec, root: Body | None) -> None:
+    """A hand's thumb and fingers: found, below the hand's root, tips below roots, disjoint."""
+    loc: Loc = ("manipulators", name)
+    links: list[tuple[str, set[str]]] = []
+    roles: list[tuple[Loc, str, FingerSpec]] = [((*loc, "thumb"), "thumb", m.thumb)]
+    roles += [((*loc, "fingers", f), f"finger '{f}'", spec) for f, spec in m.fingers.items()]
+    for floc, role, f in roles:
+        froot = b.body((*floc, "root"), f.root)
+        ftip = b.body((*floc, "tip"), f.tip)
+        if froot is not None and root is not None:
+            if froot.index == root.index or not b.world.is_ancestor(root, froot):
+                b.diag.error(
+                    (*floc, "root"),
+                    f"{role} root '{froot.name}' is not below the hand root '{root.name}'"
+                    + (
+                        " (a finger starts at its first link past the palm)"
+                        if froot.index == root.index
+                        else ""
+                    ),
+                    name=froot.name,
+                )
+                continue
+        if not b.chain_ok(floc, f"{role} of '{name}'", froot, ftip):
+            continue
+        assert froot is not None and ftip is not None
+        own = {froot.name} | {
+            b.world.bodies[c.child].name for c in b.world.compute_chain_of_connections(froot, ftip)
+        }
+        for other, theirs in links:
+            shared = sorted(own & theirs)
+            if shared:
+                b.diag.error(
+                    floc,
+                    f"{role} of '{name}' shares links with the {other} ({', '.join(shared)}); "
+                    "the fingers of a hand are disjoint chains",
+                    name=shared[0],
+                )
+                break
+        links.append((role, own))
 
 
 @dataclass(frozen=True)

@@ -61,6 +61,8 @@ def rename_semantics(data: Mapping[str, Any], n: PartNames, facts: TreeFacts) ->
             for f in ("finger", "thumb"):
                 if f in mm:
                     mm[f] = _finger(mm[f], n)
+            if isinstance(mm.get("fingers"), Mapping):  # a hand's named fingers
+                mm["fingers"] = {k: _finger(f, n) for k, f in mm["fingers"].items()}
             if "states" in mm:
                 mm["states"] = n.states(mm["states"])
             manips[n.name(k)] = mm

@@ -6,6 +6,7 @@ from robotspec.semantic.base import AssignmentError, JointState, SemanticRobotAn
 from robotspec.semantic.chains import Arm, Finger, KinematicChain, Neck, Torso
 from robotspec.semantic.manipulators import (
     GenericManipulator,
+    Hand,
     Manipulator,
     ParallelGripper,
     front_facing_axis_of,
@@ -24,6 +25,7 @@ __all__ = [
     "Finger",
     "GenericManipulator",
     "GenericSensor",
+    "Hand",
     "JointState",
     "KinematicChain",
     "Manipulator",

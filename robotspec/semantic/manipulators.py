@@ -11,7 +11,13 @@ from robotspec.model.world import Body
 from robotspec.semantic.base import JointState, SemanticRobotAnnotation
 from robotspec.semantic.chains import Finger
 
-__all__ = ["GenericManipulator", "Manipulator", "ParallelGripper", "front_facing_axis_of"]
+__all__ = [
+    "GenericManipulator",
+    "Hand",
+    "Manipulator",
+    "ParallelGripper",
+    "front_facing_axis_of",
+]
 
 
 def front_facing_axis_of(q: tuple[float, float, float, float]) -> tuple[float, float, float]:
@@ -47,6 +53,19 @@ class ParallelGripper(Manipulator):
 
     finger: Finger = field(kw_only=True)
     thumb: Finger = field(kw_only=True)
+
+
+@dataclass(eq=False, repr=False)
+class Hand(Manipulator):
+    """A thumb and named fingers (at least one): a hand of more than a gripper's two fingers."""
+
+    thumb: Finger = field(kw_only=True)
+    fingers: dict[str, Finger] = field(kw_only=True)
+
+    @property
+    def all_fingers(self) -> tuple[Finger, ...]:
+        """The thumb first, then the fingers in the spec's order."""
+        return (self.thumb, *self.fingers.values())
 
 
 @dataclass(eq=False, repr=False)

@@ -25,6 +25,7 @@ __all__ = [
     "FingerSpec",
     "GenericManipulatorSpec",
     "GenericSensorSpec",
+    "HandSpec",
     "ManipulatorSpec",
     "NeckSpec",
     "ParallelGripperSpec",
@@ -113,8 +114,29 @@ class GenericManipulatorSpec(_ManipulatorBase):
     type: Literal["generic"] = Field(description="selects this kind", examples=["generic"])
 
 
+class HandSpec(_ManipulatorBase):
+    """A hand of a thumb and named fingers (more than a parallel gripper's two)."""
+
+    type: Literal["hand"] = Field(description="selects this kind", examples=["hand"])
+    thumb: FingerSpec = Field(
+        description="the finger that opposes the others",
+        examples=[{"root": "link_12.0", "tip": "link_15.0_tip"}],
+    )
+    fingers: dict[Name, FingerSpec] = Field(
+        min_length=1,
+        description="the other fingers by name (at least one), each a chain from its root to "
+        "its tip",
+        examples=[
+            {
+                "index": {"root": "link_0.0", "tip": "link_3.0_tip"},
+                "middle": {"root": "link_4.0", "tip": "link_7.0_tip"},
+            }
+        ],
+    )
+
+
 ManipulatorSpec = Annotated[
-    ParallelGripperSpec | GenericManipulatorSpec, Field(discriminator="type")
+    ParallelGripperSpec | HandSpec | GenericManipulatorSpec, Field(discriminator="type")
 ]
 
 

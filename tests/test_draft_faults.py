@@ -466,3 +466,22 @@ def test_a_turned_camera_frame_looking_ahead_along_z_looks_along_z(tmp_path: Pat
     (cam,) = d.cameras
     assert cam.body == "head_camera_link" and cam.looks_along_z and not cam.optical
     assert "forward_facing_axis: [0, 0, 1]" in text
+
+
+def test_a_link_turned_like_an_optical_frame_is_no_camera_and_a_bare_gripper_frame_a_tcp(
+    tmp_path: Path,
+) -> None:
+    # iCub (reduced): 'neck_2' happens to be turned as REP 103's optical frames are, and
+    # carries the head: not a camera. Its hands' TCP is the bare frame 'l_gripper'.
+    joints = [
+        J("neck_fixed", "fixed", "chest", "neck_2", "0 0 0.2", rpy=OPTICAL_RPY),
+        J("head_fixed", "fixed", "neck_2", "head", "0 0.05 0"),
+        J("l_shoulder", "revolute", "chest", "l_shoulder_1", "0 0.1 0.15", "0 1 0"),
+        J("l_elbow", "revolute", "l_shoulder_1", "l_elbow_1", "0 0 -0.15", "0 1 0"),
+        J("l_wrist_yaw", "revolute", "l_elbow_1", "l_hand", "0 0 -0.15"),
+        J("l_gripper_joint", "fixed", "l_hand", "l_gripper", "0 0 -0.05", bare=True),
+    ]
+    d, _ = _draft(tmp_path, _urdf("icub", "chest", joints))
+    assert d.cameras == []
+    (hand,) = d.manipulators
+    assert hand.tool_frame == "l_gripper"

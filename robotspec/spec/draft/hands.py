@@ -280,7 +280,17 @@ def find_tool_frame(
                     b.index,
                 ),
             )
-    return None
+    # Last: a bare frame named as the gripper (iCub's 'l_gripper' below 'l_hand').
+    bare = [
+        b
+        for b in candidates
+        if "gripper" in names[b.index][0][1]
+        and not world.child_bodies(b)
+        and not _own_geometry(b)
+        and (c := world.parent_connection(b)) is not None
+        and c.is_fixed
+    ]
+    return min(bare, key=lambda b: (world.depth(b), b.index)) if bare else None
 
 
 def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:

@@ -90,6 +90,8 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
         parent_words = words(world.bodies[parent.parent].name) if parent is not None else set()
         if optical and parent_words & NOT_CAMERA_WORDS:
             continue
+        if optical and world.child_bodies(b) and not w & CAMERA_WORDS:
+            continue  # a link turned as optical frames are, carrying others (iCub's 'neck_2')
         if optical or (w & CAMERA_WORDS and not world.child_bodies(b)):
             found.append(CameraFound(_stem(b.name) or b.name, b, optical))
     # One per device: drop a camera whose name extends another's on the same rigid body, or

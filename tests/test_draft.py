@@ -146,6 +146,16 @@ def test_a_hand_alone_is_not_an_arm(tmp_path: Path) -> None:
     # The Allegro hand's fingers are four serial runs of four joints: never arms.
     d, _ = _draft("allegro_hand_description/urdf/allegro_right_hand.urdf", None, tmp_path)
     assert d.chains == []
+    # It is drafted as the hand it is: rooted at its palm, its thumb the finger off the row of
+    # the others (joints 12-15, as the shipped part spec says), a tool frame among the tips.
+    (hand,) = d.manipulators
+    assert hand.is_hand and hand.root == "palm_link" and d.lone_hand == hand.name
+    assert hand.thumb is not None and (hand.thumb.root, hand.thumb.tip) == (
+        "link_12.0",
+        "link_15.0_tip",
+    )
+    assert {f.root for f in hand.fingers.values()} == {"link_0.0", "link_4.0", "link_8.0"}
+    assert [f.parent for f in d.frames] == ["palm_link"]
 
 
 # ------------------------------------------------------------------ YAML of any name

@@ -255,9 +255,13 @@ def test_a_hand_of_fingers_alone_is_drafted_as_one(tmp_path: Path) -> None:
             xyz = f"0 {y} 0.08" if k == 0 else "0 0 0.04"
             joints.append(J(f"finger_{i}_joint_{k}", "revolute", parent, child, xyz, "0 1 0"))
             parent = child
-    d, _ = _draft(tmp_path, _urdf("hand", "palm_link", joints))
+    joints.append(J("thumb_joint_0", "revolute", "palm_link", "thumb_link_0", "0.03 0 0.03"))
+    joints.append(J("thumb_joint_1", "revolute", "thumb_link_0", "thumb_link_1", "0.03 0 0"))
+    d, text = _draft(tmp_path, _urdf("hand", "palm_link", joints))
     (hand,) = d.manipulators
-    assert not hand.is_gripper and hand.root == "palm_link"
+    assert hand.is_hand and hand.root == "palm_link" and "type: hand" in text
+    assert hand.thumb is not None and hand.thumb.tip == "thumb_link_1"  # by its name
+    assert len(hand.fingers) == 3
     assert d.frames and d.frames[0].parent == "palm_link" and hand.tool_frame == d.frames[0].name
     assert d.frames[0].xyz[2] > 0.1  # out among the finger tips
 

@@ -16,6 +16,7 @@ from robotspec.model.world import World
 from robotspec.spec.draft.hands import (
     Gripper,
     facing_quaternion,
+    find_fingers,
     find_gripper,
     find_tool_frame,
     hand_center,
@@ -282,6 +283,17 @@ class Drafter:
             m.source = f"{gripper.found} below '{gripper.root.name}'"
             if gripper.decide:
                 decide.append(gripper.decide)
+        elif (
+            hand is not None
+            and chain.role != "leg"
+            and (found := find_fingers(tree, hand)) is not None
+            and world.is_ancestor(top, found.split)
+        ):
+            m.thumb, m.fingers = found.thumb, found.fingers
+            m.source = f"{len(found.fingers) + 1} finger branches below '{found.split.name}'"
+            decide.append(
+                "a hand: " + (found.decide or "the thumb by its name") + "; fingers by their links"
+            )
         else:
             m.source = "the end of the chain" if hand is None else f"the hand at '{hand.name}'"
             if chain.role == "leg":
@@ -451,7 +463,8 @@ def draft_spec(
         if lb is not None and lb.hand is not None:
             g, _ = find_gripper(d.tree, lb.hand)
             if g is None:
-                word = "hand" if "hand" in words(lb.hand.name) else "tool"
+                fingered = find_fingers(d.tree, lb.hand) is not None
+                word = "hand" if fingered or "hand" in words(lb.hand.name) else "tool"
         else:
             word = "tool"
         d.manipulator(c, lb, join(side, word) if side else word)

@@ -28,6 +28,7 @@ from robotspec.spec.draft.tree import Tree, words
 __all__ = [
     "Gripper",
     "facing_quaternion",
+    "find_fingers",
     "find_gripper",
     "find_tool_frame",
     "hand_center",
@@ -235,6 +236,87 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
         decide=decide,
     )
     return gripper, "two finger branches"
+
+
+#: Names of a hand's fingers besides the thumb, as links often carry them.
+FINGER_NAMES = ("index", "middle", "ring", "pinky", "little")
+
+
+@dataclass(frozen=True)
+class Fingers:
+    """A hand of three or more finger branches: its thumb and the others by name."""
+
+    split: Body
+    thumb: DraftFinger
+    fingers: dict[str, DraftFinger]
+    decide: str | None
+
+
+def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
+    """The fingers of a hand at or below ``hand`` that splits into three or more branches.
+
+    The thumb is the branch named so; else the one whose base lies farthest from the others'
+    (it opposes them), which is a guess. The others are named by their links (``index``,
+    ``middle``...) or numbered.
+    """
+    world = tree.world
+    body = hand
+    while True:
+        kids = tree.moving_children(body)
+        if len(kids) != 1:
+            break
+        body = kids[0]
+    branches = [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
+    if len(branches) < 3:
+        return None
+    names = [{w for b in world.subtree(k) for w in words(b.name)} for k in branches]
+    named = [i for i, n in enumerate(names) if "thumb" in n]
+    decide = None
+    if len(named) == 1:
+        thumb_i = named[0]
+    else:
+        at = [tree.position(k) for k in branches]
+
+        def apart(i: int) -> tuple[float, float]:
+            # The others' bases on one line (a palm's row of fingers), this one off it.
+            others = at[:i] + at[i + 1 :]
+            return (-round(_line_residual(others), 6), _off_line(at[i], others))
+
+        thumb_i = max(range(len(at)), key=apart)
+        decide = "the thumb is the finger whose base lies off the row of the others'"
+    fingers: dict[str, DraftFinger] = {}
+    count = 0
+    for i, k in enumerate(branches):
+        if i == thumb_i:
+            continue
+        count += 1
+        label = next((w for w in FINGER_NAMES if w in names[i]), f"finger_{count}")
+        while label in fingers:
+            label = f"{label}_{count}"
+        fingers[label] = DraftFinger(k.name, _finger_tip(tree, k).name)
+    thumb = branches[thumb_i]
+    out = Fingers(body, DraftFinger(thumb.name, _finger_tip(tree, thumb).name), fingers, decide)
+    # A finger starts at its first link past the palm; one of a single link has no chain to
+    # write (Tiago's), and the hand is then drafted as a generic one.
+    if any(f.root == f.tip for f in (out.thumb, *out.fingers.values())):
+        return None
+    return out
+
+
+def _line_residual(points: list[np.ndarray]) -> float:
+    """How far ``points`` are from lying on one line (the spread across their principal axis)."""
+    pts = np.asarray(points)
+    s = np.linalg.svd(pts - pts.mean(axis=0), compute_uv=False)
+    return float(np.sqrt(np.sum(s[1:] ** 2)))
+
+
+def _off_line(p: np.ndarray, others: list[np.ndarray]) -> float:
+    """How far ``p`` lies from the line the ``others`` best lie on (their principal axis)."""
+    pts = np.asarray(others)
+    centre = pts.mean(axis=0)
+    _, _, vt = np.linalg.svd(pts - centre)
+    d = p - centre
+    return float(np.linalg.norm(d - (d @ vt[0]) * vt[0]))
 
 
 def _matches(hint: str, name: tuple[str, set[str]]) -> bool:

@@ -47,11 +47,18 @@ class DraftManipulator:
     front_facing: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
     #: Actuated joints of the hand (for group states); not written.
     joints: frozenset[str] = frozenset()
+    #: A hand's fingers besides its thumb, by name (written as ``type: hand``).
+    fingers: dict[str, DraftFinger] = field(default_factory=dict)
 
     @property
     def is_gripper(self) -> bool:
         """Whether the draft writes a ``parallel_gripper`` (both fingers known)."""
         return self.finger is not None and self.thumb is not None
+
+    @property
+    def is_hand(self) -> bool:
+        """Whether the draft writes a ``hand`` (a thumb and named fingers)."""
+        return self.finger is None and self.thumb is not None and bool(self.fingers)
 
 
 @dataclass

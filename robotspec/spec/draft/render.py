@@ -123,14 +123,19 @@ def _chain_body(out: list[str], c: DraftChain, indent: str) -> None:
 
 def _manipulator(out: list[str], m: DraftManipulator) -> None:
     out.append(f"  {scalar(m.name)}:  # from {comment(m.source)}{_decide(m.decide)}")
-    out.append("    type: parallel_gripper" if m.is_gripper else "    type: generic")
+    kind = "parallel_gripper" if m.is_gripper else "hand" if m.is_hand else "generic"
+    out.append(f"    type: {kind}")
     out.append(f"    root: {scalar(m.root)}")
     out.append(f"    tool_frame: {scalar(m.tool_frame)}")
     q = ", ".join(_num(v) for v in m.front_facing)
     out.append(f"    front_facing_orientation: [{q}]")
     for role, f in (("thumb", m.thumb), ("finger", m.finger)):
-        if f is not None and m.is_gripper:
+        if f is not None and (m.is_gripper or m.is_hand):
             out.append(f"    {role}: {{root: {scalar(f.root)}, tip: {scalar(f.tip)}}}")
+    if m.is_hand:
+        out.append("    fingers:")
+        for name, f in m.fingers.items():
+            out.append(f"      {scalar(name)}: {{root: {scalar(f.root)}, tip: {scalar(f.tip)}}}")
     _states(out, m.states, "    ")
 
 

@@ -274,3 +274,21 @@ def test_an_unwritable_class_store_warns_and_the_robot_still_builds(
     with pytest.warns(SdtBridgeWarning, match="could not be stored"):
         again = to_sdt(robot)
     assert type(again) is type(built)
+
+
+def test_a_hand_has_sdts_fingers_with_its_thumb() -> None:
+    from semantic_digital_twin.robots.robot_part_mixins import HasFingers, HasTwoFingers
+
+    robot, sdt_robot = _robot("b1_ur5_allegro")
+    (hand,) = _parts(sdt_robot, "EndEffector")
+    assert isinstance(hand, HasFingers) and not isinstance(hand, HasTwoFingers)
+    hand.validate()
+    assert len(hand.fingers) == 4
+    assert hand.thumb.root.name.name == "allegro_link_12.0"
+    assert hand.thumb.tip.name.name == "allegro_link_15.0_tip"
+    from robotspec.semantic import Hand
+
+    (ours,) = robot.manipulators
+    assert isinstance(ours, Hand)
+    others = {f.root.name.name for f in hand.fingers if f is not hand.thumb}
+    assert others == {f.root.name for f in ours.fingers.values()}

@@ -149,3 +149,25 @@ def test_sdts_missing_cylinder_mesh_is_named_not_a_crash(monkeypatch: pytest.Mon
     monkeypatch.setattr(pcd, "create_cylinder_shape", create_cylinder_shape)
     with pytest.raises(RobotSpecError, match="wheel lacks its resources/ folder"):
         to_sdt(HSRB.load(package_paths=[folder]))
+
+
+def test_a_hand_of_four_fingers_migrates_as_a_hand() -> None:
+    from robotspec.compiler import compile_robot
+    from robotspec.interop.sdt.classes import robot_class
+    from robotspec.interop.sdt.migrate import spec_from_sdt
+    from robotspec.interop.sdt.recipe import robot_recipe
+    from robotspec.interop.sdt.world import sdt_world
+
+    erd_robots()
+    robot = compile_robot("b1_ur5_allegro")
+    cls = robot_class(robot_recipe(robot))
+    world = sdt_world(robot.world, drive=robot.drive_type)
+    migration = spec_from_sdt(cls, world, urdf="b1_ur5_allegro.urdf")
+    (hand,) = migration.spec["manipulators"].values()
+    assert hand["type"] == "hand"
+    assert hand["thumb"] == {"root": "allegro_link_12.0", "tip": "allegro_link_15.0_tip"}
+    assert hand["fingers"] == {
+        n: {"root": f"allegro_link_{r}.0", "tip": f"allegro_link_{t}.0_tip"}
+        for n, r, t in (("index", 0, 3), ("middle", 4, 7), ("ring", 8, 11))
+    }
+    assert not any("fingers" in n for n in migration.notes)

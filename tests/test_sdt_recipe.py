@@ -169,3 +169,14 @@ def test_without_sdt_the_migrate_command_says_how_to_install_it(
     argv = ["migrate", "sdt", "semantic_digital_twin.robots.pr2:PR2", "--urdf", "pr2.urdf"]
     assert run_app(app, argv) == 1
     assert "pip install 'robotspec[sdt]'" in capsys.readouterr().err
+
+
+def test_a_hand_is_an_end_effector_with_its_thumb_first() -> None:
+    erd_robots()
+    recipe = robot_recipe(_robot("b1_ur5_allegro"))
+    (hand,) = [p for p in recipe.parts() if p.kind == "end_effector"]
+    fingers = hand.slot("fingers")
+    assert [(f.kind, f.name, f.root, f.tip) for f in fingers] == [
+        ("finger", f"allegro_hand_{n}", f"allegro_link_{r}.0", f"allegro_link_{t}.0_tip")
+        for n, r, t in (("thumb", 12, 15), ("index", 0, 3), ("middle", 4, 7), ("ring", 8, 11))
+    ]

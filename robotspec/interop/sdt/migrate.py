@@ -7,9 +7,9 @@ interface and velocity limit is read off the result into spec data. ``robotspec 
 then checks what SDT's class only assumed; :func:`~robotspec.interop.sdt.to_sdt` turns the
 spec back into SDT's classes.
 
-What a spec cannot say is reported, one line each, in :attr:`Migration.notes`: a hand with more
-than two fingers (a generic manipulator for now), a velocity limit SDT *raises* (robotspec's
-limits only tighten), a state of a kind robotspec has no name for.
+What a spec cannot say is reported, one line each, in :attr:`Migration.notes`: an end effector
+of a single finger (a generic manipulator; more than two fingers are a ``type: hand``), a velocity
+limit SDT *raises* (robotspec's limits only tighten), a state of a kind robotspec has no name for.
 """
 
 from __future__ import annotations
@@ -45,6 +45,20 @@ def _part_name(part: Any, robot_class: type) -> str:
     if name.startswith(prefix) and len(name) > len(prefix):
         name = name[len(prefix) :]
     return _snake(name)
+
+
+def _finger_names(names: list[str]) -> list[str]:
+    """Finger part names without the words all share (``left_hand_index`` -> ``index``)."""
+    words = [n.split("_") for n in names]
+    if len(words) < 2:
+        return names
+    lead = 0
+    while all(len(w) > lead + 1 and w[lead] == words[0][lead] for w in words):
+        lead += 1
+    trail = 0
+    while all(len(w) > lead + trail + 1 and w[-1 - trail] == words[0][-1 - trail] for w in words):
+        trail += 1
+    return ["_".join(w[lead : len(w) - trail]) for w in words]
 
 
 def _n(entity: Any) -> str:
@@ -193,10 +207,24 @@ def spec_from_sdt(
                 m["type"] = "parallel_gripper"
                 m["thumb"] = {"root": _n(thumb.root), "tip": _n(thumb.tip)}
                 m["finger"] = {"root": _n(other.root), "tip": _n(other.tip)}
+            elif len(fingers) > 2:
+                thumb = part.thumb
+                m["type"] = "hand"
+                m["thumb"] = {"root": _n(thumb.root), "tip": _n(thumb.tip)}
+                short = _finger_names([names.get(id(f)) or _n(f.root) for f in fingers])
+                named: dict[str, Any] = {}
+                for f, key in zip(fingers, short, strict=True):
+                    if f is thumb:
+                        continue
+                    key = key if key != "thumb" else _n(f.root)
+                    while key in named:
+                        key += "_"
+                    named[key] = {"root": _n(f.root), "tip": _n(f.tip)}
+                m["fingers"] = named
             elif fingers:
                 notes.append(
-                    f"{pname}: {len(fingers)} fingers; a spec has no hand of more than two "
-                    "fingers yet, so it is a generic manipulator"
+                    f"{pname}: one finger; a spec's hand has a thumb and another finger, so it "
+                    "is a generic manipulator"
                 )
             manipulators[pname] = m
         elif kind == "Camera":

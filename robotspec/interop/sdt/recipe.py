@@ -18,7 +18,7 @@ import re
 from dataclasses import asdict, dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Literal
 
-from robotspec.semantic import Camera, KinematicChain, ParallelGripper
+from robotspec.semantic import Camera, Hand, KinematicChain, ParallelGripper
 
 if TYPE_CHECKING:
     from robotspec.semantic import AbstractRobot, JointState, Manipulator, Sensor
@@ -224,10 +224,11 @@ def _camera(sensor: Sensor, default: bool) -> PartRecipe:
 
 def _end_effector(m: Manipulator, left_out: list[str]) -> PartRecipe:
     children: tuple[tuple[str, tuple[PartRecipe, ...]], ...] = ()
-    if isinstance(m, ParallelGripper):
+    if isinstance(m, (ParallelGripper, Hand)):
+        # SDT: the first generic parameter is the thumb (HasTwoFingers, HasFingers).
+        chains = (m.thumb, m.finger) if isinstance(m, ParallelGripper) else m.all_fingers
         fingers = tuple(
-            PartRecipe(kind="finger", name=f.name, root=f.root.name, tip=f.tip.name)
-            for f in (m.thumb, m.finger)  # SDT: the first generic parameter is the thumb
+            PartRecipe(kind="finger", name=f.name, root=f.root.name, tip=f.tip.name) for f in chains
         )
         children = (("fingers", fingers),)
     return PartRecipe(
@@ -251,7 +252,8 @@ def robot_recipe(robot: AbstractRobot) -> RobotRecipe:
 
     The mapping: the torso, neck and arms become SDT's ``Torso``, ``Neck`` and ``Arm``; a
     manipulator its arm's ``EndEffector`` (a parallel gripper ``HasTwoFingers[thumb,
-    finger]``); cameras ``Camera`` (other sensors ``Sensor``) on the neck or arm that carries
+    finger]``, a hand ``HasFingers[thumb, *fingers]``, or ``HasTwoFingers`` for a thumb and
+    one finger); cameras ``Camera`` (other sensors ``Sensor``) on the neck or arm that carries
     them, else on the robot; a robot whose base moves gets a ``MobileBase`` rooted where the
     torso starts (the robot's root without a torso) holding the torso. Arms hang below the
     torso when there is one (one arm ``HasOneArm``, two ``HasLeftRightArm`` in robotspec's

@@ -132,3 +132,18 @@ def test_hand_exports_to_srdf() -> None:
     srdf = srdf_from_robot(robot)
     assert [e.group for e in srdf.end_effectors] == ["hand"]
     assert all("hand_" not in g.name for g in srdf.groups)  # fingers are links of the hand
+
+
+def test_a_drafted_hand_reads_back_into_the_setup_draft(tmp_path: Path) -> None:
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+    from robotspec.setup.from_spec import draft_of_spec
+
+    urdf = erd_robots() / "allegro_hand_description/urdf/allegro_right_hand.urdf"
+    out = tmp_path / "allegro.yaml"
+    assert run_app(app, ["init", str(urdf), "-o", str(out)]) == 0
+    assert "type: hand" in out.read_text(encoding="utf-8")
+    draft, _, _ = draft_of_spec(str(out))
+    (hand,) = draft.manipulators
+    assert hand.is_hand and hand.thumb is not None and hand.thumb.root == "link_12.0"
+    assert {f.root for f in hand.fingers.values()} == {"link_0.0", "link_4.0", "link_8.0"}

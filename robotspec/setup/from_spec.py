@@ -206,6 +206,9 @@ def draft_of_spec(
         if m.type == "parallel_gripper":
             dm.finger = DraftFinger(m.finger.root, m.finger.tip)
             dm.thumb = DraftFinger(m.thumb.root, m.thumb.tip)
+        elif m.type == "hand":
+            dm.thumb = DraftFinger(m.thumb.root, m.thumb.tip)
+            dm.fingers = {k: DraftFinger(f.root, f.tip) for k, f in m.fingers.items()}
         draft.manipulators.append(dm)
     for name, s in spec.sensors.items():
         if s.type != "camera":  # pragma: no cover - refused above

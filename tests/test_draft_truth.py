@@ -24,7 +24,7 @@ FLOOR = {
     "chains": 0.8,
     "tool frames": 0.8,
     "cameras": 0.8,
-    "grippers": 0.6,
+    "grippers/hands": 0.6,
     "torso/neck/drive": 0.6,
 }
 

@@ -17,7 +17,8 @@ the draft has it:
   count);
 * tool frames: a drafted manipulator has the truth's tool frame, or, where the truth says the
   URDF lacks one (``{parent: LINK}``), a frame the draft proposes on that link;
-* grippers: a drafted parallel gripper whose finger tips are the truth's two;
+* grippers/hands: a drafted parallel gripper whose finger tips are the truth's two; a drafted
+  hand (``type: hand``) with the truth's thumb tip and other finger tips;
 * cameras: a camera on the truth's frame;
 * torso, neck: the same actuated joints (present in either); drive: the same type (and the
   same base joints, when the truth names them); forward: the same facing (when either says
@@ -46,7 +47,7 @@ __all__ = [
 #: The ground truth files.
 TRUTH = Path(__file__).resolve().parents[1] / "tests" / "data" / "draft_truth"
 #: The categories, in the table's order.
-CATEGORIES = ("valid", "chains", "tool frames", "grippers", "cameras", "torso/neck/drive")
+CATEGORIES = ("valid", "chains", "tool frames", "grippers/hands", "cameras", "torso/neck/drive")
 
 
 @dataclass(frozen=True)
@@ -115,7 +116,7 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
             s.add("chains", False, f"drafted {name}, not a chain of the truth")
     # Tool frames and grippers.
     frames = {f.name: f.parent for f in draft.frames}
-    grippers = [m for m in draft.manipulators if m.is_gripper]
+    grippers = [m for m in draft.manipulators if m.is_gripper or m.is_hand]
     used: set[str] = set()
     for name, m in (t.get("manipulators") or {}).items():
         tool = m.get("tool_frame")
@@ -126,25 +127,25 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
             ok = any(d.tool_frame == tool for d in draft.manipulators)
             shown = str(tool)
         s.add("tool frames", ok, f"{name}: {shown}")
-        if m.get("type") == "parallel_gripper":
+        if m.get("type") in ("parallel_gripper", "hand"):
             tips = frozenset(m["fingers"])
+            want_thumb = m.get("thumb")  # a hand's; a gripper's two tips are unordered
             hit_g = next(
                 (
                     g
                     for g in grippers
-                    if g.name not in used
-                    and g.thumb is not None
-                    and g.finger is not None
-                    and frozenset((g.thumb.tip, g.finger.tip)) == tips
+                    if g.name not in used and _tips(g, want_thumb is not None) == (want_thumb, tips)
                 ),
                 None,
             )
             if hit_g is not None:
                 used.add(hit_g.name)
-            s.add("grippers", hit_g is not None, f"{name}: fingers {sorted(tips)}")
+            what = f"thumb {want_thumb}, " if want_thumb else ""
+            s.add("grippers/hands", hit_g is not None, f"{name}: {what}fingers {sorted(tips)}")
     for g in grippers:
         if g.name not in used:
-            s.add("grippers", False, f"drafted {g.name} as a parallel gripper, not one")
+            kind = "a hand" if g.is_hand else "a parallel gripper"
+            s.add("grippers/hands", False, f"drafted {g.name} as {kind}, not one")
     # Cameras.
     want_cams = list(t.get("cameras") or [])
     have_cams = [c.body for c in draft.cameras]
@@ -173,6 +174,20 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         ok = list(getattr(d, "joints", None) or []) == list(drive["joints"])
     s.add("torso/neck/drive", ok, f"drive: {d.type if d is not None else None}")
     return s
+
+
+def _tips(m: object, hand: bool) -> tuple[str | None, frozenset[str]]:
+    """A drafted gripper's two tips (thumb ``None``), or a hand's thumb tip and other tips."""
+    from robotspec.spec.draft.model import DraftManipulator
+
+    assert isinstance(m, DraftManipulator)
+    if hand:
+        if not m.is_hand or m.thumb is None:
+            return None, frozenset()
+        return m.thumb.tip, frozenset(f.tip for f in m.fingers.values())
+    if not m.is_gripper or m.thumb is None or m.finger is None:
+        return None, frozenset()
+    return None, frozenset((m.thumb.tip, m.finger.tip))
 
 
 def _pct(got: int, of: int) -> str:

@@ -147,3 +147,17 @@ def test_a_drafted_hand_reads_back_into_the_setup_draft(tmp_path: Path) -> None:
     (hand,) = draft.manipulators
     assert hand.is_hand and hand.thumb is not None and hand.thumb.root == "link_12.0"
     assert {f.root for f in hand.fingers.values()} == {"link_0.0", "link_4.0", "link_8.0"}
+
+
+def test_the_setup_asks_about_a_drafted_hand_as_a_hand(tmp_path: Path) -> None:
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+    from robotspec.setup.from_spec import draft_of_spec
+    from robotspec.setup.questions import questions_of
+
+    urdf = erd_robots() / "allegro_hand_description/urdf/allegro_right_hand.urdf"
+    out = tmp_path / "allegro.yaml"
+    assert run_app(app, ["init", str(urdf), "-o", str(out)]) == 0
+    draft, _, _ = draft_of_spec(str(out))
+    (q,) = [q for q in questions_of(draft) if q.part == "manipulators.hand"]
+    assert q.guess.startswith("a hand of 4 fingers") and "make it generic" in q.choices

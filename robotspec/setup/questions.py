@@ -91,8 +91,14 @@ def questions_of(draft: Draft, presets: tuple[str, ...] = ()) -> tuple[Question,
     for m in draft.manipulators:
         if m.decide:
             part = f"manipulators.{m.name}"
-            kind = "a parallel gripper" if m.is_gripper else "a generic tool"
-            extra = ("make it generic",) if m.is_gripper else ()
+            kind = (
+                "a parallel gripper"
+                if m.is_gripper
+                else f"a hand of {len(m.fingers) + 1} fingers"
+                if m.is_hand
+                else "a generic tool"
+            )
+            extra = ("make it generic",) if m.is_gripper or m.is_hand else ()
             choices = (KEEP, *FACINGS, *extra, REMOVE)
             guess = f"{kind}, tool frame {m.tool_frame}"
             out.append(Question(part, part, guess, choices, "; ".join(m.decide)))

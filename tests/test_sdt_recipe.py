@@ -152,6 +152,8 @@ def test_without_sdt_the_bridge_says_how_to_install_it(monkeypatch: pytest.Monke
 
     monkeypatch.setitem(sys.modules, "semantic_digital_twin", None)
     monkeypatch.delitem(sys.modules, "robotspec.interop.sdt._api", raising=False)
+    # Where SDT is installed an earlier test imported the module: the package holds it too.
+    monkeypatch.delattr(sdt, "_api", raising=False)
     with pytest.raises(RobotSpecError, match=r"pip install 'robotspec\[sdt\]'"):
         sdt.sdt_api()
 

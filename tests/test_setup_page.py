@@ -40,7 +40,10 @@ def test_the_page_serves_and_its_controls_edit_the_spec(page: Any, tmp_path: Pat
     with urllib.request.urlopen(page.url, timeout=10) as resp:
         assert resp.status == 200
     s = page.session
-    assert "3 open questions" in page._status.content and "link_eef" in page._tree.content
+    assert "3 open questions" in page._status.content and "tool" in page._tree.content
+    page._picker("link3")(_Person())  # what a click on the tree's button calls
+    assert page.selected == "link3" and page._link.value == "link3"
+    assert tuple(page._tree_buttons["link3"].color) == SELECTED_COLOUR
     page.select("link_eef")
     assert page._link.value == "link_eef" and "(in tool)" in page.last_message
     assert page.viewer.visual_meshes["link7"][0].color != SELECTED_COLOUR

@@ -37,6 +37,8 @@ __all__ = ["SELECTED_COLOUR", "SetupPage"]
 SELECTED_COLOUR = (230, 20, 20)
 _NEW_KINDS = ("arm", "leg", "chain", "torso", "neck", "manipulator", "camera")
 _NO_PRESET = "(angles below)"
+#: Above this many links the tree is text (and the link list picks): a button each is too many.
+_MAX_TREE_BUTTONS = 400
 
 
 def _bare(session: SetupSession) -> Any:
@@ -149,6 +151,17 @@ class SetupPage:
         panel = gui.add_panel()
         with panel.add_tab("Kinematic tree"):
             self._tree = gui.add_html("")
+            self._tree_buttons: dict[str, Any] = {}
+            self._tree_colours: dict[str, tuple[int, int, int]] = {}
+            if len(self.rows) <= _MAX_TREE_BUTTONS:  # a tree to click in
+                for r in self.rows:
+                    b = gui.add_button(
+                        "· " * r.depth + r.link,
+                        color=GREY,
+                        hint=f"{r.joint} ({r.joint_type})" if r.joint else "the root link",
+                    )
+                    b.on_click(self._guarded(self._picker(r.link)))
+                    self._tree_buttons[r.link] = b
         panel.dock_left()
         panel.set_width(300)
         self._status = gui.add_markdown("")
@@ -275,6 +288,15 @@ class SetupPage:
             h.color = colour
 
     def _draw_tree(self) -> None:
+        """The tree in its parts' colours, the picked link red: buttons, or text if too many."""
+        if self._tree_buttons:
+            self._tree.content = self._legend
+            for link, button in self._tree_buttons.items():
+                c = SELECTED_COLOUR if link == self.selected else self._colours.get(link, GREY)
+                if self._tree_colours.get(link) != c:
+                    button.color = c
+                    self._tree_colours[link] = c
+            return
         out = [self._legend, "<div style='font-family:monospace;font-size:0.8em;line-height:1.45'>"]
         for r in self.rows:
             c = self._colours.get(r.link, GREY)
@@ -513,7 +535,8 @@ class SetupPage:
                 for j in joints:
                     lo, hi = self.session.joint_range(j)
                     step = max((hi - lo) / 200.0, 1e-4)
-                    sl = gui.add_slider(j, min=lo, max=hi, step=step, initial_value=(lo + hi) / 2)
+                    now = float(np.clip(self._joint_value(j), lo, hi))
+                    sl = gui.add_slider(j, min=lo, max=hi, step=step, initial_value=now)
                     sl.on_update(self._guarded(lambda _e: self._preview()))
                     self._sliders[j] = sl
             self._state_info.content = (
@@ -521,6 +544,13 @@ class SetupPage:
             )
             self._show_saved_states()
         self._preview()
+
+    def _joint_value(self, joint: str) -> float:
+        """The joint's position in the pose shown (the default pose until a slider moves)."""
+        world = self.viewer.robot.world
+        if not world.has_connection(joint):
+            return 0.0
+        return float(self.viewer.q[world.get_connection_by_name(joint).dofs[0]])
 
     def _show_saved_states(self) -> None:
         part = str(self._state_part.value)
@@ -530,13 +560,15 @@ class SetupPage:
             self._saved_states.options = options
 
     def _preview(self) -> None:
+        """Pose the robot at the sliders' values (the pose stays when another part is chosen)."""
         values = {j: float(s.value) for j, s in self._sliders.items()}
         world = self.viewer.robot.world
         q = self.viewer.q.copy()
         for j, value in values.items():
             if world.has_connection(j):
                 q[world.get_connection_by_name(j).dofs[0]] = value
-        self.viewer.update(np.asarray(q, dtype=np.float64))
+        self.viewer.q = np.asarray(q, dtype=np.float64)
+        self.viewer.update(self.viewer.q)
 
     def _slide_to(self, fraction: float) -> None:
         if not self._sliders:

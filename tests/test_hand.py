@@ -60,6 +60,8 @@ def test_hand_spec_needs_a_thumb_and_a_finger() -> None:
         HandSpec.model_validate({**ok, "fingers": {}})
     with pytest.raises(ValidationError):
         HandSpec.model_validate({k: v for k, v in ok.items() if k != "thumb"} | {"fingers": {}})
+    with pytest.raises(ValidationError, match="'thumb' is the hand's thumb"):
+        HandSpec.model_validate({**ok, "fingers": {"thumb": {"root": "e", "tip": "f"}}})
     with pytest.raises(ValidationError):  # unknown keys are refused
         HandSpec.model_validate(
             {**ok, "fingers": {"index": {"root": "e", "tip": "f"}}, "finger": {}}

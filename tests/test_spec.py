@@ -66,7 +66,7 @@ def test_manipulator_type_is_a_discriminator(tmp_path: Path) -> None:
     with pytest.raises(SpecError) as info:
         load_spec(path)
     assert str(info.value).startswith(f"{path}:8:5: error: manipulators.g:")
-    assert "'parallel_gripper', 'generic'" in str(info.value)
+    assert "'parallel_gripper', 'hand', 'generic'" in str(info.value)
 
 
 def test_yaml_syntax_error_has_line(tmp_path: Path) -> None:

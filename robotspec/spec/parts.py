@@ -134,6 +134,13 @@ class HandSpec(_ManipulatorBase):
         ],
     )
 
+    @field_validator("fingers")
+    @classmethod
+    def _not_thumb(cls, v: dict[str, FingerSpec]) -> dict[str, FingerSpec]:
+        if "thumb" in v:
+            raise ValueError("'thumb' is the hand's thumb, not one of its fingers: name it apart")
+        return v
+
 
 ManipulatorSpec = Annotated[
     ParallelGripperSpec | HandSpec | GenericManipulatorSpec, Field(discriminator="type")

@@ -222,3 +222,11 @@ def test_tiago_a_camera_model_guessed_by_name_is_a_question(tmp_path: Path) -> N
     text = s.save().read_text()
     assert "preset: kinect_v1" in text and "DECIDE: " not in text.split("delete the mark.")[1]
     check_spec(tmp_path / "tiago.yaml")
+
+
+def test_an_output_that_cannot_be_written_is_a_located_error(tmp_path: Path) -> None:
+    (tmp_path / "a_file").write_text("")
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    with pytest.raises(RobotSpecError, match="cannot write the spec's folder") as exc:
+        SetupSession.open(str(urdf), output=tmp_path / "a_file" / "xarm.yaml")
+    assert exc.value.file == str(tmp_path / "a_file" / "xarm.yaml")

@@ -112,8 +112,13 @@ def validate_text(
 
     started = time.perf_counter()
     folder = output.resolve().parent
-    folder.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{output.stem}.setup-", suffix=".yaml", dir=folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{output.stem}.setup-", suffix=".yaml", dir=folder)
+    except OSError as exc:
+        raise RobotSpecError(
+            f"cannot write the spec's folder: {exc.strerror or exc}", file=str(output), kind="file"
+        ) from None
     robot = None
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:

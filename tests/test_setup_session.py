@@ -230,3 +230,17 @@ def test_an_output_that_cannot_be_written_is_a_located_error(tmp_path: Path) -> 
     with pytest.raises(RobotSpecError, match="cannot write the spec's folder") as exc:
         SetupSession.open(str(urdf), output=tmp_path / "a_file" / "xarm.yaml")
     assert exc.value.file == str(tmp_path / "a_file" / "xarm.yaml")
+
+
+def test_a_gripper_made_a_hand_of_named_fingers_and_generic_again(tmp_path: Path) -> None:
+    s = _pr2(tmp_path)
+    with pytest.raises(SetupError, match="needs a name"):
+        s.set_manipulator("manipulators.left_eef", named=(" ", "l_gripper_r_finger_tip_link"))
+    v = s.set_manipulator("manipulators.left_eef", named=("index", "l_gripper_r_finger_tip_link"))
+    assert v.valid
+    text = s.snapshot.text
+    assert "    type: hand\n" in text
+    assert "index: {root: l_gripper_r_finger_link, tip: l_gripper_r_finger_tip_link}" in text
+    assert "thumb: {root: l_gripper_l_finger_link, tip: l_gripper_l_finger_tip_link}" in text
+    assert s.set_manipulator("manipulators.left_eef", generic=True).valid
+    assert "fingers:" not in s.snapshot.text

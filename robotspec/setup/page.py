@@ -203,6 +203,8 @@ class SetupPage:
             self._button(gui, "hand root = picked link", lambda: self._set_hand(root=True))
             self._button(gui, "thumb tip = picked link", lambda: self._set_hand(thumb=True))
             self._button(gui, "finger tip = picked link", lambda: self._set_hand(finger=True))
+            self._finger_name = gui.add_text("finger name", "index")
+            self._button(gui, "named finger tip = picked link", lambda: self._set_hand(named=True))
             self._button(gui, "no fingers (generic)", lambda: self._set_hand(generic=True))
             self._facing = gui.add_dropdown("tool faces", tuple(FACINGS))
             self._facing.on_update(self._guarded(lambda _e: self._set_hand(facing=True)))
@@ -408,6 +410,9 @@ class SetupPage:
             lines.append(f"root **{m.root}**, tool frame **{m.tool_frame}**")
             if m.thumb and m.finger:
                 lines.append(f"thumb → {m.thumb.tip}, finger → {m.finger.tip}")
+            elif m.thumb and m.fingers:
+                named = ", ".join(f"{k} → {f.tip}" for k, f in m.fingers.items())
+                lines.append(f"thumb → {m.thumb.tip}, {named}")
         elif kind == "sensors":
             cam = next(c for c in d.cameras if c.name == name)
             what = cam.preset or (cam.field_of_view and f"angles {cam.field_of_view}") or "?"
@@ -447,6 +452,7 @@ class SetupPage:
         finger: bool = False,
         generic: bool = False,
         facing: bool = False,
+        named: bool = False,
     ) -> None:
         part = self._part_name()
         name = part.removeprefix("manipulators.")
@@ -464,6 +470,8 @@ class SetupPage:
             kw["finger"] = (m.root, self._pick())
         if facing:
             kw["facing"] = FACINGS[str(self._facing.value)]
+        if named:
+            kw["named"] = (str(self._finger_name.value), self._pick())
         v = self.session.set_manipulator(part, generic=generic, **kw)
         self._after(v, f"{part} changed")
 

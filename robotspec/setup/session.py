@@ -331,14 +331,22 @@ class SetupSession:
         finger: tuple[str, str] | None = None,
         generic: bool = False,
         facing: tuple[float, float, float] | None = None,
+        named: tuple[str, str] | None = None,
     ) -> Validation:
-        """Change a hand: its root, tool frame, fingers (root, tip), or the way it faces."""
+        """Change a hand: its root, tool frame, fingers (root, tip), or the way it faces.
+
+        ``thumb`` with ``finger`` makes a parallel gripper; ``thumb`` with ``named`` fingers
+        (name, tip) a hand of named fingers (its parallel ``finger`` goes). A hand's fingers, its
+        thumb too, start at their first link past the hand's root, as the compiler requires.
+        """
         for link, what in ((root, "root"), (tool_frame, "tool frame")):
             if link is not None:
                 self._link(link, what)
-        for pair, what in ((thumb, "thumb"), (finger, "finger")):
+        for pair, what in ((thumb, "thumb"), (finger, "finger"), (named and named[1:], "finger")):
             for link in pair or ():
                 self._link(link, what)
+        if named is not None and not named[0].strip():
+            raise SetupError("a named finger needs a name", kind="finger")
 
         def change(d: Draft) -> None:
             m = _manipulator(d, part)
@@ -348,13 +356,26 @@ class SetupSession:
                 m.thumb = DraftFinger(*thumb)
             if finger is not None:
                 m.finger = DraftFinger(*finger)
+            if named is not None:
+                m.finger = None
+                m.fingers[named[0].strip()] = DraftFinger(self._past(m.root, named[1]), named[1])
+                if m.thumb is not None:
+                    m.thumb = DraftFinger(self._past(m.root, m.thumb.tip), m.thumb.tip)
             if generic:
                 m.thumb = m.finger = None
+                m.fingers = {}
             if facing is not None:
                 m.front_facing = _facing(facing)
             m.decide.clear()
 
         return self.edit(change)
+
+    def _past(self, root: str, tip: str) -> str:
+        """The first link below ``root`` on the way to ``tip`` (``root`` if tip is not below)."""
+        w = self.world
+        if root == tip or not w.has_body(root) or not w.is_ancestor(root, tip):
+            return root
+        return w.compute_chain_of_kinematic_structure_entities(root, tip)[1].name
 
     def add_manipulator(
         self, name: str, root: str, tool_frame: str, chain: str | None = None

@@ -163,3 +163,21 @@ def test_the_setup_asks_about_a_drafted_hand_as_a_hand(tmp_path: Path) -> None:
     draft, _, _ = draft_of_spec(str(out))
     (q,) = [q for q in questions_of(draft) if q.part == "manipulators.hand"]
     assert q.guess.startswith("a hand of 4 fingers") and "make it generic" in q.choices
+
+
+def test_inspect_shows_a_hands_fingers(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+
+    erd_robots()
+    assert run_app(app, ["inspect", "manipulators", "b1_ur5_allegro", "--json"]) == 0
+    (item,) = json.loads(capsys.readouterr().out)
+    assert item["type"] == "hand" and item["thumb"] == "allegro_link_15.0_tip"
+    assert item["finger"] == "allegro_link_3.0_tip, allegro_link_7.0_tip, allegro_link_11.0_tip"
+    assert run_app(app, ["inspect", "chains", "b1_ur5_allegro", "--json"]) == 0
+    kinds = {c["name"]: c["kind"] for c in json.loads(capsys.readouterr().out)}
+    assert [n for n, k in kinds.items() if k == "finger"] == [
+        f"allegro_hand_{f}" for f in ("thumb", "index", "middle", "ring")
+    ]

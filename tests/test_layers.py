@@ -27,6 +27,7 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("compiler",),
     ("robots", "collision", "export"),
     ("render", "interop"),
+    ("setup",),
     ("cli",),
 )
 #: Rooms beside the stack, with the only rooms they may use.

@@ -58,6 +58,7 @@ def setup(
     from robotspec.setup.source import is_spec_file
 
     require("viser", "viser", "setup")
+    from robotspec.cli.audit_report import audit_text
     from robotspec.setup.page import SetupPage
     from robotspec.setup.session import SetupSession
 
@@ -72,7 +73,7 @@ def setup(
     if srdf is not None and is_spec_file(robot):
         raise typer.BadParameter("a spec names its SRDF itself", param_hint="--srdf")
     session = SetupSession.open(robot, output=out, srdf=srdf, package_paths=package_path or ())
-    page = SetupPage(session, host=host, port=port)
+    page = SetupPage(session, host=host, port=port, audit_report=audit_text)
     v = session.validation
     sys.stdout.write(
         f"setting up {session.source.draft.name} at {page.url} ; saves to {out} "

@@ -26,6 +26,7 @@ import numpy as np
 from robotspec.errors import RobotSpecError
 from robotspec.render.scene import GREY, colour_parts
 from robotspec.render.viewer import RobotViewer
+from robotspec.setup.collisions import AuditReport
 from robotspec.setup.questions import FACINGS, FORWARDS, Question
 from robotspec.setup.session import SetupSession, Snapshot
 from robotspec.setup.tree import TreeRow, tree_rows
@@ -66,8 +67,16 @@ def _problem_line(p: Problem) -> str:
 class SetupPage:
     """The page of one session, served until :meth:`stop`."""
 
-    def __init__(self, session: SetupSession, *, host: str = "127.0.0.1", port: int = 8080) -> None:
+    def __init__(
+        self,
+        session: SetupSession,
+        *,
+        host: str = "127.0.0.1",
+        port: int = 8080,
+        audit_report: AuditReport | None = None,
+    ) -> None:
         self.session = session
+        self._audit_report = audit_report
         robot = session.validation.robot or _bare(session)
         self.viewer = RobotViewer(
             robot,
@@ -611,7 +620,7 @@ class SetupPage:
 
     # ------------------------------------------------------------------ checks and saving
     def _collisions(self, what: str) -> None:
-        from robotspec.setup.collisions import audit_session, generate_matrix
+        from robotspec.setup.collisions import audit_session, generate_matrix, plain_audit_report
 
         if self._busy:
             raise RobotSpecError("the collision check is running; wait for it to finish")
@@ -634,7 +643,10 @@ class SetupPage:
                     r = generate_matrix(self.session, samples=samples, progress=progress)
                     self._collision_text.content = r.summary
                 else:
-                    ok, text = audit_session(self.session, samples=samples, progress=progress)
+                    report = self._audit_report or plain_audit_report
+                    ok, text = audit_session(
+                        self.session, samples=samples, progress=progress, report=report
+                    )
                     head = "every entry is right" if ok else "**some entries are wrong**"
                     self._collision_text.content = f"{head}\n\n```\n{text}\n```"
             except RobotSpecError as exc:

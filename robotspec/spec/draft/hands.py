@@ -174,6 +174,17 @@ def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | N
     return sides if all(len(side) == 2 for side in sides) else None
 
 
+def _branches(tree: Tree, hand: Body) -> tuple[Body, list[Body]]:
+    """Where the hand first splits (below its single links), and the moving branches there."""
+    body = hand
+    while True:
+        kids = tree.moving_children(body)
+        if len(kids) != 1:
+            break
+        body = kids[0]
+    return body, [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
+
+
 def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | None, str]:
     """A parallel gripper at or below ``hand``, or ``None`` and why not.
 
@@ -182,13 +193,7 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
     the coupled pair below is.
     """
     world = tree.world
-    body = hand
-    while True:
-        kids = tree.moving_children(body)
-        if len(kids) != 1:
-            break
-        body = kids[0]
-    branches = [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
+    body, branches = _branches(tree, hand)
     uncoupled = len(branches) == 2 and not _dofs(tree, branches[0]) & _dofs(tree, branches[1])
     if uncoupled and _depth < 2:  # a horn beside a carriage is one level; never a deep search
         for k in branches:
@@ -260,13 +265,7 @@ def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
     ``middle``...) or numbered.
     """
     world = tree.world
-    body = hand
-    while True:
-        kids = tree.moving_children(body)
-        if len(kids) != 1:
-            break
-        body = kids[0]
-    branches = [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
+    body, branches = _branches(tree, hand)
     if len(branches) < 3:
         return None
     names = [{w for b in world.subtree(k) for w in words(b.name)} for k in branches]

@@ -150,6 +150,9 @@ def test_importing_robotspec_and_the_bridge_does_not_import_sdt() -> None:
 def test_without_sdt_the_bridge_says_how_to_install_it(monkeypatch: pytest.MonkeyPatch) -> None:
     from robotspec.interop import sdt
 
+    # Every SDT module as if absent: where SDT is installed, earlier tests imported them.
+    for name in [m for m in sys.modules if m.split(".")[0] == "semantic_digital_twin"]:
+        monkeypatch.setitem(sys.modules, name, None)
     monkeypatch.setitem(sys.modules, "semantic_digital_twin", None)
     monkeypatch.delitem(sys.modules, "robotspec.interop.sdt._api", raising=False)
     # Where SDT is installed an earlier test imported the module: the package holds it too.

@@ -68,6 +68,8 @@ def real_number(
     Why: a margin or tolerance of the wrong type reached numpy or coal as a bare TypeError or
     ValueError, and an infinite one was accepted by a comparison (``inf >= 0``).
     """
+    if type(value) is float and math.isfinite(value) and value >= minimum:
+        return value  # the common case, before the checks that name what is wrong
     if isinstance(value, bool | np.bool_) or not isinstance(
         value, int | float | np.integer | np.floating
     ):

@@ -180,6 +180,7 @@ class SelfCollisionChecker:
         # Built-once state is built under the lock; what queries write is per thread.
         self._lock = threading.RLock()
         self._local = threading.local()
+        self._n_dof = len(world.degrees_of_freedom)
 
     @classmethod
     def from_robot(
@@ -300,7 +301,11 @@ class SelfCollisionChecker:
         """``q`` as a batch of one (1, D), checked; a batch is refused, naming the method for it.
 
         Why: a single-configuration query once answered for the first row of a batch alone.
+        A float64 vector of the right length is passed on as it is (the hot path: its values
+        are checked by the kinematics core, whose refusal names the bad value as this would).
         """
+        if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (self._n_dof,):
+            return q[None, :]
         return self.kinematics.configuration_array(q, hint=f"SelfCollisionChecker.{batch}")[None, :]
 
     def _pair_mask(self, pair_mask: object) -> Bools:

@@ -150,8 +150,21 @@ def test_files_it_cannot_read_get_the_clis_located_errors(tmp_path: Path) -> Non
     # A shipped spec using what a draft cannot hold is refused where it uses it.
     erd_robots()
     with pytest.raises(SpecError, match="cannot edit") as refused:
-        SetupSession.open("pr2", output=tmp_path / "pr2.yaml")
+        SetupSession.open("b1_ur5_allegro", output=tmp_path / "b1.yaml")
     assert refused.value.line is not None
+
+
+def test_the_shipped_pr2_opens_and_saves_with_its_camera_heights(tmp_path: Path) -> None:
+    from robotspec.compiler import check_spec
+
+    erd_robots()
+    session = SetupSession.open("pr2", output=tmp_path / "pr2.yaml")
+    saved = session.save()
+    text = saved.read_text(encoding="utf-8")
+    assert "minimal_height: 1.166" in text and "maximal_height: 1.583" in text
+    assert "default: true" in text
+    camera = check_spec(saved).robot.cameras[0]
+    assert camera.name == "kinect"
 
 
 def test_two_threads_editing_see_one_state(tmp_path: Path) -> None:

@@ -119,8 +119,6 @@ def draft_of_spec(
             refused.append(_refuse(loaded, ("sensors", name), "a generic sensor"))
         elif s.forward_facing_axis not in (None, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)):
             refused.append(_refuse(loaded, ("sensors", name), "a camera facing that axis"))
-        elif s.minimal_height is not None or s.maximal_height is not None or s.default:
-            refused.append(_refuse(loaded, ("sensors", name), "camera heights or default"))
     if refused:
         raise refused[0] if len(refused) == 1 else RobotSpecErrors(refused)
     marks = _Marks(loaded)
@@ -224,6 +222,9 @@ def draft_of_spec(
                 decide=marks.decide(("sensors", name)),
                 preset=s.preset,
                 field_of_view=None if placeholder else angles,
+                minimal_height=s.minimal_height,
+                maximal_height=s.maximal_height,
+                default=s.default,
             )
         )
     raw = loaded.documents[0].data

@@ -97,6 +97,11 @@ class DraftCamera:
     field_of_view: tuple[float, float] | None = None
     #: A body frame (not optical) that looks along its z axis (written ``[0, 0, 1]``).
     looks_along_z: bool = False
+    #: Heights (m) the camera is claimed to reach, and whether it is the default camera: never
+    #: drafted, kept when a spec is read back for editing (``robotspec setup``).
+    minimal_height: float | None = None
+    maximal_height: float | None = None
+    default: bool = False
 
 
 @dataclass

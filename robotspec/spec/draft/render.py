@@ -228,6 +228,12 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
                     f"    field_of_view: {{horizontal: {h}, vertical: {v}}}"
                     f"  # DECIDE: the camera's angles{offer}"
                 )
+            if cam.minimal_height is not None:
+                out.append(f"    minimal_height: {_num(cam.minimal_height)}")
+            if cam.maximal_height is not None:
+                out.append(f"    maximal_height: {_num(cam.maximal_height)}")
+            if cam.default:
+                out.append("    default: true")
     if d.states:
         out.append("states:")
         for name, values in d.states.items():

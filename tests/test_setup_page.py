@@ -124,6 +124,9 @@ def test_parts_added_changed_and_removed_from_the_page(page: Any) -> None:
     page._fov.value = (1.2, 0.9)
     page._set_camera(fov=True)
     assert s.draft().cameras[0].field_of_view == (1.2, 0.9) and s.validation.valid
+    # The 3D view follows the edit: the new camera's frustum is drawn on its link.
+    drawn = [h.name for h in page.viewer._overlays]
+    assert "/robot/link7/frustum_wrist_cam" in drawn, drawn
     page._new_kind.value = "leg"
     page._new_name.value = "tail"
     page._add_part()  # root and tip at the picked link: validate says what is wrong

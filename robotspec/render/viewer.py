@@ -122,6 +122,7 @@ class RobotViewer:
         self.host = host
         self.port = int(self.server.get_port())
         self._nodes: dict[int, Any] = {}
+        self._overlays: list[Any] = []
         self._collision_meshes: dict[str, list[Any]] = {}
         #: Each body's visual mesh handles (the setup assistant recolours and clicks them).
         self.visual_meshes: dict[str, list[Any]] = {}
@@ -181,42 +182,71 @@ class RobotViewer:
                 visible=False,
             )
             self._collision_meshes.setdefault(part.body, []).append(handle)
-        for m in self.robot.manipulators:
-            self._node(m.tool_frame.index)
-            s.add_frame(
-                f"/robot/{m.tool_frame.name}/tool_frame",
-                axes_length=0.08 * size,
-                axes_radius=0.004 * size,
-            )
-        for cam in self.robot.cameras:
-            self._node(cam.root.index)
+        self.draw_overlays(self.robot)
+        if self._controls:
+            self._build_gui(world)
+
+    def draw_overlays(self, robot: AbstractRobot) -> None:
+        """Tool frames, camera frustums and the drive's arrows of ``robot``, replacing any drawn.
+
+        ``robot`` may be another compilation of the same robot (the setup assistant's after each
+        change): its parts are placed by body name on this view's nodes, so an edited tool frame
+        or camera moves where it now is; a body this view's world lacks is skipped.
+        """
+        s = self.server.scene
+        size = self.scene.size
+        for handle in self._overlays:
+            handle.remove()
+        self._overlays = []
+        world = self.robot.world
+
+        def node(name: str) -> bool:
+            if not world.has_body(name):
+                return False
+            self._node(world.get_body_by_name(name).index)
+            return True
+
+        for m in robot.manipulators:
+            if node(m.tool_frame.name):
+                self._overlays.append(
+                    s.add_frame(
+                        f"/robot/{m.tool_frame.name}/tool_frame",
+                        axes_length=0.08 * size,
+                        axes_radius=0.004 * size,
+                    )
+                )
+        for cam in robot.cameras:
+            if not node(cam.root.name):
+                continue
             f, right, down = camera_basis(cam.forward_facing_axis)
             # viser's frustum looks along +z with x right and y down (OpenCV), like an optical
             # frame; rotate it onto the camera's own axes.
             rot = np.stack([right, down, f], axis=1)
             fov = cam.field_of_view
             aspect = math.tan(fov.horizontal_angle / 2) / math.tan(fov.vertical_angle / 2)
-            s.add_camera_frustum(
-                f"/robot/{cam.root.name}/frustum_{cam.name}",
-                fov=fov.vertical_angle,
-                aspect=aspect,
-                scale=0.15 * size,
-                color=FRUSTUM_COLOUR,
-                wxyz=_wxyz(rot),
+            self._overlays.append(
+                s.add_camera_frustum(
+                    f"/robot/{cam.root.name}/frustum_{cam.name}",
+                    fov=fov.vertical_angle,
+                    aspect=aspect,
+                    scale=0.15 * size,
+                    color=FRUSTUM_COLOUR,
+                    wxyz=_wxyz(rot),
+                )
             )
-        if self.robot.drive is not None:
-            self._node(self.robot.root.index)
-            segs = drive_segments(self.robot, np.eye(4), 0.25 * size)
+        if robot.drive is not None and node(robot.root.name):
+            segs = drive_segments(robot, np.eye(4), 0.25 * size)
             pts = np.array([[seg.start, seg.end] for seg in segs], dtype=np.float64)
-            s.add_line_segments(
-                f"/robot/{self.robot.root.name}/drive",
-                pts,
-                colors=(20, 20, 20),
-                thickness=4.0,
-                thickness_units="screen",
+            self._overlays.append(
+                s.add_line_segments(
+                    f"/robot/{robot.root.name}/drive",
+                    pts,
+                    colors=(20, 20, 20),
+                    thickness=4.0,
+                    thickness_units="screen",
+                )
             )
-        if self._controls:
-            self._build_gui(world)
+        self.update(self.q)
 
     def _build_gui(self, world: Any) -> None:
         gui = self.server.gui

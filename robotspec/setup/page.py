@@ -346,6 +346,7 @@ class SetupPage:
                 with self.server.atomic():
                     for body in self.viewer.visual_meshes:
                         self._paint(body)
+                self.viewer.draw_overlays(v.robot)  # tool frames, cameras, drive as now edited
             parts = self.session.parts()
             if tuple(self._part.options) != parts:
                 self._part.options = parts

@@ -155,8 +155,6 @@ def test_files_it_cannot_read_get_the_clis_located_errors(tmp_path: Path) -> Non
 
 
 def test_the_shipped_pr2_opens_and_saves_with_its_camera_heights(tmp_path: Path) -> None:
-    from robotspec.compiler import check_spec
-
     erd_robots()
     session = SetupSession.open("pr2", output=tmp_path / "pr2.yaml")
     saved = session.save()
@@ -257,3 +255,14 @@ def test_a_gripper_made_a_hand_of_named_fingers_and_generic_again(tmp_path: Path
     assert "thumb: {root: l_gripper_l_finger_link, tip: l_gripper_l_finger_tip_link}" in text
     assert s.set_manipulator("manipulators.left_eef", generic=True).valid
     assert "fingers:" not in s.snapshot.text
+
+
+def test_the_shipped_hsrb_and_its_bare_urdf_open_and_save_valid(tmp_path: Path) -> None:
+    from tests.conftest import shared_path
+
+    folder = shared_path("robots", "hsrb")
+    for ref, name in (("hsrb", "hsrb.yaml"), (str(folder / "hsrb4s.urdf"), "draft.yaml")):
+        session = SetupSession.open(ref, output=tmp_path / name, package_paths=[folder])
+        assert session.validation.valid, session.validation.errors
+        saved = session.save()
+        assert check_spec(saved, package_paths=[folder]).robot.name

@@ -9,6 +9,7 @@ checker's first query.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from types import ModuleType
 
 from robotspec.accel import CoreChoice
@@ -17,11 +18,9 @@ __all__ = ["CHOICE", "accelerated", "core"]
 
 #: The C mesh proofs and the fallback that proves nothing.
 CHOICE = CoreChoice("robotspec.collision._meshcore", "robotspec.collision._meshcore_py")
-
-
-def core() -> ModuleType:
-    """The mesh core in use (loaded on the first call)."""
-    return CHOICE.core()
+#: The mesh core in use, loaded on the first call (the choice's own method: queries call it
+#: once each, so no wrapper frame sits in front of it).
+core: Callable[[], ModuleType] = CHOICE.core
 
 
 def accelerated() -> bool:

@@ -15,6 +15,7 @@ Python thread (the C core releases the GIL while it runs, so the slices run in p
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from types import ModuleType
 from typing import Any
 
@@ -34,11 +35,9 @@ __all__ = [
 
 #: The C kinematics core and its numpy fallback.
 CHOICE = CoreChoice("robotspec.model._kincore", "robotspec.model._kincore_py")
-
-
-def core() -> ModuleType:
-    """The kinematics core in use (loaded on the first call)."""
-    return CHOICE.core()
+#: The kinematics core in use, loaded on the first call (the choice's own method: queries call it
+#: once each, so no wrapper frame sits in front of it).
+core: Callable[[], ModuleType] = CHOICE.core
 
 
 def accelerated() -> bool:

@@ -181,31 +181,60 @@ class Diagnostics:
         return sorted(problems, key=key)
 
     def accept(self, accepted: Sequence[Accepted]) -> None:
-        """Drop the warnings the spec accepts; an acceptance that matches none is a warning.
+        """Drop the warnings the spec accepts, each entry accepting exactly one warning.
 
-        ``accepted`` are the spec's ``accept_warnings`` entries, in order; entry ``i`` matches a
-        warning located at its spec path ``at`` (or below it) whose message contains ``says``.
+        ``accepted`` are the spec's ``accept_warnings`` entries, in order. Entry ``i`` accepts
+        the warning printed at exactly its path ``at`` (not one below it: ``at: chains`` must not
+        silence every chain) whose message, after the path, contains ``says`` (case counts,
+        surrounding spaces ignored). Why so strict: an acceptance is a reviewed exception for
+        one warning; a loose one would also swallow the next, different warning at that place.
+
+        Problems with the entries themselves, each at the entry's line:
+
+        * an entry repeating an earlier one, or accepting the warning an earlier one accepts, is
+          an error (one of the two is dead weight and hides which reason holds);
+        * ``says`` matching several different warnings at ``at`` is an error naming them (it
+          accepts none of them until it quotes enough to pick one);
+        * an entry that accepts no warning is a *warning* (an error with ``--strict``), naming a
+          warning below ``at`` or at ``at`` with other words when there is one: the robot files
+          may have changed so the warning no longer occurs, and that alone must not make a
+          valid spec invalid.
         """
-        used = [False] * len(accepted)
-        kept: list[RobotSpecError] = []
-        for warning in self.warnings:
-            where = loc_text(warning.detail.location)
-            hit = False
-            for i, entry in enumerate(accepted):
-                at = entry.at.strip()
-                inside = where == at or where.startswith((f"{at}.", f"{at}["))
-                if warning.detail.location and inside and entry.says in warning.message:
-                    used[i] = hit = True
-            if not hit:
-                kept.append(warning)
-        self.warnings = kept
+        plan = _Acceptance(self.warnings)
+        first: dict[tuple[str, str], int] = {}
+        owner: dict[int, int] = {}  # warning index -> the entry accepting it
         for i, entry in enumerate(accepted):
-            if not used[i]:
-                self.warning(
+            at, says = entry.at.strip(), entry.says.strip()
+            if (at, says) in first:
+                self.error(
                     ("accept_warnings", i),
-                    f"no warning at '{entry.at}' says '{entry.says}' (any more?); "
-                    "remove this entry",
+                    f"repeats accept_warnings[{first[(at, says)]}] (at '{at}' says '{says}'); "
+                    "remove one of them",
                 )
+                continue
+            first[(at, says)] = i
+            hits = plan.matches(at, says)
+            messages = list(dict.fromkeys(plan.bodies[k] for k in hits))
+            if len(messages) > 1:
+                quoted = "; ".join(f"'{m}'" for m in messages)
+                self.error(
+                    ("accept_warnings", i, "says"),
+                    f"'{says}' matches {len(messages)} warnings at '{at}': {quoted}; "
+                    "quote more of the one to accept",
+                )
+            elif hits:
+                earlier = next((owner[k] for k in hits if k in owner), None)
+                if earlier is not None:
+                    self.error(
+                        ("accept_warnings", i),
+                        f"accepts the same warning at '{at}' as accept_warnings[{earlier}]; "
+                        "remove one of them",
+                    )
+                    continue
+                owner.update(dict.fromkeys(hits, i))
+            else:
+                self.warning(("accept_warnings", i), plan.unused(at, says))
+        self.warnings = [w for k, w in enumerate(self.warnings) if k not in owner]
 
     def raise_if_failed(self, *, strict: bool = False) -> None:
         """Raise every error (and, in strict mode, every warning as an error) at once."""
@@ -221,3 +250,49 @@ class Diagnostics:
         raise RobotSpecErrors(
             problems, summary=f"{self.loaded.file.name}: {len(problems)} problems"
         ).with_warnings(warnings)
+
+
+class _Acceptance:
+    """The warnings an ``accept_warnings`` entry may accept, by exact path and message body."""
+
+    def __init__(self, warnings: Sequence[RobotSpecError]) -> None:
+        #: Each warning's spec path (``None``: it points at no spec node, so cannot be accepted).
+        self.paths: list[str | None] = []
+        #: Each warning's message without its ``path: `` prefix: ``says`` may not match the path.
+        self.bodies: list[str] = []
+        for w in warnings:
+            where = loc_text(w.detail.location) if w.detail.location else None
+            body = w.message
+            if where is not None and body.startswith(f"{where}: "):
+                body = body[len(where) + 2 :]
+            self.paths.append(where)
+            self.bodies.append(body)
+
+    def matches(self, at: str, says: str) -> list[int]:
+        """Indexes of the warnings at exactly ``at`` whose message contains ``says``."""
+        return [
+            k
+            for k, (where, body) in enumerate(zip(self.paths, self.bodies, strict=True))
+            if where == at and says in body
+        ]
+
+    def unused(self, at: str, says: str) -> str:
+        """Why an entry accepts nothing, pointing at the warning it may have meant."""
+        text = f"no warning at '{at}' says '{says}'"
+        below = [
+            w
+            for w, body in zip(self.paths, self.bodies, strict=True)
+            if w is not None and w.startswith((f"{at}.", f"{at}[")) and says in body
+        ]
+        same_place = [b for w, b in zip(self.paths, self.bodies, strict=True) if w == at]
+        saying = [w for w, b in zip(self.paths, self.bodies, strict=True) if w and says in b]
+        close = closest_names(at, saying, n=1)
+        if below:
+            hint = f"; the warning at '{below[0]}' does: write at: {below[0]}"
+        elif same_place:
+            hint = f"; the warning there says '{same_place[0]}'"
+        elif close:
+            hint = f"; did you mean at: {close[0]}?"
+        else:
+            hint = " (any more?); remove this entry"
+        return text + hint

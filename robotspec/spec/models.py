@@ -278,6 +278,11 @@ class CollisionSpec(SpecModel):
     )
 
 
+#: Characters besides spaces an ``accept_warnings`` entry's ``says`` must have: enough words to
+#: pick one warning out of those at its path (``says: ' '`` would accept any).
+MIN_SAYS = 8
+
+
 class AcceptedWarning(SpecModel):
     """A warning the spec's author has read and accepts, with the reason (shown by ``--strict``).
 
@@ -287,12 +292,14 @@ class AcceptedWarning(SpecModel):
     """
 
     at: str = Field(
-        description="the spec path the warning is about, as the warning prints it",
+        description="the spec path the warning is about, exactly as the warning prints it "
+        "(a parent path accepts nothing below it)",
         examples=["chains.left_leg"],
         min_length=1,
     )
     says: str = Field(
-        description="a part of the warning's message",
+        description="words of the warning's message, as printed (case counts), at least "
+        f"{MIN_SAYS} characters besides spaces; they must match one warning at `at`",
         examples=["neither a manipulator nor a sensor"],
         min_length=1,
     )
@@ -301,6 +308,20 @@ class AcceptedWarning(SpecModel):
         examples=["a leg carries no tool"],
         min_length=1,
     )
+
+    @field_validator("says")
+    @classmethod
+    def _says_names_a_warning(cls, value: str) -> str:
+        """Refuse ``says`` too short to identify a warning.
+
+        Why: ``says: ' '`` (or ``a``) is a substring of every message, so it would accept
+        whatever warning appears at that path later, not the one its author read.
+        """
+        if len("".join(value.split())) < MIN_SAYS:
+            raise ValueError(
+                f"'says' must quote the warning: at least {MIN_SAYS} characters besides spaces"
+            )
+        return value
 
 
 class RobotSpec(SpecModel):

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -14,11 +16,12 @@ from robotspec.cli.options import (
     OutputFile,
     PackagePath,
     SpecArg,
-    refuse_existing,
-    refuse_link,
-    write_file,
     write_output,
 )
+from robotspec.files.writing import check_writable
+
+if TYPE_CHECKING:
+    from robotspec.semantic import AbstractRobot
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
@@ -26,6 +29,15 @@ app = typer.Typer()
 
 export_app = typer.Typer(help="Export a compiled robot to other formats.", no_args_is_help=True)
 app.add_typer(export_app, name="export")
+
+
+def _inputs(
+    spec: str, package_path: list[Path] | None, robot: AbstractRobot | None = None
+) -> dict[Path, str]:
+    """The robot's own files, which an export may never replace (``-o robot.urdf``)."""
+    from robotspec.compiler.inputs import spec_inputs
+
+    return spec_inputs(spec, package_paths=package_path or (), robot=robot)
 
 
 @export_app.command("robotinfo")
@@ -46,8 +58,8 @@ def robotinfo(
     from robotspec.driver.export import dump_robot_info_yaml
     from robotspec.export.robotinfo import export_spec_chain
 
-    if output is not None and not force:
-        refuse_existing(output)  # before the work, as the write refuses it again
+    if output is not None:
+        check_writable(output, force=force)  # before the work, as the write refuses it again
     ex = export_spec_chain(spec, chain, package_path)
     header = (
         f"RobotInfo of chain '{chain}' of {spec}, exported by robotspec.\n"
@@ -56,7 +68,8 @@ def robotinfo(
     text = dump_robot_info_yaml(ex.info, header=header)
     for note in ex.notes:
         sys.stderr.write(f"note: {note}\n")
-    if not write_output(text, output, force=force):
+    inputs = _inputs(spec, package_path) if output is not None else {}
+    if not write_output(text, output, force=force, inputs=inputs):
         return
     sys.stderr.write(
         f"wrote {output} ({len(ex.info.joint_info)} joints, chain "
@@ -79,11 +92,12 @@ def srdf(
     from robotspec.compiler import compile_robot
     from robotspec.export.srdf import srdf_from_robot, write_srdf
 
-    if output is not None and not force:
-        refuse_existing(output)
+    if output is not None:
+        check_writable(output, force=force)
     robot = compile_robot(spec, package_paths=package_path or ())
     exported = srdf_from_robot(robot)
-    if not write_output(write_srdf(exported), output, force=force):
+    inputs = _inputs(spec, package_path, robot) if output is not None else {}
+    if not write_output(write_srdf(exported), output, force=force, inputs=inputs):
         return
     sys.stderr.write(
         f"wrote {output}: {len(exported.groups)} groups, {len(exported.end_effectors)} end "
@@ -108,12 +122,13 @@ def urdf(
     from robotspec.export.urdf import joined_urdf, urdf_text
     from robotspec.spec.load import load_spec
 
-    if output is not None and not force:
-        refuse_existing(output)
+    if output is not None:
+        check_writable(output, force=force)
     loaded = load_spec(resolve_spec(spec))
     tree = joined_urdf(loaded, package_paths=package_path or ())
     text = urdf_text(tree, comment=f"{loaded.spec.name}: exported by robotspec from {spec}")
-    if not write_output(text, output, force=force):
+    inputs = _inputs(spec, package_path) if output is not None else {}
+    if not write_output(text, output, force=force, inputs=inputs):
         return
     links = sum(1 for _ in tree.iterfind("link"))
     joints = sum(1 for _ in tree.iterfind("joint"))
@@ -162,30 +177,30 @@ def bundle_cmd(
     """URDF + SRDF + a flat spec naming them: the same robot without the source files.
 
     `robotspec validate FOLDER/NAME.yaml` then compiles to the same robot (a composed one too).
-    Existing files are kept unless --force; a symbolic link is never written through.
+    Existing files are kept unless --force; a symbolic link is never written through, nor one
+    of the robot's own files.
     """
     from robotspec.cli.output import plural
     from robotspec.compiler import check_spec, resolve_spec
+    from robotspec.compiler.inputs import spec_inputs
     from robotspec.export.urdf import bundle
     from robotspec.files.meshes import read_mesh_bytes
+    from robotspec.files.writing import write_files
 
     path = resolve_spec(spec)
     stem = name or path.stem
     targets = [output / f"{stem}{suffix}" for suffix in (".urdf", ".srdf", ".yaml")]
-    for target in targets:  # all three before any is written: no half-written bundle
-        refuse_link(target)
-        if not force:
-            refuse_existing(target)
+    for target in targets:  # before the work; all three are checked again before any is written
+        check_writable(target, under=output, force=force)
     result = check_spec(path, package_paths=package_path or ())
     out = bundle(result, name=stem, package_paths=package_path or ())
+    inputs = spec_inputs(path, package_paths=package_path or (), robot=result.robot)
     copies = [(output / target, source) for target, source in out.meshes]
-    for target, _ in copies:
-        refuse_link(target)
-        if not force:
-            refuse_existing(target)
-    for target, text in zip(targets, (out.urdf, out.srdf, out.spec), strict=True):
-        write_file(target, text, force=force)
-    for target, source in copies:
-        write_file(target, read_mesh_bytes(source), force=force)
+    files: list[tuple[Path, str | Callable[[], bytes]]] = [
+        *zip(targets, (out.urdf, out.srdf, out.spec), strict=True),
+        *((target, partial(read_mesh_bytes, source)) for target, source in copies),
+    ]
+    # Every file, the mesh folder too, below --output without a link followed: checked first.
+    write_files(files, under=output, force=force, inputs=inputs)
     carried = f" and {plural(len(copies), 'mesh file')} in {stem}_meshes/" if copies else ""
     sys.stderr.write(f"wrote {output}/{stem}.urdf, .srdf and .yaml{carried}\n")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import os
 import sys
+from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -57,15 +58,18 @@ OutputFile = Annotated[
 ]
 
 
-def write_output(text: str, output: Path | None, *, force: bool = True) -> bool:
+def write_output(
+    text: str, output: Path | None, *, force: bool = True, inputs: Iterable[Path] = ()
+) -> bool:
     """Write ``text`` to ``output``, or to stdout when it is None; True if a file was written.
 
     ``force=False``: an existing ``output`` is an error (the command's ``--force`` lifts it).
+    ``inputs``: the robot's own files, which the output may never replace.
     """
     if output is None:
         sys.stdout.write(text)
         return False
-    write_file(output, text, force=force)
+    write_file(output, text, force=force, inputs=inputs)
     return True
 
 
@@ -95,52 +99,19 @@ def refuse_link(path: Path, *, raced: bool = False) -> None:
         )
 
 
-def write_file(path: Path, text: str | bytes, *, force: bool = True) -> None:
-    """Write a file the user named; a folder that is missing or read-only is their error.
+def write_file(
+    path: Path, text: str | bytes, *, force: bool = True, inputs: Iterable[Path] = ()
+) -> None:
+    """Write a file the user named: :func:`robotspec.files.writing.write_file` does the work.
 
-    Never through a symbolic link: a link planted in an output folder (``robot.urdf`` pointing
-    at ``~/.bashrc``) would otherwise have its target overwritten, so the last part of the path
-    is opened with ``O_NOFOLLOW`` and a link is refused. Nor into anything but a regular file (a
-    FIFO would block). Without ``force`` an existing file is refused (``O_EXCL``), atomically.
+    Never through a symbolic link (a link planted in an output folder, ``robot.urdf`` pointing
+    at ``~/.bashrc``, would have its target overwritten), never into anything but a regular
+    file, never over one of ``inputs`` (the robot's own files), through a temporary file renamed
+    into place. Without ``force`` an existing file is refused, atomically.
     """
-    import errno
-    import stat
+    from robotspec.files.writing import write_file as write
 
-    from robotspec.errors import RobotSpecError
-
-    shown = str(path)
-    refuse_link(path)  # also where the system has no O_NOFOLLOW
-    flags = os.O_WRONLY | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
-    flags |= os.O_TRUNC if force else os.O_EXCL
-    try:
-        if path.parent != Path(""):
-            path.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(path, flags, 0o666)
-    except OSError as exc:
-        if exc.errno == errno.EEXIST:
-            refuse_existing(path)
-        if exc.errno == errno.ELOOP:
-            refuse_link(path, raced=True)
-        raise RobotSpecError(
-            f"cannot write file: {exc.strerror or exc}", file=shown, kind="file"
-        ) from None
-    try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise RobotSpecError(
-                "is not a regular file (a device, FIFO or socket); robotspec writes only files",
-                file=shown,
-                kind="output",
-            )
-        data = text.encode("utf-8") if isinstance(text, str) else text
-        view = memoryview(data)
-        while view:
-            view = view[os.write(fd, view) :]
-    except OSError as exc:
-        raise RobotSpecError(
-            f"cannot write file: {exc.strerror or exc}", file=shown, kind="file"
-        ) from None
-    finally:
-        os.close(fd)
+    write(path, text, force=force, inputs=inputs)
 
 
 JsonFlag = Annotated[bool, typer.Option("--json", help="Print JSON instead of a table.")]

@@ -104,9 +104,9 @@ def test_spec_package_paths_cannot_widen_the_roots(tmp: Path) -> None:
     fenced(r, tmp)
     assert r.code == 1
     assert r.err == (
-        f"a/spec.yaml:6:19: error: package path '/' lies outside the spec's folder {a}; a spec "
-        "may name folders inside its own tree, or relative to it below the filesystem's "
-        "top-level and home folders (allow this one with -P/--package-path /, "
+        "a/spec.yaml:6:19: error: package path '/' resolves to /, which a spec may not name: "
+        f"it lies outside the spec's project {a} (a spec may name files and folders inside its "
+        "own project, never hidden or system ones; allow it with -P/--package-path /, "
         "or ROS_PACKAGE_PATH)\n"
     )
 
@@ -148,7 +148,7 @@ def test_minus_p_allows_a_spec_package_path_and_resolves_against_the_cwd(tmp: Pa
     )
     spec(a, "r.urdf", f"  package_paths: [{pkgs}]\n")
     refused = run_cli(tmp, "validate", "a/spec.yaml")
-    assert refused.code == 1 and "lies outside the spec's folder" in refused.text
+    assert refused.code == 1 and "outside the spec's project" in refused.text
     allowed = run_cli(tmp, "validate", "a/spec.yaml", "-P", "../pkgs")
     fenced(allowed, tmp)
     assert "lies outside" not in allowed.text
@@ -310,7 +310,15 @@ def test_srdf_on_a_device_is_refused(tmp: Path) -> None:
     r = run_cli(tmp, "validate", "a/spec.yaml")
     fenced(r, tmp)
     assert r.code == 1
-    # The spec named the device: the error points at that line.
+    # A spec may not name a device at all; the user may allow /dev, and then the file is
+    # still refused as no regular file. Both errors point at the spec's line.
+    assert r.text.splitlines()[0].startswith(
+        "a/spec.yaml:6:9: error: SRDF '/dev/zero' resolves to /dev/zero, which a spec may not "
+        "name: it lies in the system folder /dev"
+    )
+    r = run_cli(tmp, "validate", "a/spec.yaml", "-P", "/dev")
+    fenced(r, tmp)
+    assert r.code == 1
     assert r.text.splitlines()[0] == (
         "a/spec.yaml:6:9: error: /dev/zero: is not a regular file (a device, FIFO or socket), "
         "not an SRDF file"

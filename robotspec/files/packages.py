@@ -25,6 +25,7 @@ from robotspec.errors import (
     closest_names,
     did_you_mean,
 )
+from robotspec.files.fences import hidden_part, inside, system_folder
 from robotspec.files.package_search import (
     PACKAGE_NAME,
     description_root,
@@ -73,6 +74,11 @@ class PackageResolver:
     flat_folders: tuple[Path, ...] = ()
     #: Folders the caller asked to search that do not exist (listed in "searched:").
     missing_folders: tuple[Path, ...] = ()
+    #: Roots the *input* opened (the description's folder, its package, the folder above
+    #: ``urdf/``), not the user: below them no hidden file or folder and nothing in a system
+    #: folder is readable (:mod:`robotspec.files.fences`). Packages crawled on the search path
+    #: are held to the same rule unless a user root holds them.
+    strict_roots: tuple[Path, ...] = ()
     _index: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
     #: Crawled folders (folder, bare, flat) -> packages; shared by resolvers of one compilation.
     _crawls: dict[tuple[Path, bool, bool], dict[str, Path]] = field(
@@ -83,7 +89,9 @@ class PackageResolver:
     #: same package folders, and resolving each again was a third of composing).
     _real_dirs: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
     #: (root, root + separator) of each resolved root, for prefix tests on path strings.
-    _root_prefixes: list[tuple[str, str]] = field(default_factory=list, compare=False, repr=False)
+    _root_prefixes: list[tuple[str, str, bool]] = field(
+        default_factory=list, compare=False, repr=False
+    )
     _resolved: dict[tuple[str, str], Path] = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
@@ -126,13 +134,15 @@ class PackageResolver:
         bare = list(folders)
         desc: Path | None = None
         roots: list[Path] = list(folders)
+        strict: list[Path] = []
         if description is not None:
             desc = Path(description).absolute()
             near, package_roots = walk_up(Path(os.path.normpath(desc.parent)))
             folders += near
-            roots += [Path(os.path.normpath(desc.parent)), *package_roots]
+            strict += [Path(os.path.normpath(desc.parent)), *package_roots]
             if not package_roots:
-                roots += description_root(desc)
+                strict += description_root(desc)
+            roots += strict
         flat: list[Path] = []
         if use_example_robot_data:
             erd = example_robot_data_folders()
@@ -150,6 +160,7 @@ class PackageResolver:
             bare_name_folders=_unique(Path(os.path.normpath(f)) for f in bare if f.is_dir()),
             flat_folders=_unique(Path(os.path.normpath(f)) for f in flat if f.is_dir()),
             missing_folders=missing,
+            strict_roots=_unique(Path(os.path.normpath(r)) for r in strict),
             _crawls={} if share_crawls_with is None else share_crawls_with._crawls,
             _real_dirs={} if share_crawls_with is None else share_crawls_with._real_dirs,
         )
@@ -213,6 +224,7 @@ class PackageResolver:
             description=None,
             bare_name_folders=union("bare_name_folders"),
             flat_folders=union("flat_folders"),
+            strict_roots=_unique(r for res in resolvers for r in res.strict_allowed_roots()),
             _real_dirs=resolvers[0]._real_dirs if resolvers else {},
         )
         index: dict[str, Path] = {}
@@ -280,16 +292,43 @@ class PackageResolver:
 
         Why packages too: a search folder that is not a root (the parent of the package around
         the description) provides its packages, each readable on its own, but not the files
-        beside them.
+        beside them. Roots the input opened (``strict``) admit no hidden file or folder below
+        them and nothing in a system folder; roots the user gave admit everything below them.
         """
         text = str(real)
         if not self._root_prefixes:
-            folders = [*self._resolved_roots()]
-            folders += _unique(self._real_folder(f) for f in self._packages().values())
-            for r in _unique(folders):
-                root = str(r)
-                self._root_prefixes.append((root, root.rstrip(os.sep) + os.sep))
-        return any(text == root or text.startswith(prefix) for root, prefix in self._root_prefixes)
+            self._root_prefixes.extend(self._prefixes())
+        for root, prefix, strict in self._root_prefixes:
+            if text == root or text.startswith(prefix):
+                if not strict or (hidden_part(text, root) is None and not system_folder(text)):
+                    return True
+        return False
+
+    def strict_allowed_roots(self) -> list[Path]:
+        """The real roots and package folders held to the input's rule (see ``strict_roots``)."""
+        if not self._root_prefixes:
+            self._root_prefixes.extend(self._prefixes())
+        return [Path(root) for root, _, strict in self._root_prefixes if strict]
+
+    def _prefixes(self) -> list[tuple[str, str, bool]]:
+        """(root, root + separator, strict) of every real root and package folder."""
+        strict_given = {os.path.normpath(r) for r in self.strict_roots}
+        strict_real = {str(self._real_folder(r)) for r in self.strict_roots}
+        user = [
+            str(self._real_folder(r)) for r in self.roots if os.path.normpath(r) not in strict_given
+        ]
+        out: dict[str, bool] = {}
+        for r in self.roots:
+            real = str(self._real_folder(r))
+            is_strict = os.path.normpath(r) in strict_given
+            out[real] = out.get(real, True) and is_strict
+        for r in self._resolved_roots():
+            out.setdefault(str(r), str(r) in strict_real)
+        for f in self._packages().values():
+            real = str(self._real_folder(f))
+            if real not in out:
+                out[real] = not any(inside(real, u) for u in user)
+        return [(root, root.rstrip(os.sep) + os.sep, s) for root, s in out.items()]
 
     def is_allowed(self, path: str | Path) -> bool:
         """Whether ``path``, symlinks followed, lies inside one of the allowed roots."""

@@ -7,18 +7,23 @@ any node, in the extending file first; the JSON Schema for editors is produced h
 from __future__ import annotations
 
 import json
-import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from pydantic import ValidationError
 
-from robotspec.errors import NotFoundError, RobotSpecError, SpecError, raise_collected
+from robotspec.errors import NotFoundError, SpecError
 from robotspec.files.validation import validation_errors
 from robotspec.files.yamlio import LocatedYaml, load_yaml
 from robotspec.shipped import shipped_spec_files
+from robotspec.spec.fences import (
+    ForeignPath,
+    check_package_paths,
+    foreign_paths,
+    spec_may_name,
+)
 from robotspec.spec.models import RobotSpec
 
 __all__ = [
@@ -31,19 +36,6 @@ __all__ = [
     "merge_data",
     "spec_may_name",
 ]
-
-
-@dataclass(frozen=True)
-class ForeignPath:
-    """A spec's ``package_paths`` entry that lies outside the spec's own folder tree."""
-
-    given: str
-    path: Path
-    folder: Path
-    file: str
-    line: int | None
-    column: int | None
-    location: tuple[str | int, ...]
 
 
 @dataclass(frozen=True)
@@ -113,99 +105,6 @@ def _absolutize(data: dict[str, Any], folder: Path) -> None:
                 _absolute_paths(part, folder, ("urdf", "srdf", "spec"))
 
 
-def _inside(path: str, folder: str) -> bool:
-    return path == folder or path.startswith(folder.rstrip(os.sep) + os.sep)
-
-
-def _too_wide(target: str) -> bool:
-    """Whether a folder is the filesystem root, a top-level folder, or the home folder (or above).
-
-    A spec's relative ``package_paths`` may leave its tree (``../robots``: specs and robot files
-    side by side), but never name a folder that holds the whole machine or a user's files.
-    """
-    path = Path(target)
-    home = Path(os.path.realpath(Path.home()))
-    return len(path.parts) <= 2 or path == home or path in home.parents
-
-
-def spec_may_name(value: str, folder: Path, real_folder: str | None = None) -> bool:
-    """Whether a spec in ``folder`` may name the package folder ``value`` without ``-P``."""
-    target = os.path.realpath(folder / value)
-    if _inside(target, real_folder or os.path.realpath(folder)):
-        return True
-    relative = not (Path(value).is_absolute() or value.startswith("~"))
-    return relative and not _too_wide(target)
-
-
-def _foreign_paths(doc: LocatedYaml, folder: Path) -> list[ForeignPath]:
-    """The document's package folders the user must allow (symlinks followed).
-
-    Why: the spec is the user's own file, kept with their robot files: a *relative* entry
-    (``../robots``) is read as the command line's ``-P ../robots`` would be, unless it names a
-    folder too wide to be a robot's (:func:`_too_wide`). An absolute entry outside the spec's
-    own tree is the machine's layout, not the project's: the user allows it (``-P``,
-    ``ROS_PACKAGE_PATH``). What the robot's *description* files name is fenced separately, by
-    the roots these folders and the user give.
-    """
-    data = doc.data
-    where: list[tuple[tuple[str | int, ...], Any]] = []
-    desc = data.get("description") if isinstance(data, Mapping) else None
-    if isinstance(desc, Mapping):
-        where.append((("description", "package_paths"), desc.get("package_paths")))
-    parts = data.get("parts") if isinstance(data, Mapping) else None
-    if isinstance(parts, Mapping):
-        for name, part in parts.items():
-            if isinstance(part, Mapping):
-                where.append((("parts", name, "package_paths"), part.get("package_paths")))
-    real_folder = os.path.realpath(folder)
-    out: list[ForeignPath] = []
-    for loc, values in where:
-        if not isinstance(values, list):
-            continue
-        for i, value in enumerate(values):
-            if not isinstance(value, str):
-                continue
-            if spec_may_name(value, folder, real_folder):
-                continue
-            target = os.path.realpath(folder / value)
-            line, col = doc.position((*loc, i))
-            out.append(ForeignPath(value, Path(target), folder, doc.file, line, col, (*loc, i)))
-    return out
-
-
-def check_package_paths(loaded: LoadedSpec, package_paths: Sequence[str | Path] = ()) -> None:
-    """Refuse spec package folders outside the spec's tree that the user did not allow.
-
-    The user allows a folder with ``-P``/``package_paths`` (``package_paths`` here), the
-    ``ROS_PACKAGE_PATH``/``AMENT_PREFIX_PATH`` environment or an installed data package; a spec
-    entry inside one of those is accepted.
-    """
-    if not loaded.foreign_paths:
-        return
-    from robotspec.files.package_search import user_roots
-
-    roots = [os.path.realpath(r) for r in user_roots(package_paths)]
-    problems: list[RobotSpecError] = []
-    for fp in loaded.foreign_paths:
-        if any(_inside(str(fp.path), r) for r in roots):
-            continue
-        problems.append(
-            SpecError(
-                f"package path '{fp.given}' lies outside the spec's folder {fp.folder}; a spec "
-                f"may name folders inside its own tree, or relative to it below the "
-                f"filesystem's top-level and home folders (allow this one with "
-                f"-P/--package-path {fp.path}, or ROS_PACKAGE_PATH)",
-                file=fp.file,
-                line=fp.line,
-                column=fp.column,
-                kind="package path",
-                name=fp.given,
-                location=fp.location,
-            )
-        )
-    raise_collected(problems)
-
-
 def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
     """Read, merge (``extends``) and validate a spec file; every problem raised at once."""
     p = Path(path).resolve()
@@ -217,7 +116,7 @@ def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
         raise SpecError("a spec must be a YAML mapping", file=doc.file, line=1)
     data: Any = doc.data
     documents: tuple[LocatedYaml, ...] = (doc,)
-    foreign = _foreign_paths(doc, p.parent)
+    foreign = foreign_paths(doc, p.parent)
     base_file = data.get("extends")
     if isinstance(base_file, str):
         base_path = (p.parent / base_file).resolve()

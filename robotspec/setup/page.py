@@ -26,6 +26,7 @@ import numpy as np
 from robotspec.errors import RobotSpecError
 from robotspec.render.scene import GREY, colour_parts
 from robotspec.render.viewer import RobotViewer
+from robotspec.setup.access import PageAccess, start_guarded
 from robotspec.setup.collisions import AuditReport
 from robotspec.setup.questions import FACINGS, FORWARDS, Question
 from robotspec.setup.session import SetupSession, Snapshot
@@ -78,13 +79,19 @@ class SetupPage:
         self.session = session
         self._audit_report = audit_report
         robot = session.validation.robot or _bare(session)
-        self.viewer = RobotViewer(
-            robot,
-            robot.world.default_configuration(),
-            host=host,
-            port=port,
-            on_missing_mesh="skip",
-            controls=False,
+        #: This run's secret and origin rule; every handshake of the server passes it first.
+        self.access = PageAccess.for_host(host)
+        self.viewer = start_guarded(
+            self.access,
+            lambda: RobotViewer(
+                robot,
+                robot.world.default_configuration(),
+                host=host,
+                port=port,
+                on_missing_mesh="skip",
+                controls=False,
+            ),
+            lambda viewer: viewer.stop(),
         )
         self.server: Any = self.viewer.server
         self.rows: tuple[TreeRow, ...] = tree_rows(session.world)
@@ -117,8 +124,8 @@ class SetupPage:
 
     @property
     def url(self) -> str:
-        """Where to point a browser."""
-        return str(self.viewer.url)
+        """Where to point a browser: the page's address with this run's token."""
+        return self.access.address(str(self.viewer.url))
 
     def stop(self) -> None:
         """Stop serving."""

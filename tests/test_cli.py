@@ -251,7 +251,8 @@ def test_init_without_srdf_guesses_chains_and_tool(
 ) -> None:
     # UR5e: nobody wrote a spec for it; the arm and tool0 come from the tree alone.
     urdf = shared_path("robots", "ur5e", "ur5e.urdf")
-    data = _init(capsys, tmp_path / "ur5e.yaml", str(urdf))
+    # The URDF lies outside the spec's project: the user allows its folder, as init says.
+    data = _init(capsys, tmp_path / "ur5e.yaml", str(urdf), allow=(urdf.parent,))
     assert data["chains"] == {
         "arm": {"root": "base_link", "tip": "wrist_3_link", "manipulator": "tool"}
     }

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from robotspec.collision import CollisionRules
 from robotspec.compiler import check_spec, compile_robot
-from robotspec.errors import RobotSpecError, SpecError
+from robotspec.errors import RobotSpecError, RobotSpecErrors, SpecError
 from robotspec.export.srdf import srdf_from_robot, write_srdf
 from robotspec.export.urdf import bundle, joined_urdf, urdf_text
 from robotspec.model.kinematics import Kinematics
@@ -464,10 +464,16 @@ chains:
   arm: {{group: arm_manipulator}}
 """
     )
-    # The part's package folder lies outside the spec's folder: refused until the user allows it.
-    with pytest.raises(SpecError) as info:
+    # The part's files and package folder lie outside the spec's project: refused until the
+    # user allows their folder (the shipped parts need no leave).
+    with pytest.raises(RobotSpecErrors) as info:
         check_spec(spec)
-    assert info.value.line == 8 and "-P/--package-path" in info.value.message
+    assert [(d.line, d.kind) for d in info.value.details] == [
+        (6, "URDF"),
+        (7, "SRDF"),
+        (8, "package path"),
+    ]
+    assert all("-P/--package-path" in d.message for d in info.value.details)
     result = check_spec(spec, package_paths=[ur])
     assert result.warnings == ()
     robot = result.robot

@@ -136,9 +136,11 @@ def check_spec_path(
 
 
 def _user_roots(package_paths: Sequence[str | Path]) -> list[Path]:
+    """The folders the user allows, and the robots and parts shipped with robotspec."""
     from robotspec.files.package_search import user_roots
+    from robotspec.shipped import package_data
 
-    return user_roots(package_paths)
+    return [*user_roots(package_paths), package_data("specs")]
 
 
 def _allow_hint(fp: ForeignPath) -> str:

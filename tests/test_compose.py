@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from robotspec.collision import CollisionRules
 from robotspec.compiler import check_spec, compile_robot
-from robotspec.errors import RobotSpecError, RobotSpecErrors, SpecError
+from robotspec.errors import RobotSpecError, RobotSpecErrors
 from robotspec.export.srdf import srdf_from_robot, write_srdf
 from robotspec.export.urdf import bundle, joined_urdf, urdf_text
 from robotspec.model.kinematics import Kinematics

@@ -226,3 +226,29 @@ def test_refusal_names_each_reason(tmp_path: Path) -> None:
     assert "outside the spec's project" in str(refusal(str(tmp_path / "q"), project))
     assert "too wide" in str(refusal(str(project), None))
     assert hidden_part("/a/b/.c/d", "/a/b") == ".c" and hidden_part("/a/.b/c", "/a/.b") is None
+
+
+def test_extends_is_fenced_before_the_base_is_read(home: Path) -> None:
+    write(home / ".config" / "base.yaml", f"robotspec: 1\nname: {KEY}\nroot: base\n")
+    evil = write(
+        home / "Downloads" / "evil" / "spec.yaml",
+        "robotspec: 1\nextends: ../../.config/base.yaml\n",
+    )
+    r = cli(home, "validate", "Downloads/evil/spec.yaml")
+    assert r.code == 1 and not leaked(r), r.text
+    assert not [p for p in r.opened if p.endswith("base.yaml")], r.opened
+    assert r.text.startswith(
+        "Downloads/evil/spec.yaml:2:10: error: extended spec '../../.config/base.yaml' resolves "
+        f"to {home}/.config/base.yaml, which a spec may not name: it lies outside"
+    )
+    # A shipped robot by name, and a base inside the project, need no leave.
+    write(evil.parent / "r.urdf", '<robot name="r"><link name="base"/></robot>\n')
+    write(
+        evil.parent / "base.yaml",
+        "robotspec: 1\nname: R\nroot: base\ndescription: {urdf: r.urdf}\n",
+    )
+    evil.write_text("robotspec: 1\nextends: base.yaml\nname: S\n")
+    assert cli(home, "validate", "Downloads/evil/spec.yaml").code == 0
+    evil.write_text("robotspec: 1\nextends: pr2\nname: MyPR2\n")
+    r = cli(home, "inspect", "chains", "Downloads/evil/spec.yaml")
+    assert r.code == 0, r.text

@@ -124,7 +124,7 @@ def urdf(
 
     if output is not None:
         check_writable(output, force=force)
-    loaded = load_spec(resolve_spec(spec))
+    loaded = load_spec(resolve_spec(spec), allowed=package_path or ())
     tree = joined_urdf(loaded, package_paths=package_path or ())
     text = urdf_text(tree, comment=f"{loaded.spec.name}: exported by robotspec from {spec}")
     inputs = _inputs(spec, package_path) if output is not None else {}

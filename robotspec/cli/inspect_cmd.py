@@ -318,7 +318,7 @@ def parts(spec: SpecArg, as_json: JsonFlag = False, package_path: PackagePath = 
     from robotspec.compose import compose
     from robotspec.spec.load import load_spec
 
-    loaded = load_spec(resolve_spec(spec))
+    loaded = load_spec(resolve_spec(spec), allowed=package_path or ())
     if not loaded.spec.parts:
         sys.stderr.write(f"{loaded.file.name} is not composed of parts (it has no 'parts:')\n")
         raise typer.Exit(1)

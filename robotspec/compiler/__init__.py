@@ -51,7 +51,11 @@ def check_spec(
     ref: str | Path, *, package_paths: Sequence[str | Path] = (), strict: bool = False
 ) -> CompileResult:
     """Compile a spec and return its warnings; every error is raised together."""
-    return compile_loaded(load_spec(resolve_spec(ref)), package_paths=package_paths, strict=strict)
+    return compile_loaded(
+        load_spec(resolve_spec(ref), allowed=package_paths),
+        package_paths=package_paths,
+        strict=strict,
+    )
 
 
 def compile_robot(
@@ -66,7 +70,9 @@ def compile_robot(
     own class (the compiler does not know the registry of shipped robots).
     """
     result = compile_loaded(
-        load_spec(resolve_spec(ref)), package_paths=package_paths, robot_class=robot_class
+        load_spec(resolve_spec(ref), allowed=package_paths),
+        package_paths=package_paths,
+        robot_class=robot_class,
     )
     return result.robot
 
@@ -85,7 +91,7 @@ def compile_spec_for_world(
     the spec's files for its collision rules.
     """
     result = compile_loaded(
-        load_spec(resolve_spec(ref)),
+        load_spec(resolve_spec(ref), allowed=package_paths),
         package_paths=package_paths,
         world=world,
         robot_class=robot_class,

@@ -132,7 +132,7 @@ def load_part(
                 chain = " -> ".join(p.name for p in (*seen, path.resolve()))
                 diag.error((*loc, "spec"), f"parts include each other: {chain}")
                 return None
-            part_loaded = load_spec(path)
+            part_loaded = load_spec(path, allowed=package_paths)
             check_package_paths(part_loaded, package_paths)
             if part_loaded.spec.parts:
                 # A part may itself be composed: the one loop inside compose/, by design.

@@ -133,7 +133,7 @@ def bundle(
     assert robot is not None
     source = result.loaded.file
     # result.loaded is the flat spec (parts already joined); the tree comes from the source.
-    tree = joined_urdf(load_spec(source), package_paths=package_paths)
+    tree = joined_urdf(load_spec(source, allowed=package_paths), package_paths=package_paths)
     resolved = {
         Path(shape.geometry.path).resolve()
         for body in robot.world.bodies

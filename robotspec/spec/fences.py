@@ -30,7 +30,13 @@ __all__ = [
 ]
 
 #: What each kind of entry is called in messages.
-_WHAT = {"package_paths": "package path", "urdf": "URDF", "srdf": "SRDF", "spec": "part spec"}
+_WHAT = {
+    "package_paths": "package path",
+    "urdf": "URDF",
+    "srdf": "SRDF",
+    "spec": "part spec",
+    "extends": "extended spec",
+}
 
 
 @dataclass(frozen=True)
@@ -123,13 +129,15 @@ def check_spec_path(
     column: int | None,
     location: tuple[str | int, ...],
     allowed: Sequence[str | Path] = (),
+    given: str | None = None,
 ) -> None:
     """Refuse one path a spec names (``extends``) before it is read, unless allowed."""
     real = _named_target(value, folder)
     why = refusal(real, project_root(folder))
     if why is None:
         return
-    fp = ForeignPath(value, Path(real), folder, file, line, column, location, why, key)
+    shown = value if given is None else given
+    fp = ForeignPath(shown, Path(real), folder, file, line, column, location, why, key)
     problem = _problem(fp, [os.path.realpath(r) for r in _user_roots(allowed)])
     if problem is not None:
         raise problem

@@ -7,7 +7,7 @@ any node, in the extending file first; the JSON Schema for editors is produced h
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -17,10 +17,11 @@ from pydantic import ValidationError
 from robotspec.errors import NotFoundError, SpecError
 from robotspec.files.validation import validation_errors
 from robotspec.files.yamlio import LocatedYaml, load_yaml
-from robotspec.shipped import shipped_spec_files
+from robotspec.shipped import package_data, shipped_spec_files
 from robotspec.spec.fences import (
     ForeignPath,
     check_package_paths,
+    check_spec_path,
     foreign_paths,
     spec_may_name,
 )
@@ -105,8 +106,13 @@ def _absolutize(data: dict[str, Any], folder: Path) -> None:
                 _absolute_paths(part, folder, ("urdf", "srdf", "spec"))
 
 
-def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
-    """Read, merge (``extends``) and validate a spec file; every problem raised at once."""
+def load_spec(
+    path: str | Path, *, _seen: tuple[Path, ...] = (), allowed: Sequence[str | Path] = ()
+) -> LoadedSpec:
+    """Read, merge (``extends``) and validate a spec file; every problem raised at once.
+
+    ``allowed``: folders the user allows besides the spec's project (``-P``), for ``extends``.
+    """
     p = Path(path).resolve()
     if p in _seen:
         chain = " -> ".join(x.name for x in (*_seen, p))
@@ -136,7 +142,21 @@ def load_spec(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> LoadedSpec:
                 column=col,
                 location=("extends",),
             )
-        base = load_spec(base_path, _seen=(*_seen, p))
+        if base_path.parent != package_data("specs"):
+            # Fenced before it is read: a base outside the spec's project is the user's to allow.
+            line, col = doc.position(("extends",))
+            check_spec_path(
+                str(base_path),
+                p.parent,
+                key="extends",
+                file=doc.file,
+                line=line,
+                column=col,
+                location=("extends",),
+                allowed=allowed,
+                given=base_file,
+            )
+        base = load_spec(base_path, _seen=(*_seen, p), allowed=allowed)
         base_data = base.spec.model_dump(mode="json", exclude_unset=True, by_alias=True)
         base_data.pop("extends", None)
         _absolutize(base_data, base.folder)

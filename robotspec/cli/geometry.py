@@ -28,29 +28,18 @@ def check_missing_geometry(
     Returns the URIs already reported, so the per-element skips of the geometry builders are
     not printed again.
     """
-    from robotspec.description.mesh_report import missing_geometry_message, unresolved_mesh_bodies
+    from robotspec.description.mesh_report import missing_geometry_problems, unresolved_meshes
+    from robotspec.errors import raise_collected
 
-    missing = unresolved_mesh_bodies(
+    meshes = unresolved_meshes(
         robot.world, collision=collision, bodies=[b.name for b in robot.bodies]
     )
-    if not missing:
-        return frozenset()
+    problems = missing_geometry_problems(meshes, command=command, skip=skip)
     if not skip:
-        raise RobotSpecError(
-            missing_geometry_message(
-                missing,
-                what=f"pass --skip-missing-meshes to {command} without them, or make the package "
-                "findable: -P FOLDER, ROS_PACKAGE_PATH, or description.package_paths in the spec",
-            ),
-            kind="mesh",
-        )
-    _print(
-        ErrorDetail(
-            missing_geometry_message(missing, what=f"{command} goes on without them"),
-            severity="warning",
-        )
-    )
-    return frozenset(u for uris in missing.values() for u in uris)
+        raise_collected(problems, summary=f"{command}: bodies lose their geometry")
+    for problem in problems:
+        _print(problem.detail)
+    return frozenset(m.uri for m in meshes)
 
 
 def report_skipped(skipped: Iterable[RobotSpecError], reported: frozenset[str]) -> None:

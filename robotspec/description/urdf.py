@@ -336,7 +336,7 @@ def _geometry(rec: ShapeRecord, where: _Where) -> GeometryShape | None:
                 where.problems.append(exc)
                 return None
             where.missing.append(MissingMesh(uri=uri, body=where.body, error=exc))
-            return Mesh(uri=uri, path=None, scale=scale)
+            return Mesh(uri=uri, path=None, scale=scale, problem=exc)
         if not resolved.is_file():
             err = DescriptionError(
                 f"mesh '{uri}' resolves to '{resolved}', which does not exist",
@@ -349,6 +349,6 @@ def _geometry(rec: ShapeRecord, where: _Where) -> GeometryShape | None:
                 where.problems.append(err)
                 return None
             where.missing.append(MissingMesh(uri=uri, body=where.body, error=err))
-            return Mesh(uri=uri, path=None, scale=scale)
+            return Mesh(uri=uri, path=None, scale=scale, problem=err)
         path = str(resolved)
     return Mesh(uri=uri, path=path, scale=scale)

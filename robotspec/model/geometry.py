@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from robotspec.arrays import F64
+from robotspec.errors import RobotSpecError
 from robotspec.model.rotations import quaternion_to_matrix, rpy_to_matrix
 
 #: A rotation or homogeneous transform (3x3 or 4x4 float64).
@@ -99,12 +100,15 @@ class Mesh:
     """A mesh file as written in the description and where it resolved to.
 
     ``path`` is ``None`` when the description was loaded without resolving meshes; the collision
-    layer then reports it instead of skipping it silently.
+    layer then reports it instead of skipping it silently. ``problem`` is then why it did not
+    resolve (``None``: not tried): render and collisions must tell a mesh outside the allowed
+    folders from one that is simply missing, with the URDF line.
     """
 
     uri: str
     path: str | None
     scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    problem: RobotSpecError | None = field(default=None, compare=False, repr=False)
 
 
 GeometryShape = Box | Cylinder | Sphere | Capsule | Mesh

@@ -76,8 +76,11 @@ class TriangleLibrary:
 
     def _mesh(self, mesh: Mesh, body: Body) -> Triangles:
         if mesh.path is None:
+            # Why the reason: "not resolved" alone does not tell a missing package from a file
+            # outside the allowed folders, which only -P or ROS_PACKAGE_PATH can allow.
+            why = f": {mesh.problem.message}" if mesh.problem is not None else ""
             raise DescriptionError(
-                f"link '{body.name}': mesh '{mesh.uri}' was not resolved to a file",
+                f"link '{body.name}': mesh '{mesh.uri}' was not resolved to a file{why}",
                 file=mesh.uri,
                 kind="mesh",
                 name=body.name,

@@ -252,3 +252,17 @@ def test_extends_is_fenced_before_the_base_is_read(home: Path) -> None:
     evil.write_text("robotspec: 1\nextends: pr2\nname: MyPR2\n")
     r = cli(home, "inspect", "chains", "Downloads/evil/spec.yaml")
     assert r.code == 0, r.text
+
+
+def test_the_setup_assistant_opens_a_spec_behind_the_same_fence(
+    home: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from robotspec.errors import RobotSpecError
+    from robotspec.setup.from_spec import draft_of_spec
+
+    monkeypatch.setenv("HOME", str(home))
+    spec = evil_spec(home, "  package_paths: [../../.ssh]\n", LOAD_KEY)
+    with pytest.raises(RobotSpecError) as info:
+        draft_of_spec(str(spec))
+    assert "package path '../../.ssh' resolves to" in str(info.value)
+    assert KEY not in str(info.value)

@@ -101,9 +101,11 @@ def draft_of_spec(
     from robotspec.compiler import resolve_spec
     from robotspec.description.load import load_description
     from robotspec.setup.source import KEPT_KEYS
-    from robotspec.spec.load import load_spec
+    from robotspec.spec.load import check_package_paths, load_spec
 
-    loaded = load_spec(resolve_spec(ref))
+    loaded = load_spec(resolve_spec(ref), allowed=package_paths)
+    # The page opens downloaded specs too: the same fence as validate, before any file is read.
+    check_package_paths(loaded, package_paths)
     spec = loaded.spec
     refused: list[RobotSpecError] = []
     for key in ("parts", "extends"):

@@ -8,7 +8,9 @@ ends), the summary must be printed, the exit code must be 0, and Robot Raconteur
 
 from __future__ import annotations
 
+import errno
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -139,3 +141,75 @@ def test_stop_removes_only_its_own_lock_files(short_tmp: Path) -> None:
         assert set(left) < set(both)
         assert "run/identifiers/device/rrp_test_arm.pid" in left  # a's device lock: still held
     assert run_files(state) == []
+
+
+def _port_of(url: str) -> int:
+    return int(url.split("://", 1)[1].split("?", 1)[0].rsplit(":", 1)[1])
+
+
+def _bind_without_reuse(port: int) -> OSError | None:
+    """Try to listen on ``port`` as a server without SO_REUSEADDR would; the error, if any."""
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        s.bind(("127.0.0.1", port))
+    except OSError as exc:
+        return exc
+    finally:
+        s.close()
+    return None
+
+
+def test_a_driver_stopped_with_a_client_connected_restarts_on_its_port_at_once(
+    served_child: tuple[subprocess.Popen[str], str, Path], client_node: Any
+) -> None:
+    """Issue 31: after SIGTERM with a client connected, the next driver on the same port said
+    "TCP port P is already in use" for 64 s (the closed connection's TIME_WAIT on the port).
+
+    Two clients are connected: a Robot Raconteur client, and one that answers nothing (a hung
+    or slow client), so the stopping driver closes that connection first and TIME_WAIT lands
+    on the driver's port, on any machine. The test checks that it did (a plain bind fails),
+    then starts the next driver on that port at once: it must listen there and serve.
+    """
+    import RobotRaconteur as RR
+
+    proc, url, state = served_child
+    port = _port_of(url)
+    robot = client_node.ConnectService(url)
+    assert robot.robot_info.device_info.device.name == "rrp_test_arm"
+    silent = socket.create_connection(("127.0.0.1", port), timeout=5)
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=20)
+    assert proc.returncode == 0, err
+    assert "stopped by SIGTERM after" in out
+    silent.close()  # the driver closed first: its side of this connection waits in TIME_WAIT
+    try:
+        client_node.DisconnectService(robot)
+    except RR.RobotRaconteurException:
+        pass
+    blocked = _bind_without_reuse(port)
+    assert isinstance(blocked, OSError) and blocked.errno == errno.EADDRINUSE, (
+        f"the stopped driver left no TIME_WAIT on port {port}: the test proves nothing ({blocked})"
+    )
+    again = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "robotspec",
+            "drive",
+            "--sim",
+            str(RRP),
+            "--serve",
+            "--port",
+            str(port),
+            "--state-dir",
+            str(state),
+            "--duration",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert again.returncode == 0, again.stderr
+    assert "already in use" not in again.stderr
+    assert f"url:        rr+tcp://127.0.0.1:{port}?service=robot" in again.stderr

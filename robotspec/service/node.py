@@ -24,6 +24,8 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -210,6 +212,34 @@ def remove_own_run_files(paths: list[Path]) -> list[Path]:
     return removed
 
 
+#: Robot Raconteur's TcpTransport sets SO_REUSEADDR on its listening sockets only when this
+#: variable says so; it reads it (``std::getenv``) each time a server starts.
+REUSEADDR_VARIABLE = "ROBOTRACONTEUR_TCP_SERVER_REUSEADDR"
+
+
+@contextmanager
+def _reuse_address() -> Iterator[None]:
+    """While inside, a starting TcpTransport server binds with ``SO_REUSEADDR``.
+
+    Why: a driver stopped while a client is connected closes that connection first, so the
+    closed connection waits out TCP's TIME_WAIT (60 s on Linux) on the driver's own port, and
+    without ``SO_REUSEADDR`` a restarted driver could not listen on that port for a minute
+    ("TCP port P is already in use"). With it the port is free at once, while a port another
+    server is *listening* on is still refused (that needs ``SO_REUSEPORT``, which is not set).
+    The variable is set only around the start and restored after, so nothing else in the
+    process (another transport, a child process) sees it.
+    """
+    previous = os.environ.get(REUSEADDR_VARIABLE)
+    os.environ[REUSEADDR_VARIABLE] = "1"
+    try:
+        yield
+    finally:
+        if previous is None:
+            os.environ.pop(REUSEADDR_VARIABLE, None)
+        else:
+            os.environ[REUSEADDR_VARIABLE] = previous
+
+
 def _start_error(exc: BaseException, what: str, hint: str) -> ServiceError:
     return ServiceError(f"{what}: {exc} ({hint})")
 
@@ -264,7 +294,8 @@ def start_server_node(
         node.RegisterTransport(local)
         tcp = rrmod.TcpTransport(node)
         try:
-            tcp.StartServer(port, not public)
+            with _reuse_address():
+                tcp.StartServer(port, not public)
         except Exception as exc:  # noqa: BLE001 - RR raises plain Exception
             if "in use" in str(exc).lower():
                 where = "" if public else " on 127.0.0.1"

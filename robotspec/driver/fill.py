@@ -212,6 +212,17 @@ class CommandFill(CartesianJog):
             task.started = True
             task.start_time = now
         t = now - task.start_time
+        if task.last_setpoint is not None:
+            # A step longer than MAX_STEP_PERIODS (the loop stalled: a loaded machine, a pause)
+            # moves the trajectory on by the time the step covers, as the jog and halt profiles
+            # and the arm's own integration do (clock.step_duration), not by the wall time: the
+            # rest is a pause. Without this the setpoint jumped ahead by the stall, the arm
+            # could not follow, and a trajectory failed with "Trajectory tolerance failure"
+            # after a 0.1 s stall at 250 Hz (issue 31).
+            behind = (t - task.time) - self._step_dt
+            if behind > 1e-9:
+                task.start_time += behind
+                t -= behind
         measured = self._joint_position
         if task.last_setpoint is not None and measured.shape == task.last_setpoint.shape:
             tol = self._trajectory_error_tol

@@ -16,6 +16,7 @@ from robotspec.cli.geometry import (
     require_collision_geometry,
 )
 from robotspec.cli.options import (
+    Force,
     JsonFlag,
     PackagePath,
     QOpt,
@@ -220,6 +221,7 @@ def generate(
         ),
     ] = None,
     skip_missing_meshes: SkipMeshes = False,
+    force: Force = False,
     package_path: PackagePath = None,
 ) -> None:
     """Compute the disabled collision pairs (Adjacent, Default, Always, Never) as SRDF.
@@ -232,10 +234,15 @@ def generate(
     from robotspec.cli.progress import Progress
     from robotspec.collision import compare_pairs, generate_for_robot
     from robotspec.collision.convergence import compare_with_srdf, convergence
+    from robotspec.compiler.inputs import spec_inputs
     from robotspec.description.srdf_reader import load_srdf
     from robotspec.export.srdf import write_srdf
+    from robotspec.files.writing import check_writable
 
     robot = load_robot(spec, package_path)
+    inputs = spec_inputs(spec, package_paths=package_path or (), robot=robot)
+    if output is not None:  # before the samples, as the write refuses it again
+        check_writable(output, force=force, inputs=inputs)
     other = None if compare is None else load_srdf(compare, strict=False)
     if merge and robot.srdf is None:
         raise CollisionError(f"--merge: robot '{robot.name}' has no SRDF to merge into")
@@ -256,7 +263,7 @@ def generate(
         )
     report_skipped(matrix.skipped, reported)
     text = write_srdf(matrix.to_srdf(robot.srdf if merge else None, merge=True))
-    write_output(text, output)
+    write_output(text, output, force=force, inputs=inputs)
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
     lines = [
         f"{len(matrix.disabled)} pairs disabled ({counts}); {len(matrix.checked)} stay checked; "

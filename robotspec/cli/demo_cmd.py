@@ -85,6 +85,7 @@ def demo(
     from robotspec.cli.driving import run_driver
     from robotspec.cli.validation_report import report_validation
     from robotspec.export.robotinfo import export_robot_chain
+    from robotspec.files.writing import write_file
     from robotspec.robots import load
 
     def head(text: str) -> None:
@@ -110,6 +111,6 @@ def demo(
     info = exported.info
     with tempfile.TemporaryDirectory(prefix="robotspec-demo-") as tmp:
         script = Path(tmp) / "demo.yaml"
-        script.write_text(demo_scenario(info), encoding="utf-8")
+        write_file(script, demo_scenario(info), under=Path(tmp))  # a new file, no link followed
         head(f"robotspec drive --spec {robot} --chain {chain} --script <generated>")
         run_driver(info, f"{robot}_{chain}", script=script)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 from typing import Annotated
@@ -36,22 +37,25 @@ def init(
     the kinematic tree adds what the SRDF does not say. The draft validates as written; lines
     marked DECIDE are guesses a person should check.
     """
-    from robotspec.errors import RobotSpecError
+    from robotspec.compiler.inputs import description_inputs
+    from robotspec.files.fences import inside
+    from robotspec.files.package_search import user_roots
+    from robotspec.files.writing import check_writable
     from robotspec.spec.draft import render_draft
     from robotspec.spec.draft.render import camera_presets
     from robotspec.spec.draft.run import draft_from_files
     from robotspec.spec.load import spec_may_name
 
-    if output is not None and output.exists() and not force:
-        raise RobotSpecError(
-            "the file exists; pass --force to overwrite it", file=str(output), kind="output"
-        )
+    # The robot's own files are never replaced (``-o robot.urdf``); checked before the work.
+    inputs = description_inputs(urdf, srdf, package_paths=package_path or ())
+    if output is not None:
+        check_writable(output, force=force, inputs=inputs)
     folder = (output.parent if output is not None else Path.cwd()).resolve()
     draft, _ = draft_from_files(
         urdf, srdf, folder=folder, package_paths=package_path or (), name=name
     )
     text = render_draft(draft, presets=camera_presets())
-    if write_output(text, output):
+    if write_output(text, output, force=force, inputs=inputs):
         sys.stderr.write(
             f"wrote {output}: {plural(len(draft.chains), 'chain')}, "
             f"{plural(len(draft.manipulators), 'manipulator')}, "
@@ -61,11 +65,17 @@ def init(
             + "; check the lines marked DECIDE, then run "
             f"`robotspec validate {output}`\n"
         )
-    outside = [p for p in draft.package_paths if not spec_may_name(p, folder)]
+    # A spec may name files and folders outside its project only with the user's leave.
+    outside = [(folder / p).resolve() for p in draft.package_paths if not spec_may_name(p, folder)]
+    for ref in (draft.urdf, draft.srdf):
+        if ref is not None and "://" not in ref and not spec_may_name(ref, folder):
+            outside.append((folder / ref).resolve().parent)
+    allowed = [os.path.realpath(r) for r in user_roots(package_path or ())]
+    outside = [p for p in dict.fromkeys(outside) if not any(inside(str(p), r) for r in allowed)]
     if outside:
-        # A spec may name such package folders (absolute, or too wide) only with the user's leave.
-        allow = " ".join(f"-P {(folder / p).resolve()}" for p in outside)
+        allow = " ".join(f"-P {p}" for p in outside)
         sys.stderr.write(
-            f"note: package_paths outside the spec's folder are read only when allowed: "
-            f"pass {allow} (or set ROS_PACKAGE_PATH)\n"
+            f"note: the spec names files outside its project ({folder}), read only when "
+            f"allowed: pass {allow} to validate and the other commands (or set "
+            "ROS_PACKAGE_PATH; docs/security.md)\n"
         )

@@ -44,18 +44,19 @@ def sdt(
     every part, state, hardware interface and velocity limit becomes spec data. What a spec
     cannot say is printed and kept as NOTE comments. Run `robotspec validate` on the result.
     """
-    from robotspec.errors import RobotSpecError
+    from robotspec.compiler.inputs import description_inputs
+    from robotspec.files.writing import check_writable
     from robotspec.interop.sdt.migrate import migrate_files, render
 
-    if output is not None and output.exists() and not force:
-        raise RobotSpecError(
-            "the file exists; pass --force to overwrite it", file=str(output), kind="output"
-        )
+    # The robot's own files are never replaced (``-o robot.urdf``); checked before the work.
+    inputs = description_inputs(urdf, srdf, package_paths=package_path or ())
+    if output is not None:
+        check_writable(output, force=force, inputs=inputs)
     folder = (output.parent if output is not None else Path.cwd()).resolve()
     migration = migrate_files(
         target, urdf, srdf=srdf, folder=folder, package_paths=package_path or ()
     )
     for note in migration.notes:
         sys.stderr.write(f"note: {note}\n")
-    if write_output(render(migration, source=target), output):
+    if write_output(render(migration, source=target), output, force=force, inputs=inputs):
         sys.stderr.write(f"wrote {output}; run `robotspec validate {output}`\n")

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from robotspec.cli.options import write_output
+from robotspec.cli.options import Force, write_output
 from robotspec.cli.table import render_table
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
@@ -39,9 +39,10 @@ def schema(
     output: Annotated[
         Path | None, typer.Option("--output", "-o", help="Write to this file instead of stdout.")
     ] = None,
+    force: Force = False,
 ) -> None:
     """The JSON Schema of the spec format, for editors (YAML language server)."""
     from robotspec.spec.load import json_schema_text
 
     text = json_schema_text()
-    write_output(text, output)
+    write_output(text, output, force=force)

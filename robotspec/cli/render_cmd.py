@@ -49,6 +49,7 @@ def render(
 
     Needs no display: the picture is rasterized in software (numpy) and written with Pillow.
     """
+    from robotspec.compiler.inputs import spec_inputs
     from robotspec.render import VIEWS, RenderOptions, build_scene, parse_size, render_scene
     from robotspec.render.deps import require
     from robotspec.semantic.states import state_configuration
@@ -68,7 +69,12 @@ def render(
     picture = render_scene(
         scene, config, RenderOptions(width=width, height=height, view=view, title=title)
     )
-    write_file(output, picture.png())  # never through a link planted at the output path
+    # Never through a link planted at the output path, never over the robot's own files.
+    write_file(
+        output,
+        picture.png(),
+        inputs=spec_inputs(spec, package_paths=package_path or (), robot=robot),
+    )
     sys.stdout.write(f"wrote {output} ({width}x{height}, {view} view)\n")
 
 

@@ -7,6 +7,7 @@ for four times the fragments, still well under a second for a PR2.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,7 +16,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.arrays import F64
-from robotspec.errors import RobotSpecError
 from robotspec.render.raster import ViewCamera, flat_shade, rasterize
 from robotspec.render.scene import LegendEntry, RobotScene, Segment
 
@@ -49,14 +49,16 @@ class Picture:
     legend: tuple[LegendEntry, ...]
     options: RenderOptions
 
-    def save(self, path: Path) -> None:
-        """Write the image as PNG; the view and scale go into its text chunks."""
-        try:
-            path.write_bytes(self.png())
-        except OSError as exc:
-            raise RobotSpecError(
-                f"cannot write image: {exc.strerror or exc}", file=str(path), kind="file"
-            ) from None
+    def save(self, path: Path, *, force: bool = True, inputs: Iterable[Path] = ()) -> None:
+        """Write the image as PNG; the view and scale go into its text chunks.
+
+        Through :func:`robotspec.files.writing.write_file`: never through a link, never over
+        one of ``inputs`` (the robot's own files), whole or not at all; ``force=False`` keeps an
+        existing file.
+        """
+        from robotspec.files.writing import write_file
+
+        write_file(path, self.png(), force=force, inputs=inputs)
 
     def png(self) -> bytes:
         """The image as PNG bytes, the view and scale in its text chunks."""

@@ -7,6 +7,7 @@ simply gone. Keys the assistant does not edit follow, as read from the input spe
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -27,17 +28,22 @@ def spec_text(draft: Draft, kept: dict[str, Any], presets: tuple[str, ...] = ())
     return text
 
 
-def write_spec(path: Path, text: str) -> None:
-    """Write the spec atomically: a crash mid-write never leaves half a spec."""
-    from robotspec.errors import RobotSpecError
+def write_spec(
+    path: Path,
+    text: str,
+    *,
+    under: Path | None = None,
+    force: bool = True,
+    inputs: Iterable[Path] = (),
+) -> Path:
+    """Write the spec atomically: a crash mid-write never leaves half a spec.
 
-    tmp = path.with_name(f".{path.name}.saving")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp.write_text(text, encoding="utf-8")
-        tmp.replace(path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise RobotSpecError(
-            f"cannot write file: {exc.strerror or exc}", file=str(path), kind="file"
-        ) from None
+    Through :func:`robotspec.files.writing.write_file`: an exclusive temporary file renamed into
+    place (a link planted at any name the save uses is never followed), no link below ``under``
+    (the folder the user named, default the spec's own), never over one of ``inputs`` (the
+    robot's URDF, SRDF, ...). ``force`` defaults to True: the assistant saves its spec again and
+    again.
+    """
+    from robotspec.files.writing import write_file
+
+    return write_file(path, text, under=under, force=force, inputs=inputs)

@@ -452,3 +452,16 @@ def _race(target: Path, under: Path, writers: int) -> dict[int, str]:
     for t in threads:
         t.join()
     return outcome
+
+
+def test_drive_plot_never_writes_through_a_link(tmp_path: Path, victim: Path) -> None:
+    pytest.importorskip("matplotlib")
+    from robotspec.render.plot import JointTrace, plot_joint_trace
+
+    link = tmp_path / "plot.png"
+    link.symlink_to(victim / "keep.txt")
+    with pytest.raises(RobotSpecError, match=LINK):
+        plot_joint_trace(JointTrace(("j",)), link)
+    assert (victim / "keep.txt").read_text() == SECRET
+    drawn = plot_joint_trace(JointTrace(("j",)), tmp_path / "real.png")
+    assert drawn.path.read_bytes().startswith(b"\x89PNG")

@@ -119,10 +119,11 @@ def plot_joint_trace(trace: JointTrace, path: Path, *, title: str = "") -> PlotS
         "robotspec:command_lines": str(n_cmd),
         "robotspec:samples": str(len(t)),
     }
-    try:
-        fig.savefig(path, format="png", metadata=metadata)
-    except OSError as exc:
-        raise RobotSpecError(
-            f"cannot write plot: {exc.strerror or exc}", file=str(path), kind="file"
-        ) from None
+    import io
+
+    from robotspec.files.writing import write_file
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", metadata=metadata)
+    write_file(path, buffer.getvalue(), force=True)  # never through a link; whole or not at all
     return PlotSummary(path=path, position_lines=n_pos, command_lines=n_cmd, samples=len(t))

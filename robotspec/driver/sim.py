@@ -158,9 +158,7 @@ class SimRobot(RobotDriver):
         q_l = self._q.tolist()
         n = len(q_l)
         if self._homing_target is not None:
-            cap = lim.velocity * self._homing_speed
-            v_des = np.minimum(np.maximum((self._homing_target - self._q) / dt, -cap), cap)
-            v_des_l = v_des.tolist()
+            v_des_l = self._homing_velocity(q_l, dt)
         elif self._pending_pos is not None:
             pending = self._pending_pos.tolist()
             aim = self._aim(pending, now)
@@ -208,12 +206,47 @@ class SimRobot(RobotDriver):
             v_l[i] = v
         self._q[:] = q_l
         self._v[:] = v_l
-        if self._homing_target is not None and np.allclose(self._q, self._homing_target, atol=1e-9):
+        if self._homing_target is not None and self._homed_now(q_l, v_l, dt):
             self._q[:] = self._homing_target
             self._v[:] = 0.0
             self._homing_target = None
             self._sim_homed = True
             self._homing_finished(True)
+
+    def _homing_velocity(self, q_l: list[float], dt: float) -> list[float]:
+        """The velocity the homing controller asks for: toward home, braking to stop on it.
+
+        At most the homing speed, and never faster than the joint can still stop on home at its
+        acceleration limit (:func:`~robotspec.driver.profiles.braking_speed`). Why the braking:
+        homing used to run at the homing speed until it reached home and then stop dead, a
+        velocity change of the whole homing speed in one step (3.7 x the acceleration limit on
+        the RRP arm, 1.3-1.4 x on a Sawyer: issue 31); the velocity limit alone does not bound
+        the deceleration at the end.
+        """
+        assert self._homing_target is not None
+        target = self._homing_target.tolist()
+        out = []
+        for i, q in enumerate(q_l):
+            err = target[i] - q
+            cap = self._vmax_l[i] * self._homing_speed
+            brake = braking_speed(abs(err), self._acc_l[i], dt)
+            cap = brake if brake < cap else cap
+            x = err / dt if dt > 0.0 else 0.0
+            out.append(-cap if x < -cap else (cap if x > cap else x))
+        return out
+
+    def _homed_now(self, q_l: list[float], v_l: list[float], dt: float) -> bool:
+        """Whether homing has arrived: every joint on home (to 1e-9) and slow enough to stop.
+
+        "Slow enough": stopping it this step (the velocity set to zero) is a velocity change
+        within the acceleration limit, so arriving never brakes harder than the limit.
+        """
+        assert self._homing_target is not None
+        target = self._homing_target.tolist()
+        return all(
+            abs(q - target[i]) <= 1e-9 and abs(v_l[i]) <= self._acc_l[i] * dt
+            for i, q in enumerate(q_l)
+        )
 
     def _aim(self, pending: list[float], now: float) -> list[float]:
         """Where the commanded path was one period ago: the point the arm heads for now.

@@ -133,7 +133,6 @@ class SimRobot(RobotDriver):
         dt = step_duration(now, last, self._update_period)
         if dt <= 0.0:
             return
-        lim = self._limits
         stopped = self._sim_estop != EstopSource.none or self._sim_error or not self._sim_enabled
         if stopped or self._frozen:
             self._v[:] = 0.0

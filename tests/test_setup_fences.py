@@ -10,9 +10,11 @@ name of the robot's own SRDF.
 
 from __future__ import annotations
 
+import shutil
 import urllib.error
 import urllib.request
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -135,3 +137,150 @@ def test_a_viser_without_the_hook_is_refused_not_served_unguarded() -> None:
     with pytest.raises(ServiceError, match="cannot let only this page's own origin"):
         start_guarded(PageAccess(loopback=True), lambda: "server", stopped.append)
     assert stopped == ["server"]
+
+
+# ---------------------------------------------------------------------------------- the writes
+def _panda_beside_its_files(tmp_path: Path) -> tuple[Any, Path]:
+    """``robotspec setup panda.urdf --srdf panda.srdf -o panda.yaml`` in the robot's folder."""
+    from robotspec.setup import SetupSession
+
+    erd = erd_robots() / "panda_description"
+    robot = tmp_path / "robot"
+    robot.mkdir()
+    shutil.copy(erd / "urdf" / "panda.urdf", robot / "panda.urdf")
+    shutil.copy(erd / "srdf" / "panda.srdf", robot / "panda.srdf")
+    session = SetupSession.open(
+        str(robot / "panda.urdf"), srdf=str(robot / "panda.srdf"), output=robot / "panda.yaml"
+    )
+    assert session.validation.valid, session.validation.errors
+    assert session.draft().srdf == "panda.srdf"
+    return session, robot
+
+
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+
+def _xarm(tmp_path: Path, **kw: Any) -> Any:
+    from robotspec.setup import SetupSession
+
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    return SetupSession.open(str(urdf), output=tmp_path / "out" / "xarm.yaml", **kw)
+
+
+def test_save_as_outside_the_output_folder_is_refused_and_creates_nothing(tmp_path: Path) -> None:
+    from robotspec.errors import RobotSpecError
+
+    s = _xarm(tmp_path)
+    assert not (tmp_path / "out").exists()  # checking the draft there created nothing
+    (tmp_path / "out").mkdir()
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    for target in (
+        tmp_path / "elsewhere" / "deep" / "x.yaml",
+        tmp_path / "out" / ".." / "x.yaml",
+        Path.home() / ".config" / "robotspec-setup-test.yaml",
+    ):
+        with pytest.raises(RobotSpecError, match="inside .*--allow-save DIR") as exc:
+            s.save(target)
+        assert exc.value.file == str(target)
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before  # no folder, no file
+    assert not (Path.home() / ".config" / "robotspec-setup-test.yaml").exists()
+    # A link in the output's folder to another folder does not carry a save out of it.
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "out" / "sub").symlink_to(tmp_path / "elsewhere")
+    with pytest.raises(RobotSpecError, match="symbolic link"):
+        s.save(tmp_path / "out" / "sub" / "x.yaml")
+    assert list((tmp_path / "elsewhere").iterdir()) == []
+    # Inside the folder, a new subfolder is fine; --allow-save adds a folder.
+    assert s.save(tmp_path / "out" / "new" / "x.yaml").is_file()
+    s2 = _xarm(tmp_path, allow_save=[tmp_path / "elsewhere"])
+    assert s2.save(tmp_path / "elsewhere" / "x.yaml").is_file()
+
+
+def test_save_as_never_replaces_a_file_of_the_robot_or_another_file(tmp_path: Path) -> None:
+    from robotspec.errors import RobotSpecError
+    from robotspec.setup import SetupSession
+
+    session, robot = _panda_beside_its_files(tmp_path)
+    files = _tree(robot)
+    for name, why in (
+        ("panda.urdf", "a spec is a .yaml or .yml file"),
+        ("panda.srdf", "a spec is a .yaml or .yml file"),
+    ):
+        with pytest.raises(RobotSpecError, match=why):
+            session.save(robot / name)
+    # Another name of the URDF (a hard link) is still the URDF.
+    (robot / "alias.yaml").hardlink_to(robot / "panda.urdf")
+    with pytest.raises(RobotSpecError, match="this is its URDF, a file of the robot"):
+        session.save(robot / "alias.yaml")
+    (robot / "alias.yaml").unlink()
+    # Someone else's file in the folder is not replaced either.
+    (robot / "mine.yaml").write_text("name: mine\n")
+    with pytest.raises(RobotSpecError, match="the file exists and is not the spec"):
+        session.save(robot / "mine.yaml")
+    (robot / "mine.yaml").unlink()
+    # A save whose relative paths would not resolve there is refused, leaving no folder.
+    with pytest.raises(RobotSpecError, match="relative paths do not resolve"):
+        session.save(robot / "sub" / "panda.yaml")
+    assert not (robot / "sub").exists()
+    assert _tree(robot) == files  # nothing written by the refusals
+    # The output itself is saved, and saved again; the spec it was opened from only as output.
+    assert session.save() == robot / "panda.yaml"
+    assert session.save() == robot / "panda.yaml"
+    again = SetupSession.open(str(robot / "panda.yaml"), output=robot / "copy.yaml")
+    with pytest.raises(RobotSpecError, match="this is the spec it was opened from"):
+        again.save(robot / "panda.yaml")
+    in_place = SetupSession.open(str(robot / "panda.yaml"), output=robot / "panda.yaml")
+    assert in_place.save().read_text() == (robot / "panda.yaml").read_text()
+    assert (robot / "panda.urdf").read_bytes() == files["panda.urdf"]
+
+
+def test_the_collision_matrix_never_replaces_the_robots_srdf(tmp_path: Path) -> None:
+    from robotspec.compiler import check_spec
+    from robotspec.setup.collisions import audit_session, generate_matrix
+
+    session, robot = _panda_beside_its_files(tmp_path)
+    files = _tree(robot)
+    own = files["panda.srdf"]
+    assert own.count(b"<disable_collisions") == 35
+    result = generate_matrix(session, samples=200)
+    # Nothing is written before save, and the spec names a file that is not the robot's SRDF.
+    assert _tree(robot) == files
+    assert result.srdf == robot / "panda.collisions.srdf" and not result.srdf.exists()
+    assert session.draft().srdf == "panda.collisions.srdf" and session.validation.valid
+    assert "panda.collisions.srdf, which save writes" in result.summary
+    ok, report = audit_session(session, samples=100)
+    assert ".setup-" not in report
+    assert not session.snapshot.saved
+    session.save()
+    assert (robot / "panda.srdf").read_bytes() == own  # byte-identical
+    generated = (robot / "panda.collisions.srdf").read_text()
+    assert generated.count("<disable_collisions") != 35 and "<group " in generated
+    assert "srdf: panda.collisions.srdf" in (robot / "panda.yaml").read_text()
+    assert check_spec(robot / "panda.yaml").robot.srdf is not None
+    assert session.snapshot.saved
+    # Generating again replaces the session's own SRDF at save, still never the robot's.
+    generate_matrix(session, samples=100, seed=1)
+    assert not session.snapshot.saved
+    session.save()
+    assert (robot / "panda.srdf").read_bytes() == own
+    # Undone back to the robot's SRDF, the spec names it again (and save writes no SRDF).
+    session.undo()
+    session.undo()
+    assert session.draft().srdf == "panda.srdf" and session.validation.valid
+    assert "srdf: panda.srdf" in session.snapshot.text
+
+
+def test_the_setup_command_checks_its_save_options(tmp_path: Path) -> None:
+    from robotspec.cli.app import main
+
+    pytest.importorskip("viser")
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    for args in (
+        ["-o", str(tmp_path / "xarm.urdf")],
+        ["--allow-save", str(tmp_path / "missing")],
+    ):
+        with pytest.raises(SystemExit) as exc:
+            main(["setup", str(urdf), *args])
+        assert exc.value.code == 2
+    assert list(tmp_path.iterdir()) == []

@@ -102,12 +102,19 @@ def test_collision_matrix_and_audit_from_the_page(page: Any, tmp_path: Path) -> 
     while page._busy and time.monotonic() < end:
         time.sleep(0.05)
     assert "pairs disabled" in page._collision_text.content and page._progress.value == 100.0
-    assert (tmp_path / "xarm.srdf").is_file() and page.session.draft().srdf == "xarm.srdf"
+    # Kept in the session until save, which writes it beside the spec.
+    assert page.session.draft().srdf == "xarm.srdf" and not (tmp_path / "xarm.srdf").exists()
+    assert "save writes beside it" in page._collision_text.content
     page._collisions("audit")
     while page._busy and time.monotonic() < end:
         time.sleep(0.05)
     assert "every entry is right" in page._collision_text.content
-    assert page.session.validation.valid
+    assert ".setup-" not in page._collision_text.content  # named as it will be saved
+    assert page.session.validation.valid and not page.session.snapshot.saved
+    page._save()
+    assert (tmp_path / "xarm.srdf").is_file() and page.session.snapshot.saved
+    assert "<disable_collisions" in (tmp_path / "xarm.srdf").read_text()
+    check_spec(tmp_path / "xarm.yaml")
 
 
 def test_parts_added_changed_and_removed_from_the_page(page: Any) -> None:

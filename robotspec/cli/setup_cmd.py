@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 from typing import Annotated
@@ -45,6 +46,13 @@ def setup(
     force: Annotated[
         bool, typer.Option("--force", help="Start a new draft over an existing output file.")
     ] = False,
+    allow_save: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--allow-save",
+            help="A folder 'save as' may also write in (repeatable; default: -o's folder only).",
+        ),
+    ] = None,
     package_path: PackagePath = None,
 ) -> None:
     """A setup assistant in the browser: answer the draft's guesses, pick parts, save a spec.
@@ -59,10 +67,20 @@ def setup(
 
     require("viser", "viser", "setup")
     from robotspec.cli.audit_report import audit_text
+    from robotspec.setup.access import is_loopback
     from robotspec.setup.page import SetupPage
     from robotspec.setup.session import SetupSession
+    from robotspec.setup.targets import SPEC_SUFFIXES
 
     out = output if output is not None else _default_output(robot)
+    if out.suffix.lower() not in SPEC_SUFFIXES:
+        raise typer.BadParameter(f"a spec is a .yaml or .yml file, not {out}", param_hint="-o")
+    folders = [Path(os.path.normpath(Path(f).absolute())) for f in allow_save or ()]
+    missing = [str(f) for f in folders if not f.is_dir()]
+    if missing:
+        raise typer.BadParameter(
+            f"folder does not exist: {', '.join(missing)}", param_hint="--allow-save"
+        )
     if not is_spec_file(robot) and out.exists() and not force:
         raise RobotSpecError(
             f"the file exists; continue editing it with `robotspec setup {out}`, "
@@ -72,14 +90,24 @@ def setup(
         )
     if srdf is not None and is_spec_file(robot):
         raise typer.BadParameter("a spec names its SRDF itself", param_hint="--srdf")
-    session = SetupSession.open(robot, output=out, srdf=srdf, package_paths=package_path or ())
+    session = SetupSession.open(
+        robot, output=out, srdf=srdf, package_paths=package_path or (), allow_save=folders
+    )
     page = SetupPage(session, host=host, port=port, audit_report=audit_text)
     v = session.validation
+    where = ", ".join(str(f) for f in session.fence.folders)
     sys.stdout.write(
-        f"setting up {session.source.draft.name} at {page.url} ; saves to {out} "
+        f"setting up {session.source.draft.name}; saves to {out} "
         f"({len(session.snapshot.questions)} open questions, {len(v.errors)} errors); "
-        "Ctrl-C stops\n"
+        f"'save as' writes only in {where}. Ctrl-C stops.\n"
+        "Open the page at this address (its token lets only you in; do not share it):\n"
+        f"    {page.url}\n"
     )
+    if not is_loopback(host):
+        sys.stdout.write(
+            f"note: serving on {host}, so other machines can reach the page; the token is "
+            "required of every connection, and the address travels unencrypted (http)\n"
+        )
     sys.stdout.flush()
     try:
         page.viewer.wait()

@@ -1,9 +1,10 @@
 """The self-collision matrix and its audit, run from the assistant on the spec being edited.
 
 Why the Setup Assistant's way: MoveIt's assistant regenerates ``disable_collisions`` into the
-robot's SRDF (its groups and states kept) and the spec then names that SRDF. The file is written
-beside the spec (``<spec>.srdf``) so the spec refers to it by a relative path; the audit then
-reads what each entry of it does.
+robot's SRDF (its groups and states kept) and the spec then names that SRDF. The new SRDF is
+kept in the session and written by "save", beside the spec, so the spec refers to it by a
+relative path; its name is ``<spec>.srdf``, or ``<spec>.collisions.srdf`` when the former is the
+robot's own SRDF (which is never replaced). The audit then reads what each entry does.
 """
 
 from __future__ import annotations
@@ -46,25 +47,27 @@ def _robot(session: SetupSession) -> AbstractRobot:
 def generate_matrix(
     session: SetupSession, *, samples: int = 10_000, seed: int = 0, progress: Progress | None = None
 ) -> MatrixResult:
-    """Generate the matrix, write ``<spec>.srdf`` (the robot's SRDF with it), name it."""
+    """Generate the matrix into the robot's SRDF, keep it in the session, name it in the spec.
+
+    Nothing is written: "save" writes the SRDF beside the spec (``MatrixResult.srdf``).
+    """
     from robotspec.collision import generate_for_robot
     from robotspec.export.srdf import write_srdf
-    from robotspec.setup.save import write_spec
 
     robot = _robot(session)
+    session.fence.srdf_name(session.output)  # no name for it: say so before the long wait
     matrix = generate_for_robot(
         robot, samples=samples, seed=seed, processes=1, progress=progress, on_missing_mesh="skip"
     )
     srdf = matrix.to_srdf(robot.srdf, merge=False) if robot.srdf else matrix.to_srdf()
-    path = session.output.with_suffix(".srdf")
-    write_spec(path, write_srdf(srdf))
-    session.set_srdf(path.name)
+    name, _ = session.keep_srdf(write_srdf(srdf))
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
     summary = (
         f"{len(matrix.disabled)} pairs disabled ({counts}); {len(matrix.checked)} stay checked; "
-        f"{matrix.samples} samples, seed {matrix.seed}, {matrix.seconds:.1f} s; wrote {path.name}"
+        f"{matrix.samples} samples, seed {matrix.seed}, {matrix.seconds:.1f} s; the spec names "
+        f"{name}, which save writes beside it (the robot's own SRDF is never replaced)"
     )
-    return MatrixResult(path, summary)
+    return MatrixResult(session.output.parent / name, summary)
 
 
 def plain_audit_report(result: SrdfAudit, spec: str, show_ok: bool) -> str:
@@ -98,4 +101,9 @@ def audit_session(
     result = audit_srdf(
         robot, samples=samples, seed=seed, processes=1, progress=progress, on_missing_mesh="skip"
     )
-    return not result.wrong, report(result, str(session.output), False)
+    text = report(result, str(session.output), False)
+    kept = session.draft().srdf
+    if robot.srdf.file and kept and ".setup-" in Path(robot.srdf.file).name:
+        # The kept SRDF was checked as a hidden staged file: name it as it will be saved.
+        text = text.replace(robot.srdf.file, kept).replace(Path(robot.srdf.file).name, kept)
+    return not result.wrong, text

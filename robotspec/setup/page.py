@@ -275,8 +275,13 @@ class SetupPage:
             self._button(gui, "generate collision matrix", lambda: self._collisions("generate"))
             self._button(gui, "audit the SRDF", lambda: self._collisions("audit"))
             self._progress = gui.add_progress_bar(0.0, visible=False)
-            self._collision_text = gui.add_markdown("")
+            self._collision_text = gui.add_markdown(
+                "The generated SRDF stays here until *save*, which writes it beside the spec "
+                "(never over the robot's own SRDF)."
+            )
         self._save_path = gui.add_text("save as", str(self.session.output))
+        where = ", ".join(f"`{html.escape(str(f))}`" for f in self.session.fence.folders)
+        gui.add_markdown(f"<small>save as writes inside {where} only</small>")
         self._button(gui, "save", self._save)
 
     # ------------------------------------------------------------------ selection

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from robotspec.errors import RobotSpecError
+from robotspec.files.writing import check_writable, write_file
 from robotspec.model.world import World
 from robotspec.setup.questions import (
     BODY_FRAME,
@@ -28,8 +29,9 @@ from robotspec.setup.questions import (
     Question,
     questions_of,
 )
-from robotspec.setup.save import spec_text, write_spec
+from robotspec.setup.save import spec_text
 from robotspec.setup.source import Source, open_source
+from robotspec.setup.targets import SaveFence
 from robotspec.setup.tree import chain_joints, joint_range, subtree_joints
 from robotspec.setup.validation import Validation, validate_text
 from robotspec.spec.draft.model import (
@@ -103,19 +105,31 @@ class SetupSession:
     """A draft being turned into a valid spec, and where it will be saved."""
 
     def __init__(
-        self, source: Source, output: Path, *, package_paths: Sequence[str | Path] = ()
+        self,
+        source: Source,
+        output: Path,
+        *,
+        package_paths: Sequence[str | Path] = (),
+        allow_save: Sequence[Path] = (),
     ) -> None:
         self.source = source
         self.world: World = source.world
         self.output = output
         self.package_paths = tuple(package_paths)
+        #: Where saves may go, the robot's files they never replace, what this session wrote.
+        self.fence = SaveFence(output, tuple(allow_save), dict(source.inputs))
         self._lock = threading.RLock()
         self._draft = copy.deepcopy(source.draft)
         self._history: list[Draft] = []
         self._listeners: list[Callable[[Snapshot], None]] = []
         self._version = 0
-        self._saved_text: str | None = None
+        #: A generated SRDF kept until save: (its name beside the spec, its text).
+        self._pending_srdf: tuple[str, str] | None = None
+        self._saved: tuple[str, str | None] | None = None
         self._snapshot = self._make_snapshot(self._draft)
+        robot = self._snapshot.validation.robot
+        if robot is not None and robot.srdf is not None and robot.srdf.file:
+            self.fence.inputs.setdefault(Path(robot.srdf.file), "its SRDF")
 
     @classmethod
     def open(
@@ -125,10 +139,14 @@ class SetupSession:
         output: Path,
         srdf: str | None = None,
         package_paths: Sequence[str | Path] = (),
+        allow_save: Sequence[Path] = (),
     ) -> SetupSession:
-        """A session on a URDF (drafted) or a spec (read back); errors as init/validate raise."""
+        """A session on a URDF (drafted) or a spec (read back); errors as init/validate raise.
+
+        Saves go to ``output``'s folder, or a folder of ``allow_save`` (``--allow-save``).
+        """
         source = open_source(ref, srdf=srdf, output=output, package_paths=package_paths)
-        return cls(source, output, package_paths=package_paths)
+        return cls(source, output, package_paths=package_paths, allow_save=allow_save)
 
     # ------------------------------------------------------------------ reading
     @property
@@ -186,15 +204,33 @@ class SetupSession:
             self._listeners.append(listener)
 
     # ------------------------------------------------------------------ the one way to change
+    def _srdf_of(self, draft: Draft) -> tuple[str, str] | None:
+        """The generated SRDF ``draft`` names, while it is kept in the session (not saved)."""
+        pending = self._pending_srdf
+        return pending if pending is not None and draft.srdf == pending[0] else None
+
+    def _validate(self, draft: Draft, text: str, at: Path) -> Validation:
+        """What validate says of ``text`` saved as ``at`` (a kept SRDF staged beside it)."""
+        srdf = self._srdf_of(draft)
+        if srdf is None:
+            return validate_text(text, at, package_paths=self.package_paths)
+
+        def naming(staged: str) -> str:
+            d = copy.copy(draft)
+            d.srdf = staged
+            return spec_text(d, self.source.kept, self.source.presets)
+
+        return validate_text(naming, at, package_paths=self.package_paths, srdf=srdf)
+
     def _make_snapshot(self, draft: Draft) -> Snapshot:
         text = spec_text(draft, self.source.kept, self.source.presets)
-        validation = validate_text(text, self.output, package_paths=self.package_paths)
+        srdf = self._srdf_of(draft)
         return Snapshot(
             self._version,
             text,
-            validation,
+            self._validate(draft, text, self.output),
             questions_of(draft, self.source.presets),
-            saved=text == self._saved_text,
+            saved=(text, srdf and srdf[1]) == self._saved,
         )
 
     def edit(self, change: Callable[[Draft], None]) -> Validation:
@@ -467,6 +503,18 @@ class SetupSession:
         """The SRDF the spec names (a path relative to the spec, or a ``package://`` URI)."""
         return self.edit(lambda d: setattr(d, "srdf", ref))
 
+    def keep_srdf(self, text: str) -> tuple[str, Validation]:
+        """A generated SRDF, kept in the session and named by the spec; save writes it.
+
+        Why not written now: a generated file is an output like the spec, written by "save" (or
+        never); and its name, beside the spec, is never the robot's own SRDF
+        (``<spec>.srdf``, else ``<spec>.collisions.srdf``: :meth:`SaveFence.srdf_name`).
+        """
+        with self._lock:
+            name = self.fence.srdf_name(self.output)
+            self._pending_srdf = (name, text)
+            return name, self.set_srdf(name)
+
     def _states_of(self, d: Draft, part: str) -> dict[str, dict[str, float]]:
         if part == "robot":
             return d.states
@@ -533,7 +581,13 @@ class SetupSession:
 
     # ------------------------------------------------------------------ saving
     def save(self, path: Path | None = None) -> Path:
-        """Write the spec if validate accepts it; refuse (listing the errors) if not."""
+        """Write the spec if validate accepts it; refuse (listing the errors) if not.
+
+        ``path`` ("save as") must lie inside the output's folder or one ``allow_save`` gave,
+        be a ``.yaml``/``.yml`` file, not a file of the robot, and not an existing file other
+        than the output or one this session wrote. A generated SRDF kept in the session is
+        written first, beside the spec. A refused save writes and creates nothing.
+        """
         with self._lock:
             snap = self._snapshot
             target = path or self.output
@@ -544,16 +598,29 @@ class SetupSession:
                     file=str(target),
                     kind="spec",
                 )
-            if target.resolve().parent != self.output.resolve().parent:
-                check = validate_text(snap.text, target, package_paths=self.package_paths)
+            fence = self.fence
+            dest, under, replace = fence.place(target)
+            srdf = self._srdf_of(self._draft)
+            srdf_at = None if srdf is None else fence.place(dest.parent / srdf[0], what="the SRDF")
+            inputs = fence.input_map()
+            for where, folder, force in filter(None, ((dest, under, replace), srdf_at)):
+                # A link on the way is refused before the check stages anything there.
+                check_writable(where, under=folder, force=force, inputs=inputs)
+            if dest.resolve().parent != self.output.resolve().parent:
+                check = self._validate(self._draft, snap.text, dest)
                 if not check.valid:
                     raise SetupError(
                         "not saved: the spec's relative paths do not resolve from that folder",
                         file=str(target),
                         kind="spec",
                     )
-            write_spec(target, snap.text)
-            self._saved_text = snap.text
+            if srdf is not None and srdf_at is not None:
+                s_dest, s_under, s_replace = srdf_at
+                write_file(s_dest, srdf[1], under=s_under, force=s_replace, inputs=inputs)
+                fence.remember(s_dest)
+            write_file(dest, snap.text, under=under, force=replace, inputs=inputs)
+            fence.remember(dest)
+            self._saved = (snap.text, srdf and srdf[1])
             self._snapshot = Snapshot(
                 snap.version, snap.text, snap.validation, snap.questions, saved=True
             )

@@ -41,6 +41,9 @@ class Source:
     origin: str
     kept: dict[str, Any] = field(default_factory=dict)
     presets: tuple[str, ...] = ()
+    #: The robot's own files (URDF or xacro, SRDF, meshes, the spec read), each with what it
+    #: is: no save replaces one (``robotspec.setup.targets``).
+    inputs: dict[Path, str] = field(default_factory=dict)
 
 
 def is_spec_file(ref: str) -> bool:
@@ -60,17 +63,24 @@ def open_source(
     package_paths: Sequence[str | Path] = (),
 ) -> Source:
     """Open ``ref`` for editing; its problems raise the errors ``init`` or ``validate`` raise."""
+    from robotspec.setup.targets import robot_inputs
     from robotspec.spec.draft.render import camera_presets
 
     presets = camera_presets()
     if is_spec_file(ref):
+        from robotspec.compiler import resolve_spec
         from robotspec.setup.from_spec import draft_of_spec
 
         folder = output.resolve().parent
         draft, world, kept = draft_of_spec(ref, package_paths=package_paths, folder=folder)
-        return Source(draft, world, ref, kept, presets)
+        named = draft.srdf if draft.srdf and "://" not in draft.srdf else None
+        inputs = robot_inputs(
+            world, srdf=[named and folder / named], spec=resolve_spec(ref).absolute()
+        )
+        return Source(draft, world, ref, kept, presets, inputs)
     from robotspec.spec.draft.run import draft_from_files
 
     folder = output.resolve().parent
     draft, desc = draft_from_files(ref, srdf, folder=folder, package_paths=package_paths)
-    return Source(draft, desc.world, ref, {}, presets)
+    inputs = robot_inputs(desc.world, srdf=[desc.srdf.file if desc.srdf else None, srdf])
+    return Source(draft, desc.world, ref, {}, presets, inputs)

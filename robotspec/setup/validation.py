@@ -8,10 +8,12 @@ to a hidden file beside the real output, so relative references (``../urdf/robot
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -91,45 +93,116 @@ class Validation:
         return tuple(p for p in self.problems if p.part == part)
 
 
-def _problem(d: ErrorDetail, spec_file: str) -> Problem:
+def _problem(d: ErrorDetail, spec_file: str, shown: Mapping[str, str]) -> Problem:
     own = d.file is None or Path(d.file).name == Path(spec_file).name
+    message = d.message.replace(Path(spec_file).name, "the spec")
+    file = None if own else d.file
+    for staged, real in shown.items():  # a staged file is named as it will be saved
+        message = message.replace(staged, real).replace(Path(staged).name, Path(real).name)
+        file = real if file == staged else file
     return Problem(
         severity=d.severity,
-        message=d.message.replace(Path(spec_file).name, "the spec"),
+        message=message,
         part=part_of(d.location) if own else "description",
         line=d.line,
         column=d.column,
         location=tuple(d.location),
-        file=None if own else d.file,
+        file=file,
     )
 
 
-def validate_text(
-    text: str, output: Path, *, package_paths: Sequence[str | Path] = ()
-) -> Validation:
-    """Check ``text`` as if it were the file ``output``; every error and warning, located."""
-    from robotspec.compiler import check_spec
+@contextmanager
+def _scratch(output: Path) -> Iterator[Path]:
+    """The output's folder, made for the check if missing and removed again after it.
 
-    started = time.perf_counter()
+    Why: a check must leave nothing behind (a refused "save as" creates no folder); only a
+    save creates the folders it writes into.
+    """
     folder = output.resolve().parent
+    missing: list[Path] = []
+    p = folder
+    while not os.path.lexists(p) and p.parent != p:
+        missing.append(p)
+        p = p.parent
     try:
-        folder.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{output.stem}.setup-", suffix=".yaml", dir=folder)
+        for m in reversed(missing):
+            m.mkdir()
+    except OSError as exc:
+        _remove(missing)
+        raise RobotSpecError(
+            f"cannot write the spec's folder: {exc.strerror or exc}", file=str(output), kind="file"
+        ) from None
+    try:
+        yield folder
+    finally:
+        _remove(missing)
+
+
+def _remove(folders: Sequence[Path]) -> None:
+    for m in folders:  # deepest first
+        with contextlib.suppress(OSError):
+            m.rmdir()
+
+
+def _stage(folder: Path, prefix: str, suffix: str, data: str, output: Path) -> Path:
+    """A file of ``data`` in ``folder``, created exclusively (nothing planted is opened)."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=folder)
     except OSError as exc:
         raise RobotSpecError(
             f"cannot write the spec's folder: {exc.strerror or exc}", file=str(output), kind="file"
         ) from None
-    robot = None
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        try:
-            result = check_spec(tmp, package_paths=package_paths)
-            details = [d for w in result.warnings for d in w.details]
-            robot = result.robot
-        except RobotSpecError as exc:
-            details = [*exc.details, *(d for w in exc.warnings for d in w.details)]
-    finally:
+            fh.write(data)
+    except OSError as exc:
         Path(tmp).unlink(missing_ok=True)
-    problems = tuple(_problem(d, tmp) for d in details)
+        raise RobotSpecError(
+            f"cannot write the spec's folder: {exc.strerror or exc}", file=str(output), kind="file"
+        ) from None
+    return Path(tmp)
+
+
+def validate_text(
+    text: str | Callable[[str], str],
+    output: Path,
+    *,
+    package_paths: Sequence[str | Path] = (),
+    srdf: tuple[str, str] | None = None,
+) -> Validation:
+    """Check ``text`` as if it were the file ``output``; every error and warning, located.
+
+    ``srdf``: an SRDF kept in the session, not yet saved: (its name beside the spec, its text).
+    It is staged as a hidden file for the check, and ``text`` is then a function of the staged
+    file's name (the spec naming it); messages name it as it will be saved.
+    """
+    from robotspec.compiler import check_spec
+
+    started = time.perf_counter()
+    robot = None
+    with _scratch(output) as folder:
+        staged: list[Path] = []
+        try:
+            shown: dict[str, str] = {}
+            if srdf is not None:
+                # Not hidden: a spec may not name a hidden file (docs/security.md).
+                staged.append(_stage(folder, f"{output.stem}.setup-", ".srdf", srdf[1], output))
+                shown[str(staged[-1])] = str(folder / srdf[0])
+                spec = text(staged[-1].name) if callable(text) else text
+            elif isinstance(text, str):
+                spec = text
+            else:
+                raise TypeError("a spec text that names a staged SRDF needs the SRDF")
+            staged.append(_stage(folder, f".{output.stem}.setup-", ".yaml", spec, output))
+            tmp = str(staged[-1])
+            try:
+                result = check_spec(tmp, package_paths=package_paths)
+                details = [d for w in result.warnings for d in w.details]
+                robot = result.robot
+            except RobotSpecError as exc:
+                details = [*exc.details, *(d for w in exc.warnings for d in w.details)]
+        finally:
+            for f in staged:
+                f.unlink(missing_ok=True)
+    problems = tuple(_problem(d, tmp, shown) for d in details)
     return Validation(problems, time.perf_counter() - started, robot)

@@ -129,6 +129,16 @@ def test_a_loopback_page_refuses_other_host_names(page: Any) -> None:
     assert PageAccess.for_host("x").token != PageAccess.for_host("x").token  # one per run
 
 
+def test_save_as_on_the_page_outside_its_folder_says_why_and_writes_nothing(
+    page: Any, tmp_path: Path
+) -> None:
+    person = type("Person", (), {"client": object()})()
+    page._save_path.value = str(tmp_path / "elsewhere" / "x.yaml")
+    page._guarded(lambda _e: page._save())(person)
+    assert "not saved" in page.last_message and "--allow-save" in page.last_message
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_viser_without_the_hook_is_refused_not_served_unguarded() -> None:
     from robotspec.errors import ServiceError
     from robotspec.setup.access import start_guarded
@@ -284,3 +294,45 @@ def test_the_setup_command_checks_its_save_options(tmp_path: Path) -> None:
             main(["setup", str(urdf), *args])
         assert exc.value.code == 2
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_command_prints_the_address_with_its_token_and_warns_beyond_loopback(
+    tmp_path: Path,
+) -> None:
+    import os
+    import re
+    import subprocess
+    import sys
+    import time
+
+    pytest.importorskip("viser")
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    cmd = [sys.executable, "-m", "robotspec", "setup", str(urdf), "-o", str(tmp_path / "x.yaml")]
+    proc = subprocess.Popen(
+        [*cmd, "--host", "0.0.0.0", "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    try:
+        lines: list[str] = []
+        end = time.monotonic() + 120
+        while time.monotonic() < end and not any("note: serving on" in x for x in lines):
+            line = proc.stdout.readline() if proc.stdout else ""
+            if not line:
+                break
+            lines.append(line)
+        out = "".join(lines)
+        found = re.search(r"http://localhost:(\d+)/\?token=([\w-]+)", out)
+        assert found, out + (proc.stderr.read() if proc.poll() is not None and proc.stderr else "")
+        assert "note: serving on 0.0.0.0" in out and "token is required" in out
+
+        class _Page:  # what _connect needs of a page
+            viewer = type("V", (), {"port": int(found[1])})
+
+        assert _connect(_Page(), f"?token={found[2]}").startswith("state ")
+        assert _connect(_Page(), origin="http://evil.example").startswith("refused 403")
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=30)  # waits, and closes its pipes

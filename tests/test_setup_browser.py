@@ -174,6 +174,7 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
     session = SetupSession.open(str(urdf), output=out)
     page = SetupPage(session, port=0)
     try:
+        assert f"/?token={page.access.token}" in page.url  # the page is opened with its token
         d.get(page.url)
         # A second tab on the same server, its 3D hidden (software WebGL is slow), checked last.
         first = d.current_window_handle

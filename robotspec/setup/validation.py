@@ -3,7 +3,9 @@
 Why the text and not the draft object: the assistant promises that what it saves validates, so it
 checks exactly what it would write, with the compiler ``robotspec validate`` runs. The text goes
 to a hidden file beside the real output, so relative references (``../urdf/robot.urdf``,
-``package_paths``) resolve as they will in the saved spec; the file is removed at once.
+``package_paths``) resolve as they will in the saved spec; the file is removed at once. A
+generated SRDF not yet saved is staged beside it the same way. A check leaves nothing behind: a
+folder it had to create is removed again (only a save creates folders).
 """
 
 from __future__ import annotations

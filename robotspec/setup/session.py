@@ -29,7 +29,7 @@ from robotspec.setup.questions import (
     Question,
     questions_of,
 )
-from robotspec.setup.save import spec_text
+from robotspec.setup.save import spec_text, write_spec
 from robotspec.setup.source import Source, open_source
 from robotspec.setup.targets import SaveFence
 from robotspec.setup.tree import chain_joints, joint_range, subtree_joints
@@ -618,7 +618,7 @@ class SetupSession:
                 s_dest, s_under, s_replace = srdf_at
                 write_file(s_dest, srdf[1], under=s_under, force=s_replace, inputs=inputs)
                 fence.remember(s_dest)
-            write_file(dest, snap.text, under=under, force=replace, inputs=inputs)
+            write_spec(dest, snap.text, under=under, force=replace, inputs=inputs)
             fence.remember(dest)
             self._saved = (snap.text, srdf and srdf[1])
             self._snapshot = Snapshot(

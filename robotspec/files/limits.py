@@ -2,10 +2,11 @@
 
 Why caps at all: robot files are downloaded from everywhere and run through xacro, which
 evaluates expressions. robotspec's promise is that a file can at worst give an error, so every
-reader stops at a size, the YAML composer at a depth and a node count, and xacro at budgets of
-time, macro calls and value sizes. The defaults are far above any real robot (the PR2's xacro
-tree is 1.3 MB, its largest mesh 9 MB); a user with a bigger robot raises one cap with an
-environment variable, ``ROBOTSPEC_<NAME>`` (for example ``ROBOTSPEC_MAX_MESH_BYTES=1e9``).
+reader stops at a size, the YAML reader at a depth and a node count, a spec's ``extends`` chain
+at a depth, and xacro at budgets of time, macro calls and value sizes. The defaults are far
+above any real robot (the PR2's xacro tree is 1.3 MB, its largest mesh 9 MB); a user with a
+bigger robot raises one cap with an environment variable, ``ROBOTSPEC_<NAME>`` (for example
+``ROBOTSPEC_MAX_MESH_BYTES=1e9``).
 
 The values are read from the environment each time a reader asks (no module state), so a test or
 a server can change them per call.
@@ -28,8 +29,13 @@ class Limits:
     max_yaml_bytes: int = 8 * 1024 * 1024
     #: Nesting depth of YAML collections, checked before anything recurses.
     max_yaml_depth: int = 100
-    #: Nodes of one YAML document with every alias expanded (alias bombs).
+    #: Nodes of one YAML document with every alias expanded (alias bombs). An alias is shared,
+    #: not copied, so reading costs memory in proportion to the text; this bounds the work of
+    #: whatever walks the data afterwards (validation, the compiler).
     max_yaml_nodes: int = 1_000_000
+    #: Files one spec's ``extends`` chain may reach beyond the spec itself (a real chain is two
+    #: or three deep; each file is read and validated once).
+    max_extends_depth: int = 100
     #: Bytes of one URDF file, and of a xacro expansion's output.
     max_urdf_bytes: int = 64 * 1024 * 1024
     #: Bytes of one SRDF file.

@@ -15,6 +15,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from robotspec.errors import NotFoundError, SpecError
+from robotspec.files.limits import env_name, limits
 from robotspec.files.validation import validation_errors
 from robotspec.files.yamlio import LocatedYaml, load_yaml
 from robotspec.shipped import package_data, shipped_spec_files
@@ -106,69 +107,104 @@ def _absolutize(data: dict[str, Any], folder: Path) -> None:
                 _absolute_paths(part, folder, ("urdf", "srdf", "spec"))
 
 
-def load_spec(
-    path: str | Path, *, _seen: tuple[Path, ...] = (), allowed: Sequence[str | Path] = ()
-) -> LoadedSpec:
+def load_spec(path: str | Path, *, allowed: Sequence[str | Path] = ()) -> LoadedSpec:
     """Read, merge (``extends``) and validate a spec file; every problem raised at once.
 
     ``allowed``: folders the user allows besides the spec's project (``-P``), for ``extends``.
+    The chain of ``extends`` is followed in a loop (each file read once, a cycle or a chain
+    deeper than ``ROBOTSPEC_MAX_EXTENDS_DEPTH`` refused at the ``extends`` line that goes too
+    far), then validated from the last base up, each file over the one it extends.
     """
-    p = Path(path).resolve()
-    if p in _seen:
-        chain = " -> ".join(x.name for x in (*_seen, p))
-        raise SpecError(f"'extends' forms a cycle: {chain}", file=str(path))
-    doc = load_yaml(path)
-    if not isinstance(doc.data, Mapping):
-        raise SpecError("a spec must be a YAML mapping", file=doc.file, line=1)
-    data: Any = doc.data
-    documents: tuple[LocatedYaml, ...] = (doc,)
-    foreign = foreign_paths(doc, p.parent)
-    base_file = data.get("extends")
-    if isinstance(base_file, str):
-        base_path = (p.parent / base_file).resolve()
-        shipped = shipped_spec_files()
-        if not base_path.is_file() and base_file.lower() in shipped:
-            base_path = shipped[base_file.lower()]  # a shipped robot, by name
-        if not base_path.is_file():
-            line, col = doc.position(("extends",))
-            siblings = [f.name for f in p.parent.glob("*.y*ml")]
-            raise NotFoundError(
-                "spec",
-                base_file,
-                [*siblings, *shipped],
-                where="this folder or the shipped robots",
-                file=doc.file,
-                line=line,
-                column=col,
-                location=("extends",),
+    loaded: LoadedSpec | None = None
+    for file, doc in reversed(_extends_chain(path, allowed)):
+        data: Any = doc.data
+        documents: tuple[LocatedYaml, ...] = (doc,)
+        foreign = foreign_paths(doc, file.parent)
+        if loaded is not None:
+            base_data = loaded.spec.model_dump(mode="json", exclude_unset=True, by_alias=True)
+            base_data.pop("extends", None)
+            _absolutize(base_data, loaded.folder)
+            data = merge_data(base_data, {k: v for k, v in data.items() if k != "extends"})
+            data["extends"] = doc.data["extends"]
+            documents = (doc, *loaded.documents)
+            foreign += loaded.foreign_paths
+        try:
+            spec = RobotSpec.model_validate(data)
+        except ValidationError as exc:
+            raise validation_errors(exc, doc, RobotSpec, SpecError) from None
+        loaded = LoadedSpec(spec=spec, file=file, documents=documents, foreign_paths=tuple(foreign))
+    assert loaded is not None  # the chain holds the spec itself
+    return loaded
+
+
+def _extends_chain(
+    path: str | Path, allowed: Sequence[str | Path]
+) -> list[tuple[Path, LocatedYaml]]:
+    """The spec and the files it extends, in order, each read once (a loop, not recursion).
+
+    Why a loop: a chain 1,100 files deep ran out of Python's stack; now a chain longer than the
+    cap, or one that comes back to a file, is an error at the ``extends`` line that goes on.
+    """
+    cap = limits().max_extends_depth
+    file, given = Path(path).resolve(), str(path)
+    chain: list[tuple[Path, LocatedYaml]] = []
+    while True:
+        doc = load_yaml(given)
+        if not isinstance(doc.data, Mapping):
+            raise SpecError("a spec must be a YAML mapping", file=doc.file, line=1)
+        chain.append((file, doc))
+        base_file = doc.data.get("extends")
+        if not isinstance(base_file, str):
+            return chain
+        base_path = _base_path(base_file, file, doc, allowed)
+        problem = None
+        if any(base_path == seen for seen, _ in chain):
+            names = " -> ".join(f.name for f in (*(f for f, _ in chain), base_path))
+            problem = f"'extends' forms a cycle: {names}"
+        elif len(chain) > cap:
+            problem = (
+                f"'extends' chain longer than {cap} files (set "
+                f"{env_name('max_extends_depth')} to raise it)"
             )
-        if base_path.parent != package_data("specs"):
-            # Fenced before it is read: a base outside the spec's project is the user's to allow.
+        if problem is not None:
             line, col = doc.position(("extends",))
-            check_spec_path(
-                str(base_path),
-                p.parent,
-                key="extends",
-                file=doc.file,
-                line=line,
-                column=col,
-                location=("extends",),
-                allowed=allowed,
-                given=base_file,
-            )
-        base = load_spec(base_path, _seen=(*_seen, p), allowed=allowed)
-        base_data = base.spec.model_dump(mode="json", exclude_unset=True, by_alias=True)
-        base_data.pop("extends", None)
-        _absolutize(base_data, base.folder)
-        data = merge_data(base_data, {k: v for k, v in data.items() if k != "extends"})
-        data["extends"] = base_file
-        documents = (doc, *base.documents)
-        foreign += base.foreign_paths
-    try:
-        spec = RobotSpec.model_validate(data)
-    except ValidationError as exc:
-        raise validation_errors(exc, doc, RobotSpec, SpecError) from None
-    return LoadedSpec(spec=spec, file=p, documents=documents, foreign_paths=tuple(foreign))
+            raise SpecError(problem, file=doc.file, line=line, column=col, location=("extends",))
+        file, given = base_path, str(base_path)
+
+
+def _base_path(base_file: str, file: Path, doc: LocatedYaml, allowed: Sequence[str | Path]) -> Path:
+    """The file ``extends: base_file`` names in the spec ``file`` (fenced before it is read)."""
+    base_path = (file.parent / base_file).resolve()
+    shipped = shipped_spec_files()
+    if not base_path.is_file() and base_file.lower() in shipped:
+        base_path = shipped[base_file.lower()]  # a shipped robot, by name
+    line, col = doc.position(("extends",))
+    if not base_path.is_file():
+        siblings = [f.name for f in file.parent.glob("*.y*ml")]
+        raise NotFoundError(
+            "spec",
+            base_file,
+            [*siblings, *shipped],
+            where="this folder or the shipped robots",
+            file=doc.file,
+            line=line,
+            column=col,
+            location=("extends",),
+        )
+    if base_path.parent != package_data("specs"):
+        # Fenced before it is read: a base outside the spec's project is the user's to allow.
+        check_spec_path(
+            str(base_path),
+            file.parent,
+            key="extends",
+            file=doc.file,
+            line=line,
+            column=col,
+            location=("extends",),
+            allowed=allowed,
+            given=base_file,
+        )
+    return base_path
 
 
 def json_schema() -> dict[str, Any]:

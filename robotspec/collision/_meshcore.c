@@ -257,8 +257,11 @@ static void tree_free(Tree *t) {
 
 /* A tree from vertices (V, 3) and triangles (T, 3); NULL with an exception set on bad input. */
 static Tree *tree_new(PyObject *vobj, PyObject *fobj) {
+    /* One conversion at a time: numpy is never called with the previous one's error set. */
     PyArrayObject *va = (PyArrayObject *)PyArray_FROMANY(vobj, NPY_DOUBLE, 2, 2, NPY_ARRAY_IN_ARRAY);
-    PyArrayObject *fa = (PyArrayObject *)PyArray_FROMANY(fobj, NPY_INT64, 2, 2, NPY_ARRAY_IN_ARRAY);
+    PyArrayObject *fa = va == NULL ? NULL
+                                   : (PyArrayObject *)PyArray_FROMANY(fobj, NPY_INT64, 2, 2,
+                                                                      NPY_ARRAY_IN_ARRAY);
     Tree *t = NULL;
     Keyed *scratch = NULL;
     if (va == NULL || fa == NULL) goto fail;
@@ -388,6 +391,16 @@ static PyObject *py_mesh_set(PyObject *self, PyObject *args) {
 }
 
 /* ------------------------------------------------------------------------------- queries */
+
+/* The set in a capsule made by mesh_set, else NULL with a TypeError naming it (as the numpy
+ * fallback raises for anything but its own sets; PyCapsule_GetPointer's is a ValueError). */
+static const MeshSet *set_of(PyObject *cap) {
+    if (!PyCapsule_IsValid(cap, "robotspec.meshset")) {
+        PyErr_SetString(PyExc_TypeError, "expected a mesh set (from mesh_set())");
+        return NULL;
+    }
+    return PyCapsule_GetPointer(cap, "robotspec.meshset");
+}
 
 /*
  * Box a (half extents ha0, its own frame) and box b (half extents hb, centred at t with axes the
@@ -669,19 +682,25 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
     double eps;
     if (!PyArg_ParseTuple(args, "OOOOOOd", &cap, &pobj, &robj, &kobj, &g1obj, &g2obj, &eps))
         return NULL;
-    const MeshSet *s = PyCapsule_GetPointer(cap, "robotspec.meshset");
+    const MeshSet *s = set_of(cap);
     if (s == NULL) return NULL;
     if (!(eps >= 1e-9) || !isfinite(eps)) {
         /* At least a nanometre: the squared comparisons leave rounding no room below that. */
         PyErr_SetString(PyExc_ValueError, "eps must be finite and >= 1e-9");
         return NULL;
     }
-    PyArrayObject *poses = (PyArrayObject *)PyArray_FROMANY(pobj, NPY_DOUBLE, 4, 4,
-                                                            NPY_ARRAY_IN_ARRAY);
-    PyArrayObject *rows = (PyArrayObject *)PyArray_FROMANY(robj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
-    PyArrayObject *ks = (PyArrayObject *)PyArray_FROMANY(kobj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
-    PyArrayObject *g1 = (PyArrayObject *)PyArray_FROMANY(g1obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
-    PyArrayObject *g2 = (PyArrayObject *)PyArray_FROMANY(g2obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    /* One conversion at a time, in argument order: numpy is never called with an error set, and
+     * the first bad argument is the one reported (as by the numpy fallback). */
+    PyArrayObject *poses = NULL, *rows = NULL, *ks = NULL, *g1 = NULL, *g2 = NULL;
+    poses = (PyArrayObject *)PyArray_FROMANY(pobj, NPY_DOUBLE, 4, 4, NPY_ARRAY_IN_ARRAY);
+    if (poses != NULL)
+        rows = (PyArrayObject *)PyArray_FROMANY(robj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    if (rows != NULL)
+        ks = (PyArrayObject *)PyArray_FROMANY(kobj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    if (ks != NULL)
+        g1 = (PyArrayObject *)PyArray_FROMANY(g1obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    if (g1 != NULL)
+        g2 = (PyArrayObject *)PyArray_FROMANY(g2obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
     PyArrayObject *out = NULL;
     Scratch st;
     memset(&st, 0, sizeof(Scratch));
@@ -778,7 +797,7 @@ static PyObject *py_apart_one(PyObject *self, PyObject *args) {
     Py_ssize_t row, i, j;
     double eps;
     if (!PyArg_ParseTuple(args, "OOnnnd", &cap, &pobj, &row, &i, &j, &eps)) return NULL;
-    const MeshSet *s = PyCapsule_GetPointer(cap, "robotspec.meshset");
+    const MeshSet *s = set_of(cap);
     if (s == NULL) return NULL;
     PyArrayObject *poses = geometry_poses(pobj, s, "apart_one");
     if (poses == NULL) return NULL;
@@ -895,7 +914,7 @@ static PyObject *py_on_surface(PyObject *self, PyObject *args) {
     Py_ssize_t row, g;
     double tol;
     if (!PyArg_ParseTuple(args, "OOnnOd", &cap, &pobj, &row, &g, &xobj, &tol)) return NULL;
-    const MeshSet *s = PyCapsule_GetPointer(cap, "robotspec.meshset");
+    const MeshSet *s = set_of(cap);
     if (s == NULL) return NULL;
     PyArrayObject *poses = geometry_poses(pobj, s, "on_surface");
     if (poses == NULL) return NULL;

@@ -6,8 +6,9 @@ point it finds on the mesh only lets the checker skip coal's exact mesh distance
 that proves nothing and finds no point on a surface gives every answer, from coal, the same to
 coal's tolerance, only slower on nearly touching meshes (see benchmarks/bench_fallback.py).
 
-The arguments are checked as the C core checks them (see ``_meshcore.pyi``), so a caller's
-mistake fails the same way whichever core runs; :mod:`robotspec.collision.meshcore` chooses.
+The arguments are read and checked as the C core reads and checks them, in its order (see
+``_meshcore.pyi`` and :mod:`robotspec.model._core_args`), so a caller's mistake raises the same
+exception with the same message whichever core runs; :mod:`robotspec.collision.meshcore` chooses.
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from robotspec.model._core_args import from_any, index, real, table
 
 _INT32_MAX = 2**31 - 1
 
@@ -30,22 +33,23 @@ class MeshSet:
 
 
 def _mesh(item: object) -> None:
-    """Check one (vertices (V, 3), triangles (T >= 1, 3)) mesh as the C core does."""
+    """Check one (vertices (V, 3), triangles (T >= 1, 3)) mesh as the C core's ``tree_new`` does."""
     if not isinstance(item, tuple) or len(item) != 2:
         raise TypeError("mesh_set: each mesh is (vertices, triangles) or None")
-    v = np.asarray(item[0])
-    f = np.asarray(item[1])
-    if not np.can_cast(v.dtype, np.float64, "safe"):
-        raise TypeError(f"mesh_set: cannot read vertices of {v.dtype} as float64")
-    if not np.can_cast(f.dtype, np.int64, "safe"):
-        raise TypeError(f"mesh_set: cannot read triangles of {f.dtype} as int64")
-    if v.ndim != 2 or f.ndim != 2:
-        raise ValueError("a mesh needs vertices (V, 3) and triangles (T >= 1, 3)")
+    v = from_any(item[0], np.float64, 2, 2)
+    f = from_any(item[1], np.int64, 2, 2)
     if v.shape[1] != 3 or f.shape[1] != 3 or not 1 <= f.shape[0] <= _INT32_MAX // 4:
         raise ValueError("a mesh needs vertices (V, 3) and triangles (T >= 1, 3)")
-    if f.min() < 0 or f.max() >= v.shape[0]:
+    # Corner by corner, as the C core reads them: the first bad one says what is wrong.
+    corners = f.reshape(-1)
+    out = (corners < 0) | (corners >= v.shape[0])
+    if out.all():  # (no vertex at all, or none in range: nothing to read)
         raise ValueError("a triangle refers to a vertex out of range")
-    if not np.isfinite(v[np.unique(f)]).all():
+    infinite = ~np.isfinite(v[np.where(out, 0, corners)]).all(axis=1) & ~out
+    bad = np.flatnonzero(out | infinite)
+    if bad.size:
+        if out[bad[0]]:
+            raise ValueError("a triangle refers to a vertex out of range")
         raise ValueError("a mesh vertex is not finite")
 
 
@@ -61,9 +65,7 @@ def mesh_set(meshes: Any) -> object:
 
 
 def _set_of(obj: object) -> MeshSet:
-    if not isinstance(obj, MeshSet):
-        raise TypeError("expected a mesh set (from mesh_set())")
-    return obj
+    return table(obj, MeshSet, "a mesh set (from mesh_set())")
 
 
 def _eps(eps: float) -> None:
@@ -71,26 +73,13 @@ def _eps(eps: float) -> None:
         raise ValueError("eps must be finite and >= 1e-9")
 
 
-def _int_array(obj: object, what: str) -> np.ndarray[Any, Any]:
-    a = np.asarray(obj)
-    if not np.can_cast(a.dtype, np.int64, "safe"):
-        raise TypeError(f"apart: cannot read {what} of {a.dtype} as int64")
-    if a.ndim != 1:
-        raise ValueError(f"apart: {what} must have 1 dimension")
-    return a.astype(np.int64)
-
-
 def apart(meshes: object, poses: Any, rows: Any, pairs: Any, g1: Any, g2: Any, eps: float) -> Any:
+    eps = real(eps)
     s = _set_of(meshes)
-    eps = float(eps)
     _eps(eps)
-    p = np.asarray(poses)
-    if not np.can_cast(p.dtype, np.float64, "safe"):
-        raise TypeError(f"apart: cannot read poses of {p.dtype} as float64")
-    if p.ndim != 4:
-        raise ValueError("apart: poses must have 4 dimensions")
-    r, k = _int_array(rows, "rows"), _int_array(pairs, "pairs")
-    a, b = _int_array(g1, "g1"), _int_array(g2, "g2")
+    p = from_any(poses, np.float64, 4, 4)
+    r, k = from_any(rows, np.int64, 1, 1), from_any(pairs, np.int64, 1, 1)
+    a, b = from_any(g1, np.int64, 1, 1), from_any(g2, np.int64, 1, 1)
     n, ng = p.shape[0], p.shape[1]
     if ng != s.n or p.shape[2:] != (4, 4) or len(k) != len(r) or len(b) != len(a):
         raise ValueError("apart: arrays of the wrong shape")
@@ -121,21 +110,22 @@ def _poses(obj: object, s: MeshSet, who: str) -> np.ndarray[Any, Any]:
 
 
 def apart_one(meshes: object, poses: Any, row: int, i: int, j: int, eps: float) -> int:
+    row, i, j, eps = index(row), index(i), index(j), real(eps)
     s = _set_of(meshes)
     p = _poses(poses, s, "apart_one")
     if not (0 <= row < p.shape[0] and 0 <= i < s.n and 0 <= j < s.n):
         raise ValueError("apart_one: a candidate is out of range")
-    _eps(float(eps))
+    _eps(eps)
     return 0
 
 
 def on_surface(meshes: object, poses: Any, row: int, g: int, point: Any, tol: float) -> bool:
+    row, g, tol = index(row), index(g), real(tol)
     s = _set_of(meshes)
     p = _poses(poses, s, "on_surface")
     x = _borrowable(point, "on_surface", "point")
     if x.size != 3:
         raise ValueError("on_surface: point of the wrong shape (3 values)")
-    tol = float(tol)
     if not (0 <= row < p.shape[0] and 0 <= g < s.n and tol >= 0.0 and math.isfinite(tol)):
         raise ValueError("on_surface: row, geometry or tolerance out of range")
     return False  # not found: the checker asks coal for the meshes' own distance

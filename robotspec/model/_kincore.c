@@ -208,6 +208,23 @@ static inline void identity(double *m) {
     m[0] = m[5] = m[10] = m[15] = 1.0;
 }
 
+/* The table in a capsule made by this module's constructor, else NULL with a TypeError naming it
+ * (PyCapsule_GetPointer's own error is a ValueError about capsules, which the caller never made;
+ * the numpy fallback raises this same TypeError for anything but its own tables). */
+static void *table(PyObject *cap, const char *name, const char *what) {
+    if (!PyCapsule_IsValid(cap, name)) {
+        PyErr_Format(PyExc_TypeError, "expected %s", what);
+        return NULL;
+    }
+    return PyCapsule_GetPointer(cap, name);
+}
+
+#define TREE_OF(cap) ((const Tree *)table((cap), "robotspec.tree", "a tree program (from tree())"))
+#define CHAIN_OF(cap) \
+    ((const Chain *)table((cap), "robotspec.chain", "a chain program (from chain())"))
+#define GEOMS_OF(cap) \
+    ((const Geoms *)table((cap), "robotspec.geoms", "a geometry table (from geoms())"))
+
 /* ------------------------------------------------------------------------------- the tree */
 
 /*
@@ -345,7 +362,7 @@ static void tree_run(const Tree *t, const double *q, double *out, double *scratc
 static PyObject *py_fk(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj;
     if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
-    const Tree *t = PyCapsule_GetPointer(cap, "robotspec.tree");
+    const Tree *t = TREE_OF(cap);
     if (t == NULL) return NULL;
     PyArrayObject *q = as_config(qobj, 1, t->n_dof);
     if (q == NULL) return NULL;
@@ -436,7 +453,7 @@ static PyObject *py_fk_batch(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj, *oobj = Py_None;
     int stream = 0;
     if (!PyArg_ParseTuple(args, "OO|Op", &cap, &qobj, &oobj, &stream)) return NULL;
-    const Tree *t = PyCapsule_GetPointer(cap, "robotspec.tree");
+    const Tree *t = TREE_OF(cap);
     if (t == NULL) return NULL;
     PyArrayObject *q = as_config(qobj, 2, t->n_dof);
     if (q == NULL) return NULL;
@@ -483,7 +500,7 @@ static PyObject *py_fk_batch(PyObject *self, PyObject *args) {
 static PyObject *py_tree_size(PyObject *self, PyObject *args) {
     PyObject *cap;
     if (!PyArg_ParseTuple(args, "O", &cap)) return NULL;
-    const Tree *t = PyCapsule_GetPointer(cap, "robotspec.tree");
+    const Tree *t = TREE_OF(cap);
     if (t == NULL) return NULL;
     return Py_BuildValue("nn", t->n_out, t->n_dof);
 }
@@ -570,7 +587,7 @@ static void chain_run(const Chain *c, const double *qv, double *o) {
 static PyObject *py_chain_fk(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj;
     if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
-    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
+    const Chain *c = CHAIN_OF(cap);
     if (c == NULL) return NULL;
     PyArrayObject *q = as_config(qobj, 1, c->n_dof);
     if (q == NULL) return NULL;
@@ -584,7 +601,7 @@ static PyObject *py_chain_fk(PyObject *self, PyObject *args) {
 static PyObject *py_chain_fk_batch(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj;
     if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
-    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
+    const Chain *c = CHAIN_OF(cap);
     if (c == NULL) return NULL;
     PyArrayObject *q = as_config(qobj, 2, c->n_dof);
     if (q == NULL) return NULL;
@@ -605,7 +622,7 @@ static PyObject *py_chain_fk_batch(PyObject *self, PyObject *args) {
 static PyObject *py_chain_jacobian(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj;
     if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
-    const Chain *c = PyCapsule_GetPointer(cap, "robotspec.chain");
+    const Chain *c = CHAIN_OF(cap);
     if (c == NULL) return NULL;
     PyArrayObject *q = as_config(qobj, 1, c->n_dof);
     if (q == NULL) return NULL;
@@ -691,8 +708,10 @@ static PyObject *py_geoms(PyObject *self, PyObject *args) {
     Py_ssize_t n_body;
     if (!PyArg_ParseTuple(args, "OOOOOOn", &body, &btg, &center, &half, &g1, &g2, &n_body))
         return NULL;
-    Py_ssize_t ng = PyObject_Length(body), np_ = PyObject_Length(g1);
-    if (ng < 0 || np_ < 0) return NULL;
+    Py_ssize_t ng = PyObject_Length(body);
+    if (ng < 0) return NULL;
+    Py_ssize_t np_ = PyObject_Length(g1); /* not called with body's error set */
+    if (np_ < 0) return NULL;
     Geoms *g = calloc(1, sizeof(Geoms));
     if (g == NULL) return PyErr_NoMemory();
     g->n_geom = ng;
@@ -766,7 +785,7 @@ static PyObject *py_broad(PyObject *self, PyObject *args) {
     PyObject *cap, *pobj, *mobj;
     double margin;
     if (!PyArg_ParseTuple(args, "OOdO", &cap, &pobj, &margin, &mobj)) return NULL;
-    const Geoms *g = PyCapsule_GetPointer(cap, "robotspec.geoms");
+    const Geoms *g = GEOMS_OF(cap);
     if (g == NULL) return NULL;
     PyArrayObject *poses = (PyArrayObject *)PyArray_FROMANY(pobj, NPY_DOUBLE, 3, 4,
                                                             NPY_ARRAY_IN_ARRAY);

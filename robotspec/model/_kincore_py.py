@@ -4,7 +4,12 @@ Why a second implementation: the C core is an accelerator, not a requirement. A 
 install could not compile it (no compiler, an unusual platform) or who turns it off
 (``ROBOTSPEC_NO_ACCEL=1``) still gets every answer, the same to floating-point rounding, only
 slower (see benchmarks/bench_fallback.py). The entry points, their arguments and their errors
-are the C core's (see ``_kincore.pyi``); :mod:`robotspec.model.kincore` chooses between the two.
+are the C core's (see ``_kincore.pyi``): each argument is read as the C core reads it
+(:mod:`robotspec.model._core_args`), in the C core's order, so a mistake raises the same
+exception with the same message whichever core runs. :mod:`robotspec.model.kincore` chooses.
+
+One configuration and a batch run the same code (a batch of one): ``fk(q)`` and
+``fk_batch(Q)[i]`` agree bit for bit, as in the C core, where both run one loop per sample.
 
 How it stays vectorised: a tree program's rows are grouped by depth (a row's parent slot is
 written by a shallower row), so one numpy call per depth moves every body of that depth, for
@@ -20,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from robotspec.arrays import F64, I64
+from robotspec.model._core_args import from_any, index, real, table, truth
 
 KIND_FIXED = 0
 KIND_REVOLUTE = 1
@@ -30,41 +36,25 @@ _CHUNK = 256
 
 
 # ----------------------------------------------------------------------------------- helpers
-def as_array(obj: object, dtype: type[np.generic], what: str) -> np.ndarray[Any, Any]:
-    """``obj`` as a native-order array of ``dtype``; TypeError when it cannot safely be one.
-
-    Python numbers are converted as the C core's ``PyArray_FROMANY`` converts them; an array
-    is cast only when no value can change (not float to int, not complex to float).
-    """
-    if not isinstance(obj, np.ndarray):
-        return np.asarray(obj, dtype=dtype)
-    a = obj
-    if a.dtype != dtype:
-        if not np.can_cast(a.dtype, dtype, "safe"):
-            raise TypeError(f"{what}: cannot read {a.dtype} as {np.dtype(dtype)}")
-        a = a.astype(dtype)
-    return a
+def _copy_i64(obj: object, want: int, what: str) -> I64:
+    """The C core's ``copy_i64``: exactly one dimension, ``want`` int64 values."""
+    return _sized(from_any(obj, np.int64, 1, 1), want, what)
 
 
-def _sized(obj: object, dtype: type[np.generic], want: int, what: str) -> np.ndarray[Any, Any]:
-    a = as_array(obj, dtype, what)
+def _copy_f64(obj: object, want: int, what: str) -> F64:
+    """The C core's ``copy_f64``: any shape holding ``want`` float64 values."""
+    return _sized(from_any(obj, np.float64), want, what)
+
+
+def _sized(a: np.ndarray[Any, Any], want: int, what: str) -> np.ndarray[Any, Any]:
     if a.size != want:
         raise ValueError(f"{what}: expected {want} values, got {a.size}")
     return a.reshape(-1).copy()
 
 
-def _count(value: object, what: str) -> int:
-    """A count argument (the C core's ``n``): an integer."""
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise TypeError(f"{what} must be an integer, got {type(value).__name__}")
-    return int(value)
-
-
 def _config(obj: object, ndim: int, width: int) -> F64:
-    """A configuration (ndim 1) or batch (ndim 2) of ``width`` finite values, as float64."""
-    a = as_array(obj, np.float64, "configuration")
-    if a.ndim != ndim:
-        raise ValueError(f"configuration must have {ndim} dimension(s), got {a.ndim}")
+    """The C core's ``as_config``: a configuration (ndim 1) or batch (ndim 2) of finite values."""
+    a = from_any(obj, np.float64, ndim, ndim)
     if a.shape[-1] != width:
         raise ValueError("configuration has the wrong number of values")
     if not np.isfinite(a).all():
@@ -155,23 +145,19 @@ def tree(
     n_out: int,
     n_dof: int,
 ) -> object:
-    n_slots = _count(n_slots, "n_slots")
-    n_out = _count(n_out, "n_out")
-    n_dof = _count(n_dof, "n_dof")
-    n = len(parent)
-    p = _sized(parent, np.int64, n, "parent")
-    c = _sized(child, np.int64, n, "child")
-    k = _sized(kind, np.int64, n, "kind")
-    d = _sized(dof, np.int64, n, "dof")
-    o = _sized(origin, np.float64, 16 * n, "origin").reshape(n, 4, 4)
-    a = _sized(axis, np.float64, 3 * n, "axis").reshape(n, 3)
-    m = _sized(mul, np.float64, n, "mul")
-    f = _sized(off, np.float64, n, "off")
+    # In the C core's order: the counts (parsed first), the rows' number, the arrays, each row.
+    n_slots, n_out, n_dof = index(n_slots), index(n_out), index(n_dof)
+    n = len(parent)  # TypeError as PyObject_Length raises
     if not 1 <= n_out <= n_slots or n_slots > n_out + n or n_dof < 0:
         raise ValueError("tree program: slot or DOF counts out of range")
-    depth = np.full(n_slots, -1, dtype=np.int64)
-    depth[0] = 0
-    row_depth = np.zeros(n, dtype=np.int64)
+    p = _copy_i64(parent, n, "parent")
+    c = _copy_i64(child, n, "child")
+    k = _copy_i64(kind, n, "kind")
+    d = _copy_i64(dof, n, "dof")
+    o = _copy_f64(origin, 16 * n, "origin").reshape(n, 4, 4)
+    a = _copy_f64(axis, 3 * n, "axis").reshape(n, 3)
+    m = _copy_f64(mul, n, "mul")
+    f = _copy_f64(off, n, "off")
     for r in range(n):
         pr, ch = int(p[r]), int(c[r])
         if (
@@ -181,13 +167,18 @@ def tree(
             or (k[r] != KIND_FIXED and not 0 <= d[r] < n_dof)
         ):
             raise ValueError("tree program refers to a slot or DOF out of range")
+        if not KIND_FIXED <= k[r] <= KIND_PRISMATIC:
+            raise ValueError("tree program has a motion kind out of range")
+    depth = np.full(n_slots, -1, dtype=np.int64)
+    depth[0] = 0
+    row_depth = np.zeros(n, dtype=np.int64)
+    for r in range(n):
+        pr, ch = int(p[r]), int(c[r])
         if depth[pr] < 0:
             raise ValueError("tree program reads a slot before a row writes it")
         depth[ch] = row_depth[r] = depth[pr] + 1
     if (depth[1:n_out] < 0).any():
         raise ValueError("tree program leaves a body's pose unset")
-    if k.size and (k.min() < KIND_FIXED or k.max() > KIND_PRISMATIC):
-        raise ValueError("tree program has a motion kind out of range")
     reads = np.where(k == KIND_FIXED, n_dof, d)  # a fixed row's DOF is never read, nor checked
     order = np.argsort(row_depth, kind="stable")
     ends = np.searchsorted(row_depth[order], np.arange(1, int(row_depth.max(initial=0)) + 2))
@@ -209,9 +200,7 @@ def tree(
 
 
 def _tree_of(obj: object) -> Tree:
-    if not isinstance(obj, Tree):
-        raise TypeError("expected a tree program (from tree())")
-    return obj
+    return table(obj, Tree, "a tree program (from tree())")
 
 
 def tree_size(tree: object) -> tuple[int, int]:
@@ -243,20 +232,17 @@ def _values(t: Tree, q: F64) -> F64:
 def fk(tree: object, q: object) -> F64:
     t = _tree_of(tree)
     qa = _config(q, 1, t.n_dof)
-    # One sample: a 4x4 product per row and depth (np.matmul) costs fewer numpy calls than
-    # _compose's whole-array steps, which pay off on batches; the two agree to rounding.
-    slots = np.empty((t.n_slots, 4, 4))
-    slots[0] = np.eye(4)
-    row = np.matmul(t.origin, _full(_motions(t.kind, t.axis, _values(t, qa[None, :])[0])))
-    for lo, hi in t.levels:
-        slots[t.child[lo:hi]] = np.matmul(slots[t.parent[lo:hi]], row[lo:hi])
-    pose: F64 = slots[: t.n_out]
-    pose[:, 3] = (0.0, 0.0, 0.0, 1.0)
+    # A batch of one, by the batch's own operations: np.matmul (BLAS, whose sums may fuse or
+    # reorder) would differ from fk_batch in the last bit.
+    poses: F64 = np.empty((1, t.n_out, 4, 4))
+    _run_tree(t, qa[None, :], poses)
+    pose: F64 = poses[0]
     return pose
 
 
 def fk_batch(tree: object, q: object, out: Any = None, stream: bool = False) -> F64:
     """Every pose of a batch; ``stream`` is the C core's choice of stores, meaningless here."""
+    truth(stream)  # read as the C core reads it (an array of several values is an error)
     t = _tree_of(tree)
     qa = _config(q, 2, t.n_dof)
     n = qa.shape[0]
@@ -320,23 +306,22 @@ def chain(
     n_cols: int,
     n_dof: int,
 ) -> object:
-    n_cols = _count(n_cols, "n_cols")
-    n_dof = _count(n_dof, "n_dof")
-    n = len(kind)
+    n_cols, n_dof = index(n_cols), index(n_dof)
+    n = len(kind)  # TypeError as PyObject_Length raises
+    if n_cols < 0 or n_dof < 0:
+        raise ValueError("chain program: column or DOF count out of range")
     c = Chain(
         n_cols,
         n_dof,
-        _sized(pre, np.float64, 16 * n, "pre").reshape(n, 4, 4),
-        _sized(post, np.float64, 16, "post").reshape(4, 4),
-        _sized(kind, np.int64, n, "kind"),
-        _sized(axis, np.float64, 3 * n, "axis").reshape(n, 3),
-        _sized(dof, np.int64, n, "dof"),
-        _sized(mul, np.float64, n, "mul"),
-        _sized(off, np.float64, n, "off"),
-        _sized(col, np.int64, n, "col"),
+        _copy_f64(pre, 16 * n, "pre").reshape(n, 4, 4),
+        _copy_f64(post, 16, "post").reshape(4, 4),
+        _copy_i64(kind, n, "kind"),
+        _copy_f64(axis, 3 * n, "axis").reshape(n, 3),
+        _copy_i64(dof, n, "dof"),
+        _copy_f64(mul, n, "mul"),
+        _copy_f64(off, n, "off"),
+        _copy_i64(col, n, "col"),
     )
-    if n_cols < 0 or n_dof < 0:
-        raise ValueError("chain program: column or DOF count out of range")
     bad = (
         (c.dof < 0)
         | (c.dof >= n_dof)
@@ -350,9 +335,7 @@ def chain(
 
 
 def _chain_of(obj: object) -> Chain:
-    if not isinstance(obj, Chain):
-        raise TypeError("expected a chain program (from chain())")
-    return obj
+    return table(obj, Chain, "a chain program (from chain())")
 
 
 def _chain_run(c: Chain, q: F64) -> F64:
@@ -368,12 +351,7 @@ def _chain_run(c: Chain, q: F64) -> F64:
 def chain_fk(chain: object, q: object) -> F64:
     c = _chain_of(chain)
     qa = _config(q, 1, c.n_dof)
-    steps = np.matmul(c.pre, _full(_motions(c.kind, c.axis, qa[c.dof] * c.mul + c.off)))
-    tip = np.eye(4)
-    for step in steps:  # one 4x4 product per motion: fewer numpy calls than _compose's
-        tip = tip @ step
-    pose: F64 = tip @ c.post
-    pose[3] = (0.0, 0.0, 0.0, 1.0)
+    pose: F64 = _chain_run(c, qa[None, :])[0]  # a batch of one: chain_fk_batch's bits
     return pose
 
 
@@ -428,16 +406,16 @@ class Geoms:
 def geoms(
     body: Any, body_to_geom: Any, center: Any, half: Any, g1: Any, g2: Any, n_body: int
 ) -> object:
-    n_body = _count(n_body, "n_body")
+    n_body = index(n_body)
     ng, npair = len(body), len(g1)
     g = Geoms(
         n_body,
-        _sized(body, np.int64, ng, "body"),
-        _sized(body_to_geom, np.float64, 16 * ng, "body_T_geom").reshape(ng, 4, 4),
-        _sized(center, np.float64, 3 * ng, "center").reshape(ng, 3),
-        _sized(half, np.float64, 3 * ng, "half").reshape(ng, 3),
-        _sized(g1, np.int64, npair, "g1"),
-        _sized(g2, np.int64, npair, "g2"),
+        _copy_i64(body, ng, "body"),
+        _copy_f64(body_to_geom, 16 * ng, "body_T_geom").reshape(ng, 4, 4),
+        _copy_f64(center, 3 * ng, "center").reshape(ng, 3),
+        _copy_f64(half, 3 * ng, "half").reshape(ng, 3),
+        _copy_i64(g1, npair, "g1"),
+        _copy_i64(g2, npair, "g2"),
     )
     if ((g.body < 0) | (g.body >= n_body)).any():
         raise ValueError("geometry on a body out of range")
@@ -476,22 +454,16 @@ def _obb_separated(fa: F64, ha: F64, fb: F64, hb: F64) -> np.ndarray[Any, np.dty
 
 
 def broad(geoms: object, body_poses: Any, margin: float, mask: Any) -> tuple[Any, Any, Any]:
-    if not isinstance(geoms, Geoms):
-        raise TypeError("expected a geometry table (from geoms())")
-    g = geoms
-    margin = float(margin)
-    bp = as_array(body_poses, np.float64, "body poses")
-    if bp.ndim not in (3, 4):
-        raise ValueError("body poses must have 3 or 4 dimensions")
+    margin = real(margin)
+    g = table(geoms, Geoms, "a geometry table (from geoms())")
+    bp = from_any(body_poses, np.float64, 3, 4)
     if bp.ndim == 3:
         bp = bp[None]
     if bp.shape[1:] != (g.n_body, 4, 4):
         raise ValueError("body poses have the wrong shape")
     keep = np.ones(len(g.g1), dtype=np.bool_)
     if mask is not None:
-        m = as_array(mask, np.uint8, "pair mask")
-        if m.ndim != 1:
-            raise ValueError("pair mask must have 1 dimension")
+        m = from_any(mask, np.uint8, 1, 1)
         if m.size != len(g.g1):
             raise ValueError("pair mask has the wrong size")
         keep = m != 0

@@ -60,11 +60,13 @@ def fk_batch(tree: object, q: object, threads: int = 1, out: Any = None) -> F64:
     if threads <= 1:
         poses: F64 = c.fk_batch(tree, q, out, out is not None)
         return poses
-    from robotspec.model._kincore_py import as_array, check_out
+    from robotspec.model._core_args import from_any
+    from robotspec.model._kincore_py import check_out
 
     n_out, n_dof = c.tree_size(tree)
-    # Converted once here (native, contiguous float64), not once per slice by the core.
-    arr = np.ascontiguousarray(as_array(q, np.float64, "configuration"))
+    # Converted once here (native, contiguous float64), not once per slice by the core; read
+    # and checked as the core reads and checks it, so the errors are the core's.
+    arr = np.ascontiguousarray(from_any(q, np.float64, 2, 2))
     if arr.shape[1] != n_dof:
         raise ValueError("configuration has the wrong number of values")
     if not np.isfinite(arr).all():

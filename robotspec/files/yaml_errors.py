@@ -177,7 +177,8 @@ def _character_error(text: str, index: int, file: str) -> RobotSpecError:
 def _worded(context: str | None, problem: str, text: str, index: int) -> str:
     for where, pattern, wording in _WORDING:
         if (where is None or where == context) and pattern.search(problem):
-            return wording.format(found=_found(text, index), char=_char(text, index))
+            found = _found(text, index) if "{found}" in wording else ""
+            return wording.replace("{found}", found).replace("{char}", _char(text, index))
     return problem
 
 
@@ -192,6 +193,8 @@ def _char(text: str, index: int) -> str:
     ch = text[index]
     if ch.isprintable() and ch not in "'\\":
         return f"'{ch}'"
+    if ch in "\t\n\r":
+        return repr(ch)
     return f"'\\x{ord(ch):02x}'" if ord(ch) < 0x100 else f"'\\u{ord(ch):04x}'"
 
 

@@ -23,7 +23,6 @@ the order of the steps and the waiting of blocking calls.
 from __future__ import annotations
 
 import heapq
-import math
 import threading
 from abc import ABC, abstractmethod
 from collections.abc import Callable
@@ -50,6 +49,7 @@ from robotspec.driver.handles import (
     TrajectoryGenerator,
     TrajectoryStatus,
 )
+from robotspec.driver.loop_timing import LoopStats
 from robotspec.driver.state import (
     CommandMode,
     RobotState,
@@ -63,6 +63,7 @@ __all__ = [
     "STREAM_STALE_SEQNOS",
     "Completion",
     "DriverLoop",
+    "LoopStats",
     "RobotJointCommand",
     "TrajectoryGenerator",
     "TrajectoryStatus",
@@ -128,16 +129,26 @@ class DriverLoop(CommandFill, ABC):
         Why public: with a simulated clock, tests and scripts drive the loop step by step.
         Missed deadlines are skipped, not caught up (as the reference does).
         """
-        self._clock.sleep_until(self._next_deadline)
+        timing = self._timing
+        self._clock.sleep_until(timing.next_deadline)
         t = self._clock.now()
-        self._next_deadline += self._update_period
-        if t > self._next_deadline:
-            missed = math.floor((t - self._next_deadline) / self._update_period) + 1
-            self._next_deadline += missed * self._update_period
+        timing.woke(t)
         now = t - self._epoch
         self._run_scheduled(now)
         self._run_timestep(now)
         return self._state
+
+    def loop_stats(self) -> LoopStats:
+        """Steps run, periods missed and the latest wake-up, by the loop's own clock.
+
+        Why: whether something (a client's upload, the machine's load) made the loop miss its
+        deadlines is counted where the deadlines are kept; benchmarks and tests read it here.
+        """
+        return self._timing.stats()
+
+    def reset_loop_stats_worst(self) -> None:
+        """Start a new window for :attr:`LoopStats.worst_late_s` (counts keep running)."""
+        self._timing.reset_worst()
 
     def run_for(self, seconds: float) -> RobotState:
         """Step the loop for ``seconds`` of (clock) time."""

@@ -36,6 +36,7 @@ from robotspec.driver.handles import (
     Completion,
     TrajectoryTask,
 )
+from robotspec.driver.loop_timing import LoopTiming
 from robotspec.driver.profiles import JogMotion, StreamLimiter
 from robotspec.driver.robot_info import (
     PayloadInfo,
@@ -179,7 +180,8 @@ class LoopState:
         self._sent_dt = update_period
         self._sent_last_step = False
         self._epoch = self._clock.now()
-        self._next_deadline = self._epoch
+        #: Deadlines, and the loop's own count of late wake-ups and missed periods.
+        self._timing = LoopTiming(update_period, self._epoch)
         self._thread: threading.Thread | None = None
         #: Callers blocked in :meth:`_wait_for` on the loop thread: (predicate, event).
         self._waiters: list[tuple[Callable[[], bool], threading.Event]] = []

@@ -62,7 +62,7 @@ from robotspec.driver.state import (
     OperationalMode,
     RobotState,
 )
-from robotspec.driver.trajectory import JointTrajectory, load_trajectory
+from robotspec.driver.trajectory import JointTrajectory, TrajectoryColumns, load_trajectory
 from robotspec.errors import DriverError
 from robotspec.model.rotations import quat_wxyz_to_matrix
 
@@ -415,13 +415,20 @@ class RobotDriver(DriverLoop):
 
     # ------------------------------------------------------------------ trajectories
 
-    def execute_trajectory(self, trajectory: JointTrajectory) -> TrajectoryGenerator:
+    def execute_trajectory(
+        self, trajectory: JointTrajectory | TrajectoryColumns
+    ) -> TrajectoryGenerator:
         """Check and queue a trajectory; drive it by calling ``Next()`` on the generator.
 
-        The waypoint checks and the interpolation setup run *outside* the loop's lock (they only
-        read the immutable limits and the speed ratio, sampled once): a client uploading 50,000
-        waypoints must not make the loop miss its periods. Only the start-point and mode checks
-        and the queueing take the lock.
+        Everything proportional to the trajectory runs on the caller's thread (the service
+        thread that received the upload), outside the loop's lock: decoding into arrays, the
+        waypoint checks and the plan (interpolation and any stretch) only read the immutable
+        limits and the speed ratio, sampled once. The finished plan reaches the loop at a
+        period boundary in one O(1) hand-over: the start-point and mode checks and one
+        reference stored (active task or queue) under the lock the loop holds for each whole
+        step. The loop then samples it in O(1) per step (O(log n) when it enters a new
+        segment) and publishes scalars of it, never a copy. So a client uploading 50,000
+        waypoints does not make the loop miss its periods.
         """
         ratio = self._speed_ratio
         interp = load_trajectory(trajectory, self._joint_names, self._limits, ratio)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import bisect
 import math
 import time
+from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -40,10 +41,14 @@ from robotspec.driver.errors import InvalidArgumentError
 from robotspec.driver.stretch import Stretch, time_scale
 
 __all__ = [
+    "CHUNK",
     "JointTrajectory",
+    "TrajectoryColumns",
     "TrajectoryInterpolator",
     "Waypoint",
+    "columns_of",
     "load_trajectory",
+    "pause",
     "MIN_WAYPOINTS",
     "MAX_WAYPOINT_GAP",
 ]
@@ -58,18 +63,20 @@ _TIME_EPS = 1e-9
 CHUNK = 256
 
 
-def _yield() -> None:
+def pause() -> None:
     """Let another thread (the loop) take the interpreter now, if it is waiting."""
     time.sleep(0)
 
 
-def _to_lists(a: F64) -> list[Any]:
-    """``a.tolist()`` in chunks (see :data:`CHUNK`)."""
-    out: list[Any] = []
-    for start in range(0, a.shape[0], CHUNK):
-        out.extend(a[start : start + CHUNK].tolist())
-        _yield()
-    return out
+def _floats(a: F64) -> array[float]:
+    """``a`` (1-D) as a Python ``array('d')``: plain floats for the loop's per-step lookups.
+
+    Why not a list: a list of 50,000 floats is 50,000 objects, made in chunks on the uploading
+    thread and freed one by one wherever the last reference goes, the loop thread included
+    (a trajectory that completes there). An ``array('d')`` is one buffer, copied in and freed
+    at once, and indexing it still gives plain floats (bisect and the Hermite sums need them).
+    """
+    return array("d", np.ascontiguousarray(a, dtype=np.float64).tobytes())
 
 
 def _rows(rows: Sequence[Sequence[float]], n: int) -> F64:
@@ -78,7 +85,7 @@ def _rows(rows: Sequence[Sequence[float]], n: int) -> F64:
     out = np.empty((m, n))
     for start in range(0, m, CHUNK):
         out[start : start + CHUNK] = np.array(rows[start : start + CHUNK], dtype=np.float64)
-        _yield()
+        pause()
     return out
 
 
@@ -157,7 +164,7 @@ class TrajectoryInterpolator:
         self.n_waypoints = int(times.shape[0])
         h = np.diff(times)
         delta = np.diff(positions, axis=0) / h[:, None]
-        _yield()  # a large trajectory: let the loop thread in between whole-array steps
+        pause()  # a large trajectory: let the loop thread in between whole-array steps
         d = np.zeros_like(positions)
         if positions.shape[0] > 2:
             h0 = h[:-1, None]
@@ -166,10 +173,10 @@ class TrajectoryInterpolator:
             w2 = h1 + 2.0 * h0
             d0, d1 = delta[:-1], delta[1:]
             same = d0 * d1 > 0.0
-            _yield()
+            pause()
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 hm = (w1 + w2) / (w1 / d0 + w2 / d1)
-            _yield()
+            pause()
             d[1:-1] = np.where(same & np.isfinite(hm), hm, 0.0)
         if velocities is not None:
             given = ~np.isnan(velocities[:, 0])
@@ -182,8 +189,8 @@ class TrajectoryInterpolator:
         #: Per waypoint, its velocity over the planned one (None when nothing was stretched).
         self.speed_scale: F64 | None = None
         if limits is not None:
-            _yield()
-            timing = time_scale(times, positions, d, limits, pause=_yield)
+            pause()
+            timing = time_scale(times, positions, d, limits, pause=pause)
             times, d = timing.times, timing.velocities
             self.stretch = timing.stretch
             self.segment_stretch = timing.segment_stretch
@@ -195,12 +202,12 @@ class TrajectoryInterpolator:
         #: The curve's velocity at each waypoint, ``(m, n)`` (given ones scaled by any stretch).
         self.velocities = d
         self._h = h
-        self._stretch_l: list[float] = (
-            [] if self.segment_stretch is None else _to_lists(self.segment_stretch)
+        self._stretch_l: array[float] = (
+            array("d") if self.segment_stretch is None else _floats(self.segment_stretch)
         )
         # Plain-float copies for evaluate(), which the loop calls every step.
-        self._times_l: list[float] = _to_lists(times)
-        self._h_l: list[float] = _to_lists(h)
+        self._times_l: array[float] = _floats(times)
+        self._h_l: array[float] = _floats(h)
         # Rows as plain floats only for the segment being sampled: converting all 50,000 rows
         # up front made 100,000 small lists, and the garbage collector's pass over them froze
         # the loop thread for 170 ms.
@@ -223,7 +230,12 @@ class TrajectoryInterpolator:
             return self.positions[-1].copy(), self.n_waypoints - 1
         if t <= 0.0:
             return self.positions[0].copy(), 0
-        k = bisect.bisect_right(self._times_l, t) - 1
+        k = self._segment
+        times = self._times_l
+        if not (0 <= k and times[k] <= t < times[k + 1]):
+            # Not the segment of the last step (a step in a new segment, or the first):
+            # O(log n) by bisection; within a segment, O(1).
+            k = bisect.bisect_right(times, t) - 1
         h = self._h_l[k]
         s = (t - self._times_l[k]) / h
         s2 = s * s
@@ -247,8 +259,98 @@ class TrajectoryInterpolator:
         return np.array(out), k
 
 
+@dataclass(frozen=True)
+class TrajectoryColumns:
+    """A trajectory as arrays, one row per waypoint: what the checks and the planner read.
+
+    Why arrays: a client's trajectory of 50,000 waypoints as Python objects (a waypoint, its
+    tuples, their floats) is hundreds of thousands of objects to make, check and collect, all
+    holding the interpreter the driver loop needs every period. A front end that receives
+    waypoints (the Robot Raconteur service) fills these arrays directly; the in-process
+    :class:`JointTrajectory` is converted by :func:`columns_of`.
+
+    Attributes:
+        joint_names: as given (empty: the robot's order).
+        times: each waypoint's ``time_from_start`` as given, ``(m,)``.
+        positions: ``(m, n)``; rows of the wrong length are NaN (``lengths`` says so).
+        lengths: each waypoint's ``joint_position`` length, ``(m,)``.
+        option_sizes: lengths of ``joint_velocity``, ``position_tolerance`` and
+            ``velocity_tolerance``, ``(m, 3)``.
+        velocities: ``(m, n)``, NaN rows where a waypoint gave none (or not ``n`` of them);
+            None when no waypoint gave any.
+    """
+
+    joint_names: tuple[str, ...]
+    times: F64
+    positions: F64
+    lengths: npt.NDArray[np.intp]
+    option_sizes: npt.NDArray[np.intp]
+    velocities: F64 | None = None
+
+    @classmethod
+    def empty(cls, m: int, n: int, joint_names: Sequence[str] = ()) -> TrajectoryColumns:
+        """Columns for ``m`` waypoints of ``n`` joints, to be filled row by row."""
+        return cls(
+            tuple(joint_names),
+            np.zeros(m),
+            np.full((m, n), np.nan),
+            np.zeros(m, dtype=np.intp),
+            np.zeros((m, 3), dtype=np.intp),
+            None,
+        )
+
+    @property
+    def size(self) -> int:
+        """The number of waypoints."""
+        return int(self.times.shape[0])
+
+
+def columns_of(traj: JointTrajectory, n: int) -> TrajectoryColumns:
+    """The waypoints of ``traj`` as :class:`TrajectoryColumns` for ``n`` joints.
+
+    Values are converted only when every array has a valid length, so a length error is
+    reported before a value error, in the reference's order.
+
+    Raises:
+        InvalidArgumentError: a value is not a number.
+    """
+    wps = traj.waypoints or ()
+    m = len(wps)
+    cols = TrajectoryColumns.empty(m, n, traj.joint_names)
+    rows: list[Sequence[float]] = []
+    vrows: list[Sequence[float]] = []
+    vidx: list[int] = []
+    try:
+        for start in range(0, m, CHUNK):
+            for i in range(start, min(m, start + CHUNK)):
+                w = wps[i]
+                jp, jv = w.joint_position, w.joint_velocity
+                cols.lengths[i] = len(jp)
+                sizes = (len(jv), len(w.position_tolerance), len(w.velocity_tolerance))
+                cols.option_sizes[i] = sizes
+                cols.times[i] = w.time_from_start
+                rows.append(jp)
+                if len(jv) == n:
+                    vrows.append(jv)
+                    vidx.append(i)
+            pause()
+        sizes_ok = (cols.option_sizes == 0) | (cols.option_sizes == n)
+        if not (np.all(cols.lengths == n) and np.all(sizes_ok)):
+            return cols  # _check_and_plan reports the first wrong length
+        cols.positions[:] = _rows(rows, n)
+        velocities = None
+        if vidx:
+            velocities = np.full((m, n), np.nan)
+            velocities[np.array(vidx)] = _rows(vrows, n)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidArgumentError("Waypoint values must be numbers") from None
+    return TrajectoryColumns(
+        cols.joint_names, cols.times, cols.positions, cols.lengths, cols.option_sizes, velocities
+    )
+
+
 def load_trajectory(
-    traj: JointTrajectory,
+    traj: JointTrajectory | TrajectoryColumns,
     joint_names: Sequence[str],
     limits: JointLimitArrays,
     speed_ratio: float,
@@ -257,6 +359,8 @@ def load_trajectory(
 
     The interpolator follows the waypoints' velocities (times ``speed_ratio``) and is slowed
     where it would exceed the velocity or acceleration limits (its ``stretch`` says how much).
+    Everything here is array work on the caller's thread, never under the loop's lock: the
+    loop receives the finished interpolator in one step (``execute_trajectory``).
 
     Raises:
         InvalidArgumentError: with the reference's message for the first failed check; or when
@@ -265,16 +369,28 @@ def load_trajectory(
     n = len(joint_names)
     if traj.joint_names and tuple(traj.joint_names) != tuple(joint_names):
         raise InvalidArgumentError("Joint names in trajectory must match robot joint names")
-    if traj.waypoints is None:
-        raise InvalidArgumentError("Waypoint list must not be null")
-    wps = traj.waypoints
-    if len(wps) < MIN_WAYPOINTS:
+    if isinstance(traj, JointTrajectory):
+        if traj.waypoints is None:
+            raise InvalidArgumentError("Waypoint list must not be null")
+        count = len(traj.waypoints)
+        first_time = traj.waypoints[0].time_from_start if count else 0.0
+    else:
+        count = traj.size
+        first_time = float(traj.times[0]) if count else 0.0
+    if count < MIN_WAYPOINTS:
         raise InvalidArgumentError(
-            f"Waypoint list must contain five or more waypoints (got {len(wps)})"
+            f"Waypoint list must contain five or more waypoints (got {count})"
         )
-    if wps[0].time_from_start != 0.0:
+    if first_time != 0.0:
         raise InvalidArgumentError("Trajectory time_from_start must equal zero for first waypoint")
-    m = len(wps)
+    cols = columns_of(traj, n) if isinstance(traj, JointTrajectory) else traj
+    return _check_and_plan(cols, n, limits, speed_ratio)
+
+
+def _check_and_plan(
+    cols: TrajectoryColumns, n: int, limits: JointLimitArrays, speed_ratio: float
+) -> TrajectoryInterpolator:
+    """The per-waypoint checks in the reference's order, then the interpolator."""
     # Vectorised checks (a 50,000-waypoint upload must not hold the interpreter for a second),
     # then the first failure in the reference's order: by waypoint, then by check.
     failures: list[tuple[int, int, str]] = []
@@ -285,48 +401,24 @@ def load_trajectory(
             i = int(hits[0])
             failures.append((i, rank, message.format(i=i)))
 
-    # One pass over the waypoint objects, in chunks that yield the interpreter to the loop.
-    lengths = np.empty(m, dtype=np.intp)
-    opt_sizes = np.empty((m, 3), dtype=np.intp)
-    raw = np.empty(m)
-    vel_finite = np.ones(m, dtype=bool)
-    wp_fast = np.zeros(m, dtype=bool)
-    rows: list[Sequence[float]] = []
-    given: list[tuple[int, list[float]]] = []
-    vmax = limits.velocity.tolist()
-    try:
-        for start in range(0, m, CHUNK):
-            for i in range(start, min(m, start + CHUNK)):
-                w = wps[i]
-                jp, jv = w.joint_position, w.joint_velocity
-                lengths[i] = len(jp)
-                opt_sizes[i] = (len(jv), len(w.position_tolerance), len(w.velocity_tolerance))
-                raw[i] = w.time_from_start
-                rows.append(jp)
-                if jv:
-                    vs = [float(v) for v in jv]
-                    vel_finite[i] = all(map(math.isfinite, vs))
-                    wp_fast[i] = len(vs) == n and any(
-                        abs(v * speed_ratio) > lim for v, lim in zip(vs, vmax, strict=True)
-                    )
-                    if len(vs) == n:
-                        given.append((i, vs))
-            _yield()
-    except (TypeError, ValueError, OverflowError):
-        raise InvalidArgumentError("Waypoint values must be numbers") from None
-    first(0, lengths != n, "Waypoint {i} invalid joint array length")
+    first(0, cols.lengths != n, "Waypoint {i} invalid joint array length")
     for rank, what in enumerate(("joint_velocity", "position_tolerance", "velocity_tolerance"), 1):
-        sizes = opt_sizes[:, rank - 1]
+        sizes = cols.option_sizes[:, rank - 1]
         first(rank, (sizes != 0) & (sizes != n), f"Waypoint {{i}} invalid {what} array length")
     if failures:
         raise InvalidArgumentError(min(failures)[2])
-    try:
-        pos = _rows(rows, n)
-    except (TypeError, ValueError, OverflowError):
-        raise InvalidArgumentError("Waypoint values must be numbers") from None
+    pos, raw = cols.positions, cols.times
+    given = cols.option_sizes[:, 0] == n
+    vel = cols.velocities
+    vel_finite = np.ones(raw.shape[0], dtype=bool)
+    wp_fast = np.zeros(raw.shape[0], dtype=bool)
+    if vel is not None and given.any():
+        with np.errstate(invalid="ignore", over="ignore"):
+            vel_finite = ~given | np.all(np.isfinite(vel), axis=1)
+            wp_fast = given & np.any(np.abs(vel * speed_ratio) > limits.velocity, axis=1)
     finite = np.all(np.isfinite(pos), axis=1) & np.isfinite(raw) & vel_finite
     first(4, ~finite, "Waypoint {i} contains NaN or infinite values")
-    _yield()  # each whole-array step below takes a millisecond or two: yield between them
+    pause()  # each whole-array step below takes a millisecond or two: yield between them
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         times = raw / speed_ratio
         dt = np.diff(times)
@@ -335,10 +427,10 @@ def load_trajectory(
         first(5, inc & finite, "Waypoint {i} time_from_start must be increasing")
         far = np.concatenate([[False], gap > MAX_WAYPOINT_GAP + _TIME_EPS])
         first(6, far & finite, "Waypoint {i} more than 100 ms from previous waypoint")
-        _yield()
+        pause()
         outside = np.any(pos < limits.lower, axis=1) | np.any(pos > limits.upper, axis=1)
         first(7, outside & finite, "Waypoint {i} exceeds joint limits")
-        _yield()
+        pause()
         fd = np.abs(np.diff(pos, axis=0)) / dt[:, None]
         fd_fast = np.concatenate([[False], np.any(fd > limits.velocity, axis=1)])
         first(8, (wp_fast | fd_fast) & finite, "Waypoint {i} exceeds joint velocity limits")
@@ -346,9 +438,8 @@ def load_trajectory(
         # A non-finite waypoint poisons its neighbours' differences: report it first.
         raise InvalidArgumentError(min(failures)[2])
     velocities = None
-    if given:
+    if vel is not None and given.any():
         # The client's velocities are on its time axis: on the driver's (÷ speed ratio) they
         # are faster by the ratio, as the velocity check above takes them.
-        velocities = np.full((m, n), np.nan)
-        velocities[[i for i, _ in given]] = np.array([v for _, v in given]) * speed_ratio
+        velocities = np.where(given[:, None], vel * speed_ratio, np.nan)
     return TrajectoryInterpolator(times, pos, velocities, limits)

@@ -35,7 +35,7 @@ from robotspec.driver.robot_info import (
     Vector3,
 )
 from robotspec.driver.state import RobotState
-from robotspec.driver.trajectory import JointTrajectory, Waypoint
+from robotspec.driver.trajectory import CHUNK, JointTrajectory, TrajectoryColumns, pause
 from robotspec.service.node import rr
 
 __all__ = [
@@ -44,6 +44,7 @@ __all__ = [
     "from_varvalue",
     "payload_from_rr",
     "pose_from_rr",
+    "release_waypoints",
     "robot_info_dict",
     "joint_command_from_rr",
     "to_varvalue",
@@ -91,34 +92,79 @@ def robot_info_dict(info: RobotInfo) -> tuple[dict[str, Any], list[str]]:
 # ---------------------------------------------------------------------------- client -> driver
 
 
-def _floats(values: Any, what: str) -> tuple[float, ...]:
-    try:
-        arr = np.asarray(values, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        raise InvalidArgumentError(f"{what} must be an array of numbers") from None
-    return tuple(float(x) for x in arr)
+def trajectory_from_rr(traj: Any, n: int) -> JointTrajectory | TrajectoryColumns:
+    """A ``JointTrajectory`` structure as the driver's columns for ``n`` joints.
 
-
-def trajectory_from_rr(traj: Any) -> JointTrajectory:
-    """A ``JointTrajectory`` structure as the driver's trajectory (null fields are refused)."""
+    Straight into arrays (:class:`~robotspec.driver.trajectory.TrajectoryColumns`), a chunk of
+    waypoints at a time, making no object per waypoint: a 35,000-waypoint upload used to become
+    35,000 ``Waypoint`` objects with their tuples and floats first, work that held the
+    interpreter the driver loop needs. The checks themselves are the driver's (the reference's
+    order and messages). A null waypoint list is handed on as such (the driver refuses it in
+    the reference's order); null fields are refused.
+    """
     if traj is None:
         raise InvalidArgumentError("Trajectory must not be null")
-    if traj.waypoints is None:
-        return JointTrajectory(joint_names=tuple(traj.joint_names or ()), waypoints=None)
-    wps = []
-    for i, w in enumerate(traj.waypoints):
-        if w is None:
-            raise InvalidArgumentError(f"Waypoint {i} must not be null")
-        wps.append(
-            Waypoint(
-                joint_position=_floats(w.joint_position, f"waypoint {i} joint_position"),
-                time_from_start=float(w.time_from_start),
-                joint_velocity=_floats(w.joint_velocity, f"waypoint {i} joint_velocity"),
-                position_tolerance=_floats(w.position_tolerance, f"waypoint {i} tolerance"),
-                velocity_tolerance=_floats(w.velocity_tolerance, f"waypoint {i} tolerance"),
+    names = tuple(traj.joint_names or ())
+    wps = traj.waypoints
+    if wps is None:
+        return JointTrajectory(joint_names=names, waypoints=None)
+    m = len(wps)
+    cols = TrajectoryColumns.empty(m, n, names)
+    velocities: Any = None
+    for start in range(0, m, CHUNK):
+        for i in range(start, min(m, start + CHUNK)):
+            w = wps[i]
+            if w is None:
+                raise InvalidArgumentError(f"Waypoint {i} must not be null")
+            jp = _array(w.joint_position, i, "joint_position")
+            jv = _array(w.joint_velocity, i, "joint_velocity")
+            cols.lengths[i] = jp.shape[0]
+            cols.option_sizes[i] = (
+                jv.shape[0],
+                _array(w.position_tolerance, i, "tolerance").shape[0],
+                _array(w.velocity_tolerance, i, "tolerance").shape[0],
             )
-        )
-    return JointTrajectory(joint_names=tuple(traj.joint_names or ()), waypoints=tuple(wps))
+            cols.times[i] = float(w.time_from_start)
+            if jp.shape[0] == n:
+                cols.positions[i] = jp
+            if jv.shape[0] == n:
+                if velocities is None:
+                    velocities = np.full((m, n), np.nan)
+                velocities[i] = jv
+        pause()
+    if velocities is None:
+        return cols
+    return TrajectoryColumns(
+        cols.joint_names, cols.times, cols.positions, cols.lengths, cols.option_sizes, velocities
+    )
+
+
+def release_waypoints(traj: Any) -> None:
+    """Empty a decoded ``JointTrajectory``'s waypoint list a chunk at a time.
+
+    Why: once converted, the decoded waypoints (one structure and four arrays each) are
+    garbage, and Robot Raconteur drops them all at once when the call returns: for 35,000
+    waypoints one deallocation cascade of 26 ms that holds the interpreter, two or more of the
+    loop's periods. Emptied here from the end, a chunk at a time with a pause between, no
+    single step holds it for more than a fraction of a millisecond. Harmless for the caller's
+    structure: Robot Raconteur's own copy is the message, already decoded.
+    """
+    wps = getattr(traj, "waypoints", None)
+    if not isinstance(wps, list):
+        return
+    while wps:
+        del wps[-CHUNK:]
+        pause()
+
+
+def _array(values: Any, i: int, what: str) -> Any:
+    """A waypoint's array as float64, 1-D (Robot Raconteur already decodes ``double[]`` so)."""
+    if isinstance(values, np.ndarray) and values.dtype == np.float64 and values.ndim == 1:
+        return values  # what Robot Raconteur hands over: no copy, no check
+    try:
+        return np.asarray(values if values is not None else (), dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(f"waypoint {i} {what} must be an array of numbers") from None
 
 
 def joint_command_from_rr(cmd: Any, unit_names: dict[int, str]) -> RobotJointCommand:

@@ -63,6 +63,10 @@ NODE_DIRECTORY_FIELDS = (
 MAX_STATE_DIR_CHARS = 107 - len("/run/socket/0123456789abcdef.sock")
 
 
+#: Set once the structure-class cache is installed (:func:`rr`).
+_types_cached: list[bool] = []
+
+
 def missing_packages() -> list[str]:
     """The optional packages the service needs that are not installed (empty when ready)."""
     need = {
@@ -84,7 +88,14 @@ def rr() -> Any:
             f"serving needs {' and '.join(missing)}; install them with "
             "pip install 'robotspec[robotraconteur]'"
         )
-    return importlib.import_module("RobotRaconteur")
+    module = importlib.import_module("RobotRaconteur")
+    if not _types_cached:
+        # One class per structure type, not one per decoded value (see rr_types).
+        from robotspec.service.rr_types import install
+
+        install(importlib.import_module("RobotRaconteur.RobotRaconteurPythonUtil"))
+        _types_cached.append(True)
+    return module
 
 
 def companion(module: str) -> Any:

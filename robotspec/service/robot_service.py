@@ -270,7 +270,11 @@ class RobotService:
     def execute_trajectory(self, trajectory: Any) -> TrajectoryGeneratorService:
         """Check and queue a trajectory; the client drives it with ``Next()``."""
         with rr_errors():
-            gen = self.driver.execute_trajectory(convert.trajectory_from_rr(trajectory))
+            try:
+                columns = convert.trajectory_from_rr(trajectory, len(self.driver.joint_names))
+            finally:
+                convert.release_waypoints(trajectory)
+            gen = self.driver.execute_trajectory(columns)
         return TrajectoryGeneratorService(self.run_async, self.node, gen)
 
     def home(self) -> HomingGeneratorService:

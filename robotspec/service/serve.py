@@ -8,7 +8,6 @@ shuts down cleanly.
 
 from __future__ import annotations
 
-import gc
 import signal
 import sys
 import threading
@@ -21,6 +20,7 @@ from types import FrameType
 from robotspec.driver.robot_driver import RobotDriver
 from robotspec.driver.robot_info import RobotInfo
 from robotspec.driver.rr_names import rr_name_problem, rr_name_suggestion
+from robotspec.service.realtime import prepare_process
 from robotspec.service.server import RobotServer, ServeOptions
 
 __all__ = ["serve_driver", "serve_option_problem"]
@@ -127,11 +127,10 @@ def serve_driver(
     with _stop_on_signals(stop, received):
         server = RobotServer(driver, info, options, fallback_name=fallback_name)
         with server:
-            # Everything loaded so far lives as long as the process: move it out of the cyclic
-            # collector's reach, so a full collection (tens of ms over all of pydantic, numpy
-            # and RR) does not stall the 250 Hz loop. This is the process's own CLI, so the
-            # global setting is ours to make.
-            gc.freeze()
+            # This is the process's own CLI, so the global settings are ours to make: what is
+            # loaded so far out of the collector's reach, and a switch interval that hands the
+            # interpreter to the loop within a fraction of its period (see service.realtime).
+            prepare_process(driver.update_period)
             exposure = (
                 "on every interface, discoverable"
                 if public

@@ -39,6 +39,7 @@ from robotspec.driver.state import (
 
 from .driver_support import RRP, robotinfo
 from .service_support import (
+    WAIT,
     Served,
     client_node,
     rr_exception,
@@ -147,7 +148,7 @@ def test_param_changed_event(rrp: Served) -> None:
 
     rrp.robot.param_changed += on_changed
     fault(rrp, "disabled", True)
-    assert got.wait(5.0)
+    assert got.wait(WAIT)
     assert seen == ["fault.disabled"]
     fault(rrp, "disabled", False)
 
@@ -254,7 +255,7 @@ def _async_next_twice(gen: Any) -> list[tuple[str, Any]]:
 
     gen.AsyncNext(None, handler)
     gen.AsyncNext(None, handler)
-    assert done.wait(15.0), results
+    assert done.wait(WAIT), results
     return results
 
 

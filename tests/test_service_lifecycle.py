@@ -35,7 +35,7 @@ from robotspec.driver.state import CommandMode
 from robotspec.service.server import RobotServer, ServeOptions
 
 from .driver_support import RRP
-from .service_support import client_node, short_tmp
+from .service_support import CHILD_WAIT, client_node, short_tmp
 
 __all__ = ["client_node", "short_tmp"]  # fixtures from service_support, used by the tests below
 
@@ -71,7 +71,7 @@ def served_child(short_tmp: Path) -> Iterator[tuple[subprocess.Popen[str], str, 
         assert proc.stderr is not None
         url = ""
         seen: list[str] = []
-        deadline = time.monotonic() + 20
+        deadline = time.monotonic() + CHILD_WAIT
         while not url and time.monotonic() < deadline:
             line = proc.stderr.readline()
             seen.append(line)
@@ -104,7 +104,7 @@ def test_signal_stops_the_server_cleanly(
     robot.command_mode = int(CommandMode.jog)
     assert any(f.endswith(".pid") for f in run_files(state))  # locks held while serving
     proc.send_signal(sig)
-    out, err = proc.communicate(timeout=20)
+    out, err = proc.communicate(timeout=CHILD_WAIT)
     assert proc.returncode == 0, err
     assert f"stopped by {said} after" in out
     assert "Traceback" not in err
@@ -178,7 +178,7 @@ def test_a_driver_stopped_with_a_client_connected_restarts_on_its_port_at_once(
     assert robot.robot_info.device_info.device.name == "rrp_test_arm"
     silent = socket.create_connection(("127.0.0.1", port), timeout=5)
     proc.send_signal(signal.SIGTERM)
-    out, err = proc.communicate(timeout=20)
+    out, err = proc.communicate(timeout=CHILD_WAIT)
     assert proc.returncode == 0, err
     assert "stopped by SIGTERM after" in out
     silent.close()  # the driver closed first: its side of this connection waits in TIME_WAIT
@@ -208,7 +208,7 @@ def test_a_driver_stopped_with_a_client_connected_restarts_on_its_port_at_once(
         ],
         capture_output=True,
         text=True,
-        timeout=60,
+        timeout=CHILD_WAIT,
     )
     assert again.returncode == 0, again.stderr
     assert "already in use" not in again.stderr

@@ -93,7 +93,7 @@ def test_velocity_stream_over_rr_brakes_before_the_limit(ur5e: Served) -> None:
             wire.OutValue = cmd
             return bool(driver.sim_position[0] >= lim.upper[0] - 1e-6)
 
-        wait_until(stream_and_check, timeout=10.0)
+        wait_until(stream_and_check)
         wait_until(lambda: stream_and_check() and abs(driver.sim_velocity[0]) < 1e-9)
     finally:
         wire.Close()

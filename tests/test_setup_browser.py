@@ -28,8 +28,17 @@ DOCS_IMAGES = Path(__file__).resolve().parents[1] / "docs" / "images"
 FLAGS = (
     "--headless --no-sandbox --disable-gpu --disable-background-networking "
     "--disable-component-update --disable-sync --no-first-run --use-angle=swiftshader "
-    "--enable-unsafe-swiftshader"
+    "--enable-unsafe-swiftshader "
+    # A tab in the background must keep up (the test checks the second tab last): by default
+    # Chromium lowers a background renderer's priority and throttles its timers, and on a busy
+    # machine such a tab then gets no CPU at all ("timed out waiting for the second tab";
+    # chromedriver itself timed out reading it, issue 31). Puppeteer passes the same flags.
+    "--disable-background-timer-throttling --disable-renderer-backgrounding "
+    "--disable-backgrounding-occluded-windows"
 ).split()
+#: How long any one thing on the page is waited for. It bounds a hang only: each takes well
+#: under 2 s on an idle machine, and many times that with every core busy (issue 31).
+HANG = 120.0
 #: Small, so software WebGL keeps up; the docs' screenshots are taken larger.
 WINDOW = "1400,900" if os.environ.get("ROBOTSPEC_DOC_SCREENSHOTS") == "1" else "1000,680"
 
@@ -60,7 +69,7 @@ def driver(tmp_path: Path) -> Iterator[Any]:
         d.quit()
 
 
-def _wait(what: str, cond: Callable[[], Any], timeout: float = 20.0) -> Any:
+def _wait(what: str, cond: Callable[[], Any], timeout: float = HANG) -> Any:
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         try:
@@ -96,12 +105,28 @@ def _robot_pixels(d: Any, pause: float = 0.0) -> tuple[int, int] | None:
     return left + int(xs[k]), int(0.15 * h) + int(ys[k])
 
 
+def _click(d: Any, what: str, find: Callable[[], Any]) -> None:
+    """Find an element, scroll to it and click it, again while the page redraws it.
+
+    Why again: React may replace the element between the find and the click (a stale
+    reference), the more likely the slower the machine; a failed click did not click.
+    """
+
+    def click() -> bool:
+        el = find()
+        if not el:
+            return False
+        d.execute_script("arguments[0].scrollIntoView({block: 'center'})", el)
+        el.click()
+        return True
+
+    _wait(what, click)
+
+
 def _click_text(d: Any, text: str, tag: str = "button") -> None:
     from selenium.webdriver.common.by import By
 
-    el = _wait(text, lambda: d.find_element(By.XPATH, f"//{tag}[normalize-space()='{text}']"))
-    d.execute_script("arguments[0].scrollIntoView({block: 'center'})", el)
-    el.click()
+    _click(d, text, lambda: d.find_element(By.XPATH, f"//{tag}[normalize-space()='{text}']"))
 
 
 def _click_tree(d: Any, link: str) -> None:
@@ -110,34 +135,26 @@ def _click_tree(d: Any, link: str) -> None:
 
     text = "normalize-space()"
     xpath = f"//button[substring({text}, string-length({text}) - {len(link) - 1}) = '{link}']"
-    el = _wait(link, lambda: d.find_element(By.XPATH, xpath))
-    d.execute_script("arguments[0].scrollIntoView({block: 'center'})", el)
-    el.click()
+    _click(d, link, lambda: d.find_element(By.XPATH, xpath))
 
 
 def _tab(d: Any, title: str) -> None:
     from selenium.webdriver.common.by import By
 
     xpath = f"//*[@role='tab' and @title='{title}']"
-    _wait(title, lambda: d.find_element(By.XPATH, xpath)).click()
+    _click(d, title, lambda: d.find_element(By.XPATH, xpath))
 
 
 def _choose(d: Any, handle: Any, option: str) -> None:
     """Pick ``option`` in a viser dropdown (a Mantine select whose input id is the handle's)."""
     from selenium.webdriver.common.by import By
 
-    box = _wait(
-        "dropdown", lambda: (e := d.find_element(By.ID, handle._impl.uuid)).is_displayed() and e
+    _click(
+        d, "dropdown", lambda: (e := d.find_element(By.ID, handle._impl.uuid)).is_displayed() and e
     )
-    d.execute_script("arguments[0].scrollIntoView({block: 'center'})", box)
-    box.click()
     xpath = f"//*[@role='option' and normalize-space()='{option}']"
-    item = _wait(
-        option, lambda: [e for e in d.find_elements(By.XPATH, xpath) if e.is_displayed()][0]
-    )
-    d.execute_script("arguments[0].scrollIntoView({block: 'center'})", item)
-    item.click()
-    _wait(f"{option} chosen", lambda: handle.value == option, 10)
+    _click(d, option, lambda: [e for e in d.find_elements(By.XPATH, xpath) if e.is_displayed()][0])
+    _wait(f"{option} chosen", lambda: handle.value == option)
 
 
 _SHOW_3D = "document.querySelectorAll('canvas').forEach(c => c.style.display = '')"
@@ -152,7 +169,7 @@ def _shot(d: Any, name: str) -> None:
             "return [...document.querySelectorAll('canvas')].some(c => c.style.display == 'none')"
         )
         d.execute_script(_SHOW_3D)
-        _wait("the robot drawn", lambda: _robot_pixels(d, pause=0.4), 60)
+        _wait("the robot drawn", lambda: _robot_pixels(d, pause=0.4))
         time.sleep(1.0)
         d.save_screenshot(str(DOCS_IMAGES / name))
         if hidden:
@@ -189,7 +206,7 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         d.get(page.url)
         second = d.current_window_handle
         d.switch_to.window(first)
-        centre = _wait("the robot drawn", lambda: _robot_pixels(d, pause=0.4), 60)
+        centre = _wait("the robot drawn", lambda: _robot_pixels(d, pause=0.4))
         first_picture = time.perf_counter() - started
         _shot(d, "setup-questions.png")
 
@@ -199,9 +216,9 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         size = body.size
         dx, dy = centre[0] - size["width"] // 2, centre[1] - size["height"] // 2
         ActionChains(d).move_to_element_with_offset(body, dx, dy).click().perform()
-        picked = _wait("a link picked by a click", lambda: page.selected, 10)
+        picked = _wait("a link picked by a click", lambda: page.selected)
         assert picked.startswith("link")
-        _wait("the pick shown", lambda: page._link.value == picked, 5)
+        _wait("the pick shown", lambda: page._link.value == picked)
         # Software WebGL redraws the scene without end; hidden, it leaves the CPU to the page.
         d.execute_script(
             "document.querySelectorAll('canvas').forEach(c => c.style.display = 'none')"
@@ -222,7 +239,7 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         _tab(d, "Parts")
         _choose(d, page._part, "chains.arm")
         _click_tree(d, "link_eef")  # a pick in the tree: the link list and the robot follow
-        _wait("the tree's pick", lambda: page.selected == page._link.value == "link_eef", 10)
+        _wait("the tree's pick", lambda: page.selected == page._link.value == "link_eef")
         t0 = time.perf_counter()
         _click_text(d, "tip = picked link")
         _wait("the error shown", lambda: "not below the chain's tip" in body.text)
@@ -254,8 +271,14 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         _shot(d, "setup-saved.png")
         # The second tab shows the one state: every answer, the pick, the save.
         d.switch_to.window(second)
-        other = d.find_element(By.TAG_NAME, "body")
-        _wait("the second tab", lambda: "0 open questions" in other.text and "saved" in other.text)
+        d.execute_cdp_cmd("Page.bringToFront", {})  # as a user looks at it
+        _wait(
+            "the second tab",
+            lambda: (
+                "0 open questions" in (t := d.find_element(By.TAG_NAME, "body").text)
+                and "saved" in t
+            ),
+        )
     except Exception:
         d.save_screenshot(str(tmp_path / "failure.png"))  # kept by pytest, to look at
         raise
@@ -273,4 +296,5 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         f"\nsetup timings: command to first picture {first_picture:.2f} s, "
         f"change to validation shown {change_to_shown:.2f} s"
     )
-    assert change_to_shown < 5.0
+    # No bound on these times here: on a busy machine they are many times what they are at rest
+    # (issue 31). benchmarks/bench_setup.py measures them at rest (the README's table).

@@ -573,10 +573,10 @@ def test_billion_laughs_is_refused_without_expansion() -> None:
         '<?xml version="1.0"?>\n<!DOCTYPE robot [\n<!ENTITY lol0 "lol">'
         f'{lols}\n]>\n<robot name="&lol9;"><group name="&lol9;"/></robot>\n'
     ).encode()
-    start = time.perf_counter()
+    start = time.thread_time()  # this thread's CPU time: the same on a busy machine
     with pytest.raises(RobotSpecError) as exc:
         parse_srdf_bytes(data, "lol.srdf")
-    assert time.perf_counter() - start < 0.5
+    assert time.thread_time() - start < 0.5
     assert isinstance(exc.value, SrdfError)
     assert str(exc.value) == (
         "lol.srdf:3: error: XML entity declarations are not allowed (found 'lol0')"

@@ -287,8 +287,8 @@ def test_yaml_alias_bomb_is_refused_before_it_expands(tmp: Path) -> None:
     fenced(r, tmp)
     assert r.code == 1
     assert r.text.splitlines()[0] == (
-        "bomb.yaml:7:15: error: YAML document too large with its aliases expanded (more than "
-        "1000000 nodes; set ROBOTSPEC_MAX_YAML_NODES to raise it)"
+        "bomb.yaml:6:10: error: YAML aliases stand for too many nodes (more than 100000 in "
+        "all; set ROBOTSPEC_MAX_YAML_ALIAS_NODES to raise it)"
     )
 
 

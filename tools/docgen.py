@@ -279,7 +279,15 @@ The schema carries what the tables below show: each field's description, example
 
 `extends: NAME` starts from another spec (a file next to this one, or a shipped robot such as
 `pr2`): mappings are merged key by key, lists and values are replaced, and the extending file's
-lines are the ones errors point at.
+lines are the ones errors point at. A base may extend another, up to 100 files deep
+(`ROBOTSPEC_MAX_EXTENDS_DEPTH`); a chain deeper than that, or one that comes back to a file, is
+an error at the `extends` line that goes on.
+
+Within one file, YAML anchors, aliases and merge keys work as YAML 1.1 defines them: `<<: *arm`
+gives a mapping the keys of `arm` it does not write itself, so `{<<: *arm, tip: flange}`
+overrides one key wherever it stands, and in `<<: [*a, *b]` the earlier mapping wins. A key
+written twice, an alias inside the collection it names and a merge of anything but mappings are
+errors at their line; an error inside an alias or a merged key points where the value is written.
 """
 
 _RULES_INTRO = """\

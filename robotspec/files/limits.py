@@ -33,6 +33,12 @@ class Limits:
     #: not copied, so reading costs memory in proportion to the text; this bounds the work of
     #: whatever walks the data afterwards (validation, the compiler).
     max_yaml_nodes: int = 1_000_000
+    #: Nodes the aliases of one YAML document stand for, in all (each alias counts its anchor's
+    #: nodes, aliases inside expanded). Why besides the node cap: validation and the compiler
+    #: walk every value an alias stands for, so a 16 kB spec of 990 aliases of a 500-joint state
+    #: held 570 MB; a real document's anchors (a chain, a state, a joint's limits reused) stand
+    #: for a few thousand.
+    max_yaml_alias_nodes: int = 100_000
     #: Files one spec's ``extends`` chain may reach beyond the spec itself (a real chain is two
     #: or three deep; each file is read and validated once).
     max_extends_depth: int = 100

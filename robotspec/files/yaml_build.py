@@ -7,8 +7,9 @@ Why our own pass instead of PyYAML's composer and constructor:
   composers recurse once per nesting level: 50,000 ``[`` kill the process).
 * **aliases are shared, not copied.** An alias is the anchored value itself (as
   ``yaml.safe_load`` gives it), so nine aliases of nine aliases of ... cost the text they are
-  written in; the expanded size is only *counted*, against ``ROBOTSPEC_MAX_YAML_NODES``, for the
-  work later readers of the data do.
+  written in; the expanded size is only *counted*, against ``ROBOTSPEC_MAX_YAML_NODES`` and
+  ``ROBOTSPEC_MAX_YAML_ALIAS_NODES``, for the work later readers of the data do (validation
+  walks every value an alias stands for).
 * **merge keys as YAML 1.1 states them** (https://yaml.org/type/merge.html): ``<<: *base`` or
   ``<<: [*a, *b]`` inserts the keys the mapping does not give itself, the earlier source winning
   (PyYAML 6.0.4 lets the later win for keys longer than one character: yaml/pyyaml#953); an
@@ -127,6 +128,7 @@ class _Reader:
         self.cap = cap
         self.build = build
         self.stack: list[_Frame] = []
+        self.alias_nodes = 0  # nodes the aliases read so far stand for
         self.anchors: dict[str, _Anchor] = {}
         self.root: Any = None
         self.marks: dict[Loc, int] = {}  # packed (line, column) of each value
@@ -204,6 +206,15 @@ class _Reader:
             raise self._error(
                 f"recursive alias '*{event.anchor}': it stands for a collection it is part of "
                 f"(anchored '&{event.anchor}' at line {anchor.line})",
+                line,
+                col,
+            )
+        self.alias_nodes += anchor.size
+        if self.alias_nodes > self.cap.max_yaml_alias_nodes:
+            raise self._error(
+                f"YAML aliases stand for too many nodes (more than "
+                f"{self.cap.max_yaml_alias_nodes} in all; set "
+                f"{env_name('max_yaml_alias_nodes')} to raise it)",
                 line,
                 col,
             )

@@ -380,6 +380,8 @@ def test_generated_merges_read_as_the_spec_and_safe_load_read_them(
 ) -> None:
     text, expected, ambiguous = case
     safe = yaml.safe_load(text)
+    if hasattr(yaml, "CSafeLoader"):
+        assert yaml.load(text, Loader=yaml.CSafeLoader) == safe
     check_safe = PYYAML_FOLLOWS_THE_SPEC or not ambiguous
     for composer in (yamlio._SafeComposer, yamlio._PySafeComposer):
         with pytest.MonkeyPatch.context() as mp:

@@ -465,3 +465,20 @@ def test_drive_plot_never_writes_through_a_link(tmp_path: Path, victim: Path) ->
     assert (victim / "keep.txt").read_text() == SECRET
     drawn = plot_joint_trace(JointTrace(("j",)), tmp_path / "real.png")
     assert drawn.path.read_bytes().startswith(b"\x89PNG")
+
+
+def test_a_state_log_is_never_written_through_a_link(tmp_path: Path) -> None:
+    from robotspec.driver.statelog import StateLog
+
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me\n")
+    (tmp_path / "log.csv").symlink_to(victim)
+    with pytest.raises(RobotSpecError, match="is a symbolic link"):
+        StateLog(tmp_path / "log.csv", ("j1",), 1)
+    assert victim.read_text() == "keep me\n"
+    os.mkfifo(tmp_path / "fifo.csv")
+    with pytest.raises(RobotSpecError, match="not a regular file"):
+        StateLog(tmp_path / "fifo.csv", ("j1",), 1)
+    log = StateLog(tmp_path / "ok.csv", ("j1",), 1)
+    log.close()
+    assert (tmp_path / "ok.csv").read_text().startswith("t,seqno")

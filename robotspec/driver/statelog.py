@@ -7,7 +7,10 @@ pose per chain) and are easy to stream through ``jq``.
 from __future__ import annotations
 
 import csv
+import errno
 import json
+import os
+import stat
 from pathlib import Path
 from typing import IO, Any
 
@@ -17,6 +20,40 @@ from robotspec.errors import RobotSpecError
 __all__ = ["LOG_SUFFIXES", "StateLog"]
 
 LOG_SUFFIXES = {".csv": "csv", ".jsonl": "jsonl", ".json": "jsonl", ".ndjson": "jsonl"}
+
+
+def _open_log(path: Path) -> IO[str]:
+    """The log file, opened as ``write_file`` opens outputs: never through a link, never a FIFO.
+
+    Why not :func:`robotspec.files.writing.write_file`: a log is streamed row by row while the
+    driver runs, not written whole; the last component is opened with ``O_NOFOLLOW`` (a link
+    planted at the log's name is refused) and must be a regular file.
+    """
+    flags = os.O_WRONLY | os.O_CREAT | os.O_TRUNC
+    flags |= getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+    try:
+        if path.is_symlink():
+            raise OSError(errno.ELOOP, "is a symbolic link")
+        fd = os.open(path, flags, 0o666)
+    except OSError as exc:
+        why = {
+            errno.ELOOP: "is a symbolic link; robotspec does not write through links",
+            errno.ENXIO: "not a regular file (a FIFO without a reader)",
+        }.get(exc.errno or 0, exc.strerror or str(exc))
+        raise RobotSpecError(
+            f"cannot write log: {why}",
+            file=str(path),
+            kind="output",
+        ) from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise RobotSpecError(
+            "cannot write log: not a regular file (a device, FIFO or socket)",
+            file=str(path),
+            kind="output",
+        )
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "w", encoding="utf-8", newline="")
 
 
 class StateLog:
@@ -31,10 +68,7 @@ class StateLog:
         self.format = fmt
         self.path = path
         self.rows = 0
-        try:
-            self._fh: IO[str] = path.open("w", encoding="utf-8", newline="")
-        except OSError as exc:
-            raise RobotSpecError(f"cannot write log: {exc.strerror}", file=str(path)) from None
+        self._fh: IO[str] = _open_log(path)
         self._names = joint_names
         self._n_chains = n_chains
         self._csv: Any = None

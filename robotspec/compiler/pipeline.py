@@ -200,7 +200,7 @@ def _check_srdf(
         # An SRDF often outlives its URDF (HSRB's names odom_x/y/t); like MoveIt, warn and
         # ignore the element. A spec that *uses* a stale name still fails on its own line.
         diag.add(err.with_severity("warning"))
-    for err in self_pair_warnings(srdf):
+    for err in [*srdf.warnings, *self_pair_warnings(srdf)]:
         diag.add(err)
     return srdf
 

@@ -14,11 +14,13 @@ always writes MoveIt's dialect.
 
 Problems come in two grades. A malformed file (a missing required attribute, a number that is not
 a number, an unknown virtual joint type, two groups of one name, groups that contain each other)
-is always an error. A dangling group reference (a group state or end effector naming a group the
-file does not define, a subgroup that is not defined, a group state without a group) is an error
-in strict mode, the default. MoveIt logs and skips such elements and pinocchio ignores groups
-altogether, so several pinocchio-made SRDFs of example-robot-data have them; ``strict=False``
-keeps them as they are and :func:`check_srdf_references` lists them.
+is always an error, except a virtual joint declared twice: MoveIt keeps the first, so robotspec
+warns at the second and reads the first (``Srdf.warnings``). A dangling group reference (a group
+state or end effector naming a group the file does not define, a subgroup that is not defined, a
+group state without a group) is an error in strict mode, the default. MoveIt logs and skips such
+elements and pinocchio ignores groups altogether, so several pinocchio-made SRDFs of
+example-robot-data have them; ``strict=False`` keeps them as they are and
+:func:`check_srdf_references` lists them.
 """
 
 from __future__ import annotations
@@ -180,6 +182,9 @@ class Srdf:
     disabled_collisions: tuple[DisabledCollision, ...] = ()
     disable_default_collisions: tuple[DisableDefaultCollisions, ...] = ()
     enabled_collisions: tuple[EnabledCollision, ...] = ()
+    #: What the reader passed over as MoveIt does (a second virtual joint of one name), each a
+    #: located warning the compiler reports; not part of the file's contents, so never compared.
+    warnings: tuple[SrdfError, ...] = field(default=(), compare=False)
 
     @property
     def group_names(self) -> tuple[str, ...]:

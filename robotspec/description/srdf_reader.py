@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Protocol, TypeVar
 
@@ -125,6 +126,7 @@ class _Reader:
     def __init__(self, file: str | None) -> None:
         self.file = file
         self.errors: list[RobotSpecError] = []
+        self.warnings: list[SrdfError] = []
         # The root's children by tag, with their document position: one pass over a file
         # whose thousand ``disable_collisions`` would otherwise be walked once per element kind.
         self._by_tag: dict[str, list[tuple[int, etree._Element]]] = {}
@@ -147,7 +149,7 @@ class _Reader:
             if isinstance(child.tag, str):
                 self._by_tag.setdefault(child.tag, []).append((i, child))
         robot_name = self.attr(root, "name", "<robot>", kind="robot") or ""
-        return Srdf(
+        srdf = Srdf(
             robot_name=robot_name,
             file=self.file,
             groups=self._unique(self._all(root, ("group",), self.group), "group"),
@@ -155,8 +157,8 @@ class _Reader:
             end_effectors=self._unique(
                 self._all(root, ("end_effector",), self.end_effector), "end_effector"
             ),
-            virtual_joints=self._unique(
-                self._all(root, ("virtual_joint",), self.virtual_joint), "virtual_joint"
+            virtual_joints=self._first_virtual_joints(
+                self._all(root, ("virtual_joint",), self.virtual_joint)
             ),
             passive_joints=self._all(root, ("passive_joint",), self.passive_joint),
             disabled_collisions=self._all(
@@ -167,6 +169,7 @@ class _Reader:
             ),
             enabled_collisions=self._all(root, ("enable_collisions",), self.enabled),
         )
+        return replace(srdf, warnings=tuple(self.warnings)) if self.warnings else srdf
 
     def _all(
         self,
@@ -198,6 +201,44 @@ class _Reader:
             else:
                 first[name] = line
         return records
+
+    def _first_virtual_joints(self, joints: tuple[VirtualJoint, ...]) -> tuple[VirtualJoint, ...]:
+        """Each virtual joint once, the first of a name kept, with a warning at each repeat.
+
+        Why not an error: MoveIt's srdfdom reads the first and ignores the rest, so a file with a
+        pasted-twice ``<virtual_joint>`` works in MoveIt; refusing the whole SRDF for it made
+        every group and end effector of the file unusable.
+        """
+        first: dict[str, VirtualJoint] = {}
+        for v in joints:
+            kept = first.setdefault(v.name, v)
+            if kept is v:
+                continue
+            same = (v.type, v.parent_frame, v.child_link) == (
+                kept.type,
+                kept.parent_frame,
+                kept.child_link,
+            )
+            differs = (
+                ""
+                if same
+                else (
+                    f" (this one: {v.type} from '{v.parent_frame}' to '{v.child_link}'; the first: "
+                    f"{kept.type} from '{kept.parent_frame}' to '{kept.child_link}')"
+                )
+            )
+            self.warnings.append(
+                SrdfError(
+                    f"virtual_joint '{v.name}' is declared again (first on line {kept.line})"
+                    f"{differs}; read as MoveIt does, the first declaration only (delete this one)",
+                    file=self.file,
+                    line=v.line,
+                    kind="virtual_joint",
+                    name=v.name,
+                    severity="warning",
+                )
+            )
+        return tuple(first.values())
 
     def group(self, el: etree._Element) -> Group | None:
         name = self.attr(el, "name", "<group>", kind="group")

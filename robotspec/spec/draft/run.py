@@ -62,4 +62,8 @@ def draft_from_files(
         name=name or desc.world.name,
     )
     draft.package_paths = extra_paths
+    if desc.srdf is not None:  # what the SRDF reader passed over as MoveIt does (a repeat)
+        draft.notes += [
+            f"{Path(w.file or '').name}:{w.line}: {w.message}" for w in desc.srdf.warnings
+        ]
     return draft, desc

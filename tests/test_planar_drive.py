@@ -160,3 +160,144 @@ def test_drive_errors_are_located_in_the_spec(
     with pytest.raises(RobotSpecError) as info:
         check_spec(spec(tmp_path, drive, root))
     assert str(info.value).replace(f"{tmp_path}/", "").startswith(message)
+
+
+# ------------------------------------------------------------------- a URDF planar joint as drive
+def wheel(name: str, x: float, y: float, *, radius: float = 0.08, axis: str = "0 1 0") -> str:
+    """A continuous joint turning a flat cylinder about its own axis (no 'wheel' in its name)."""
+    turn = "1.5708 0 0" if axis == "0 1 0" else "0 0 0"
+    return f"""
+  <link name="{name}_link"><collision><origin rpy="{turn}"/>
+    <geometry><cylinder radius="{radius}" length="0.04"/></geometry></collision></link>
+  <joint name="{name}" type="continuous"><parent link="base_link"/><child link="{name}_link"/>
+    <origin xyz="{x} {y} 0"/><axis xyz="{axis}"/></joint>"""
+
+
+def planar_urdf(wheels: str = "", above: str = "") -> str:
+    """world -(fixed)-> odom -(planar)-> base_link with an arm joint, and the given wheels."""
+    return f"""<robot name="omni">
+  <link name="world"/><link name="odom"/>
+  <link name="base_link">
+    <collision><geometry><box size="0.6 0.5 0.2"/></geometry></collision></link>
+  <link name="arm"/>
+  <joint name="world_odom" type="fixed"><parent link="world"/><child link="odom"/></joint>
+  <joint name="base_joint" type="planar"><parent link="odom"/><child link="base_link"/>
+    <axis xyz="0 0 1"/></joint>
+  <joint name="j1" type="revolute"><parent link="base_link"/><child link="arm"/>
+    <origin xyz="0.2 0 0.1"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>{wheels}{above}
+</robot>
+"""
+
+
+FOUR = "".join(
+    wheel(n, x, y)
+    for n, x, y in [("fl", 0.2, 0.2), ("fr", 0.2, -0.2), ("rl", -0.2, 0.2), ("rr", -0.2, -0.2)]
+)
+
+
+def planar_spec(tmp_path: Path, drive: str) -> Path:
+    (tmp_path / "omni.urdf").write_text(planar_urdf(FOUR))
+    path = tmp_path / "omni.yaml"
+    path.write_text(
+        "robotspec: 1\nname: O\ndescription: {urdf: omni.urdf}\nroot: base_link\n"
+        f"drive: {drive}\n"
+    )
+    return path
+
+
+@pytest.mark.parametrize("drive", ["{type: omni}", "{type: differential, joint: base_joint}"])
+def test_a_urdf_planar_joint_is_declared_as_the_drive(tmp_path: Path, drive: str) -> None:
+    robot = check_spec(planar_spec(tmp_path, drive)).robot
+    assert robot.drive is not None and robot.drive.name == "base_joint"
+    assert robot.drive.type is ConnectionType.PLANAR and robot.root.name == "base_link"
+
+
+def test_a_drive_that_cannot_be_the_planar_joint_is_refused_at_its_keys(tmp_path: Path) -> None:
+    with pytest.raises(RobotSpecError) as info:
+        check_spec(planar_spec(tmp_path, "{type: floating, joint: base, parent_frame: world}"))
+    text = str(info.value).replace(f"{tmp_path}/", "")
+    what = "the URDF's planar joint 'base_joint' above the root 'base_link'"
+    assert f"omni.yaml:5:15: error: drive.type: {what} is the drive: its type is omni or" in text
+    assert f"drive.joint: {what} is the drive; name it 'base_joint' or leave joint out" in text
+    assert f"drive.parent_frame: {what} moves it in 'odom'; write 'odom'" in text
+
+
+def test_a_drive_above_the_planar_joint_says_which_root_to_take(tmp_path: Path) -> None:
+    path = planar_spec(tmp_path, "{type: omni}")
+    path.write_text(path.read_text().replace("root: base_link", "root: world"))
+    with pytest.raises(RobotSpecError, match="make its child 'base_link' the robot's root"):
+        check_spec(path)
+
+
+# ------------------------------------------------------------------------------- drafting it
+def drafted(tmp_path: Path, urdf_text: str, srdf: str | None = None):  # type: ignore[no-untyped-def]
+    """The draft of a URDF (and SRDF) in tmp_path, written and validated as written."""
+    from robotspec.spec.draft import render_draft
+    from robotspec.spec.draft.run import draft_from_files
+
+    (tmp_path / "r.urdf").write_text(urdf_text)
+    srdf_ref = None
+    if srdf is not None:
+        (tmp_path / "r.srdf").write_text(srdf)
+        srdf_ref = str(tmp_path / "r.srdf")
+    draft, _ = draft_from_files(str(tmp_path / "r.urdf"), srdf_ref, folder=tmp_path)
+    (tmp_path / "draft.yaml").write_text(render_draft(draft))
+    check_spec(tmp_path / "draft.yaml")
+    return draft
+
+
+def test_an_omni_base_of_four_wheels_and_a_planar_joint_is_drafted_as_that_drive(
+    tmp_path: Path,
+) -> None:
+    d = drafted(tmp_path, planar_urdf(FOUR))
+    assert d.root == "base_link" and d.drive is not None
+    assert (d.drive.type, d.drive.joint, d.drive.joints) == ("omni", "base_joint", None)
+    assert d.drive.decide is not None and "4 wheels: omni?" in d.drive.decide
+
+
+def test_two_wheels_make_the_planar_joint_differential(tmp_path: Path) -> None:
+    d = drafted(tmp_path, planar_urdf(wheel("left_drive", 0, 0.2) + wheel("right_drive", 0, -0.2)))
+    assert d.drive is not None and d.drive.type == "differential"
+
+
+def test_a_spinning_part_about_a_vertical_axis_is_no_wheel(tmp_path: Path) -> None:
+    from robotspec.spec.draft.base import wheel_joints
+
+    rotor = wheel("spinner", 0, 0, axis="0 0 1")
+    assert [c.name for c in wheel_joints(world_of(planar_urdf(FOUR + rotor)))] == [
+        "fl",
+        "fr",
+        "rl",
+        "rr",
+    ]
+
+
+def renamed(text: str) -> str:
+    """The x, y, theta base under other names, below a fixed joint from a 'map' frame."""
+    text = text.replace('<link name="odom"/>', '<link name="map"/><link name="odom"/>', 1)
+    text = text.replace(
+        '<joint name="odom_x"',
+        '<joint name="map_odom" type="fixed"><parent link="map"/><child link="odom"/></joint>\n'
+        '  <joint name="joint_a"',
+        1,
+    )
+    return text.replace('"odom_y"', '"joint_b"').replace('"odom_theta"', '"joint_c"')
+
+
+def test_x_y_theta_joints_are_drafted_as_the_drive_by_their_axes_not_names(
+    tmp_path: Path,
+) -> None:
+    d = drafted(tmp_path, renamed(urdf()))
+    assert d.root == "base_link" and d.drive is not None
+    assert (d.drive.type, d.drive.joints) == ("omni", ("joint_a", "joint_b", "joint_c"))
+
+
+def test_the_urdf_base_joints_win_over_an_srdf_virtual_joint_above_them(tmp_path: Path) -> None:
+    srdf = (
+        '<robot name="r"><virtual_joint name="vj" type="floating" parent_frame="world" '
+        'child_link="map"/></robot>'
+    )
+    d = drafted(tmp_path, renamed(urdf()), srdf)
+    assert d.root == "base_link" and d.drive is not None
+    assert d.drive.joints == ("joint_a", "joint_b", "joint_c")

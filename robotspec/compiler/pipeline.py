@@ -88,8 +88,15 @@ def _prepare_world(
         frames.append((name, f.parent, f.pose()))
     if frames:
         world = world.add_frames(frames)
-    if add_drive and spec.drive is not None and spec.drive.joints is not None:
-        return _urdf_drive(spec, world, diag)
+    if add_drive and spec.drive is not None:
+        from robotspec.compiler.base_joint import base_joint_above_root, check_urdf_base_joint
+
+        above = base_joint_above_root(world, spec.root_link)
+        if above is not None:
+            check_urdf_base_joint(spec, above, world, diag)
+            return world
+        if spec.drive.joints is not None:
+            return _urdf_drive(spec, world, diag)
     if not add_drive or world.parent_connection(world.root) is not None:
         return world
     drive = spec.drive
@@ -113,12 +120,7 @@ def _prepare_world(
             return world.with_base_connection(joint, parent, kind)
         except RobotSpecError as exc:
             at = "parent_frame" if exc.detail.kind == "link" else "joint"
-            hint = (
-                "; if the URDF models the base's motion itself, name its x, y and theta joints "
-                "in drive.joints"
-                if at == "parent_frame"
-                else ""
-            )
+            hint = _own_base_hint(world) if at == "parent_frame" else ""
             diag.error(("drive", at), exc.message + hint, name=exc.detail.name)
             return world
     if vj is not None:
@@ -134,6 +136,21 @@ def _prepare_world(
             )
             return world
     return world
+
+
+def _own_base_hint(world: World) -> str:
+    """How to declare a base the URDF moves itself: its planar joint's child as the root."""
+    planar = next((c for c in world.connections if c.type is ConnectionType.PLANAR), None)
+    if planar is not None:
+        child = world.bodies[planar.child].name
+        return (
+            f"; the URDF's planar joint '{planar.name}' moves the base: make its child "
+            f"'{child}' the robot's root, and that joint is the drive"
+        )
+    return (
+        "; if the URDF models the base's motion itself, name its x, y and theta joints "
+        "in drive.joints"
+    )
 
 
 def _urdf_drive(spec: RobotSpec, world: World, diag: Diagnostics) -> World:

@@ -42,7 +42,10 @@ class DriveSpec(SpecModel):
         examples=["omni"],
     )
     joint: Name | None = Field(
-        default=None, description="name of the base connection", examples=["world_joint"]
+        default=None,
+        description="name of the base connection; a URDF planar (or floating) joint whose "
+        "child is the robot's root is the drive as it is: name it here or leave this out",
+        examples=["world_joint"],
     )
     parent_frame: Name = Field(
         default="odom", description="the frame the base moves in", examples=["odom_combined"]

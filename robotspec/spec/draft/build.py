@@ -13,6 +13,7 @@ import numpy as np
 from robotspec.description.srdf import Srdf
 from robotspec.model.entities import Body
 from robotspec.model.world import World
+from robotspec.spec.draft.base import own_base, own_drive
 from robotspec.spec.draft.hands import (
     Gripper,
     facing_quaternion,
@@ -105,25 +106,22 @@ class Drafter:
         vj = None
         if srdf is not None:
             vj = next((v for v in srdf.virtual_joints if world.has_body(v.child_link)), None)
-        if vj is not None:
+        own = own_base(world)
+        if own is not None and vj is not None:
+            above = world.get_body_by_name(vj.child_link)
+            if above is not own.root and above not in world.ancestors(own.root):
+                own = None  # the SRDF's virtual joint moves a link below the URDF's base joints
+        if own is not None:
+            # The URDF moves its base itself (LoCoBot, a simulator's planar joint): those joints
+            # are the drive, not an arm's or a neck's, and the robot starts below them.
+            root, drive = own.root, own_drive(world, own)
+        elif vj is not None:
             root = world.get_body_by_name(vj.child_link)
             kind = {"planar": "omni", "floating": "floating", "fixed": "fixed"}.get(vj.type)
             if kind is not None and (kind == "fixed" or root is world.root):
                 drive = DraftDrive(
                     kind, vj.name, vj.parent_frame, f"the SRDF's virtual joint '{vj.name}'"
                 )
-        elif (base := base_joints(world)) is not None:
-            # The URDF moves its base itself (LoCoBot): those joints are the drive, not an arm's
-            # or a neck's, and the robot starts below them.
-            root = world.bodies[world.get_connection_by_name(base[2]).child]
-            wheels = [c for c in world.connections if "wheel" in words(c.name) and c.is_active]
-            kind = "differential" if len(wheels) == 2 else "omni"
-            drive = DraftDrive(
-                kind,
-                source="the URDF's base joints",
-                decide=f"the URDF's x, y, theta joints move the base; {kind}?",
-                joints=base,
-            )
         self.tree = Tree(world, root)
         self.limbs = find_limbs(self.tree)
         self.forward, forward_why = facing(self.tree, self.limbs)
@@ -410,34 +408,6 @@ class Drafter:
             m = self.manipulator(chain, limb, name, hand_start)
             if m is not None:
                 m.source = f"the SRDF end effector '{ee.name}' ({m.source})"
-
-
-def base_joints(world: World) -> tuple[str, str, str] | None:
-    """The URDF's own planar base: prismatic x, prismatic y, revolute z below its root, if so.
-
-    Proven by the compiler's own check (``collapse_planar_joints``), so a drafted
-    ``drive.joints`` always validates.
-    """
-    from robotspec.errors import RobotSpecError
-    from robotspec.model.planar_drive import collapse_planar_joints
-
-    body = world.root
-    found: list[str] = []
-    while len(found) < 3:
-        kids = world.child_bodies(body)
-        moving = [k for k in kids if (c := world.parent_connection(k)) and not c.is_fixed]
-        if len(moving) != 1:
-            return None
-        body = moving[0]
-        c = world.parent_connection(body)
-        assert c is not None
-        found.append(c.name)
-    joints = (found[0], found[1], found[2])
-    try:
-        collapse_planar_joints(world, joints)
-    except RobotSpecError:
-        return None
-    return joints
 
 
 def _fixed_above(world: World, body: Body) -> bool:

@@ -1,0 +1,94 @@
+"""The blind corpus's manifests and truths are consistent (issue 30); nothing here drafts.
+
+Every manifest of ``tests/data/blind_corpus/`` lists robots whose ``half`` is the salted hash's
+answer (``tools.corpus.split.half``), never a choice, and each robot has a truth file in
+``tests/data/blind_truth/`` in the format of ``tests/data/draft_truth`` (only known keys).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from tools.corpus.split import half
+
+DATA = Path(__file__).resolve().parent / "data"
+MANIFESTS = sorted((DATA / "blind_corpus").glob("*.yaml"))
+TRUTHS = DATA / "blind_truth"
+
+TOP = {"robot", "forward", "chains", "manipulators", "cameras", "torso", "neck", "drive"}
+CHAIN = {"root", "tip", "kind"}
+MANIPULATOR = {"type", "tool_frame", "thumb", "fingers"}
+PART = {"root", "tip"}
+DRIVE = {"type", "joints"}
+
+
+def _entries(path: Path) -> list[dict[str, Any]]:
+    data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+    robots = data.get("robots") or []
+    assert isinstance(robots, list)
+    return robots
+
+
+def _all() -> list[tuple[str, dict[str, Any]]]:
+    return [(p.name, e) for p in MANIFESTS for e in _entries(p)]
+
+
+def test_the_pypi_manifest_is_there() -> None:
+    assert DATA / "blind_corpus" / "pypi.yaml" in MANIFESTS
+    assert len(_entries(DATA / "blind_corpus" / "pypi.yaml")) >= 25
+
+
+def test_ids_are_unique_across_manifests() -> None:
+    ids = [e["id"] for _, e in _all()]
+    assert len(ids) == len(set(ids)), sorted(i for i in ids if ids.count(i) > 1)
+
+
+@pytest.mark.parametrize(
+    ("manifest", "entry"), _all(), ids=lambda v: v if isinstance(v, str) else v["id"]
+)
+def test_half_is_the_salted_hash(manifest: str, entry: dict[str, Any]) -> None:
+    assert entry["half"] == half(entry["id"]), f"{manifest}: {entry['id']}"
+
+
+@pytest.mark.parametrize(
+    ("manifest", "entry"), _all(), ids=lambda v: v if isinstance(v, str) else v["id"]
+)
+def test_every_robot_has_a_truth_of_known_keys(manifest: str, entry: dict[str, Any]) -> None:
+    path = TRUTHS / (entry["id"].replace("/", "__") + ".yaml")
+    assert path.is_file(), f"{manifest}: {entry['id']} has no truth {path.name}"
+    text = path.read_text(encoding="utf-8")
+    assert text.startswith("#"), f"{path.name}: the truth starts with a comment saying what it is"
+    t = yaml.safe_load(text)
+    assert t["robot"] == entry["id"]
+    assert set(t) <= TOP, set(t) - TOP
+    for name, c in (t.get("chains") or {}).items():
+        assert set(c) <= CHAIN and {"root", "tip"} <= set(c), name
+        assert c.get("kind", "arm") in ("arm", "leg", "chain"), name
+    for name, m in (t.get("manipulators") or {}).items():
+        assert set(m) <= MANIPULATOR and {"type", "tool_frame"} <= set(m), name
+        assert m["type"] in ("parallel_gripper", "hand", "generic"), name
+        tool = m["tool_frame"]
+        assert isinstance(tool, str) or (isinstance(tool, dict) and set(tool) == {"parent"}), name
+        if m["type"] == "parallel_gripper":
+            assert len(m["fingers"]) == 2 and "thumb" not in m, name
+        if m["type"] == "hand":
+            assert isinstance(m["thumb"], str) and len(m["fingers"]) >= 1, name
+    assert all(isinstance(c, str) for c in t.get("cameras") or [])
+    for key in ("torso", "neck"):
+        assert t.get(key) is None or set(t[key]) == PART, key
+    drive = t.get("drive") or {"type": "fixed"}
+    assert set(drive) <= DRIVE and drive["type"] in ("omni", "differential", "fixed", "floating")
+    if "joints" in drive:
+        assert len(drive["joints"]) == 3
+    if "forward" in t:
+        assert len(t["forward"]) == 3
+
+
+def test_every_truth_is_listed() -> None:
+    listed = {e["id"].replace("/", "__") for _, e in _all()}
+    orphans = sorted(p.stem for p in TRUTHS.glob("*.yaml") if p.stem not in listed)
+    assert not orphans, f"truths without a manifest entry: {orphans}"

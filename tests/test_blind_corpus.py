@@ -92,3 +92,39 @@ def test_every_truth_is_listed() -> None:
     listed = {e["id"].replace("/", "__") for _, e in _all()}
     orphans = sorted(p.stem for p in TRUTHS.glob("*.yaml") if p.stem not in listed)
     assert not orphans, f"truths without a manifest entry: {orphans}"
+
+
+def test_the_holdout_is_measured_as_totals_only(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The protocol in code: nothing per robot of the holdout half is printed.
+    from tools.corpus import measure
+    from tools.draft_score import RobotScore
+
+    robots = [
+        measure.CorpusRobot(f"x/secret_{h}", h, Path("a.urdf"), None, (), {})
+        for h in ("tune", "holdout")
+    ]
+
+    def fake(robot: measure.CorpusRobot, truth: object, tmp: Path) -> tuple[RobotScore, str]:
+        s = RobotScore(robot.id)
+        s.add("valid", False, "the draft does not validate", marked=False)
+        s.add("chains", False, "arm not drafted", marked=False)
+        return s, "init: a problem"
+
+    monkeypatch.setattr(measure, "corpus_robots", lambda: (robots, []))
+    monkeypatch.setattr(measure, "measure_robot", fake)
+
+    class Truths(dict[str, object]):
+        def __missing__(self, key: str) -> object:
+            return None
+
+    monkeypatch.setattr(measure, "_truths", lambda: Truths())
+    assert measure.main(["--half", "holdout"]) == 0
+    out = capsys.readouterr().out
+    assert "secret" not in out and "not drafted" not in out and "problem" not in out
+    assert "| holdout | 1 | 0/1 (0 %) | 0/1 (0 %) |" in out
+    assert measure.main(["--half", "tune"]) == 0
+    assert "x/secret_tune" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        measure.main(["--half", "holdout", "--only", "x/secret_holdout"])

@@ -23,6 +23,11 @@ the draft has it:
 * torso, neck: the same actuated joints (present in either); drive: the same type (and the
   same base joints, when the truth names them); forward: the same facing (when either says
   it is not +x).
+
+Whether a wrong item carried a ``DECIDE`` mark (``RobotScore.unmarked`` lists those that did
+not): an extra drafted chain, camera, gripper, torso, neck, drive or facing by its own mark; a
+missed chain when a drafted chain over some of its joints is marked; a missed tool frame or
+gripper when some drafted manipulator is marked; a missed camera never (nothing asks to look).
 """
 
 from __future__ import annotations
@@ -42,6 +47,7 @@ __all__ = [
     "main",
     "score_draft",
     "score_lines",
+    "score_missing",
 ]
 
 #: The ground truth files.
@@ -79,17 +85,26 @@ class RobotScore:
     robot: str
     counts: dict[str, tuple[int, int]] = field(default_factory=dict)
     wrong: list[str] = field(default_factory=list)
+    #: The wrong items the draft states without a ``DECIDE`` mark (a subset of ``wrong``).
+    unmarked: list[str] = field(default_factory=list)
 
-    def add(self, category: str, right: bool, what: str) -> None:
-        """Count one item of ``category``; ``what`` says what was wrong when it is not right."""
+    def add(self, category: str, right: bool, what: str, marked: bool = True) -> None:
+        """Count one item of ``category``; ``what`` says what was wrong when it is not right.
+
+        ``marked``: whether the draft item this concerns carries a ``DECIDE`` mark (or the draft
+        says nothing there); a wrong item without one is also listed in ``unmarked``.
+        """
         got, of = self.counts.get(category, (0, 0))
         self.counts[category] = (got + int(right), of + 1)
         if not right:
             self.wrong.append(f"{category}: {what}")
+            if not marked:
+                self.unmarked.append(f"{category}: {what}")
 
 
 def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> RobotScore:
     """The draft of ``truth``'s robot against it (see the module docstring)."""
+    from robotspec.errors import RobotSpecError
     from robotspec.model.world import World
     from robotspec.spec.draft.model import Draft
 
@@ -99,7 +114,10 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
     s.add("valid", valid, "the draft does not validate as written")
 
     def joints(root: str, tip: str) -> frozenset[str]:
-        conns = world.compute_chain_of_connections(root, tip)
+        try:
+            conns = world.compute_chain_of_connections(root, tip)
+        except RobotSpecError:  # the loaded files lack a link of the truth
+            return frozenset({f"<no chain {root} -> {tip}>"})
         return frozenset(c.name for c in conns if c.is_active)
 
     # Chains: kind and joints.
@@ -110,13 +128,27 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         hit = next((i for i, d in enumerate(drafted) if i not in matched and d[:2] == want), None)
         if hit is not None:
             matched.add(hit)
-        s.add("chains", hit is not None, f"{name} ({c['root']} -> {c['tip']}) not drafted")
+        # A miss is marked when a drafted chain over some of its joints asks to be checked.
+        near = [d for d in draft.chains if d.joints & want[1]]
+        s.add(
+            "chains",
+            hit is not None,
+            f"{name} ({c['root']} -> {c['tip']}) not drafted",
+            marked=any(d.decide for d in near),
+        )
     for i, (_, _, name) in enumerate(drafted):
         if i not in matched:
-            s.add("chains", False, f"drafted {name}, not a chain of the truth")
+            s.add(
+                "chains",
+                False,
+                f"drafted {name}, not a chain of the truth",
+                marked=bool(draft.chains[i].decide),
+            )
     # Tool frames and grippers.
     frames = {f.name: f.parent for f in draft.frames}
     grippers = [m for m in draft.manipulators if m.is_gripper or m.is_hand]
+    # A missed tool frame or gripper is marked when a drafted manipulator asks to be checked.
+    any_marked = any(m.decide for m in draft.manipulators)
     used: set[str] = set()
     for name, m in (t.get("manipulators") or {}).items():
         tool = m.get("tool_frame")
@@ -126,7 +158,7 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         else:
             ok = any(d.tool_frame == tool for d in draft.manipulators)
             shown = str(tool)
-        s.add("tool frames", ok, f"{name}: {shown}")
+        s.add("tool frames", ok, f"{name}: {shown}", marked=any_marked)
         if m.get("type") in ("parallel_gripper", "hand"):
             tips = frozenset(m["fingers"])
             want_thumb = m.get("thumb")  # a hand's; a gripper's two tips are unordered
@@ -141,19 +173,34 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
             if hit_g is not None:
                 used.add(hit_g.name)
             what = f"thumb {want_thumb}, " if want_thumb else ""
-            s.add("grippers/hands", hit_g is not None, f"{name}: {what}fingers {sorted(tips)}")
+            s.add(
+                "grippers/hands",
+                hit_g is not None,
+                f"{name}: {what}fingers {sorted(tips)}",
+                marked=any_marked,
+            )
     for g in grippers:
         if g.name not in used:
             kind = "a hand" if g.is_hand else "a parallel gripper"
-            s.add("grippers/hands", False, f"drafted {g.name} as {kind}, not one")
+            s.add(
+                "grippers/hands",
+                False,
+                f"drafted {g.name} as {kind}, not one",
+                marked=bool(g.decide),
+            )
     # Cameras.
     want_cams = list(t.get("cameras") or [])
     have_cams = [c.body for c in draft.cameras]
     for body in want_cams:
-        s.add("cameras", body in have_cams, f"{body} not a camera")
-    for body in have_cams:
-        if body not in want_cams:
-            s.add("cameras", False, f"drafted {body}, not a camera of the truth")
+        s.add("cameras", body in have_cams, f"{body} not a camera", marked=False)
+    for cam in draft.cameras:
+        if cam.body not in want_cams:
+            s.add(
+                "cameras",
+                False,
+                f"drafted {cam.body}, not a camera of the truth",
+                marked=bool(cam.decide),
+            )
     # Torso, neck, drive.
     for key in ("torso", "neck"):
         want_part = t.get(key)
@@ -162,17 +209,57 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
             continue
         want_j = None if want_part is None else joints(want_part["root"], want_part["tip"])
         have_j = None if have_part is None else have_part.joints
-        s.add("torso/neck/drive", want_j == have_j, f"{key}: {sorted(have_j or [])}")
+        s.add(
+            "torso/neck/drive",
+            want_j == have_j,
+            f"{key}: {sorted(have_j or [])}",
+            marked=have_part is not None and bool(have_part.decide),
+        )
     want_fwd = tuple(float(v) for v in t.get("forward") or (1.0, 0.0, 0.0))
     have_fwd = draft.forward or (1.0, 0.0, 0.0)
     if want_fwd != (1.0, 0.0, 0.0) or have_fwd != (1.0, 0.0, 0.0):
-        s.add("torso/neck/drive", want_fwd == have_fwd, f"forward: {list(have_fwd)}")
+        s.add(
+            "torso/neck/drive",
+            want_fwd == have_fwd,
+            f"forward: {list(have_fwd)}",
+            marked=bool(draft.forward_decide),
+        )
     drive = t.get("drive") or {"type": "fixed"}
     d = draft.drive
     ok = d is not None and d.type == drive["type"]
     if ok and "joints" in drive:
         ok = list(getattr(d, "joints", None) or []) == list(drive["joints"])
-    s.add("torso/neck/drive", ok, f"drive: {d.type if d is not None else None}")
+    s.add(
+        "torso/neck/drive",
+        ok,
+        f"drive: {d.type if d is not None else None}",
+        marked=d is not None and bool(d.decide),
+    )
+    return s
+
+
+def score_missing(truth: Truth) -> RobotScore:
+    """The score of a robot ``init`` drafted nothing for: every item of its truth is wrong.
+
+    Nothing is counted as stated without a mark: a failed ``init`` says so loudly.
+    """
+    t = truth.data
+    s = RobotScore(truth.robot)
+    s.add("valid", False, "no draft")
+    for name in t.get("chains") or {}:
+        s.add("chains", False, f"{name}: no draft")
+    for name, m in (t.get("manipulators") or {}).items():
+        s.add("tool frames", False, f"{name}: no draft")
+        if m.get("type") in ("parallel_gripper", "hand"):
+            s.add("grippers/hands", False, f"{name}: no draft")
+    for body in t.get("cameras") or []:
+        s.add("cameras", False, f"{body}: no draft")
+    for key in ("torso", "neck"):
+        if t.get(key) is not None:
+            s.add("torso/neck/drive", False, f"{key}: no draft")
+    if tuple(t.get("forward") or (1.0, 0.0, 0.0)) != (1.0, 0.0, 0.0):
+        s.add("torso/neck/drive", False, "forward: no draft")
+    s.add("torso/neck/drive", False, "drive: no draft")
     return s
 
 

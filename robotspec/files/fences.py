@@ -14,7 +14,8 @@ lies and nothing it says:
 * never the **system** folders (``/etc``, ``/proc``, ``/sys``, ``/dev``, ``/boot``, ``/run``);
 
 all checked on real paths, after every symbolic link is resolved. The same hidden and system
-rules hold for the folders a description widens the reads to (its own folder, its package).
+rules hold for the folders a description widens the reads to (its own folder, its package, and
+the *marked* project around it: :func:`marked_project`).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ __all__ = [
     "SYSTEM_FOLDERS",
     "hidden_part",
     "inside",
+    "marked_project",
     "project_root",
     "refusal",
     "system_folder",
@@ -98,9 +100,28 @@ def project_root(folder: str | Path) -> Path | None:
     marker (a dotfiles repository in the home folder) can widen a project to them.
     """
     start = os.path.realpath(folder)
+    marked = _marked(start)
+    if marked is not None:
+        return marked
+    if too_wide(start):
+        return None
+    if os.path.basename(start) in SPEC_FOLDER_NAMES and not too_wide(os.path.dirname(start)):
+        return Path(os.path.dirname(start))
+    return Path(start)
+
+
+#: Folders an installer fills: a project marker above them (the virtual environment's project)
+#: does not make the installed files one project with it.
+INSTALL_FOLDERS = frozenset({"site-packages", "dist-packages"})
+
+
+def _marked(start: str, *, stop_at_installs: bool = False) -> Path | None:
+    """The nearest folder at or above the real folder ``start`` holding a project marker."""
     current = start
     for _ in range(MAX_PROJECT_DEPTH):
         if too_wide(current):
+            break
+        if stop_at_installs and os.path.basename(current) in INSTALL_FOLDERS:
             break
         if any(os.path.lexists(os.path.join(current, name)) for name in PROJECT_FILES):
             return Path(current)
@@ -108,11 +129,20 @@ def project_root(folder: str | Path) -> Path | None:
         if parent == current:
             break
         current = parent
-    if too_wide(start):
-        return None
-    if os.path.basename(start) in SPEC_FOLDER_NAMES and not too_wide(os.path.dirname(start)):
-        return Path(os.path.dirname(start))
-    return Path(start)
+    return None
+
+
+def marked_project(folder: str | Path) -> Path | None:
+    """The project a robot description in ``folder`` reads inside (real path), if it has one.
+
+    Why only a marked one: a description may read the project that holds it (``robots/arm``
+    naming ``../../hands/meshes`` beside it, in a repository keeping both), which its user
+    checked out or created; a download has no marker above its own folder, so it stays
+    confined to its folder and package. Never the home folder or anything above it, and never
+    across a ``site-packages`` folder (an installed wheel is no part of the virtual
+    environment's project).
+    """
+    return _marked(os.path.realpath(folder), stop_at_installs=True)
 
 
 def refusal(real: str, project: Path | None) -> str | None:

@@ -16,7 +16,14 @@ from pathlib import Path
 
 from robotspec.files.reading import read_head
 
-__all__ = ["PACKAGE_NAME", "example_robot_data_folders", "folder_packages", "user_roots", "walk_up"]
+__all__ = [
+    "PACKAGE_NAME",
+    "enclosing_packages",
+    "example_robot_data_folders",
+    "folder_packages",
+    "user_roots",
+    "walk_up",
+]
 
 #: How deep below a search folder the crawl looks for ``package.xml`` (rospack crawls without a
 #: bound; a bound keeps a stray ``/`` or home folder on the path from scanning the disk).
@@ -182,6 +189,40 @@ def description_root(description: Path) -> list[Path]:
     if parent == home or parent.parent == parent:
         return []
     return [parent]
+
+
+#: How many folders above the description's folder may be packages enclosing it by name.
+MAX_ENCLOSING = 8
+
+
+def enclosing_packages(
+    description_folder: Path, own_roots: Sequence[Path]
+) -> list[tuple[str, Path]]:
+    """The packages that hold the description, nearest first: (name, folder) pairs.
+
+    Why first of all: the file being read belongs to the package around it, so its
+    ``package://kinova_description/...`` and ``$(find my_robot)`` mean that package, not an
+    installed one of the same name (example-robot-data's ``kinova_description``) nor one on the
+    user's path. A folder counts by its ``package.xml`` name and by its own name (a description
+    kept without a manifest: ``my_robot/urdf/robot.urdf`` naming ``package://my_robot/...``).
+    Only folders the description may read anyway are walked (``own_roots``: its folder, its
+    package, the folder above ``urdf/``, its marked project), so no name widens the reads.
+    """
+    out: list[tuple[str, Path]] = []
+    folder = description_folder
+    for _ in range(MAX_ENCLOSING):
+        if folder != description_folder and not any(
+            folder == r or folder.is_relative_to(r) for r in own_roots
+        ):
+            break
+        if (folder / "package.xml").is_file():
+            out.append((declared_name(folder), folder))
+        if PACKAGE_NAME.match(folder.name):
+            out.append((folder.name, folder))
+        if folder.parent == folder:
+            break
+        folder = folder.parent
+    return out
 
 
 def user_roots(

@@ -25,10 +25,11 @@ from robotspec.errors import (
     closest_names,
     did_you_mean,
 )
-from robotspec.files.fences import hidden_part, inside, system_folder
+from robotspec.files.fences import hidden_part, inside, marked_project, system_folder
 from robotspec.files.package_search import (
     PACKAGE_NAME,
     description_root,
+    enclosing_packages,
     example_robot_data_folders,
     folder_packages,
     user_roots,
@@ -44,6 +45,21 @@ _SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.\-]*)://")
 def _has_dotdot(path: str) -> bool:
     """Whether a path has a '..' component (as ``".." in Path(path).parts``, without pathlib)."""
     return ".." in path.split(os.sep)
+
+
+def _as_given(folder: Path, real_project: Path | None) -> list[Path]:
+    """The real ``real_project`` spelled as ``folder``'s ancestors are (links in between kept).
+
+    Why: ``folder`` is absolute but not symlink-resolved, the project real; comparing the two
+    would miss a project reached through a link (``/tmp`` on macOS).
+    """
+    if real_project is None:
+        return []
+    real = Path(os.path.realpath(folder))
+    for up, up_real in zip((folder, *folder.parents), (real, *real.parents), strict=False):
+        if up_real == real_project:
+            return [up]
+    return [real_project]
 
 
 def _unique(paths: Iterable[Path]) -> tuple[Path, ...]:
@@ -79,6 +95,10 @@ class PackageResolver:
     #: folder is readable (:mod:`robotspec.files.fences`). Packages crawled on the search path
     #: are held to the same rule unless a user root holds them.
     strict_roots: tuple[Path, ...] = ()
+    #: The packages holding the description, nearest first (:func:`enclosing_packages`): they
+    #: rank above every search folder, so the file's own package wins over one of its name on
+    #: the user's path or installed.
+    own_packages: tuple[tuple[str, Path], ...] = ()
     _index: dict[str, Path] = field(default_factory=dict, compare=False, repr=False)
     #: Crawled folders (folder, bare, flat) -> packages; shared by resolvers of one compilation.
     _crawls: dict[tuple[Path, bool, bool], dict[str, Path]] = field(
@@ -135,13 +155,20 @@ class PackageResolver:
         desc: Path | None = None
         roots: list[Path] = list(folders)
         strict: list[Path] = []
+        own: list[tuple[str, Path]] = []
         if description is not None:
             desc = Path(description).absolute()
-            near, package_roots = walk_up(Path(os.path.normpath(desc.parent)))
+            here = Path(os.path.normpath(desc.parent))
+            near, package_roots = walk_up(here)
             folders += near
-            strict += [Path(os.path.normpath(desc.parent)), *package_roots]
+            bare.append(here)  # a folder beside the robot file is found by its name
+            strict += [here, *package_roots]
             if not package_roots:
                 strict += description_root(desc)
+            project = marked_project(here)
+            if project is not None:  # the repository or package holding it (docs/security.md)
+                strict.append(project)
+            own = enclosing_packages(here, [*strict[1:], *_as_given(here, project)])
             roots += strict
         flat: list[Path] = []
         if use_example_robot_data:
@@ -161,6 +188,7 @@ class PackageResolver:
             flat_folders=_unique(Path(os.path.normpath(f)) for f in flat if f.is_dir()),
             missing_folders=missing,
             strict_roots=_unique(Path(os.path.normpath(r)) for r in strict),
+            own_packages=tuple(own),
             _crawls={} if share_crawls_with is None else share_crawls_with._crawls,
             _real_dirs={} if share_crawls_with is None else share_crawls_with._real_dirs,
         )
@@ -192,6 +220,8 @@ class PackageResolver:
         """The index itself (not a copy): lookups run once per mesh."""
         if not self._index:
             index: dict[str, Path] = {}
+            for name, path in self.own_packages:
+                index.setdefault(name, path)
             for folder in self.search_folders:
                 key = (folder, folder in self.bare_name_folders, folder in self.flat_folders)
                 found = self._crawls.get(key)

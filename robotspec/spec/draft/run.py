@@ -17,6 +17,24 @@ from robotspec.spec.draft.paths import portable_ref, relative_path
 __all__ = ["draft_from_files"]
 
 
+def _named_packages(desc: Description) -> dict[str, Path]:
+    """The packages a draft may write ``package://`` URIs of.
+
+    Why not all the resolver knows: around the description, a folder counts as a package by
+    its name alone so that the robot's own references resolve (``package://my_robot/...``
+    from ``my_robot/urdf/``), but ``package://urdf/robot.urdf`` would be no reference a person
+    writes or another tool finds; there a package needs its ``package.xml``.
+    """
+    resolver = desc.resolver
+    here = None if resolver.description is None else resolver.description.parent
+    listed = {f for f in resolver.bare_name_folders if f != here}  # -P, environment, installed
+    return {
+        name: folder
+        for name, folder in resolver.packages().items()
+        if (folder / "package.xml").is_file() or folder.parent in listed
+    }
+
+
 def draft_from_files(
     urdf: str,
     srdf: str | None,
@@ -30,7 +48,8 @@ def draft_from_files(
 
     References are ``package://`` URIs where the file is in a package the spec can find, else
     paths relative to ``folder``; packages found only beside the URDF get their parent folder
-    written into ``description.package_paths`` (relative too), so the spec works elsewhere.
+    written into ``description.package_paths`` (relative too), so the spec works elsewhere;
+    so are the folders given as ``package_paths`` (``-P``), which the spec needs as written.
     """
     from robotspec.files.packages import PackageResolver
 
@@ -38,9 +57,11 @@ def draft_from_files(
     desc = load_description(
         urdf, srdf=srdf, package_paths=package_paths, meshes="keep", base_folder=base
     )
-    findable = PackageResolver.create(None, extra_paths=package_paths).packages()
+    # What a spec finds without flags: the environment's packages and the installed data. The
+    # user's -P is not written anywhere else, so the folders it names go into package_paths.
+    findable = PackageResolver.create(None).packages()
     findable_roots = {p.resolve() for p in findable.values()}
-    packages = desc.resolver.packages()
+    packages = _named_packages(desc)
     extra_paths: list[str] = []
 
     def ref(given: str) -> str:
@@ -61,6 +82,11 @@ def draft_from_files(
         srdf_ref=None if srdf is None else ref(srdf),
         name=name or desc.world.name,
     )
+    for given in package_paths:
+        if Path(given).is_dir():
+            entry = relative_path(Path(given), folder)
+            if entry not in extra_paths:
+                extra_paths.append(entry)
     draft.package_paths = extra_paths
     if desc.srdf is not None:  # what the SRDF reader passed over as MoveIt does (a repeat)
         draft.notes += [

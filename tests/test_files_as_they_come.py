@@ -213,3 +213,36 @@ def test_init_with_p_writes_package_paths_so_the_spec_validates_as_written(
             assert run_app(app, ["validate", str(out)]) == 1
             assert mesh_path(out, (src,)).name == "base.stl"
         capsys.readouterr()
+
+
+# ------------------------------------------------------------------------------- real robots
+def test_the_shared_pr2_reads_its_own_package_not_the_installed_one() -> None:
+    from robotspec.files.packages import PackageResolver
+
+    from .conftest import SHARED, erd_robots
+
+    xacro = SHARED / "robots" / "pr2" / "pr2_description" / "robots" / "pr2.urdf.xacro"
+    if not xacro.is_file():
+        pytest.skip(f"{xacro} is absent (the shared robots are not on this machine)")
+    if not (erd_robots() / "pr2_description").is_dir():
+        pytest.skip("example-robot-data has no pr2_description to shadow it")
+    resolver = PackageResolver.create(xacro, extra_paths=[erd_robots()])  # even behind -P
+    assert resolver.find_package("pr2_description") == xacro.parents[1]
+
+
+def test_the_shared_ur5e_drafted_outside_its_project_validates_with_the_noted_p(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+
+    from .conftest import SHARED
+
+    xacro = SHARED / "robots" / "ur5e" / "ur_description" / "urdf" / "ur5e.xacro"
+    if not xacro.is_file():
+        pytest.skip(f"{xacro} is absent (the shared robots are not on this machine)")
+    out = tmp_path / "ur5e.yaml"
+    assert run_app(app, ["init", str(xacro), "-o", str(out)]) == 0
+    note = capsys.readouterr().err
+    allow = note.split("pass -P ", 1)[1].split(" ", 1)[0]
+    assert run_app(app, ["validate", str(out), "-P", allow]) == 0, capsys.readouterr()

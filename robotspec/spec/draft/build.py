@@ -340,20 +340,41 @@ class Drafter:
         """
         tree, world = self.tree, self.world
         root = tree.root
-        gripper, _ = find_gripper(tree, root)
+        # Where the fingers split: down the single moving branch from the root, through a mount
+        # (fixed joints) and a wrist (at most MAX_WRIST joints, drafted as a chain of its own).
+        split, wrist = root, []
+        while len(kids := tree.moving_children(split)) == 1:
+            c = world.parent_connection(kids[0])
+            if c is not None and c.is_active:
+                wrist.append(c.name)
+            split = kids[0]
+        if len(wrist) > MAX_WRIST:
+            split, wrist = root, []
+        gripper, _ = find_gripper(tree, split)
         # Fingers have phalanges: a branch of one joint (a rotor, a wheel) is not one.
         branches = [
             k
-            for k in tree.moving_children(root)
+            for k in tree.moving_children(split)
             if sum(1 for b in world.subtree(k) if not _fixed_above(world, b)) >= 2
         ]
-        named = any(is_named(b.name, HAND_WORDS | FINGER_WORDS) for b in world.subtree(root))
-        small = hand_span(tree, root) <= MAX_HAND_SPAN
+        named = any(is_named(b.name, HAND_WORDS | FINGER_WORDS) for b in world.subtree(split))
+        small = hand_span(tree, split) <= MAX_HAND_SPAN
         if gripper is None and not (len(branches) >= 2 and (small or named)):
             return None
-        holder = DraftChain("hand", root.name, root.name, "the URDF tree")
-        m = self.manipulator(holder, None, "gripper" if gripper else "hand", start=root)
-        if m is not None:
+        if wrist:
+            holder = DraftChain(
+                unique("wrist", self.names),
+                root.name,
+                split.name,
+                "the URDF tree",
+                joints=frozenset(wrist),
+                decide=[f"a wrist: {len(wrist)} joint(s) from the root to where the fingers split"],
+            )
+            self.draft.chains.append(holder)
+        else:
+            holder = DraftChain("hand", root.name, root.name, "the URDF tree")
+        m = self.manipulator(holder, None, "gripper" if gripper else "hand", start=split)
+        if m is not None and not wrist:
             m.decide.insert(0, "a hand alone (no arm): rooted at the robot's root")
             self.draft.lone_hand = m.name
         return m
@@ -408,6 +429,10 @@ class Drafter:
             m = self.manipulator(chain, limb, name, hand_start)
             if m is not None:
                 m.source = f"the SRDF end effector '{ee.name}' ({m.source})"
+
+
+#: Most joints between a lone hand's root and where its fingers split (a wrist, not an arm).
+MAX_WRIST = 3
 
 
 def _fixed_above(world: World, body: Body) -> bool:

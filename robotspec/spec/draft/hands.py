@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robotspec.model.entities import Body
+from robotspec.model.world import World
 from robotspec.spec.draft.limbs import FINGER_WORDS, HAND_WORDS, is_named
 from robotspec.spec.draft.model import DraftFinger
 from robotspec.spec.draft.tree import Tree, words
@@ -84,7 +85,23 @@ def _finger_tip(tree: Tree, branch: Body) -> Body:
     moved = [b for b in inside if (c := world.parent_connection(b)) is not None and not c.is_fixed]
     # A fixed tip link with geometry is the finger's tip (Baxter's 'r_gripper_l_finger_tip').
     solid = [b for b in inside if b.collisions or b.visuals]
-    return max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
+    tip = max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
+    # A bare frame the URDF fixes at the end of the last phalanx is the tip it names (Ability's
+    # 'index_tip', D'Claw's 'link_f1_head'): the only thing hanging there, nothing below it.
+    kids = world.child_bodies(tip)
+    if len(kids) == 1 and _bare_fixed_leaf(world, kids[0]):
+        return kids[0]
+    return tip
+
+
+def _bare_fixed_leaf(world: World, body: Body) -> bool:
+    c = world.parent_connection(body)
+    return (
+        c is not None
+        and c.is_fixed
+        and not world.child_bodies(body)
+        and not (body.collisions or body.visuals)
+    )
 
 
 def _dofs(tree: Tree, branch: Body) -> set[int]:
@@ -385,6 +402,16 @@ def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:
         for b in world.subtree(top)
         if b is not top and not world.child_bodies(b) and _own_geometry(b)
     ]
+    if not tips:  # tips the URDF names as bare frames at the fingers' ends (Ability's '*_tip')
+        tips = [
+            b
+            for b in world.subtree(top)
+            if b is not top
+            and _bare_fixed_leaf(world, b)
+            and (up := world.parent_connection(b)) is not None
+            and (c := world.parent_connection(world.bodies[up.parent])) is not None
+            and not c.is_fixed
+        ]
     if not tips:
         return None
     mid = np.mean([tree.poses[b.index][:3, 3] for b in tips], axis=0)

@@ -1,0 +1,117 @@
+"""Drafts of robot shapes met on the blind corpus's tune half (issue 30), each on a small layout.
+
+Each layout is the shape of a mistake the drafter made on real robots: read what the files
+already say (tip frames, tool frames, wheels) before guessing from names.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robotspec.compiler import check_spec
+from robotspec.spec.draft import Draft, render_draft
+from robotspec.spec.draft.run import draft_from_files
+
+_BOX = '<visual><geometry><box size="{s} {s} {s}"/></geometry></visual>'
+_WHEEL = (
+    '<visual><geometry><cylinder radius="0.1" length="0.04"/></geometry></visual>'
+    '<collision><geometry><cylinder radius="0.1" length="0.04"/></geometry></collision>'
+)
+
+
+def _link(name: str, geometry: str | None = None, size: float = 0.02) -> str:
+    inner = geometry if geometry is not None else _BOX.format(s=size)
+    return f'<link name="{name}">{inner}</link>'
+
+
+def _joint(
+    name: str,
+    parent: str,
+    child: str,
+    kind: str = "revolute",
+    xyz: str = "0 0 0.05",
+    axis: str = "0 1 0",
+    rpy: str = "0 0 0",
+) -> str:
+    limit = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    if kind == "prismatic":
+        limit = '<limit lower="0" upper="0.04" effort="1" velocity="1"/>'
+    moving = (
+        "" if kind == "fixed" else f'<axis xyz="{axis}"/>' + (limit if kind != "continuous" else "")
+    )
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}" rpy="{rpy}"/>{moving}</joint>'
+    )
+
+
+def _draft(tmp_path: Path, name: str, parts: list[str]) -> Draft:
+    urdf = tmp_path / f"{name}.urdf"
+    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
+    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
+    spec = tmp_path / f"{name}.yaml"
+    spec.write_text(render_draft(draft))
+    assert check_spec(spec).robot is not None  # valid as written
+    return draft
+
+
+def _finger(prefix: str, parent: str, xyz: str, tip: str) -> list[str]:
+    """A 2-joint finger from ``parent`` ending at a bare fixed frame ``tip``."""
+    return [
+        _link(f"{prefix}_1"),
+        _joint(f"{prefix}_q1", parent, f"{prefix}_1", xyz=xyz),
+        _link(f"{prefix}_2"),
+        _joint(f"{prefix}_q2", f"{prefix}_1", f"{prefix}_2", xyz="0 0 0.03"),
+        f'<link name="{tip}"/>',
+        _joint(f"{tip}_joint", f"{prefix}_2", tip, kind="fixed", xyz="0 0 0.03"),
+    ]
+
+
+def test_a_hand_on_a_mount_and_a_wrist_gets_its_wrist_chain_and_the_tip_frames(
+    tmp_path: Path,
+) -> None:
+    # The Shadow and Inspire hands: root, a fixed mount, a 2-joint wrist, then the palm where
+    # the fingers split; each finger ends at a bare frame the URDF names as its tip.
+    parts = [
+        _link("forearm", size=0.05),
+        _link("mount"),
+        _joint("mount_joint", "forearm", "mount", kind="fixed"),
+        _link("wrist"),
+        _joint("wrist_q1", "mount", "wrist", axis="1 0 0"),
+        _link("palm", size=0.05),
+        _joint("wrist_q2", "wrist", "palm"),
+        *_finger("thumb", "palm", "0.03 0.03 0.02", "thumb_tip"),
+        *_finger("index", "palm", "0.03 0 0.06", "index_tip"),
+        *_finger("middle", "palm", "0 0 0.06", "middle_tip"),
+        *_finger("ring", "palm", "-0.03 0 0.06", "ring_tip"),
+    ]
+    d = _draft(tmp_path, "wristhand", parts)
+    (wrist,) = d.chains
+    assert (wrist.root, wrist.tip, wrist.joints) == (
+        "forearm",
+        "palm",
+        frozenset({"wrist_q1", "wrist_q2"}),
+    )
+    (hand,) = d.manipulators
+    assert hand.is_hand and hand.thumb is not None and hand.thumb.tip == "thumb_tip"
+    assert {f.tip for f in hand.fingers.values()} == {"index_tip", "middle_tip", "ring_tip"}
+    # A tool frame between the tips, on the palm; the hand is on its wrist, not alone.
+    assert [f.parent for f in d.frames] == ["palm"] and hand.tool_frame == d.frames[0].name
+    assert wrist.manipulator == hand.name and d.lone_hand is None
+
+
+def test_a_hand_alone_behind_a_fixed_mount_is_a_hand(tmp_path: Path) -> None:
+    # The Ability hand: base_link -> base -> palm (fixed joints), then five fingers.
+    parts = [
+        _link("base_link", size=0.05),
+        _link("palm", size=0.05),
+        _joint("mount", "base_link", "palm", kind="fixed"),
+        *_finger("thumb", "palm", "0.03 0.03 0.02", "thumb_tip"),
+        *_finger("index", "palm", "0.03 0 0.06", "index_tip"),
+        *_finger("middle", "palm", "0 0 0.06", "middle_tip"),
+    ]
+    d = _draft(tmp_path, "mounted", parts)
+    assert d.chains == []
+    (hand,) = d.manipulators
+    assert hand.is_hand and hand.root == "palm" and d.lone_hand == hand.name
+    assert hand.thumb is not None and hand.thumb.tip == "thumb_tip"

@@ -13,9 +13,10 @@ from robotspec.spec.draft import Draft, render_draft
 from robotspec.spec.draft.run import draft_from_files
 
 _BOX = '<visual><geometry><box size="{s} {s} {s}"/></geometry></visual>'
+#: A wheel's shape: a flat cylinder about the link's y axis.
 _WHEEL = (
-    '<visual><geometry><cylinder radius="0.1" length="0.04"/></geometry></visual>'
-    '<collision><geometry><cylinder radius="0.1" length="0.04"/></geometry></collision>'
+    '<collision><origin rpy="1.5708 0 0"/>'
+    '<geometry><cylinder radius="0.1" length="0.04"/></geometry></collision>'
 )
 
 
@@ -115,3 +116,21 @@ def test_a_hand_alone_behind_a_fixed_mount_is_a_hand(tmp_path: Path) -> None:
     (hand,) = d.manipulators
     assert hand.is_hand and hand.root == "palm" and d.lone_hand == hand.name
     assert hand.thumb is not None and hand.thumb.tip == "thumb_tip"
+
+
+def test_two_wheels_are_no_gripper(tmp_path: Path) -> None:
+    # Freight, TurtleBot3: a base whose two moving branches are wheels (continuous joints about
+    # a level axis, each turning a flat cylinder), named as nothing in particular.
+    parts = [
+        _link("chassis", size=0.3),
+        _link("left_roller", _WHEEL),
+        _joint("left_j", "chassis", "left_roller", "continuous", "0 0.2 0", "0 1 0"),
+        _link("left_hub"),
+        _joint("left_hub_j", "left_roller", "left_hub", "fixed", "0 0.02 0"),
+        _link("right_roller", _WHEEL),
+        _joint("right_j", "chassis", "right_roller", "continuous", "0 -0.2 0", "0 1 0"),
+        _link("right_hub"),
+        _joint("right_hub_j", "right_roller", "right_hub", "fixed", "0 -0.02 0"),
+    ]
+    d = _draft(tmp_path, "rover", parts)
+    assert d.manipulators == [] and d.frames == []

@@ -13,7 +13,7 @@ import numpy as np
 from robotspec.description.srdf import Srdf
 from robotspec.model.entities import Body
 from robotspec.model.world import World
-from robotspec.spec.draft.base import own_base, own_drive
+from robotspec.spec.draft.base import own_base, own_drive, wheel_joints
 from robotspec.spec.draft.hands import (
     Gripper,
     facing_quaternion,
@@ -351,11 +351,20 @@ class Drafter:
         if len(wrist) > MAX_WRIST:
             split, wrist = root, []
         gripper, _ = find_gripper(tree, split)
+        # Wheels (continuous joints about a level axis turning a wheel's shape) are never fingers.
+        wheels = {c.child for c in wheel_joints(world)}
+
+        def rolls(body: Body) -> bool:
+            return any(a.index in wheels for a in (*world.ancestors(body), body))
+
+        if gripper is not None and (rolls(gripper.thumb_tip) or rolls(gripper.finger_tip)):
+            gripper = None
         # Fingers have phalanges: a branch of one joint (a rotor, a wheel) is not one.
         branches = [
             k
             for k in tree.moving_children(split)
             if sum(1 for b in world.subtree(k) if not _fixed_above(world, b)) >= 2
+            and not any(b.index in wheels for b in world.subtree(k))
         ]
         named = any(is_named(b.name, HAND_WORDS | FINGER_WORDS) for b in world.subtree(split))
         small = hand_span(tree, split) <= MAX_HAND_SPAN

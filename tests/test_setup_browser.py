@@ -29,16 +29,19 @@ FLAGS = (
     "--headless --no-sandbox --disable-gpu --disable-background-networking "
     "--disable-component-update --disable-sync --no-first-run --use-angle=swiftshader "
     "--enable-unsafe-swiftshader "
-    # A tab in the background must keep up (the test checks the second tab last): by default
-    # Chromium lowers a background renderer's priority and throttles its timers, and on a busy
-    # machine such a tab then gets no CPU at all ("timed out waiting for the second tab";
-    # chromedriver itself timed out reading it, issue 31). Puppeteer passes the same flags.
+    # The second tab waits in the background: by default Chromium lowers a background
+    # renderer's priority and throttles its timers, which on a busy machine starves it further
+    # (issue 31; what it still has to catch up on is waited for in the test). Puppeteer passes
+    # the same flags.
     "--disable-background-timer-throttling --disable-renderer-backgrounding "
     "--disable-backgrounding-occluded-windows"
 ).split()
 #: How long any one thing on the page is waited for. It bounds a hang only: each takes well
 #: under 2 s on an idle machine, and many times that with every core busy (issue 31).
 HANG = 120.0
+#: The same for a background tab brought to the front (see the test) and for any one
+#: chromedriver command (selenium's own default, 120 s, cut such a tab short).
+CATCH_UP = 600.0
 #: Small, so software WebGL keeps up; the docs' screenshots are taken larger.
 WINDOW = "1400,900" if os.environ.get("ROBOTSPEC_DOC_SCREENSHOTS") == "1" else "1000,680"
 
@@ -63,6 +66,7 @@ def driver(tmp_path: Path) -> Iterator[Any]:
     for flag in (*FLAGS, f"--window-size={WINDOW}", f"--user-data-dir={tmp_path / 'profile'}"):
         opts.add_argument(flag)
     d = selenium.Chrome(service=Service(chromedriver), options=opts)
+    d.command_executor.client_config.timeout = CATCH_UP
     try:
         yield d
     finally:
@@ -71,15 +75,19 @@ def driver(tmp_path: Path) -> Iterator[Any]:
 
 def _wait(what: str, cond: Callable[[], Any], timeout: float = HANG) -> Any:
     end = time.monotonic() + timeout
+    error: Exception | None = None
+    tries = 0
     while time.monotonic() < end:
+        tries += 1
         try:
             got = cond()
-        except Exception:  # noqa: BLE001 - the page is still drawing; ask again
-            got = None
+        except Exception as exc:  # noqa: BLE001 - the page is still drawing; ask again
+            got, error = None, exc
         if got:
             return got
         time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}")
+    last = f"; the last error: {type(error).__name__}: {str(error)[:300]}" if error else ""
+    raise AssertionError(f"timed out waiting for {what} ({tries} tries in {timeout:g} s{last})")
 
 
 def _robot_pixels(d: Any, pause: float = 0.0) -> tuple[int, int] | None:
@@ -206,17 +214,32 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         d.get(page.url)
         second = d.current_window_handle
         d.switch_to.window(first)
+        d.execute_cdp_cmd("Page.bringToFront", {})  # the tab the user works in
         centre = _wait("the robot drawn", lambda: _robot_pixels(d, pause=0.4))
         first_picture = time.perf_counter() - started
         _shot(d, "setup-questions.png")
 
         # A click on the robot picks the link under the pointer, in the page and the tree.
         body = d.find_element(By.TAG_NAME, "body")
-        ActionChains(d).move_to_element_with_offset(body, 0, 0).perform()
         size = body.size
-        dx, dy = centre[0] - size["width"] // 2, centre[1] - size["height"] // 2
-        ActionChains(d).move_to_element_with_offset(body, dx, dy).click().perform()
-        picked = _wait("a link picked by a click", lambda: page.selected)
+        first_spot = [centre]
+
+        def click_robot() -> str | None:
+            """Click the robot while nothing is picked, where it is drawn now: on a busy machine
+            a click missed now and then (the view still moving; issue 31). Again is harmless."""
+            if page.selected is not None:
+                return page.selected
+            at = first_spot.pop() if first_spot else _robot_pixels(d, pause=0.4)
+            if at is not None:
+                dx, dy = at[0] - size["width"] // 2, at[1] - size["height"] // 2
+                ActionChains(d).move_to_element_with_offset(body, 0, 0).perform()
+                ActionChains(d).move_to_element_with_offset(body, dx, dy).click().perform()
+                end = time.monotonic() + 5.0
+                while page.selected is None and time.monotonic() < end:
+                    time.sleep(0.1)
+            return page.selected
+
+        picked = _wait("a link picked by a click", click_robot)
         assert picked.startswith("link")
         _wait("the pick shown", lambda: page._link.value == picked)
         # Software WebGL redraws the scene without end; hidden, it leaves the CPU to the page.
@@ -270,14 +293,18 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         _wait("save shown", lambda: "accepts it" in body.text)
         _shot(d, "setup-saved.png")
         # The second tab shows the one state: every answer, the pick, the save.
+        # Brought to the front, as a user looks at it, a background tab first works through
+        # what it was sent meanwhile: seconds at rest, minutes with every core busy (measured:
+        # its first answer to chromedriver after 147-214 s under three burners; issue 31).
         d.switch_to.window(second)
-        d.execute_cdp_cmd("Page.bringToFront", {})  # as a user looks at it
+        d.execute_cdp_cmd("Page.bringToFront", {})
         _wait(
             "the second tab",
             lambda: (
                 "0 open questions" in (t := d.find_element(By.TAG_NAME, "body").text)
                 and "saved" in t
             ),
+            CATCH_UP,
         )
     except Exception:
         d.save_screenshot(str(tmp_path / "failure.png"))  # kept by pytest, to look at

@@ -134,3 +134,72 @@ def test_two_wheels_are_no_gripper(tmp_path: Path) -> None:
     ]
     d = _draft(tmp_path, "rover", parts)
     assert d.manipulators == [] and d.frames == []
+
+
+def _arm(end: str) -> list[str]:
+    """A base and a 4-joint arm ending at ``end``."""
+    parts = [_link("base", size=0.1)]
+    parent = "base"
+    for i, axis in enumerate(("0 0 1", "0 1 0", "0 1 0", "0 0 1"), 1):
+        child = end if i == 4 else f"link{i}"
+        parts += [_link(child, size=0.04), _joint(f"j{i}", parent, child, xyz="0 0 0.2", axis=axis)]
+        parent = child
+    return parts
+
+
+def _jaws(root: str, half_width: float) -> list[str]:
+    """Two prismatic jaws below ``root``, at +-``half_width`` along y, reaching 5 cm out."""
+    parts = []
+    for side, sign in (("left", 1), ("right", -1)):
+        parts += [
+            _link(f"{side}_jaw", '<visual><origin xyz="0 0 0.05"/>'
+                  '<geometry><box size="0.01 0.01 0.1"/></geometry></visual>'),
+            _joint(f"{side}_jaw_q", root, f"{side}_jaw", "prismatic",
+                   f"0 {sign * half_width} 0", f"0 {sign} 0"),
+        ]  # fmt: skip
+    return parts
+
+
+def test_a_tcp_beside_the_gripper_on_its_mount_is_the_tool_frame(tmp_path: Path) -> None:
+    # Kinova Gen3 lite: the wrist carries a mount; on it hang 'tool_frame' and the gripper.
+    parts = [
+        *_arm("wrist"),
+        _link("mount"),
+        _joint("mount_joint", "wrist", "mount", "fixed"),
+        '<link name="tool_frame"/>',
+        _joint("tool_frame_joint", "mount", "tool_frame", "fixed", "0 0 0.13"),
+        _link("gripper_base", size=0.04),
+        _joint("gripper_base_joint", "mount", "gripper_base", "fixed"),
+        *_jaws("gripper_base", 0.03),
+    ]
+    d = _draft(tmp_path, "tcpbeside", parts)
+    (m,) = d.manipulators
+    assert m.is_gripper and m.tool_frame == "tool_frame" and m.root == "mount"
+    assert d.frames == []
+
+
+def test_a_gripper_link_between_its_finger_tips_is_the_tool_frame(tmp_path: Path) -> None:
+    # Fetch: the fingers slide from 'gripper_link' symmetrically; their tips' midpoint is it.
+    parts = [
+        *_arm("wrist"),
+        _link("gripper_link", size=0.04),
+        _joint("gripper_joint", "wrist", "gripper_link", "fixed", "0 0 0.1"),
+        *_jaws("gripper_link", 0.03),
+    ]
+    d = _draft(tmp_path, "between", parts)
+    (m,) = d.manipulators
+    assert m.is_gripper and m.tool_frame == "gripper_link" and d.frames == []
+    assert any("between the finger tips" in r for r in m.decide)
+
+
+def test_the_one_frame_fixed_on_a_fingerless_hand_is_its_tool_frame(tmp_path: Path) -> None:
+    # iCub's rigid hands: 'l_hand' carries one bare frame, 'l_hand_dh_frame'.
+    parts = [
+        *_arm("l_hand"),
+        '<link name="l_hand_dh_frame"/>',
+        _joint("l_hand_dh_joint", "l_hand", "l_hand_dh_frame", "fixed", "0 0 0.06"),
+    ]
+    d = _draft(tmp_path, "rigid", parts)
+    (m,) = d.manipulators
+    assert m.tool_frame == "l_hand_dh_frame" and d.frames == []
+    assert any("one frame fixed on the hand" in r for r in m.decide)

@@ -229,6 +229,19 @@ class Drafter:
         )
         prefer = None if gripper is None else gripper.root
         tool = find_tool_frame(tree, top, others, prefer)
+        # A TCP the URDF hangs beside the gripper, on the mount that carries it (Kinova's
+        # 'tool_frame' on 'dummy_link', next to 'gripper_base_link'): the mount is the root.
+        mount = top
+        while tool is None and gripper is not None and mount is not tip:
+            up = world.parent_connection(mount)
+            if up is None or not up.is_fixed:
+                break
+            mount = world.bodies[up.parent]
+            tool = find_tool_frame(tree, mount, others, prefer)
+            if tool is not None and (world.child_bodies(tool) or world.is_ancestor(tool, top)):
+                tool = None  # the mount itself, a flange above the gripper: not beside it
+            if tool is not None:
+                top = mount
         # A tool frame above the hand (a flange, a wrist F/T sensor) only when the hand has no
         # tips to put one between.
         tipless = hand is None or hand_center(tree, top) is None
@@ -251,12 +264,18 @@ class Drafter:
             ] / 2
             local = np.linalg.inv(tree.poses[gripper.root.index]) @ np.append(mid, 1.0)
             xyz = (round(float(local[0]), 4), round(float(local[1]), 4), round(float(local[2]), 4))
-            frame = DraftFrame(
-                tool_name,
-                gripper.root.name,
-                xyz,
-                "the URDF has no tool frame: between the finger tips in the default pose",
-            )
+            if float(np.linalg.norm(local[:3])) < ON_ROOT:
+                # The gripper's own link sits between its finger tips (Fetch's 'gripper_link'):
+                # it is the tool frame the URDF has, not a new one at the same place.
+                tool_name = gripper.root.name
+                decide.append(f"the tool frame '{tool_name}': between the finger tips")
+            else:
+                frame = DraftFrame(
+                    tool_name,
+                    gripper.root.name,
+                    xyz,
+                    "the URDF has no tool frame: between the finger tips in the default pose",
+                )
         elif hand is not None and (center := hand_center(tree, top)) is not None:
             tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))
             frame = DraftFrame(
@@ -265,6 +284,11 @@ class Drafter:
                 center,
                 "the URDF has no tool frame: between the hand's tips in the default pose",
             )
+        elif hand is not None and len(marks := _bare_frames(world, top)) == 1:
+            # A fingerless hand with one frame fixed on it (iCub's 'l_hand_dh_frame'): the frame
+            # the URDF gives the hand, whatever its name.
+            tool_name = marks[0].name
+            decide.append(f"the tool frame '{tool_name}': the one frame fixed on the hand")
         else:
             tool_name = top.name
             decide.append("no tool frame link found; add one under description.frames")
@@ -440,8 +464,21 @@ class Drafter:
                 m.source = f"the SRDF end effector '{ee.name}' ({m.source})"
 
 
+#: A point between the finger tips this close to the gripper's link (m) is that link.
+ON_ROOT = 0.01
 #: Most joints between a lone hand's root and where its fingers split (a wrist, not an arm).
 MAX_WRIST = 3
+
+
+def _bare_frames(world: World, body: Body) -> list[Body]:
+    """The frames fixed on ``body``: children on fixed joints, without geometry or children."""
+    out = []
+    for k in world.child_bodies(body):
+        c = world.parent_connection(k)
+        if c is not None and c.is_fixed and not world.child_bodies(k):
+            if not (k.collisions or k.visuals):
+                out.append(k)
+    return out
 
 
 def _fixed_above(world: World, body: Body) -> bool:

@@ -409,6 +409,7 @@ def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:
             if b is not top
             and _bare_fixed_leaf(world, b)
             and (up := world.parent_connection(b)) is not None
+            and up.parent != top.index  # on a finger, not on the hand itself
             and (c := world.parent_connection(world.bodies[up.parent])) is not None
             and not c.is_fixed
         ]

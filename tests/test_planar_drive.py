@@ -261,6 +261,27 @@ def test_two_wheels_make_the_planar_joint_differential(tmp_path: Path) -> None:
     assert d.drive is not None and d.drive.type == "differential"
 
 
+def caster(name: str, x: float, y: float) -> str:
+    """A swivel (continuous, vertical axis) holding a wheel that rolls about a level axis."""
+    rolling = wheel(f"{name}_roll", 0, 0)
+    rolling = rolling.replace('parent link="base_link"', f'parent link="{name}"')
+    return f"""
+  <link name="{name}"/>
+  <joint name="{name}_swivel" type="continuous"><parent link="base_link"/><child link="{name}"/>
+    <origin xyz="{x} {y} -0.05"/><axis xyz="0 0 1"/></joint>{rolling}"""
+
+
+def test_casters_beside_two_driven_wheels_keep_the_base_differential(tmp_path: Path) -> None:
+    from robotspec.spec.draft.base import wheel_joints
+
+    two = wheel("left_drive", 0, 0.2) + wheel("right_drive", 0, -0.2)
+    casters = "".join(caster(n, x, y) for n, x, y in [("cb", -0.2, 0.15), ("cf", 0.2, -0.15)])
+    urdf = planar_urdf(two + casters)
+    assert [c.name for c in wheel_joints(world_of(urdf))] == ["left_drive", "right_drive"]
+    d = drafted(tmp_path, urdf)
+    assert d.drive is not None and d.drive.type == "differential"
+
+
 def test_a_spinning_part_about_a_vertical_axis_is_no_wheel(tmp_path: Path) -> None:
     from robotspec.spec.draft.base import wheel_joints
 

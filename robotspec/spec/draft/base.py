@@ -110,6 +110,20 @@ def _wheel_shaped(body: Body, axis: np.ndarray) -> bool:
     return False
 
 
+def _on_a_swivel(world: World, c: Connection) -> bool:
+    """Whether the wheel joint ``c`` hangs from a body another turning joint moves (a caster).
+
+    Why: a caster's wheel is a flat cylinder on a level continuous joint like a driven wheel,
+    but it follows its swivel; counting it made a two-wheeled base with four casters (TIAGo)
+    look like a six-wheeled omni base.
+    """
+    above = world.parent_connection(world.bodies[c.parent])
+    return above is not None and above.type in (
+        ConnectionType.CONTINUOUS,
+        ConnectionType.REVOLUTE,
+    )
+
+
 def wheel_joints(world: World) -> list[Connection]:
     """The joints that turn wheels: named so, or continuous and wheel-shaped about a level axis.
 
@@ -129,6 +143,8 @@ def wheel_joints(world: World) -> list[Connection]:
             continue
         if c.type is not ConnectionType.CONTINUOUS:
             continue
+        if _on_a_swivel(world, c):
+            continue  # a caster's wheel: it rolls where its swivel lets it, nobody drives it
         axis = np.asarray(c.axis, dtype=np.float64)
         if not _wheel_shaped(world.bodies[c.child], axis):
             continue

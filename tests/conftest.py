@@ -60,3 +60,22 @@ def all_pairs_checker(name: str) -> object:
     names = tuple(b.name for b in robot.bodies_with_collisions)
     pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
     return SelfCollisionChecker(robot.world, CollisionRules(bodies=names), pairs=pairs)
+
+
+#: YAML is read with libyaml where PyYAML has it, else in Python: tests of the reader run both.
+PARSERS = ["libyaml", "python"]
+
+
+@pytest.fixture(params=PARSERS)
+def parser(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
+    """Which YAML parser robotspec's reader uses in this test (both, one after the other)."""
+    import yaml
+
+    from robotspec.files import yamlio
+
+    if request.param == "libyaml":
+        if not hasattr(yaml, "CSafeLoader"):
+            pytest.skip("this PyYAML was built without libyaml")
+    else:
+        monkeypatch.setattr(yamlio, "_SafeComposer", yamlio._PySafeComposer)
+    return str(request.param)

@@ -14,18 +14,6 @@ from hypothesis import strategies as st
 from robotspec.errors import RobotSpecError
 from robotspec.files import yamlio
 
-PARSERS = ["libyaml", "python"]
-
-
-@pytest.fixture(params=PARSERS)
-def parser(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
-    if request.param == "libyaml":
-        if not hasattr(yaml, "CSafeLoader"):
-            pytest.skip("this PyYAML was built without libyaml")
-    else:
-        monkeypatch.setattr(yamlio, "_SafeComposer", yamlio._PySafeComposer)
-    return str(request.param)
-
 
 @pytest.mark.parametrize("depth", [101, 1_001, 5_000, 50_000])
 def test_deep_nesting_is_refused_at_the_limit_with_its_place(parser: str, depth: int) -> None:

@@ -23,18 +23,6 @@ from robotspec.errors import RobotSpecError
 from robotspec.files import yamlio
 from robotspec.spec.load import load_spec
 
-PARSERS = ["libyaml", "python"]
-
-
-@pytest.fixture(params=PARSERS)
-def parser(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
-    if request.param == "libyaml":
-        if not hasattr(yaml, "CSafeLoader"):
-            pytest.skip("this PyYAML was built without libyaml")
-    else:
-        monkeypatch.setattr(yamlio, "_SafeComposer", yamlio._PySafeComposer)
-    return str(request.param)
-
 
 def load(text: str) -> Any:
     return yamlio.load_yaml_text(text, "f.yaml").data

@@ -203,3 +203,43 @@ def test_the_one_frame_fixed_on_a_fingerless_hand_is_its_tool_frame(tmp_path: Pa
     (m,) = d.manipulators
     assert m.tool_frame == "l_hand_dh_frame" and d.frames == []
     assert any("one frame fixed on the hand" in r for r in m.decide)
+
+
+def test_init_drafts_a_xacro_as_configured_by_its_arguments(tmp_path: Path) -> None:
+    # Franka's fr3.urdf.xacro adds the hand only with hand:=true: `--xacro-arg` drafts the robot
+    # as configured, and the draft keeps the arguments so that it loads the same robot.
+    import yaml
+
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+
+    arm = "".join(_arm("wrist"))
+    jaws = "".join(
+        [
+            _link("gripper_base", size=0.04),
+            _joint("gripper_base_joint", "wrist", "gripper_base", "fixed"),
+            *_jaws("gripper_base", 0.03),
+        ]
+    )
+    xacro = tmp_path / "arm.urdf.xacro"
+    xacro.write_text(
+        '<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:arg name="hand" default="false"/>'
+        f'{arm}<xacro:if value="$(arg hand)">{jaws}</xacro:if></robot>'
+    )
+    out = tmp_path / "arm.yaml"
+    argv = ["init", str(xacro), "-o", str(out), "--xacro-arg", "hand=true"]
+    assert run_app(app, argv) == 0
+    data = yaml.safe_load(out.read_text())
+    assert data["description"]["xacro_args"] == {"hand": "true"}
+    (m,) = data["manipulators"].values()
+    assert m["type"] == "parallel_gripper"
+    assert check_spec(out).robot is not None  # valid as written, with the hand
+    # Without the argument: the xacro's default, no hand; a malformed argument is refused.
+    plain = tmp_path / "plain.yaml"
+    assert run_app(app, ["init", str(xacro), "-o", str(plain)]) == 0
+    assert "xacro_args" not in yaml.safe_load(plain.read_text())["description"]
+    assert (
+        run_app(app, ["init", str(xacro), "-o", str(tmp_path / "x.yaml"), "--xacro-arg", "hand"])
+        == 2
+    )

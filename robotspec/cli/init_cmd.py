@@ -16,6 +16,17 @@ from robotspec.cli.output import plural
 app = typer.Typer()
 
 
+def _xacro_args(values: list[str]) -> dict[str, str]:
+    """``--xacro-arg NAME=VALUE`` options as a map (a later repeat of a name wins)."""
+    out: dict[str, str] = {}
+    for value in values:
+        key, eq, val = value.partition("=")
+        if not eq or not key.strip():
+            raise typer.BadParameter(f"{value!r} is not NAME=VALUE", param_hint="'--xacro-arg'")
+        out[key.strip()] = val
+    return out
+
+
 @app.command()
 def init(
     urdf: Annotated[str, typer.Argument(help="The robot's URDF or xacro (path or package://).")],
@@ -30,6 +41,15 @@ def init(
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
     package_path: PackagePath = None,
+    xacro_arg: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--xacro-arg",
+            help="A xacro argument NAME=VALUE (repeatable); written into the draft's "
+            "description.xacro_args.",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Draft a spec: arms, grippers, cameras, neck, torso and drive, from the SRDF and the tree.
 
@@ -46,13 +66,19 @@ def init(
     from robotspec.spec.draft.run import draft_from_files
     from robotspec.spec.load import spec_may_name
 
+    xacro_args = _xacro_args(xacro_arg or [])
     # The robot's own files are never replaced (``-o robot.urdf``); checked before the work.
     inputs = description_inputs(urdf, srdf, package_paths=package_path or ())
     if output is not None:
         check_writable(output, force=force, inputs=inputs)
     folder = (output.parent if output is not None else Path.cwd()).resolve()
     draft, _ = draft_from_files(
-        urdf, srdf, folder=folder, package_paths=package_path or (), name=name
+        urdf,
+        srdf,
+        folder=folder,
+        package_paths=package_path or (),
+        name=name,
+        xacro_args=xacro_args,
     )
     text = render_draft(draft, presets=camera_presets())
     if write_output(text, output, force=force, inputs=inputs):

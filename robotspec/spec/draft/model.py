@@ -144,6 +144,8 @@ class Draft:
     frames: list[DraftFrame] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     package_paths: list[str] = field(default_factory=list)
+    #: The xacro arguments the robot was drafted with (``description.xacro_args``).
+    xacro_args: dict[str, str] = field(default_factory=dict)
     states: dict[str, JointState] = field(default_factory=dict)
     #: The manipulator of a hand or gripper drafted alone (no arm carries it), if one was.
     lone_hand: str | None = None

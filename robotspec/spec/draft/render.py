@@ -153,6 +153,9 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
     out.append(f"  urdf: {scalar(d.urdf)}")
     if d.srdf:
         out.append(f"  srdf: {scalar(d.srdf)}")
+    if d.xacro_args:
+        args = ", ".join(f"{scalar(k)}: {scalar(v)}" for k, v in d.xacro_args.items())
+        out.append(f"  xacro_args: {{{args}}}")
     if d.package_paths:
         out.append("  # Folders holding the packages named above (relative to this file).")
         out.append("  package_paths: [" + ", ".join(scalar(p) for p in d.package_paths) + "]")

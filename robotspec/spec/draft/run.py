@@ -6,7 +6,7 @@ very drafts users get.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from robotspec.description.load import Description, load_description
@@ -43,6 +43,7 @@ def draft_from_files(
     package_paths: Sequence[str | Path] = (),
     name: str | None = None,
     base_folder: Path | None = None,
+    xacro_args: Mapping[str, str] | None = None,
 ) -> tuple[Draft, Description]:
     """The draft of a spec to be written in ``folder``, and the files it was drafted from.
 
@@ -50,12 +51,18 @@ def draft_from_files(
     paths relative to ``folder``; packages found only beside the URDF get their parent folder
     written into ``description.package_paths`` (relative too), so the spec works elsewhere;
     so are the folders given as ``package_paths`` (``-P``), which the spec needs as written.
+    ``xacro_args`` are passed to xacro and written into ``description.xacro_args``.
     """
     from robotspec.files.packages import PackageResolver
 
     base = base_folder or Path.cwd()
     desc = load_description(
-        urdf, srdf=srdf, package_paths=package_paths, meshes="keep", base_folder=base
+        urdf,
+        srdf=srdf,
+        package_paths=package_paths,
+        xacro_args=xacro_args,
+        meshes="keep",
+        base_folder=base,
     )
     # What a spec finds without flags: the environment's packages and the installed data. The
     # user's -P is not written anywhere else, so the folders it names go into package_paths.
@@ -88,6 +95,7 @@ def draft_from_files(
             if entry not in extra_paths:
                 extra_paths.append(entry)
     draft.package_paths = extra_paths
+    draft.xacro_args = dict(xacro_args or {})
     if desc.srdf is not None:  # what the SRDF reader passed over as MoveIt does (a repeat)
         draft.notes += [
             f"{Path(w.file or '').name}:{w.line}: {w.message}" for w in desc.srdf.warnings

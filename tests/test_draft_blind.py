@@ -243,3 +243,70 @@ def test_init_drafts_a_xacro_as_configured_by_its_arguments(tmp_path: Path) -> N
         run_app(app, ["init", str(xacro), "-o", str(tmp_path / "x.yaml"), "--xacro-arg", "hand"])
         == 2
     )
+
+
+def test_an_arm_ending_where_its_fingers_split_ends_there_whatever_the_palm_is_named(
+    tmp_path: Path,
+) -> None:
+    # xArm7 with the Ability hand: the arm's flange carries 'thumb_base', which carries every
+    # finger; a palm named after the thumb is still the hand, not a finger ending the arm.
+    parts = [
+        *_arm("link4"),
+        _link("thumb_base", size=0.05),
+        _joint("wrist2thumb", "link4", "thumb_base", "fixed", "0 0 0.03"),
+        *_finger("thumb", "thumb_base", "0.03 0.03 0.02", "thumb_tip"),
+        *_finger("index", "thumb_base", "0.03 0 0.06", "index_tip"),
+        *_finger("middle", "thumb_base", "0 0 0.06", "middle_tip"),
+    ]
+    d = _draft(tmp_path, "palmthumb", parts)
+    (arm,) = d.chains
+    assert (arm.role, arm.root, arm.tip) == ("arm", "base", "link4")
+    (hand,) = d.manipulators
+    assert hand.is_hand and hand.thumb is not None and hand.thumb.tip == "thumb_tip"
+
+
+def _draft_srdf(tmp_path: Path, name: str, parts: list[str], groups: str) -> Draft:
+    urdf = tmp_path / f"{name}.urdf"
+    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
+    srdf = tmp_path / f"{name}.srdf"
+    srdf.write_text(f'<robot name="{name}">{groups}</robot>')
+    draft, _ = draft_from_files(str(urdf), str(srdf), folder=tmp_path, base_folder=tmp_path)
+    spec = tmp_path / f"{name}.yaml"
+    spec.write_text(render_draft(draft))
+    assert check_spec(spec).robot is not None  # valid as written
+    return draft
+
+
+def test_srdf_groups_are_evidence_not_the_answer(tmp_path: Path) -> None:
+    # A mobile manipulator's SRDF: an 'arm' group the tree confirms, a one-joint 'gripper'
+    # group, a 'base' group of the URDF's own x, y and theta base joints.
+    parts = [
+        *_arm("wrist"),
+        _link("jaw_base", size=0.04),
+        _joint("jaw_base_joint", "wrist", "jaw_base", "fixed"),
+        *_jaws("jaw_base", 0.03),
+        '<link name="odom"/><link name="odom_x"/><link name="odom_y"/>',
+        _joint("x_j", "odom", "odom_x", "prismatic", "0 0 0", "1 0 0"),
+        _joint("y_j", "odom_x", "odom_y", "prismatic", "0 0 0", "0 1 0"),
+        _joint("theta_j", "odom_y", "base", "continuous", "0 0 0", "0 0 1"),
+    ]
+    groups = (
+        '<group name="arm"><chain base_link="base" tip_link="wrist"/></group>'
+        '<group name="gripper"><joint name="left_jaw_q"/></group>'
+        '<group name="base"><chain base_link="odom" tip_link="base"/></group>'
+    )
+    d = _draft_srdf(tmp_path, "mobile", parts, groups)
+    # Neither the one-joint gripper group nor the base group is a chain.
+    assert [c.srdf_group for c in d.chains] == ["arm"]
+    assert any("'gripper' moves one joint" in n for n in d.notes)
+    assert any("'base' moves the base" in n for n in d.notes)
+    # The group the tree confirms is stated, and the gripper beside the base is the arm's, a
+    # parallel gripper (not a generic tool).
+    (arm,) = d.chains
+    assert arm.role == "arm" and not arm.decide
+    (m,) = d.manipulators
+    assert m.is_gripper and arm.manipulator == m.name
+    # A group the tree does not confirm (two of the arm's four joints) is a question.
+    sweep = '<group name="sweep"><joint name="j2"/><joint name="j3"/></group>'
+    (part,) = _draft_srdf(tmp_path, "sweep", parts, sweep).chains
+    assert part.srdf_group == "sweep" and part.decide

@@ -151,7 +151,23 @@ class Drafter:
             joins = _SubsetIndex([lb.joints for lb in limbs] + [gc.joints for gc in found])
             accepted: set[frozenset[str]] = set()
             hands = [lb.hand for lb in limbs if lb.hand is not None]
+            base = own_base(self.world)
+            base_joints = {c.name for c in wheel_joints(self.world)}
+            if base is not None:
+                base_joints |= set(base.joints or ()) | ({base.planar} if base.planar else set())
             for gc in found:
+                # A group is evidence of what a planner moves together, not of what the part
+                # is: one joint is a gripper's or a tool's, the base's joints are the drive.
+                if len(gc.joints) == 1:
+                    self.draft.notes.append(
+                        f"SRDF group {gc.group.name!r} moves one joint: not drafted as a chain"
+                    )
+                    continue
+                if gc.joints <= base_joints:
+                    self.draft.notes.append(
+                        f"SRDF group {gc.group.name!r} moves the base: the drive, not a chain"
+                    )
+                    continue
                 if gc.joints in accepted or joins.has_strict_subset(gc.joints):
                     self.draft.notes.append(
                         f"SRDF group {gc.group.name!r} joins or repeats other chains; not drafted"
@@ -177,6 +193,12 @@ class Drafter:
                     srdf_group=gc.group.name,
                     joints=gc.joints,
                 )
+                if limb is None or limb.joints != gc.joints:
+                    # The tree does not confirm the group as an arm or a leg of these joints.
+                    c.decide.append(
+                        "the SRDF groups these joints; the tree finds "
+                        + ("no arm or leg there" if limb is None else f"a {limb.kind} of others")
+                    )
                 out.append((c, limb))
         rest = [lb for i, lb in enumerate(limbs) if i not in used]
         for kind in ("arm", "leg"):

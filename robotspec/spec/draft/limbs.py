@@ -130,7 +130,10 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     actuated = [c for c in moving if c.is_active]
     # Two joints make a leg when its links say so (Solo-8's hip and knee: 'FL_upperleg').
     fewest = MIN_LIMB_JOINTS - int(_count(bodies, LEG_WORDS) >= 2)
-    if len(actuated) < fewest or _named(bodies, FINGER_WORDS):
+    # The link where the run splits into fingers is a palm whatever its name (xArm7's Ability
+    # hand: 'thumb_base' carries every finger); only the links above it must not be fingers'.
+    palm = cut is None and bodies[-1] is seg.end and len(tree.moving_children(seg.end)) >= 2
+    if len(actuated) < fewest or _named(bodies[:-1] if palm else bodies, FINGER_WORDS):
         return None
     reach = tree.length(seg, upto)
     if reach < MIN_LIMB_LENGTH:

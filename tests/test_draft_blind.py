@@ -310,3 +310,30 @@ def test_srdf_groups_are_evidence_not_the_answer(tmp_path: Path) -> None:
     sweep = '<group name="sweep"><joint name="j2"/><joint name="j3"/></group>'
     (part,) = _draft_srdf(tmp_path, "sweep", parts, sweep).chains
     assert part.srdf_group == "sweep" and part.decide
+
+
+def test_a_gripper_link_far_from_its_frame_ends_an_arm_and_a_tcp_beside_it_is_the_tool_frame(
+    tmp_path: Path,
+) -> None:
+    # Alicia-M: the wrist carries 'tool0' and 'grasp_base', whose frame lies 70 cm out (the
+    # fingers' joints bring them back): the fingers are short, so the arm ends there, and the
+    # leaf 'tool0' beside the gripper is its TCP, not 'grasp_base' (it carries the fingers).
+    parts = [
+        *_arm("link4"),
+        '<link name="tool0"/>',
+        _joint("tool0_joint", "link4", "tool0", "fixed", "0 0 0.15"),
+        _link("grasp_base"),
+        _joint("grasp_base_joint", "link4", "grasp_base", "fixed", "0 0 0.7"),
+        *_jaws("grasp_base", 0.03),
+    ]
+    parts = [
+        p.replace('<origin xyz="0 0.03 0"', '<origin xyz="0 0.03 -0.6"').replace(
+            '<origin xyz="0 -0.03 0"', '<origin xyz="0 -0.03 -0.6"'
+        )
+        for p in parts
+    ]
+    d = _draft(tmp_path, "faraway", parts)
+    (arm,) = d.chains
+    assert (arm.role, arm.tip) == ("arm", "link4")
+    (m,) = d.manipulators
+    assert m.is_gripper and m.tool_frame == "tool0" and d.frames == []

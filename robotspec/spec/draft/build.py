@@ -253,17 +253,22 @@ class Drafter:
         tool = find_tool_frame(tree, top, others, prefer)
         # A TCP the URDF hangs beside the gripper, on the mount that carries it (Kinova's
         # 'tool_frame' on 'dummy_link', next to 'gripper_base_link'): the mount is the root.
+        # So is a TCP frame beside a gripper whose own link (carrying the fingers) was the only
+        # name found (Alicia-M's 'tool0' on the wrist beside 'grasp_base').
+        carrying = tool is not None and gripper is not None and tool is gripper.root
         mount = top
-        while tool is None and gripper is not None and mount is not tip:
+        while (tool is None or carrying) and gripper is not None and mount is not tip:
             up = world.parent_connection(mount)
             if up is None or not up.is_fixed:
                 break
             mount = world.bodies[up.parent]
-            tool = find_tool_frame(tree, mount, others, prefer)
-            if tool is not None and (world.child_bodies(tool) or world.is_ancestor(tool, top)):
-                tool = None  # the mount itself, a flange above the gripper: not beside it
-            if tool is not None:
-                top = mount
+            beside = find_tool_frame(tree, mount, others, prefer, leaf=carrying)
+            if beside is not None and (
+                world.child_bodies(beside) or world.is_ancestor(beside, top)
+            ):
+                beside = None  # the mount itself, a flange above the gripper: not beside it
+            if beside is not None:
+                tool, top, carrying = beside, mount, False
         # A tool frame above the hand (a flange, a wrist F/T sensor) only when the hand has no
         # tips to put one between.
         tipless = hand is None or hand_center(tree, top) is None

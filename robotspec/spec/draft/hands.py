@@ -347,16 +347,22 @@ def _named_as(name: str) -> tuple[str, set[str]]:
 
 
 def find_tool_frame(
-    tree: Tree, top: Body, exclude: frozenset[int] = frozenset(), prefer: Body | None = None
+    tree: Tree,
+    top: Body,
+    exclude: frozenset[int] = frozenset(),
+    prefer: Body | None = None,
+    leaf: bool = False,
 ) -> Body | None:
     """The best-named tool frame in ``top``'s subtree (``exclude``: bodies of other parts).
 
     Of equally named frames, one hanging from ``prefer`` (where the fingers split) wins: the
     TCP sits between the fingers, the flange above them (Interbotix's 'ee_gripper_link' beside
-    'ee_arm_link').
+    'ee_arm_link'). ``leaf``: only frames without children count.
     """
     world = tree.world
     candidates = [b for b in world.subtree(top) if b.index not in exclude]
+    if leaf:  # frames only (a TCP), never a link carrying fingers
+        candidates = [b for b in candidates if not world.child_bodies(b)]
     near = set() if prefer is None else {b.index for b in world.subtree(prefer)}
     # The link's name, or its fixed joint's (Baxter's 'right_gripper' hangs on 'right_endpoint').
     names: dict[int, list[tuple[str, set[str]]]] = {}

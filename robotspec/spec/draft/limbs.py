@@ -148,7 +148,10 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     if cut is not None:
         hand = seg.bodies[cut]
     elif len(tree.moving_children(seg.end)) >= 2:
-        if hand_span(tree, seg.end) > MAX_HAND_SPAN:
+        # How far the branches reach from where each starts, not from the end's frame: a link
+        # frame may lie far from its geometry (Alicia-M's 'grasp_base', 70 cm out of the wrist).
+        branches = tree.moving_children(seg.end)
+        if max(hand_span(tree, k) for k in branches) > MAX_HAND_SPAN:
             return None  # limbs branch off here: a trunk (simple_humanoid's waist), not an arm
         hand = seg.end
     if hand is None and _named(bodies, HEAD_WORDS) and not _named(bodies, ARM_WORDS):

@@ -337,3 +337,17 @@ def test_a_gripper_link_far_from_its_frame_ends_an_arm_and_a_tcp_beside_it_is_th
     assert (arm.role, arm.tip) == ("arm", "link4")
     (m,) = d.manipulators
     assert m.is_gripper and m.tool_frame == "tool0" and d.frames == []
+
+
+def test_a_tcp_the_urdf_names_is_stated_a_guessed_name_is_asked(tmp_path: Path) -> None:
+    # UR's 'tool0', Franka's '*_tcp': a bare frame named as a TCP is the files' answer, with no
+    # DECIDE mark on it; a frame found by a weaker name ('flange') stays a question.
+    for frame, asked in (("tool0", False), ("hand_tcp", False), ("flange", True)):
+        parts = [
+            *_arm("wrist"),
+            f'<link name="{frame}"/>',
+            _joint(f"{frame}_joint", "wrist", frame, "fixed", "0 0 0.1"),
+        ]
+        (m,) = _draft(tmp_path, f"arm_{frame}", parts).manipulators
+        assert m.tool_frame == frame
+        assert any("by its name" in r for r in m.decide) is asked

@@ -22,6 +22,7 @@ from robotspec.spec.draft.hands import (
     find_tool_frame,
     hand_center,
     hand_joints,
+    is_named_tcp,
 )
 from robotspec.spec.draft.limbs import (
     FINGER_WORDS,
@@ -282,7 +283,9 @@ class Drafter:
         frame: DraftFrame | None = None
         if tool is not None:
             tool_name = tool.name
-            if not decide:  # (above the hand: said already)
+            # A bare frame named as a TCP is the files' answer (no question); other names and
+            # links are guesses. (Above the hand: said already.)
+            if not decide and not is_named_tcp(world, tool):
                 decide.append(f"the tool frame '{tool.name}' by its name")
         elif gripper is not None:
             tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))

@@ -34,6 +34,7 @@ __all__ = [
     "find_tool_frame",
     "hand_center",
     "hand_joints",
+    "is_named_tcp",
 ]
 
 #: How tool frames are usually named, best first: (substring of the name, or a whole word).
@@ -344,6 +345,27 @@ def _matches(hint: str, name: tuple[str, set[str]]) -> bool:
 
 def _named_as(name: str) -> tuple[str, set[str]]:
     return name.lower(), words(name)
+
+
+#: Names a URDF gives its TCP: a bare frame so named is a tool frame the files decide.
+TCP_NAMES: tuple[str, ...] = (
+    "tool_frame",
+    "tcp",
+    "grasping_frame",
+    "grasp_frame",
+    "tool0",
+    "end_effector_link",
+    "ee_link",
+)
+
+
+def is_named_tcp(world: World, body: Body) -> bool:
+    """Whether ``body`` is a bare frame (a leaf without geometry, on a fixed joint) named a TCP."""
+    c = world.parent_connection(body)
+    if c is None or not c.is_fixed or world.child_bodies(body) or _own_geometry(body):
+        return False
+    name = _named_as(body.name)
+    return any(_matches(hint, name) for hint in TCP_NAMES)
 
 
 def find_tool_frame(

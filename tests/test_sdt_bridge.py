@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import os
 import pickle
 import subprocess
 import sys
@@ -167,19 +168,38 @@ def test_the_world_copy_keeps_the_classes() -> None:
     )
 
 
-def test_a_fresh_process_rebuilds_the_classes(tmp_path: Path) -> None:
-    # What SDT's ORM and world synchroniser do: replay the world's modifications from JSON
-    # elsewhere, finding each class by its path; and a class pickles by reference.
+def test_the_robot_is_named_by_its_spec_not_its_class() -> None:
+    robot, sdt_robot = _robot("pr2")
+    assert type(sdt_robot).__name__.startswith("PR2_")  # the class: name and digest
+    assert sdt_robot.name.name == robot.name == "PR2"  # SDT's own PR2 is "PR2"
+    states = {str(s.name) for p in sdt_robot._robot_parts for s in p.joint_states}
+    assert "left_arm_park" in {s.name.name for p in sdt_robot._robot_parts for s in p.joint_states}
+    assert not any(type(sdt_robot).__name__[-10:] in s for s in states)  # no digest in them
+    arm = sdt_robot.get_left_arm_if_specified()
+    assert arm.name.name == robot.left_arm.name
+
+
+def test_another_install_with_an_empty_cache_reads_the_pickle_and_history(
+    tmp_path: Path,
+) -> None:
+    # Issue 32: the same spec, its files installed elsewhere (a copy, as another venv has),
+    # another (empty) class store: the pickled class loads without any stored recipe, is the
+    # class to_sdt builds there, and the world history written here replays there.
     from krrood.adapters.json_serializer import to_json
 
+    from tests.test_sdt_recipe import pr2_elsewhere
+
     _, sdt_robot = _robot("pr2")
-    assert pickle.loads(pickle.dumps(type(sdt_robot))) is type(sdt_robot)
+    cls = type(sdt_robot)
+    assert pickle.loads(pickle.dumps(cls)) is cls
     blocks = sdt_robot._world._model_manager.model_modification_blocks
     history = tmp_path / "history.json"
     history.write_text(json.dumps([[to_json(m) for m in b.modifications] for b in blocks]))
-    (tmp_path / "class.pkl").write_bytes(pickle.dumps(type(sdt_robot)))
+    (tmp_path / "class.pkl").write_bytes(pickle.dumps(cls))
+    elsewhere = pr2_elsewhere(tmp_path / "other-venv")
+    empty = tmp_path / "empty-store"
     code = f"""
-import json, pickle, sys
+import json, pickle, sys, warnings
 sys.path.append({str(STAND_INS)!r})
 from krrood.adapters.json_serializer import from_json
 from semantic_digital_twin.adapters.world_entity_kwargs_tracker import (
@@ -195,13 +215,34 @@ with world.modify_world():
         for m in block:
             from_json(m, **kwargs).apply(world)
 [robot] = world.get_semantic_annotations_by_type(AbstractRobot)
-print(type(robot) is cls, type(robot).__module__, len(robot._robot_parts), robot.validate())
+from robotspec.interop.sdt import to_sdt
+from robotspec.robots import load
+warnings.simplefilter("ignore")
+here = load("pr2", package_paths=[{str(elsewhere)!r}])
+assert here.world.source.startswith({str(elsewhere)!r}), here.world.source
+built = to_sdt(here)
+print(type(robot) is cls, type(built) is cls, robot.name.name, len(robot._robot_parts))
 """
+    env = {**os.environ, "ROBOTSPEC_SDT_CLASSES": str(empty)}
     out = subprocess.run(
-        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=False
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=False, env=env
     )
     assert out.returncode == 0, out.stderr[-2000:]
-    assert out.stdout.split()[-4:] == ["True", "robotspec.interop.sdt.classes", "12", "True"]
+    assert out.stdout.split()[-4:] == ["True", "True", "PR2", "12"]
+
+
+def test_threads_build_one_class(tmp_path: Path) -> None:
+    from concurrent.futures import ThreadPoolExecutor
+    from dataclasses import replace
+
+    from robotspec.interop.sdt.classes import robot_class
+    from robotspec.interop.sdt.recipe import robot_recipe
+
+    robot, _ = _robot("pr2")
+    recipe = replace(robot_recipe(robot), name="PR2_threads")  # a class not built yet
+    with ThreadPoolExecutor(4) as pool:
+        classes = list(pool.map(lambda _: robot_class(recipe), range(8)))
+    assert all(c is classes[0] for c in classes)
 
 
 def test_hsrb_builds_although_sdts_parser_refuses_its_urdf(
@@ -274,6 +315,18 @@ def test_an_unwritable_class_store_warns_and_the_robot_still_builds(
     with pytest.warns(SdtBridgeWarning, match="could not be stored"):
         again = to_sdt(robot)
     assert type(again) is type(built)
+    monkeypatch.delenv("ROBOTSPEC_SDT_CLASSES")
+    with pytest.warns(SdtBridgeWarning, match="could not be stored"):
+        to_sdt(robot, class_store=blocker / "sub")
+
+
+def test_class_store_keeps_the_recipe_where_asked(tmp_path: Path) -> None:
+    from robotspec.interop.sdt import to_sdt
+
+    robot, built = _robot("pr2")
+    again = to_sdt(robot, class_store=tmp_path)
+    assert type(again) is type(built)
+    assert [p.name for p in tmp_path.iterdir()] == [f"{type(built).__name__[-10:]}.json"]
 
 
 def test_a_hand_has_sdts_fingers_with_its_thumb() -> None:

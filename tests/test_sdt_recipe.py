@@ -185,3 +185,68 @@ def test_a_hand_is_an_end_effector_with_its_thumb_first() -> None:
         ("finger", f"allegro_hand_{n}", f"allegro_link_{r}.0", f"allegro_link_{t}.0_tip")
         for n, r, t in (("thumb", 12, 15), ("index", 0, 3), ("middle", 4, 7), ("ring", 8, 11))
     ]
+
+
+def pr2_elsewhere(folder: Path) -> Path:
+    """example-robot-data's PR2 copied under ``folder`` (another install): its package folder."""
+    import shutil
+
+    share = erd_robots().parent
+    copy = folder / "share" / "example-robot-data"
+    (copy / "robots").mkdir(parents=True)
+    shutil.copy2(share / "package.xml", copy / "package.xml")
+    shutil.copytree(share / "robots" / "pr2_description", copy / "robots" / "pr2_description")
+    return folder / "share"
+
+
+def test_the_digest_is_the_robots_not_the_install_paths(tmp_path: Path) -> None:
+    # Issue 32: the class names (the digest) travel in pickles and world histories; the same
+    # spec read from files installed elsewhere must give the same recipe and digest.
+    from robotspec.robots import load
+
+    here = _pr2()
+    there = load("pr2", package_paths=[pr2_elsewhere(tmp_path)])
+    assert there.world.source is not None and there.world.source.startswith(str(tmp_path))
+    assert here.world.source != there.world.source
+    first, second = robot_recipe(here), robot_recipe(there)
+    # The package as its package.xml names it (example-robot-data's declares
+    # example_robot_descriptions), the file relative to it.
+    assert first.source.startswith("package://")
+    assert first.source.endswith("/robots/pr2_description/urdf/pr2.urdf")
+    assert first == second and first.digest() == second.digest()
+    assert first.name == "PR2"
+    assert str(tmp_path) not in json.dumps(second.to_json())
+
+
+def test_recipes_are_written_only_where_the_user_asks(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from robotspec.interop.sdt.classes import class_store, remember
+
+    recipe = robot_recipe(_pr2())
+    monkeypatch.delenv("ROBOTSPEC_SDT_CLASSES", raising=False)
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    assert class_store() is None and remember(recipe) is None  # the default: in memory
+    assert not any(tmp_path.iterdir())
+    asked = remember(recipe, tmp_path / "mine")
+    assert asked == tmp_path / "mine" / f"{recipe.digest()}.json" and asked.is_file()
+    monkeypatch.setenv("ROBOTSPEC_SDT_CLASSES", str(tmp_path / "env"))
+    assert remember(recipe) == tmp_path / "env" / f"{recipe.digest()}.json"
+
+
+def test_a_damaged_recipe_file_is_named(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Not an AttributeError from deep inside: the file, and what to do about it.
+    from robotspec.interop.sdt import classes
+
+    damaged = tmp_path / "0123456789.json"
+    damaged.write_text('{"name": "PR2", "root":')
+    monkeypatch.setenv("ROBOTSPEC_SDT_CLASSES", str(tmp_path))
+    with pytest.raises(RobotSpecError, match="damaged") as info:
+        classes.PR2_0123456789  # noqa: B018 - the lookup is the test
+    assert info.value.file == str(damaged)
+    damaged.write_text('{"name": "PR2"}')  # valid JSON, not a recipe
+    with pytest.raises(RobotSpecError, match="damaged"):
+        classes.PR2_0123456789  # noqa: B018
+    with pytest.raises(AttributeError, match="no stored recipe"):
+        classes.PR2_abcdefabcd  # noqa: B018 - absent is still an AttributeError

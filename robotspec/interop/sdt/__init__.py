@@ -12,6 +12,7 @@ the part classes, :mod:`._api` is the one place SDT is imported.
 
 from __future__ import annotations
 
+import os
 import warnings
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
@@ -46,7 +47,7 @@ def sdt_api() -> ModuleType:
     return _api
 
 
-def to_sdt(robot: AbstractRobot) -> Any:
+def to_sdt(robot: AbstractRobot, *, class_store: str | os.PathLike[str] | None = None) -> Any:
     """``robot`` as SDT's ``AbstractRobot`` (built by SDT's own ``from_world``) in a new World.
 
     The world holds robotspec's bodies, joints, limits (velocity limits as tightened by the
@@ -54,6 +55,11 @@ def to_sdt(robot: AbstractRobot) -> Any:
     axes, cameras, states and collision rules (see :func:`.recipe.robot_recipe`). What has no
     place in SDT is left out with an :class:`SdtBridgeWarning` each. The robot is returned;
     its world is ``result._world``.
+
+    ``class_store``: a folder to keep the generated classes' recipe in, for a fresh process
+    that meets the classes by their path alone (a world history replayed, SDT's ORM);
+    default ``$ROBOTSPEC_SDT_CLASSES``, and without it nothing is written: the classes live
+    in memory and pickle with their recipe (docs/sdt.md, "Where class recipes are kept").
     """
     from robotspec.interop.sdt.classes import remember, robot_class
     from robotspec.interop.sdt.recipe import robot_recipe
@@ -64,11 +70,12 @@ def to_sdt(robot: AbstractRobot) -> Any:
         warnings.warn(f"{robot.name}: {note}", SdtBridgeWarning, stacklevel=2)
     cls = robot_class(recipe)
     try:
-        remember(recipe)
+        remember(recipe, class_store)
     except OSError as exc:  # this process works without it; a fresh one cannot rebuild
         warnings.warn(
             f"{robot.name}: the recipe of its SDT classes could not be stored ({exc}); another "
-            "process will not find them (set ROBOTSPEC_SDT_CLASSES to a writable folder)",
+            "process will not find them by path (give class_store or ROBOTSPEC_SDT_CLASSES "
+            "a writable folder)",
             SdtBridgeWarning,
             stacklevel=2,
         )

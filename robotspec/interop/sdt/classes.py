@@ -4,32 +4,48 @@ Why generated classes at all: SDT's robot parts are abstract and wired by generi
 parameters, so a robot *is* a set of classes (``Arm[Gripper]``, ``Torso, HasNeck[Neck]``), and
 ``from_world`` builds parts from those parameters. Why here: SDT copies a world by replaying its
 history and serialises parts by class path, so each class must be found again as
-``robotspec.interop.sdt.classes.<Name>``. Names end in the recipe's digest: the same robot gives
-the same classes (built once per process), two different robots of one name never clash.
+``robotspec.interop.sdt.classes.<Name>``. Names end in the recipe's digest, which holds no
+machine path: the same robot gives the same classes (built once per process, on any machine),
+two different robots of one name never clash.
 
-A fresh process (an unpickle, a load from SDT's ORM) asks this module for a class it has not
-built: :func:`__getattr__` rebuilds it from the recipe :func:`remember` stored when the class
-was first made (in ``$ROBOTSPEC_SDT_CLASSES``, default ``~/.cache/robotspec/sdt-classes``).
+A class pickles with its recipe (its metaclass's reducer), so an unpickle in a fresh process
+rebuilds it with nothing stored. A fresh process that meets a class by its path alone (a world
+replayed from its JSON history, SDT's ORM) asks :func:`__getattr__`, which rebuilds it from a
+recipe :func:`remember` stored, only where the user asked for it (``to_sdt(...,
+class_store=...)`` or ``$ROBOTSPEC_SDT_CLASSES``; docs/sdt.md says why nothing is written
+otherwise). The registry is guarded by a lock: two threads never build one class twice.
 """
 
 from __future__ import annotations
 
+import copyreg
 import json
 import os
 import re
 import sys
 import tempfile
+import threading
+import types
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from robotspec.errors import RobotSpecError
 from robotspec.interop.sdt.recipe import PartRecipe, RobotRecipe
 
 __all__ = ["class_store", "remember", "robot_class"]
 
 _MODULE = sys.modules[__name__]
 _BUILT: dict[str, type] = {}
+#: Guards ``_BUILT``, the module's attributes and the metaclasses (re-entrant: a robot's
+#: class builds its part classes inside it).
+_LOCK = threading.RLock()
+#: Folders recipes were stored in by this process (``to_sdt(..., class_store=...)``).
+_STORES: list[Path] = []
+#: One metaclass per SDT metaclass: the generated classes' own, whose reducer pickles a class
+#: with its recipe.
+_METAS: dict[type, type] = {}
 
 
 def _camel(name: str) -> str:
@@ -44,11 +60,73 @@ def _register(name: str, cls: type) -> type:
     return cls
 
 
-def _make(name: str, bases: tuple[Any, ...], namespace: dict[str, Any]) -> type:
-    """A dataclass of SDT's kind (``eq=False`` as all of SDT's parts), registered here."""
-    import types
+def _rebuild(data: dict[str, Any], name: str) -> type:
+    """The class ``name`` of the recipe ``data``: what an unpickle calls (see :func:`_reduce`)."""
+    with _LOCK:
+        if name not in _BUILT:
+            robot_class(RobotRecipe.from_json(data))
+        if name not in _BUILT:
+            raise RobotSpecError(
+                f"the pickled recipe makes no SDT class {name!r} (pickled by another robotspec?)",
+                kind="dependency",
+                name=name,
+            )
+        return _BUILT[name]
 
-    cls = types.new_class(name, bases, {}, lambda ns: ns.update(namespace))
+
+def _reduce(cls: type) -> Any:
+    """A generated class pickles as its recipe and name, so any process can rebuild it."""
+    recipe: RobotRecipe | None = cls.__dict__.get("_robotspec_recipe")
+    if recipe is None:  # a user's subclass of a generated class: by reference, as any class
+        return cls.__qualname__
+    return _rebuild, (recipe.to_json(), cls.__name__)
+
+
+def _metaclass(sdt_meta: type) -> type:
+    """SDT's metaclass with the pickle reducer of the generated classes (made once)."""
+    with _LOCK:
+        meta = _METAS.get(sdt_meta)
+        if meta is None:
+            meta = types.new_class(f"RobotspecSdt{sdt_meta.__name__}", (sdt_meta,))
+            meta.__module__ = __name__
+            copyreg.pickle(meta, _reduce)
+            _METAS[sdt_meta] = meta
+        return meta
+
+
+def _make(
+    sdt: Any,
+    name: str,
+    bases: tuple[Any, ...],
+    namespace: dict[str, Any],
+    *,
+    recipe: RobotRecipe,
+    sdt_name: str,
+    after_init: Callable[[Any], None] | None = None,
+) -> type:
+    """A dataclass of SDT's kind (``eq=False`` as all of SDT's parts), registered here.
+
+    Its SDT ``name`` is ``sdt_name`` (the spec's robot or part name), not SDT's default, the
+    class name, which ends in the digest: joint-state names and world histories name the
+    robot as its spec does. ``after_init`` runs after SDT's ``__post_init__``.
+    """
+    resolved = types.resolve_bases(bases)
+    sdt_meta, _, _ = types.prepare_class(name, resolved)
+    cell: list[Any] = []  # the class, once made (super() needs it)
+
+    def __post_init__(self: Any) -> None:  # noqa: N807 - the dataclass hook
+        unnamed = self.name is None
+        super(cell[0], self).__post_init__()
+        if unnamed:
+            self.name = sdt.PrefixedName(sdt_name, prefix=self.name.prefix)
+        if after_init is not None:
+            after_init(self)
+
+    namespace = {**namespace, "_robotspec_recipe": recipe, "__post_init__": __post_init__}
+    cls = types.new_class(
+        name, bases, {"metaclass": _metaclass(sdt_meta)}, lambda ns: ns.update(namespace)
+    )
+    cell.append(cls)
     return _register(name, dataclass(eq=False)(cls))
 
 
@@ -144,8 +222,8 @@ def _factory(sdt: Any, part: PartRecipe) -> Callable[[Any, Any], Any]:
     return setup
 
 
-def _part_class(sdt: Any, part: PartRecipe, robot: str, digest: str) -> type:
-    built = {slot: [_part_class(sdt, p, robot, digest) for p in ps] for slot, ps in part.children}
+def _part_class(sdt: Any, part: PartRecipe, recipe: RobotRecipe, digest: str) -> type:
+    built = {slot: [_part_class(sdt, p, recipe, digest) for p in ps] for slot, ps in part.children}
     kind = {
         "mobile_base": sdt.parts.MobileBase,
         "torso": sdt.parts.Torso,
@@ -175,18 +253,23 @@ def _part_class(sdt: Any, part: PartRecipe, robot: str, digest: str) -> type:
             bases.append(sdt.mixins.HasFingers[tuple(fingers)])
         axis = part.front_facing_axis
 
-        def post_init(self: Any) -> None:
-            kind["end_effector"].__post_init__(self)
+        def after_init(self: Any) -> None:
             if axis is not None:  # robotspec's axis, stated in the spec, not derived
                 self.front_facing_axis = sdt.Vector3(*axis)
-
-        namespace["__post_init__"] = post_init
     else:
         upper, sides = _upper_mixins(sdt, built)
         bases = [kind[part.kind], *upper]
         namespace.update(sides)
-    name = f"{robot}_{_camel(part.kind)}_{_camel(part.name)}_{digest}"
-    return _BUILT.get(name) or _make(name, tuple(bases), namespace)
+    name = f"{recipe.name}_{_camel(part.kind)}_{_camel(part.name)}_{digest}"
+    return _BUILT.get(name) or _make(
+        sdt,
+        name,
+        tuple(bases),
+        namespace,
+        recipe=recipe,
+        sdt_name=part.name,
+        after_init=after_init if part.kind == "end_effector" else None,
+    )
 
 
 # ------------------------------------------------------------------------------- robot
@@ -196,11 +279,15 @@ def robot_class(recipe: RobotRecipe) -> type:
 
     digest = recipe.digest()
     name = f"{recipe.name}_{digest}"
-    if name in _BUILT:
-        return _BUILT[name]
-    sdt = sdt_api()
+    with _LOCK:
+        if name in _BUILT:
+            return _BUILT[name]
+        return _robot_class(sdt_api(), recipe, name, digest)
+
+
+def _robot_class(sdt: Any, recipe: RobotRecipe, name: str, digest: str) -> type:
     built = {
-        slot: [_part_class(sdt, p, recipe.name, digest) for p in ps] for slot, ps in recipe.children
+        slot: [_part_class(sdt, p, recipe, digest) for p in ps] for slot, ps in recipe.children
     }
     upper, sides = _upper_mixins(sdt, built)
 
@@ -251,42 +338,66 @@ def robot_class(recipe: RobotRecipe) -> type:
         "_setup_collision_rules": _setup_collision_rules,
         **sides,
     }
-    return _make(name, (sdt.parts.AbstractRobot, *upper), namespace)
+    return _make(
+        sdt, name, (sdt.parts.AbstractRobot, *upper), namespace, recipe=recipe, sdt_name=recipe.name
+    )
 
 
 # ------------------------------------------------------------------- fresh processes
-def class_store() -> Path:
-    """Where recipes are kept for fresh processes: ``$ROBOTSPEC_SDT_CLASSES`` or the cache."""
+def class_store(folder: str | os.PathLike[str] | None = None) -> Path | None:
+    """Where recipes are kept: ``folder``, else ``$ROBOTSPEC_SDT_CLASSES``, else nowhere."""
+    if folder is not None:
+        return Path(folder)
     env = os.environ.get("ROBOTSPEC_SDT_CLASSES")
-    if env:
-        return Path(env)
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "robotspec" / "sdt-classes"
+    return Path(env) if env else None
 
 
-def remember(recipe: RobotRecipe) -> Path:
-    """Store ``recipe`` (once, atomically) so another process can rebuild its classes."""
-    folder = class_store()
-    path = folder / f"{recipe.digest()}.json"
-    if not path.is_file():
-        folder.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(recipe.to_json(), f)
-        os.replace(tmp, path)
+def remember(recipe: RobotRecipe, folder: str | os.PathLike[str] | None = None) -> Path | None:
+    """Store ``recipe`` (once, atomically) where :func:`class_store` says; None: nowhere."""
+    store = class_store(folder)
+    if store is None:
+        return None
+    path = store / f"{recipe.digest()}.json"
+    with _LOCK:
+        if folder is not None and store not in _STORES:
+            _STORES.append(store)
+        if not path.is_file():
+            store.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=store, suffix=".tmp")
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                json.dump(recipe.to_json(), f)
+            os.replace(tmp, path)
     return path
+
+
+def _stored(path: Path) -> RobotRecipe:
+    """The recipe stored at ``path``, or a RobotSpecError naming the damaged file."""
+    try:
+        return RobotRecipe.from_json(json.loads(path.read_text(encoding="utf-8")))
+    except (OSError, ValueError, KeyError, TypeError, IndexError) as exc:
+        raise RobotSpecError(
+            f"the stored SDT class recipe {path} is damaged ({type(exc).__name__}: {exc}); "
+            "delete it, and to_sdt(robot, class_store=...) writes it again",
+            file=path,
+            kind="file",
+        ) from exc
 
 
 def __getattr__(name: str) -> type:
     """A class this process has not built yet, rebuilt from its stored recipe."""
     match = re.search(r"_([0-9a-f]{10})$", name)
-    path = None if match is None else class_store() / f"{match.group(1)}.json"
-    if path is None or not path.is_file():
-        raise AttributeError(
-            f"module {__name__!r} has no class {name!r}: it is made by "
-            "robotspec.interop.sdt.to_sdt(robot), and no stored recipe has its digest"
-        )
-    robot_class(RobotRecipe.from_json(json.loads(path.read_text(encoding="utf-8"))))
-    if name not in _BUILT:
-        raise AttributeError(f"the stored recipe {path} makes no class {name!r}")
-    return _BUILT[name]
+    with _LOCK:
+        env = class_store()
+        stores = [*_STORES, *([env] if env is not None else [])]
+        paths = [] if match is None else [s / f"{match.group(1)}.json" for s in stores]
+        path = next((p for p in paths if p.is_file()), None)
+        if path is None:
+            raise AttributeError(
+                f"module {__name__!r} has no class {name!r}: it is made by "
+                "robotspec.interop.sdt.to_sdt(robot) (or an unpickle of it), and no stored "
+                "recipe has its digest (docs/sdt.md: where class recipes are kept)"
+            )
+        robot_class(_stored(path))
+        if name not in _BUILT:
+            raise AttributeError(f"the stored recipe {path} makes no class {name!r}")
+        return _BUILT[name]

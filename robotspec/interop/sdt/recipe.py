@@ -16,6 +16,7 @@ import hashlib
 import json
 import re
 from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from robotspec.semantic import Camera, Hand, KinematicChain, ParallelGripper
@@ -29,6 +30,7 @@ __all__ = [
     "PartRecipe",
     "RobotRecipe",
     "StateRecipe",
+    "portable_source",
     "robot_recipe",
 ]
 
@@ -126,7 +128,12 @@ class RobotRecipe:
         return [q for _, ps in self.children for p in ps for q in p.walk()]
 
     def digest(self) -> str:
-        """A short hash of the recipe's content: the suffix of its generated class names."""
+        """A short hash of the recipe's content: the suffix of its generated class names.
+
+        A function of the robot, not of the machine: the recipe holds body, joint and part
+        names, values and a portable ``source`` (:func:`portable_source`), no machine path, so
+        the same spec gives the same digest wherever its files are installed.
+        """
         data = asdict(self)
         data.pop("left_out")
         text = json.dumps(data, sort_keys=True, default=str)
@@ -247,6 +254,28 @@ def _safe(name: str) -> str:
     return re.sub(r"\W", "_", name)
 
 
+def portable_source(path: str | None) -> str:
+    """The description file as a machine-independent name: ``package://pkg/rel`` or its name.
+
+    Why: the recipe's digest names the generated classes, and those names travel (pickles,
+    world histories); an absolute path would make them depend on where the files are installed.
+    The nearest enclosing ROS package (a folder with ``package.xml``) gives a ``package://``
+    URI, as a spec writes it; a file in no package is named by its description folder (the one
+    above ``urdf/``) and its own name, else its name alone.
+    """
+    if not path:
+        return ""
+    from robotspec.files.package_search import declared_name, description_root
+
+    file = Path(path)
+    for folder in file.parents:
+        if (folder / "package.xml").is_file():
+            return f"package://{declared_name(folder)}/{file.relative_to(folder).as_posix()}"
+    for root in description_root(file):
+        return f"{root.name}/{file.relative_to(root).as_posix()}"
+    return file.name
+
+
 def robot_recipe(robot: AbstractRobot) -> RobotRecipe:
     """The SDT parts of a compiled robot (see the module docstring and docs/sdt.md).
 
@@ -344,7 +373,7 @@ def robot_recipe(robot: AbstractRobot) -> RobotRecipe:
     return RobotRecipe(
         name=_safe(robot.name),
         root=robot.root.name,
-        source=robot.world.source or "",
+        source=portable_source(robot.world.source),
         children=tuple(top),
         disabled_pairs=tuple((a, b) for a, b in pairs),
         disabled_bodies=tuple(sorted(robot.disabled_collision_bodies)),

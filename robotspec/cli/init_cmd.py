@@ -58,13 +58,12 @@ def init(
     marked DECIDE are guesses a person should check.
     """
     from robotspec.compiler.inputs import description_inputs
-    from robotspec.files.fences import inside
+    from robotspec.files.fences import inside, project_root, refusal
     from robotspec.files.package_search import user_roots
     from robotspec.files.writing import check_writable
     from robotspec.spec.draft import render_draft
     from robotspec.spec.draft.render import camera_presets
     from robotspec.spec.draft.run import draft_from_files
-    from robotspec.spec.load import spec_may_name
 
     xacro_args = _xacro_args(xacro_arg or [])
     # The robot's own files are never replaced (``-o robot.urdf``); checked before the work.
@@ -92,10 +91,14 @@ def init(
             f"`robotspec validate {output}`\n"
         )
     # A spec may name files and folders outside its project only with the user's leave.
-    outside = [(folder / p).resolve() for p in draft.package_paths if not spec_may_name(p, folder)]
-    for ref in (draft.urdf, draft.srdf):
-        if ref is not None and "://" not in ref and not spec_may_name(ref, folder):
-            outside.append((folder / ref).resolve().parent)
+    project = project_root(folder)  # once: every entry is judged against the same project
+    outside = []
+    for ref in (*draft.package_paths, draft.urdf, draft.srdf):
+        if ref is None or "://" in ref:
+            continue
+        real = Path(os.path.realpath(folder / ref))
+        if refusal(str(real), project) is not None:
+            outside.append(real if ref in draft.package_paths else real.parent)
     # Not this run's -P: the spec is validated later, where the user must pass it again.
     allowed = [os.path.realpath(r) for r in user_roots(())]
     outside = [p for p in dict.fromkeys(outside) if not any(inside(str(p), r) for r in allowed)]

@@ -76,29 +76,6 @@ def write_output(
 Force = Annotated[bool, typer.Option("--force", help="Overwrite existing files.")]
 
 
-def refuse_existing(path: Path) -> None:
-    """An error if ``path`` exists (a link too, even a dangling one): nothing is overwritten."""
-    from robotspec.errors import RobotSpecError
-
-    if path.is_symlink() or path.exists():
-        raise RobotSpecError(
-            "the file exists; pass --force to overwrite it", file=str(path), kind="output"
-        )
-
-
-def refuse_link(path: Path, *, raced: bool = False) -> None:
-    """An error if ``path`` is a symbolic link (``raced``: the open met one, made since)."""
-    from robotspec.errors import RobotSpecError
-
-    if raced or path.is_symlink():
-        raise RobotSpecError(
-            "is a symbolic link; robotspec does not write through links (remove it or name "
-            "another file)",
-            file=str(path),
-            kind="output",
-        )
-
-
 def write_file(
     path: Path, text: str | bytes, *, force: bool = True, inputs: Iterable[Path] = ()
 ) -> None:

@@ -98,11 +98,12 @@ def spec_inputs(
 def _add_spec(
     out: dict[Path, str], path: Path, package_paths: Sequence[str | Path], whose: str, depth: int
 ) -> None:
+    from robotspec.compose.parts import spec_path
     from robotspec.spec.load import load_spec
 
     out.setdefault(path, whose.format("spec"))
     try:
-        loaded = load_spec(path)
+        loaded = load_spec(path, allowed=package_paths)
     except (RobotSpecError, OSError, RecursionError):
         return
     for doc in loaded.documents[1:]:
@@ -132,20 +133,9 @@ def _add_spec(
         ).items():
             out.setdefault(p, role)
         if part.spec:
-            sub = _part_spec(part.spec, folder)
+            sub = spec_path(part.spec, folder)
             if sub is not None and sub not in out:
                 _add_spec(out, sub, package_paths, of, depth + 1)
-
-
-def _part_spec(ref: str, folder: Path) -> Path | None:
-    """A part's spec as the composer finds it: a path, or a shipped robot's or part's name."""
-    from robotspec.shipped import shipped_part_files, shipped_spec_files
-
-    p = Path(ref) if Path(ref).is_absolute() else folder / ref
-    if p.is_file():
-        return p
-    key = ref.lower()
-    return shipped_spec_files().get(key) or shipped_part_files().get(key)
 
 
 def robot_inputs(robot: AbstractRobot) -> dict[Path, str]:

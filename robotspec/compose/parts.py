@@ -88,7 +88,7 @@ def description_tree(
     return tree, urdf, resolver, srdf
 
 
-def _spec_path(ref: str, folder: Path) -> Path | None:
+def spec_path(ref: str, folder: Path) -> Path | None:
     """A part's spec: a path, a shipped robot's name, or a shipped part's name."""
     p = Path(ref) if Path(ref).is_absolute() else folder / ref
     if p.is_file():
@@ -114,7 +114,7 @@ def load_part(
     loc: Loc = ("parts", name)
     try:
         if ps.spec is not None:
-            path = _spec_path(ps.spec, loaded.folder)
+            path = spec_path(ps.spec, loaded.folder)
             if path is None:
                 candidates = [
                     *shipped_spec_files(),

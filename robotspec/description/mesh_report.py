@@ -36,7 +36,6 @@ __all__ = [
     "missing_geometry_message",
     "missing_geometry_problems",
     "summarize_missing_meshes",
-    "unresolved_mesh_bodies",
     "unresolved_meshes",
 ]
 
@@ -170,20 +169,6 @@ def unresolved_meshes(
                 file = p.file if p is not None and p.file is not None else world.source
                 line = p.line if p is not None and p.line is not None else shape.line
                 out.append(UnresolvedMesh(body.name, g.uri, file, line, p))
-    return out
-
-
-def unresolved_mesh_bodies(
-    world: World, *, collision: bool, bodies: Iterable[str] | None = None
-) -> dict[str, list[str]]:
-    """Body name -> the URIs of its meshes that did not resolve to a file (visual or collision).
-
-    The commands that need geometry ask this before building it, so that they can name every
-    body that loses geometry at once instead of failing on the first mesh.
-    """
-    out: dict[str, list[str]] = {}
-    for m in unresolved_meshes(world, collision=collision, bodies=bodies):
-        out.setdefault(m.body, []).append(m.uri)
     return out
 
 

@@ -79,10 +79,13 @@ def _floats(a: F64) -> array[float]:
     return array("d", np.ascontiguousarray(a, dtype=np.float64).tobytes())
 
 
-def _rows(rows: Sequence[Sequence[float]], n: int) -> F64:
-    """``np.array(rows)`` as an ``(m, n)`` float array, in chunks (see :data:`CHUNK`)."""
+def _rows(rows: Sequence[Sequence[float]], n: int, out: F64 | None = None) -> F64:
+    """``np.array(rows)`` as an ``(m, n)`` float array, in chunks (see :data:`CHUNK`).
+
+    Into ``out`` when given: no second array of every waypoint on the uploading thread.
+    """
     m = len(rows)
-    out = np.empty((m, n))
+    out = np.empty((m, n)) if out is None else out
     for start in range(0, m, CHUNK):
         out[start : start + CHUNK] = np.array(rows[start : start + CHUNK], dtype=np.float64)
         pause()
@@ -337,7 +340,7 @@ def columns_of(traj: JointTrajectory, n: int) -> TrajectoryColumns:
         sizes_ok = (cols.option_sizes == 0) | (cols.option_sizes == n)
         if not (np.all(cols.lengths == n) and np.all(sizes_ok)):
             return cols  # _check_and_plan reports the first wrong length
-        cols.positions[:] = _rows(rows, n)
+        _rows(rows, n, cols.positions)
         velocities = None
         if vidx:
             velocities = np.full((m, n), np.nan)

@@ -59,17 +59,17 @@ def _home() -> str:
     return os.path.realpath(Path.home())
 
 
-def too_wide(folder: str) -> bool:
+def too_wide(folder: str, home: str | None = None) -> bool:
     """Whether a real folder holds the whole machine or a user's files.
 
     The filesystem root, a top-level folder (``/home``, ``/tmp``), the home folder and every
-    folder above it are too wide to be one robot project's.
+    folder above it are too wide to be one robot project's. ``home``: the real home folder, when
+    the caller tests many folders (a walk up resolves it once, not per level).
     """
     path = Path(folder)
     if len(path.parts) <= 2:
         return True
-    home = _home()
-    return inside(home, folder)
+    return inside(home if home is not None else _home(), folder)
 
 
 def system_folder(real: str) -> str | None:
@@ -103,10 +103,12 @@ def project_root(folder: str | Path) -> Path | None:
     marked = _marked(start)
     if marked is not None:
         return marked
-    if too_wide(start):
+    home = _home()
+    if too_wide(start, home):
         return None
-    if os.path.basename(start) in SPEC_FOLDER_NAMES and not too_wide(os.path.dirname(start)):
-        return Path(os.path.dirname(start))
+    parent = os.path.dirname(start)
+    if os.path.basename(start) in SPEC_FOLDER_NAMES and not too_wide(parent, home):
+        return Path(parent)
     return Path(start)
 
 
@@ -118,8 +120,9 @@ INSTALL_FOLDERS = frozenset({"site-packages", "dist-packages"})
 def _marked(start: str, *, stop_at_installs: bool = False) -> Path | None:
     """The nearest folder at or above the real folder ``start`` holding a project marker."""
     current = start
+    home = _home()
     for _ in range(MAX_PROJECT_DEPTH):
-        if too_wide(current):
+        if too_wide(current, home):
             break
         if stop_at_installs and os.path.basename(current) in INSTALL_FOLDERS:
             break

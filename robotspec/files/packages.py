@@ -343,7 +343,6 @@ class PackageResolver:
     def _prefixes(self) -> list[tuple[str, str, bool]]:
         """(root, root + separator, strict) of every real root and package folder."""
         strict_given = {os.path.normpath(r) for r in self.strict_roots}
-        strict_real = {str(self._real_folder(r)) for r in self.strict_roots}
         user = [
             str(self._real_folder(r)) for r in self.roots if os.path.normpath(r) not in strict_given
         ]
@@ -352,8 +351,6 @@ class PackageResolver:
             real = str(self._real_folder(r))
             is_strict = os.path.normpath(r) in strict_given
             out[real] = out.get(real, True) and is_strict
-        for r in self._resolved_roots():
-            out.setdefault(str(r), str(r) in strict_real)
         for f in self._packages().values():
             real = str(self._real_folder(f))
             if real not in out:

@@ -124,16 +124,16 @@ def _on_a_swivel(world: World, c: Connection) -> bool:
     )
 
 
-def wheel_joints(world: World) -> list[Connection]:
+def wheel_joints(world: World, poses: np.ndarray | None = None) -> list[Connection]:
     """The joints that turn wheels: named so, or continuous and wheel-shaped about a level axis.
 
     Why both: a name is enough when it says ``wheel`` (meshes cannot be measured here); a
     nameless wheel is known by its cylinder turning about its own axis, held level in the
-    default pose (a propeller's axis stands up).
+    default pose (a propeller's axis stands up). ``poses``: the default pose's forward
+    kinematics when the caller has them (the drafter's tree), computed here otherwise.
     """
     moving = [c for c in world.connections if c.is_active]
     out = []
-    poses: np.ndarray | None = None
     for c in moving:
         named = words(c.name) | words(world.bodies[c.child].name)
         if named & _NOT_WHEELS:
@@ -156,13 +156,12 @@ def wheel_joints(world: World) -> list[Connection]:
     return out
 
 
-def own_drive(world: World, base: OwnBase) -> DraftDrive:
+def own_drive(world: World, base: OwnBase, wheels: list[Connection]) -> DraftDrive:
     """The drafted drive of the URDF's own base: omni, or differential on exactly two wheels.
 
     Why a DECIDE mark: the joints say the base moves in the plane, not whether it can move
     sideways; two driven wheels say it cannot, anything else is drafted omni for a person to check.
     """
-    wheels = wheel_joints(world)
     kind = "differential" if len(wheels) == 2 else "omni"
     why = f"{len(wheels)} wheels: {kind}?" if wheels else f"{kind}?"
     if base.joints is not None:

@@ -107,7 +107,7 @@ class Drafter:
         vj = None
         if srdf is not None:
             vj = next((v for v in srdf.virtual_joints if world.has_body(v.child_link)), None)
-        own = own_base(world)
+        own = self.own_base = own_base(world)  # kept before the filter: chains() reads it
         if own is not None and vj is not None:
             above = world.get_body_by_name(vj.child_link)
             if above is not own.root and above not in world.ancestors(own.root):
@@ -115,7 +115,7 @@ class Drafter:
         if own is not None:
             # The URDF moves its base itself (LoCoBot, a simulator's planar joint): those joints
             # are the drive, not an arm's or a neck's, and the robot starts below them.
-            root, drive = own.root, own_drive(world, own)
+            root = own.root
         elif vj is not None:
             root = world.get_body_by_name(vj.child_link)
             kind = {"planar": "omni", "floating": "floating", "fixed": "fixed"}.get(vj.type)
@@ -124,6 +124,10 @@ class Drafter:
                     kind, vj.name, vj.parent_frame, f"the SRDF's virtual joint '{vj.name}'"
                 )
         self.tree = Tree(world, root)
+        # Found once, on the tree's poses (one forward kinematics for the whole draft).
+        self.wheels = wheel_joints(world, self.tree.poses)
+        if own is not None:
+            drive = own_drive(world, own, self.wheels)
         self.limbs = find_limbs(self.tree)
         self.forward, forward_why = facing(self.tree, self.limbs)
         self.draft = Draft(
@@ -152,8 +156,8 @@ class Drafter:
             joins = _SubsetIndex([lb.joints for lb in limbs] + [gc.joints for gc in found])
             accepted: set[frozenset[str]] = set()
             hands = [lb.hand for lb in limbs if lb.hand is not None]
-            base = own_base(self.world)
-            base_joints = {c.name for c in wheel_joints(self.world)}
+            base = self.own_base
+            base_joints = {c.name for c in self.wheels}
             if base is not None:
                 base_joints |= set(base.joints or ()) | ({base.planar} if base.planar else set())
             for gc in found:
@@ -406,7 +410,7 @@ class Drafter:
             split, wrist = root, []
         gripper, _ = find_gripper(tree, split)
         # Wheels (continuous joints about a level axis turning a wheel's shape) are never fingers.
-        wheels = {c.child for c in wheel_joints(world)}
+        wheels = {c.child for c in self.wheels}
 
         def rolls(body: Body) -> bool:
             return any(a.index in wheels for a in (*world.ancestors(body), body))

@@ -14,7 +14,6 @@ import numpy as np
 
 from robotspec.model.entities import Body
 from robotspec.model.world import World
-from robotspec.spec.draft.base import wheel_joints
 from robotspec.spec.draft.limbs import HEAD_WORDS
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
 from robotspec.spec.draft.naming import unique
@@ -208,7 +207,7 @@ def add_drive(d: Drafter) -> None:
     if draft.drive is not None:
         return
     joints = [c for c in world.connections if not c.is_fixed]
-    wheels = wheel_joints(world)
+    wheels = d.wheels
     casters = [c for c in joints if "caster" in words(c.name) and "wheel" not in words(c.name)]
     legs = [c for c in draft.chains if c.role == "leg"]
     rotors = [c for c in joints if words(c.name) & {"rotor", "propeller", "prop"}]

@@ -29,6 +29,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from tools.corpus.fetch import cache_root
+
 __all__ = ["MANIFEST", "GithubRobot", "cache_root", "extract", "load_manifest", "main", "mirror_of"]
 
 #: The manifest: one entry per robot, with the commit its truth was written from.
@@ -55,12 +57,6 @@ class GithubRobot:
     def folder(self) -> Path:
         """The extracted tree of this robot's commit."""
         return cache_root() / "github" / f"{self.repo.replace('/', '+')}@{self.commit}"
-
-
-def cache_root() -> Path:
-    """``$ROBOTSPEC_CORPUS``, else ``~/.cache/robotspec-corpus``."""
-    env = os.environ.get("ROBOTSPEC_CORPUS")
-    return Path(env) if env else Path.home() / ".cache" / "robotspec-corpus"
 
 
 def load_manifest(path: Path = MANIFEST) -> list[GithubRobot]:

@@ -34,6 +34,9 @@ class Description:
     srdf: Srdf | None
     resolver: PackageResolver = field(repr=False)
     warnings: tuple[RobotSpecError, ...] = ()
+    #: The URDF's element tree (xacro run): what the world does not keep (``<gazebo>`` sensors,
+    #: transmissions), read by ``robotspec init`` as evidence.
+    urdf_xml: etree._Element | None = field(default=None, repr=False, compare=False)
 
 
 def resolve_file(
@@ -109,4 +112,5 @@ def load_description(
         srdf=srdf_data,
         resolver=resolver,
         warnings=tuple(issues),
+        urdf_xml=root,
     )

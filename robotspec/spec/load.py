@@ -17,7 +17,7 @@ from pydantic import ValidationError
 from robotspec.errors import NotFoundError, SpecError
 from robotspec.files.limits import env_name, limits
 from robotspec.files.validation import validation_errors
-from robotspec.files.yamlio import LocatedYaml, load_yaml
+from robotspec.files.yamlio import LocatedYaml, load_yaml, load_yaml_text
 from robotspec.shipped import package_data, shipped_spec_files
 from robotspec.spec.fences import (
     ForeignPath,
@@ -107,16 +107,20 @@ def _absolutize(data: dict[str, Any], folder: Path) -> None:
                 _absolute_paths(part, folder, ("urdf", "srdf", "spec"))
 
 
-def load_spec(path: str | Path, *, allowed: Sequence[str | Path] = ()) -> LoadedSpec:
+def load_spec(
+    path: str | Path, *, allowed: Sequence[str | Path] = (), text: str | None = None
+) -> LoadedSpec:
     """Read, merge (``extends``) and validate a spec file; every problem raised at once.
 
     ``allowed``: folders the user allows besides the spec's project (``-P``), for ``extends``.
+    ``text``: the spec's text, read as if it were the file ``path`` (which need not exist):
+    ``robotspec setup`` validates what it would save without writing anything.
     The chain of ``extends`` is followed in a loop (each file read once, a cycle or a chain
     deeper than ``ROBOTSPEC_MAX_EXTENDS_DEPTH`` refused at the ``extends`` line that goes too
     far), then validated from the last base up, each file over the one it extends.
     """
     loaded: LoadedSpec | None = None
-    for file, doc in reversed(_extends_chain(path, allowed)):
+    for file, doc in reversed(_extends_chain(path, allowed, text)):
         data: Any = doc.data
         documents: tuple[LocatedYaml, ...] = (doc,)
         foreign = foreign_paths(doc, file.parent)
@@ -138,7 +142,7 @@ def load_spec(path: str | Path, *, allowed: Sequence[str | Path] = ()) -> Loaded
 
 
 def _extends_chain(
-    path: str | Path, allowed: Sequence[str | Path]
+    path: str | Path, allowed: Sequence[str | Path], text: str | None = None
 ) -> list[tuple[Path, LocatedYaml]]:
     """The spec and the files it extends, in order, each read once (a loop, not recursion).
 
@@ -149,7 +153,7 @@ def _extends_chain(
     file, given = Path(path).resolve(), str(path)
     chain: list[tuple[Path, LocatedYaml]] = []
     while True:
-        doc = load_yaml(given)
+        doc = load_yaml(given) if text is None or chain else load_yaml_text(text, given)
         if not isinstance(doc.data, Mapping):
             raise SpecError("a spec must be a YAML mapping", file=doc.file, line=1)
         chain.append((file, doc))

@@ -97,6 +97,11 @@ class DraftCamera:
     field_of_view: tuple[float, float] | None = None
     #: A body frame (not optical) that looks along its z axis (written ``[0, 0, 1]``).
     looks_along_z: bool = False
+    #: The viewing axis the files state in ``body``'s frame (a Gazebo sensor's), when it is
+    #: neither +x nor +z; written as ``forward_facing_axis``.
+    axis: tuple[float, float, float] | None = None
+    #: What states the camera (a Gazebo sensor), written as ``# from ...``; None for a guess.
+    source: str | None = None
     #: Heights (m) the camera is claimed to reach, and whether it is the default camera: never
     #: drafted, kept when a spec is read back for editing (``robotspec setup``).
     minimal_height: float | None = None

@@ -211,10 +211,15 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
             else "; or replace this line with 'preset: NAME'"
         )
         for cam in d.cameras:
-            out.append(f"  {scalar(cam.name)}:{_decide(cam.decide)}")
+            source = f"  # from {comment(cam.source)}" if cam.source else ""
+            out.append(f"  {scalar(cam.name)}:{source}{_decide(cam.decide)}")
             out.append("    type: camera")
             if cam.optical:
                 out.append(f"    body: {scalar(cam.body)}  # an optical frame: looks along +z")
+            elif cam.axis is not None:
+                out.append(f"    body: {scalar(cam.body)}")
+                axis = ", ".join(_num(a) for a in cam.axis)
+                out.append(f"    forward_facing_axis: [{axis}]  # the view axis the URDF states")
             elif cam.looks_along_z:
                 out.append(f"    body: {scalar(cam.body)}")
                 out.append("    forward_facing_axis: [0, 0, 1]  # a body frame looking along +z")

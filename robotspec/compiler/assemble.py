@@ -145,6 +145,7 @@ def assemble(b: Build, r: Resolved, robot_class: type[AbstractRobot]) -> Abstrac
         controlled_joint_names=None
         if spec.controlled_joints is None
         else tuple(spec.controlled_joints),
+        sdt_class=None if spec.sdt is None else spec.sdt.class_,
     )
     sensors = _sensors(b, r)
     manipulators = _manipulators(b, r)

@@ -68,6 +68,8 @@ class AbstractRobot:
     #: The direction the robot faces in its root's frame (a horizontal unit vector; REP 103: +x).
     forward_axis: tuple[float, float, float] = field(default=(1.0, 0.0, 0.0), kw_only=True)
     controlled_joint_names: tuple[str, ...] | None = field(default=None, kw_only=True)
+    #: The semantic digital twin robot class the spec names (``sdt: {class: ...}``), if any.
+    sdt_class: str | None = field(default=None, kw_only=True)
     _sides: tuple[tuple[int, ...], tuple[KinematicChain, KinematicChain]] | None = field(
         default=None, init=False, repr=False
     )

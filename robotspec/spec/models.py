@@ -37,6 +37,7 @@ from robotspec.spec.parts import (
     SensorSpec,
     TorsoSpec,
 )
+from robotspec.spec.sdt import SdtSpec
 
 __all__ = [
     "AttachSpec",
@@ -415,6 +416,11 @@ class RobotSpec(SpecModel):
         description="robot-level named joint states",
         examples=[{"zero": {"head_pan_joint": 0.0}}],
         json_schema_extra={"unit": "rad or m (per joint)"},
+    )
+    sdt: SdtSpec | None = Field(
+        default=None,
+        description="the semantic digital twin's robot class this robot is (to_sdt)",
+        examples=[{"class": "PR2"}],
     )
     accept_warnings: list[AcceptedWarning] = Field(
         default_factory=list,

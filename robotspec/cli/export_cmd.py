@@ -204,3 +204,62 @@ def bundle_cmd(
     write_files(files, under=output, force=force, inputs=inputs)
     carried = f" and {plural(len(copies), 'mesh file')} in {stem}_meshes/" if copies else ""
     sys.stderr.write(f"wrote {output}/{stem}.urdf, .srdf and .yaml{carried}\n")
+
+
+@export_app.command("mjcf")
+def mjcf_cmd(
+    spec: SpecArg,
+    output: Annotated[
+        Path,
+        typer.Option("--output", "-o", help="The MJCF file; meshes go to STEM_meshes/ beside it."),
+    ],
+    gravity_compensation: Annotated[
+        bool,
+        typer.Option(
+            "--gravity-compensation",
+            help="Cancel gravity on every body (counterbalanced arms, gravity feed-forward).",
+        ),
+    ] = False,
+    force: Force = False,
+    package_path: PackagePath = None,
+) -> None:
+    """MuJoCo's MJCF of the compiled robot, with its semantics and position servos.
+
+    Every body is kept (fixed links too); tool frames become sites, cameras cameras, disabled
+    pairs excludes, mimic joints equality couplings, named states keyframes; each commanded
+    joint gets a position servo within its limits and effort. Meshes are written as binary STL
+    (COLLADA converted). Velocity limits, which MJCF cannot hold, are listed in a comment.
+    """
+    from robotspec.cli.output import plural
+    from robotspec.compiler import check_spec, resolve_spec
+    from robotspec.compiler.inputs import spec_inputs
+    from robotspec.export.mjcf import mjcf_export
+    from robotspec.export.urdf import joined_urdf
+    from robotspec.files.writing import write_files
+    from robotspec.spec.load import load_spec
+
+    if output.suffix.lower() != ".xml":
+        raise typer.BadParameter(f"{output} must end in .xml (MuJoCo's MJCF)", param_hint="-o")
+    folder = output.parent
+    check_writable(output, under=folder, force=force)
+    path = resolve_spec(spec)
+    result = check_spec(path, package_paths=package_path or ())
+    robot = result.robot
+    assert robot is not None
+    paths = package_path or ()
+    tree = joined_urdf(load_spec(path, allowed=paths), package_paths=paths)
+    out = mjcf_export(robot, tree, name=output.stem, gravity_compensation=gravity_compensation)
+    inputs = spec_inputs(path, package_paths=package_path or (), robot=robot)
+    files: list[tuple[Path, str | Callable[[], bytes]]] = [
+        (output, out.xml),
+        *((folder / rel, produce) for rel, produce in out.meshes),
+    ]
+    write_files(files, under=folder, force=force, inputs=inputs)
+    for note in out.notes:
+        sys.stderr.write(f"note: {note}\n")
+    carried = f" and {plural(len(out.meshes), 'mesh file')} in {output.stem}_meshes/"
+    sys.stderr.write(
+        f"wrote {output}: {len(robot.world.bodies)} bodies, "
+        f"{plural(len(out.joints), 'joint')}, {plural(len(out.actuated), 'position servo')}"
+        f"{carried if out.meshes else ''}\n"
+    )

@@ -1,0 +1,205 @@
+"""A compiled robot as MuJoCo's MJCF: every body, the spec's semantics, servos, keyframes.
+
+Why not MuJoCo's own URDF reader: it drops every link on a fixed joint (the tool frames with
+them), every COLLADA mesh and every velocity limit, adds no actuators and knows nothing of an
+SRDF. robotspec has the whole robot compiled (composed parts joined, frames added, names
+resolved, disabled pairs read), so the export writes MJCF from the world model:
+
+* one ``<body>`` per body (fixed links too), placed by its joint's origin; a joint per moving
+  connection, named as robotspec names it; a floating drive is a ``<freejoint>``;
+* inertials and damping from the URDF (:mod:`robotspec.export.mjcf_dynamics`), meshes as binary
+  STL (:mod:`robotspec.export.mjcf_meshes`);
+* each manipulator's tool frame as a ``<site>`` named after the tool frame, each camera as a
+  ``<camera>`` with its vertical field of view, looking along the spec's forward axis;
+* disabled collision pairs as ``<exclude>``, disabled bodies' geoms colliding with nothing,
+  mimic joints as ``<equality><joint>`` couplings;
+* one position servo per commanded 1-DOF joint, range and effort from its limits, gains from
+  its inertia (:func:`robotspec.export.mjcf_dynamics.joint_inertias`);
+* the default configuration and every named state as a ``<key>``.
+
+What MJCF cannot hold (velocity limits) is listed in a comment at the top of the file.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from lxml import etree
+
+from robotspec.arrays import F64
+from robotspec.export.mjcf_bodies import TINY_MASS, BodyWriter, MjcfJoint, num, nums
+from robotspec.export.mjcf_dynamics import joint_inertias
+from robotspec.model.entities import ConnectionType
+from robotspec.model.rotations import matrix_to_quat_wxyz, rpy_to_matrix
+from robotspec.semantic import AbstractRobot
+from robotspec.semantic.base import JointState
+
+__all__ = ["MjcfExport", "MjcfJoint", "SERVO_HZ", "mjcf_export"]
+
+#: The natural frequency every position servo is tuned to (critically damped), in Hz.
+SERVO_HZ = 8.0
+
+
+@dataclass(frozen=True)
+class MjcfExport:
+    """The MJCF text, its mesh files, the joints in MuJoCo's qpos order, and the notes."""
+
+    xml: str
+    meshes: tuple[tuple[str, Callable[[], bytes]], ...]
+    joints: tuple[MjcfJoint, ...]
+    actuated: tuple[str, ...]
+    notes: tuple[str, ...]
+
+    def qpos(self, robot: AbstractRobot, q: Sequence[float] | F64) -> F64:
+        """MuJoCo's ``qpos`` for robotspec's configuration ``q`` (mimic joints followed)."""
+        values = np.asarray(q, dtype=np.float64)
+        out: list[float] = []
+        for j in self.joints:
+            if j.kind != "free":
+                out.append(j.multiplier * float(values[j.dof]) + j.offset)
+                continue
+            c = robot.world.connections[j.connection]
+            x, y, z, roll, pitch, yaw = (float(values[d]) for d in c.dofs)
+            moved = np.eye(4)
+            moved[:3, :3] = rpy_to_matrix(roll, pitch, yaw)
+            moved[:3, 3] = (x, y, z)
+            pose = c.origin @ moved
+            out.extend(float(v) for v in pose[:3, 3])
+            out.extend(float(v) for v in matrix_to_quat_wxyz(pose[:3, :3]))
+        return np.asarray(out, dtype=np.float64)
+
+
+def _states(robot: AbstractRobot) -> dict[str, JointState]:
+    """Every named state by the robot's key for it (``left_arm.park``, ``torso.low``)."""
+    found = dict(robot.joint_states)
+    for m in robot.manipulators:
+        for state_name, state in m.states.items():
+            found.setdefault(f"{m.name}.{state_name}", state)
+    return found
+
+
+def mjcf_export(
+    robot: AbstractRobot,
+    tree: etree._Element,
+    *,
+    name: str,
+    servo_hz: float = SERVO_HZ,
+    gravity_compensation: bool = False,
+) -> MjcfExport:
+    """The MJCF of ``robot``; ``tree`` is its joined URDF (inertials, damping), ``name`` the stem.
+
+    The meshes go to the folder ``NAME_meshes`` beside the MJCF file (its ``meshdir``).
+    ``gravity_compensation`` cancels gravity on every body (MuJoCo's ``gravcomp``), as a
+    counterbalanced arm (PR2: springs the URDF does not describe) or a controller's gravity
+    feed-forward does; without it, joints whose URDF effort cannot hold their links sag.
+    """
+    world = robot.world
+    b = BodyWriter(robot, tree, f"{name}_meshes")
+    root_el = etree.Element("mujoco", model=robot.name)
+    compiler = etree.SubElement(root_el, "compiler", angle="radian", autolimits="true")
+    compiler.set("meshdir", f"{name}_meshes")
+    compiler.set("inertiafromgeom", "false")
+    compiler.set("balanceinertia", "true")
+    etree.SubElement(root_el, "option", timestep="0.002", integrator="implicitfast")
+    default = etree.SubElement(root_el, "default")
+    visual = etree.SubElement(etree.SubElement(default, "default", {"class": "visual"}), "geom")
+    visual.attrib.update({"contype": "0", "conaffinity": "0", "group": "2"})
+    collision = etree.SubElement(default, "default", {"class": "collision"})
+    etree.SubElement(collision, "geom", group="3")
+    asset = etree.SubElement(root_el, "asset")
+    worldbody = etree.SubElement(root_el, "worldbody")
+    root = world.bodies[0]
+    b.body(worldbody, root, None)
+    for child in world.child_bodies(root):
+        conn = world.parent_connection(child)
+        if conn is not None and conn.type is ConnectionType.FLOATING:
+            b.body(worldbody, child, conn)  # the root sits at the origin: same place
+    if gravity_compensation:
+        for body_el in worldbody.iter("body"):
+            body_el.set("gravcomp", "1")
+    for asset_name, file_name, scale in b.assets.declarations():
+        mesh = etree.SubElement(asset, "mesh", name=asset_name, file=file_name)
+        if scale != (1.0, 1.0, 1.0):
+            mesh.set("scale", nums(scale))
+    if not len(asset):
+        root_el.remove(asset)
+    order = [b.joints[el.get("name", "")] for el in worldbody.iter("joint", "freejoint")]
+
+    pairs = sorted(tuple(sorted(p)) for p in robot.disabled_collision_pairs if len(p) == 2)
+    if pairs:
+        contact = etree.SubElement(root_el, "contact")
+        for first, second in pairs:
+            etree.SubElement(contact, "exclude", body1=first, body2=second)
+
+    mimics = [c for c in world.connections if c.mimic is not None]
+    if mimics:
+        equality = etree.SubElement(root_el, "equality")
+        for c in mimics:
+            assert c.mimic is not None
+            leader = world.connections_of_dof(c.dofs[0])[0].name
+            coef = (c.mimic.offset, c.mimic.multiplier, 0.0, 0.0, 0.0)
+            etree.SubElement(equality, "joint", joint1=c.name, joint2=leader, polycoef=nums(coef))
+
+    drive = robot.drive
+    servoed = [
+        c
+        for c in world.connections
+        if c.is_active and c.is_1dof and (drive is None or c.index != drive.index)
+    ]
+    q0 = world.default_configuration()
+    poses = robot.kinematics.forward(q0)
+    inertia = joint_inertias(world, poses, b.inertials, servoed)
+    omega = 2.0 * math.pi * servo_hz
+    if servoed:
+        actuator = etree.SubElement(root_el, "actuator")
+        for c in servoed:
+            dof = world.degrees_of_freedom[c.dofs[0]]
+            m = max(inertia[c.name], TINY_MASS)
+            act = etree.SubElement(actuator, "position", name=c.name, joint=c.name)
+            act.set("kp", num(m * omega * omega))
+            act.set("kv", num(2.0 * m * omega))
+            if c.type is not ConnectionType.CONTINUOUS and dof.is_bounded:
+                act.set("ctrlrange", nums((dof.lower, dof.upper)))
+            if math.isfinite(dof.effort) and dof.effort > 0.0:
+                act.set("forcerange", nums((-dof.effort, dof.effort)))
+
+    out = MjcfExport("", tuple(b.assets.files()), tuple(order), (), ())
+    keyframe = etree.SubElement(root_el, "keyframe")
+    keys = [("default", q0)]
+    for key_name, state in _states(robot).items():
+        keys.append((key_name, world.configuration(state.as_dict())))
+    index = {c.name: i for i, c in enumerate(servoed)}
+    qpos_index = {j.name: i for i, j in enumerate(order)}
+    for key_name, q in keys:
+        qpos = out.qpos(robot, q)
+        ctrl = [qpos[qpos_index[c.name]] for c in servoed]
+        key = etree.SubElement(keyframe, "key", name=key_name, qpos=nums(qpos))
+        if index:
+            key.set("ctrl", nums(ctrl))
+
+    limited = [
+        f"{d.name}: {num(d.velocity)}"
+        for d in world.degrees_of_freedom
+        if math.isfinite(d.velocity)
+    ]
+    header = [
+        f" {robot.name}: exported by robotspec (robotspec export mjcf). ",
+        " MJCF cannot hold velocity limits; the robot's, per degree of freedom (rad/s or m/s): "
+        + ("; ".join(limited) if limited else "none")
+        + " ",
+        f" Position servos: critically damped at {servo_hz:g} Hz from each joint's inertia at the "
+        "default configuration; forcerange is the URDF effort. ",
+        " Gravity compensated on every body (gravcomp). "
+        if gravity_compensation
+        else " Gravity acts in full: an effort limit that cannot hold a link lets it sag. ",
+    ]
+    header += [f" note: {n} " for n in b.notes]
+    for i, text in enumerate(header):
+        root_el.insert(i, etree.Comment(text.replace("--", "- -")))
+    etree.indent(root_el, space="  ")
+    xml = etree.tostring(root_el, encoding="unicode") + "\n"
+    actuated = tuple(c.name for c in servoed)
+    return MjcfExport(xml, out.meshes, out.joints, actuated, tuple(b.notes))

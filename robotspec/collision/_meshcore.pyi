@@ -2,6 +2,9 @@
 
 from typing import Any
 
+#: The interface version compiled into the core (meshcore.INTERFACE must equal it).
+INTERFACE: int
+
 def mesh_set(meshes: Any) -> object: ...
 def apart(
     meshes: object, poses: Any, rows: Any, pairs: Any, g1: Any, g2: Any, eps: float

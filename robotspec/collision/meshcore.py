@@ -14,10 +14,14 @@ from types import ModuleType
 
 from robotspec.accel import CoreChoice
 
-__all__ = ["CHOICE", "accelerated", "core"]
+__all__ = ["CHOICE", "INTERFACE", "accelerated", "core"]
 
+#: The version of the calls into ``_meshcore.c`` (its ``MESHCORE_INTERFACE``): bump both together
+#: whenever an entry point's arguments or results change (a stale core is refused, see
+#: robotspec/accel.py).
+INTERFACE = 1
 #: The C mesh proofs and the fallback that proves nothing.
-CHOICE = CoreChoice("robotspec.collision._meshcore", "robotspec.collision._meshcore_py")
+CHOICE = CoreChoice("robotspec.collision._meshcore", "robotspec.collision._meshcore_py", INTERFACE)
 #: The mesh core in use, loaded on the first call (the choice's own method: queries call it
 #: once each, so no wrapper frame sits in front of it).
 core: Callable[[], ModuleType] = CHOICE.core

@@ -21,16 +21,19 @@
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 #include <math.h>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define KIND_FIXED 0
-#define KIND_REVOLUTE 1
-#define KIND_PRISMATIC 2
+#include "_kincore_kernels.h"
+
+/*
+ * The version of the calls between this module and robotspec/model/kincore.py (its INTERFACE):
+ * bump both whenever an entry point's arguments, results or table layout change. The module
+ * exports it as INTERFACE, and robotspec/accel.py refuses a module whose number differs (a
+ * stale build left beside newer Python files) instead of letting it misread the tables.
+ */
+#define KINCORE_INTERFACE 1
 
 /* ------------------------------------------------------------------------------- helpers */
 
@@ -96,117 +99,6 @@ static PyArrayObject *as_config(PyObject *obj, int ndim, Py_ssize_t width) {
     return a;
 }
 
-/* out(3x4) = a(3x4) * b(3x4), both read as 4x4 row-major with an implicit last row 0 0 0 1. */
-static inline void mul34(const double *a, const double *b, double *out) {
-    for (int r = 0; r < 3; r++) {
-        const double a0 = a[4 * r], a1 = a[4 * r + 1], a2 = a[4 * r + 2], a3 = a[4 * r + 3];
-        out[4 * r] = a0 * b[0] + a1 * b[4] + a2 * b[8];
-        out[4 * r + 1] = a0 * b[1] + a1 * b[5] + a2 * b[9];
-        out[4 * r + 2] = a0 * b[2] + a1 * b[6] + a2 * b[10];
-        out[4 * r + 3] = a0 * b[3] + a1 * b[7] + a2 * b[11] + a3;
-    }
-}
-
-static inline void sin_cos(double v, double *s, double *c) {
-#if defined(__GLIBC__) && defined(_GNU_SOURCE)
-    sincos(v, s, c);
-#else
-    *s = sin(v);
-    *c = cos(v);
-#endif
-}
-
-/*
- * Motion codes: the general kinds above, plus rotations about and translations along a frame
- * axis (x, y, z), which touch two columns or one translation instead of a full product. The
- * axis's sign is folded into the motion's multiplier and offset when the program is built.
- */
-#define CODE_ROT_X 3
-#define CODE_PRI_X 6
-
-/* Apply one elementary motion to pose m in place: m = m * Rot(axis, v) or m * Trans(axis v). */
-static inline void apply_motion(double *m, int code, const double *axis, double v) {
-    if (code == KIND_REVOLUTE) {
-        const double x = axis[0], y = axis[1], z = axis[2];
-        double s, c;
-        sin_cos(v, &s, &c);
-        const double t = 1.0 - c;
-        const double r00 = c + x * x * t, r01 = x * y * t - z * s, r02 = x * z * t + y * s;
-        const double r10 = y * x * t + z * s, r11 = c + y * y * t, r12 = y * z * t - x * s;
-        const double r20 = z * x * t - y * s, r21 = z * y * t + x * s, r22 = c + z * z * t;
-        for (int r = 0; r < 3; r++) {
-            const double a0 = m[4 * r], a1 = m[4 * r + 1], a2 = m[4 * r + 2];
-            m[4 * r] = a0 * r00 + a1 * r10 + a2 * r20;
-            m[4 * r + 1] = a0 * r01 + a1 * r11 + a2 * r21;
-            m[4 * r + 2] = a0 * r02 + a1 * r12 + a2 * r22;
-        }
-    } else if (code == KIND_PRISMATIC) {
-        const double dx = axis[0] * v, dy = axis[1] * v, dz = axis[2] * v;
-        for (int r = 0; r < 3; r++) {
-            m[4 * r + 3] += m[4 * r] * dx + m[4 * r + 1] * dy + m[4 * r + 2] * dz;
-        }
-    } else if (code >= CODE_ROT_X && code < CODE_ROT_X + 3) {
-        /* About frame axis k: columns i = k+1 and j = k+2 (mod 3) mix. */
-        const int k = code - CODE_ROT_X, i = (k + 1) % 3, j = (k + 2) % 3;
-        double s, c;
-        sin_cos(v, &s, &c);
-        for (int r = 0; r < 3; r++) {
-            const double ai = m[4 * r + i], aj = m[4 * r + j];
-            m[4 * r + i] = c * ai + s * aj;
-            m[4 * r + j] = c * aj - s * ai;
-        }
-    } else if (code >= CODE_PRI_X && code < CODE_PRI_X + 3) {
-        const int k = code - CODE_PRI_X;
-        m[3] += m[k] * v;
-        m[7] += m[4 + k] * v;
-        m[11] += m[8 + k] * v;
-    }
-}
-
-/* out = a * b where b's rotation is the identity (a translation only). */
-static inline void mul34_translate(const double *a, const double *b, double *out) {
-    for (int r = 0; r < 3; r++) {
-        const double a0 = a[4 * r], a1 = a[4 * r + 1], a2 = a[4 * r + 2];
-        out[4 * r] = a0;
-        out[4 * r + 1] = a1;
-        out[4 * r + 2] = a2;
-        out[4 * r + 3] = a0 * b[3] + a1 * b[7] + a2 * b[11] + a[4 * r + 3];
-    }
-}
-
-static int is_identity_rotation(const double *o) {
-    return o[0] == 1.0 && o[1] == 0.0 && o[2] == 0.0 && o[4] == 0.0 && o[5] == 1.0 &&
-           o[6] == 0.0 && o[8] == 0.0 && o[9] == 0.0 && o[10] == 1.0;
-}
-
-/*
- * The fast code of a motion about/along a unit frame axis (sign folded into mul and off), or
- * the general kind.
- */
-static int motion_code(int kind, const double *axis, double *mul, double *off) {
-    if (kind != KIND_REVOLUTE && kind != KIND_PRISMATIC) return kind;
-    for (int k = 0; k < 3; k++) {
-        const double a = axis[k];
-        if ((a == 1.0 || a == -1.0) && axis[(k + 1) % 3] == 0.0 && axis[(k + 2) % 3] == 0.0) {
-            *mul *= a;
-            *off *= a;
-            return (kind == KIND_REVOLUTE ? CODE_ROT_X : CODE_PRI_X) + k;
-        }
-    }
-    return kind;
-}
-
-static inline void last_row(double *m) {
-    m[12] = 0.0;
-    m[13] = 0.0;
-    m[14] = 0.0;
-    m[15] = 1.0;
-}
-
-static inline void identity(double *m) {
-    memset(m, 0, 16 * sizeof(double));
-    m[0] = m[5] = m[10] = m[15] = 1.0;
-}
 
 /* The table in a capsule made by this module's constructor, else NULL with a TypeError naming it
  * (PyCapsule_GetPointer's own error is a ValueError about capsules, which the caller never made;
@@ -227,17 +119,6 @@ static void *table(PyObject *cap, const char *name, const char *what) {
 
 /* ------------------------------------------------------------------------------- the tree */
 
-/*
- * A tree program: op k computes slot child[k] = slot parent[k] * origin[k] * motion_k(q).
- * Slot 0 is the root (identity); slots below n_out are the returned bodies, the others are
- * scratch (the intermediate frames of planar and floating connections).
- */
-typedef struct {
-    Py_ssize_t n_ops, n_slots, n_out, n_dof;
-    int64_t *parent, *child, *kind, *dof;
-    double *origin, *axis, *mul, *off;
-    int *code, *translate; /* motion code (see motion_code), origin without rotation */
-} Tree;
 
 static void tree_free(PyObject *capsule) {
     Tree *t = PyCapsule_GetPointer(capsule, "robotspec.tree");
@@ -339,25 +220,6 @@ static PyObject *py_tree(PyObject *self, PyObject *args) {
     return cap;
 }
 
-/* Every output pose of one configuration into out (n_out x 16); scratch has the other slots. */
-static void tree_run(const Tree *t, const double *q, double *out, double *scratch) {
-    identity(out);
-    for (Py_ssize_t k = 0; k < t->n_ops; k++) {
-        const int64_t p = t->parent[k], c = t->child[k];
-        const double *pp = p < t->n_out ? out + 16 * p : scratch + 16 * (p - t->n_out);
-        double *cp = c < t->n_out ? out + 16 * c : scratch + 16 * (c - t->n_out);
-        if (t->translate[k]) {
-            mul34_translate(pp, t->origin + 16 * k, cp);
-        } else {
-            mul34(pp, t->origin + 16 * k, cp);
-        }
-        const int code = t->code[k];
-        if (code != KIND_FIXED) {
-            apply_motion(cp, code, t->axis + 3 * k, q[t->dof[k]] * t->mul[k] + t->off[k]);
-        }
-        last_row(cp);
-    }
-}
 
 static PyObject *py_fk(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj;
@@ -386,43 +248,6 @@ static PyObject *py_fk(PyObject *self, PyObject *args) {
     return (PyObject *)out;
 }
 
-/*
- * Why stage each sample in a small buffer when writing into a caller's array: a batch result
- * (100 MB for 10,000 PR2 samples) does not fit in any cache, and plain stores first read every
- * line they write. Computing a sample where it stays in cache and then streaming it out
- * (non-temporal stores, where the CPU has them) writes the result once. A fresh result is written
- * in place instead: its pages were just zeroed by the kernel and sit in cache, where streaming
- * would only evict them (measured: 36 against 25 ms for 10,000 PR2 samples).
- */
-static void stream_copy(double *dst, const double *src, size_t n) {
-#if defined(__SSE2__)
-    if (((uintptr_t)dst & 15) == 0) {
-        size_t k = 0;
-        for (; k + 2 <= n; k += 2) _mm_stream_pd(dst + k, _mm_load_pd(src + k));
-        for (; k < n; k++) dst[k] = src[k];
-        return;
-    }
-#endif
-    memcpy(dst, src, n * sizeof(double));
-}
-
-/* Samples 0 .. n of q into out; scratch holds the scratch slots, stage (16-byte aligned) one
- * sample's output when streaming. */
-static void fk_run_batch(const Tree *t, const double *q, npy_intp n, double *out, double *scratch,
-                         double *stage, int stream) {
-    const size_t width = 16 * (size_t)t->n_out;
-    for (npy_intp i = 0; i < n; i++) {
-        if (stream) {
-            tree_run(t, q + i * t->n_dof, stage, scratch);
-            stream_copy(out + i * (npy_intp)width, stage, width);
-        } else {
-            tree_run(t, q + i * t->n_dof, out + i * (npy_intp)width, scratch);
-        }
-    }
-#if defined(__SSE2__)
-    if (stream) _mm_sfence();
-#endif
-}
 
 /* The caller's out array when it is one the core may write as native float64 poses (N, B, 4, 4):
  * TypeError for the wrong type, byte order or alignment, ValueError for the wrong shape. */
@@ -473,7 +298,7 @@ static PyObject *py_fk_batch(PyObject *self, PyObject *args) {
             return NULL;
         }
         out = (PyArrayObject *)oobj;
-        Py_INCREF(out);
+        Py_INCREF((PyObject *)out);
     }
     Py_ssize_t n_scratch = t->n_slots - t->n_out;
     /* Scratch slots, then a 16-byte aligned stage of one sample's output. */
@@ -502,21 +327,10 @@ static PyObject *py_tree_size(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "O", &cap)) return NULL;
     const Tree *t = TREE_OF(cap);
     if (t == NULL) return NULL;
-    return Py_BuildValue("nn", t->n_out, t->n_dof);
+    return Py_BuildValue("nn", (Py_ssize_t)t->n_out, (Py_ssize_t)t->n_dof);
 }
 
 /* ------------------------------------------------------------------------------ a chain */
-
-/*
- * A chain program: T = pre[0] m_0(q) pre[1] m_1(q) ... pre[n-1] m_{n-1}(q) post, where pre[i]
- * holds the fixed transforms before elementary motion i; col[i] is the Jacobian column motion i
- * adds to (mimic joints add to their leader's column, scaled by mul[i]).
- */
-typedef struct {
-    Py_ssize_t n, n_cols, n_dof;
-    int64_t *kind, *dof, *col;
-    double *pre, *post, *axis, *mul, *off;
-} Chain;
 
 static void chain_free(PyObject *capsule) {
     Chain *c = PyCapsule_GetPointer(capsule, "robotspec.chain");
@@ -572,17 +386,6 @@ static PyObject *py_chain(PyObject *self, PyObject *args) {
     return cap;
 }
 
-static void chain_run(const Chain *c, const double *qv, double *o) {
-    double t[16], u[16];
-    identity(t);
-    for (Py_ssize_t i = 0; i < c->n; i++) {
-        mul34(t, c->pre + 16 * i, u);
-        apply_motion(u, (int)c->kind[i], c->axis + 3 * i, qv[c->dof[i]] * c->mul[i] + c->off[i]);
-        memcpy(t, u, 12 * sizeof(double));
-    }
-    mul34(t, c->post, o);
-    last_row(o);
-}
 
 static PyObject *py_chain_fk(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj;
@@ -636,7 +439,7 @@ static PyObject *py_chain_jacobian(PyObject *self, PyObject *args) {
         if (z != zbuf) free(z);
         if (p != pbuf) free(p);
         Py_DECREF(q);
-        Py_XDECREF(out);
+        Py_XDECREF((PyObject *)out);
         return out == NULL ? NULL : PyErr_NoMemory();
     }
     double t[16], u[16], tip[16];
@@ -678,18 +481,6 @@ static PyObject *py_chain_jacobian(PyObject *self, PyObject *args) {
 }
 
 /* ------------------------------------------------------------------ collision broad phase */
-
-/*
- * Geometries (each on a body, with a body-frame box) and the geometry pairs to test. The broad
- * phase keeps a (sample, pair) when the boxes' world-aligned bounds come within the margin and
- * no separating axis of the two oriented boxes (15 axes) parts them by more than the margin:
- * both tests are conservative, so coal's narrow phase decides every answer.
- */
-typedef struct {
-    Py_ssize_t n_geom, n_pair, n_body;
-    int64_t *body, *g1, *g2;
-    double *body_T_geom, *center, *half;
-} Geoms;
 
 static void geoms_free(PyObject *capsule) {
     Geoms *g = PyCapsule_GetPointer(capsule, "robotspec.geoms");
@@ -747,34 +538,6 @@ static PyObject *py_geoms(PyObject *self, PyObject *args) {
     return cap;
 }
 
-static int obb_separated(const double *a, const double *ha, const double *b, const double *hb) {
-    /* a, b: world poses (4x4 rows) of the box frames; ha, hb: inflated half extents. */
-    double r[3][3], ar[3][3], t[3], d[3];
-    for (int x = 0; x < 3; x++) d[x] = b[4 * x + 3] - a[4 * x + 3];
-    for (int x = 0; x < 3; x++) {
-        for (int y = 0; y < 3; y++) {
-            r[x][y] = a[x] * b[y] + a[4 + x] * b[4 + y] + a[8 + x] * b[8 + y];
-            ar[x][y] = fabs(r[x][y]) + 1e-9;
-        }
-        t[x] = a[x] * d[0] + a[4 + x] * d[1] + a[8 + x] * d[2];
-    }
-    for (int x = 0; x < 3; x++) {
-        if (fabs(t[x]) > ha[x] + ar[x][0] * hb[0] + ar[x][1] * hb[1] + ar[x][2] * hb[2]) return 1;
-        double tb = t[0] * r[0][x] + t[1] * r[1][x] + t[2] * r[2][x];
-        if (fabs(tb) > ha[0] * ar[0][x] + ha[1] * ar[1][x] + ha[2] * ar[2][x] + hb[x]) return 1;
-    }
-    for (int x = 0; x < 3; x++) {
-        int x1 = (x + 1) % 3, x2 = (x + 2) % 3;
-        for (int y = 0; y < 3; y++) {
-            int y1 = (y + 1) % 3, y2 = (y + 2) % 3;
-            double lhs = fabs(t[x2] * r[x1][y] - t[x1] * r[x2][y]);
-            double rhs = ha[x1] * ar[x2][y] + ha[x2] * ar[x1][y] + hb[y1] * ar[x][y2] +
-                         hb[y2] * ar[x][y1];
-            if (lhs > rhs) return 1;
-        }
-    }
-    return 0;
-}
 
 /*
  * broad(geoms, body_poses (N, B, 4, 4) or (B, 4, 4), margin, mask or None)
@@ -803,7 +566,7 @@ static PyObject *py_broad(PyObject *self, PyObject *args) {
         mask = (PyArrayObject *)PyArray_FROMANY(mobj, NPY_UINT8, 1, 1, NPY_ARRAY_IN_ARRAY);
         if (mask == NULL || PyArray_SIZE(mask) != g->n_pair) {
             Py_DECREF(poses);
-            Py_XDECREF(mask);
+            Py_XDECREF((PyObject *)mask);
             if (mask != NULL) PyErr_SetString(PyExc_ValueError, "pair mask has the wrong size");
             return NULL;
         }
@@ -880,11 +643,11 @@ static PyObject *py_broad(PyObject *self, PyObject *args) {
     free(lo);
     free(hi);
     Py_DECREF(poses);
-    Py_XDECREF(mask);
+    Py_XDECREF((PyObject *)mask);
     if (failed) {
         free(rows);
         free(ks);
-        Py_XDECREF(gp);
+        Py_XDECREF((PyObject *)gp);
         return PyErr_Occurred() ? NULL : PyErr_NoMemory();
     }
     npy_intp kd[1] = {nk};
@@ -893,8 +656,8 @@ static PyObject *py_broad(PyObject *self, PyObject *args) {
     if (ra == NULL || ka == NULL) {
         free(rows);
         free(ks);
-        Py_XDECREF(ra);
-        Py_XDECREF(ka);
+        Py_XDECREF((PyObject *)ra);
+        Py_XDECREF((PyObject *)ka);
         Py_DECREF(gp);
         return NULL;
     }
@@ -931,5 +694,10 @@ static struct PyModuleDef module = {
 
 PyMODINIT_FUNC PyInit__kincore(void) {
     import_array();
-    return PyModule_Create(&module);
+    PyObject *m = PyModule_Create(&module);
+    if (m != NULL && PyModule_AddIntConstant(m, "INTERFACE", KINCORE_INTERFACE) != 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
 }

@@ -2,6 +2,9 @@
 
 from typing import Any
 
+#: The interface version compiled into the core (kincore.INTERFACE must equal it).
+INTERFACE: int
+
 def tree(
     parent: Any,
     child: Any,

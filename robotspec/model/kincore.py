@@ -26,6 +26,7 @@ from robotspec.arrays import F64
 
 __all__ = [
     "CHOICE",
+    "INTERFACE",
     "NO_ACCEL_ENV",
     "accelerated",
     "accelerators_disabled",
@@ -33,8 +34,12 @@ __all__ = [
     "fk_batch",
 ]
 
+#: The version of the calls into ``_kincore.c`` (its ``KINCORE_INTERFACE``): bump both together
+#: whenever an entry point's arguments, results or table layout change, so that a core left from
+#: an older build is refused (robotspec/accel.py) instead of misreading the new tables.
+INTERFACE = 1
 #: The C kinematics core and its numpy fallback.
-CHOICE = CoreChoice("robotspec.model._kincore", "robotspec.model._kincore_py")
+CHOICE = CoreChoice("robotspec.model._kincore", "robotspec.model._kincore_py", INTERFACE)
 #: The kinematics core in use, loaded on the first call (the choice's own method: queries call it
 #: once each, so no wrapper frame sits in front of it).
 core: Callable[[], ModuleType] = CHOICE.core
@@ -50,11 +55,17 @@ def fk_batch(tree: object, q: object, threads: int = 1, out: Any = None) -> F64:
 
     With ``threads`` > 1 the samples are split into that many contiguous slices, one core call
     each on its own thread; the result does not depend on the split. ``q`` is checked whole
-    before any slice runs, so an error leaves ``out`` untouched.
+    before any slice runs, so an error leaves ``out`` untouched. A ``q`` that is not an array
+    (a list of lists) is converted first, as the core converts it (same errors), so that it is
+    split over the threads too instead of running on one.
     """
     c = core()
     if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= 64:
         raise ValueError(f"threads must be between 1 and 64, got {threads!r}")
+    if not isinstance(q, np.ndarray):
+        from robotspec.model._core_args import from_any
+
+        q = from_any(q, np.float64, 2, 2)
     n = q.shape[0] if isinstance(q, np.ndarray) and q.ndim == 2 else 0
     threads = min(threads, n)
     if threads <= 1:

@@ -11,6 +11,7 @@ import typer
 from robotspec.cli import (
     collisions_cmd,
     demo_cmd,
+    doctor_cmd,
     drive_cmd,
     export_cmd,
     init_cmd,
@@ -37,6 +38,15 @@ def _root(
     verbose: Annotated[
         bool, typer.Option("--verbose", "-v", help="Show a traceback on errors (for bug reports).")
     ] = False,
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            is_eager=True,
+            callback=doctor_cmd.print_version,
+            help="Print the version and which cores answer queries (C or fallback), and exit.",
+        ),
+    ] = False,
 ) -> None:
     """Robot semantics as data: load, validate, inspect and drive robots."""
     if verbose:
@@ -57,6 +67,7 @@ for _module in (  # in the order a user meets them: check, look, start, write, d
     render_cmd,
     drive_cmd,
     demo_cmd,
+    doctor_cmd,
 ):
     app.add_typer(_module.app)
 

@@ -14,7 +14,7 @@ import pytest
 
 from robotspec.cli.app import main
 from robotspec.compiler import check_spec
-from robotspec.errors import DescriptionError, RobotSpecError, SpecError
+from robotspec.errors import DescriptionError, RobotSpecError
 from robotspec.setup import SetupSession
 from robotspec.setup.questions import KEEP
 from robotspec.setup.session import SetupError
@@ -136,7 +136,7 @@ def test_a_spec_keeps_its_marks_and_what_setup_does_not_edit(tmp_path: Path) -> 
     again = SetupSession.open(str(spec), output=tmp_path / "b" / "xarm.yaml")
     assert [q.id for q in again.snapshot.questions] == ["chains.arm", "manipulators.tool"]
     assert again.validation.valid
-    assert "collision:\n  buffer_distance: 0.02" in again.snapshot.text
+    assert again.snapshot.text == text  # kept as written: setup edits the text, not a render
 
 
 def test_files_it_cannot_read_get_the_clis_located_errors(tmp_path: Path) -> None:
@@ -147,11 +147,6 @@ def test_files_it_cannot_read_get_the_clis_located_errors(tmp_path: Path) -> Non
     with pytest.raises(RobotSpecError) as exc:
         SetupSession.open(str(bad), output=tmp_path / "x.yaml")
     assert exc.value.file is not None and exc.value.file.endswith("bad.yaml")
-    # A shipped spec using what a draft cannot hold is refused where it uses it.
-    erd_robots()
-    with pytest.raises(SpecError, match="cannot edit") as refused:
-        SetupSession.open("b1_ur5_allegro", output=tmp_path / "b1.yaml")
-    assert refused.value.line is not None
 
 
 def test_the_shipped_pr2_opens_and_saves_with_its_camera_heights(tmp_path: Path) -> None:
@@ -179,7 +174,8 @@ def test_two_threads_editing_see_one_state(tmp_path: Path) -> None:
         t.start()
     for t in threads:
         t.join()
-    assert sorted(seen) == list(range(1, 7)) and s.snapshot.version == 6
+    # In the order made (a listener may skip a state a newer one replaced), ending on the last.
+    assert seen == sorted(set(seen)) and seen[-1] == 6 and s.snapshot.version == 6
     assert len(s.part_states("robot")) == 6 and s.validation.valid
 
 
@@ -238,9 +234,12 @@ def test_tiago_a_camera_model_guessed_by_name_is_a_question(tmp_path: Path) -> N
 def test_an_output_that_cannot_be_written_is_a_located_error(tmp_path: Path) -> None:
     (tmp_path / "a_file").write_text("")
     urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
-    with pytest.raises(RobotSpecError, match="cannot write the spec's folder") as exc:
-        SetupSession.open(str(urdf), output=tmp_path / "a_file" / "xarm.yaml")
-    assert exc.value.file == str(tmp_path / "a_file" / "xarm.yaml")
+    # Opening writes nothing (validation reads the text from memory); saving says why not.
+    s = SetupSession.open(str(urdf), output=tmp_path / "a_file" / "xarm.yaml")
+    with pytest.raises(RobotSpecError) as exc:
+        s.save()
+    assert exc.value.file is not None and "a_file" in exc.value.file
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
 
 
 def test_a_gripper_made_a_hand_of_named_fingers_and_generic_again(tmp_path: Path) -> None:

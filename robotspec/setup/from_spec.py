@@ -6,11 +6,13 @@ loader knows the line of every node; a mark on the line of a part is that part's
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from robotspec.errors import RobotSpecError, RobotSpecErrors, SpecError
+from robotspec.files.yamlio import LocatedYaml
 from robotspec.model.world import World
 from robotspec.spec.draft.model import (
     Draft,
@@ -24,9 +26,12 @@ from robotspec.spec.draft.model import (
 from robotspec.spec.draft.render import PLACEHOLDER_FOV
 from robotspec.spec.load import LoadedSpec
 
-__all__ = ["draft_of_spec"]
+__all__ = ["ReadSpec", "draft_of_spec"]
 
 _MARK = "# DECIDE:"
+#: The camera axes a draft holds (optical +z, body +x); a camera facing another way is kept as
+#: written, like a generic sensor.
+_AXES = (None, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
 _FROM = "# from "
 
 
@@ -73,18 +78,6 @@ class _Marks:
         return rest.split("  # DECIDE:")[0].strip()
 
 
-def _refuse(loaded: LoadedSpec, loc: tuple[str | int, ...], what: str) -> SpecError:
-    file, line, col = loaded.position(loc)
-    return SpecError(
-        f"robotspec setup cannot edit {what} yet; edit this spec in a text editor",
-        file=file,
-        line=line,
-        column=col,
-        kind="spec",
-        location=loc,
-    )
-
-
 def _rebase(ref: str, loaded: LoadedSpec, folder: Path | None) -> str:
     """A file reference of the spec as the saved spec in ``folder`` must write it."""
     from robotspec.spec.draft.paths import relative_path
@@ -94,10 +87,31 @@ def _rebase(ref: str, loaded: LoadedSpec, folder: Path | None) -> str:
     return relative_path(loaded.folder / ref, folder)
 
 
+@dataclass(frozen=True)
+class ReadSpec:
+    """A spec read for editing (see :func:`draft_of_spec`)."""
+
+    #: The draft, its file paths as the spec saved in the output's folder must write them.
+    draft: Draft
+    world: World
+    #: Top-level keys kept as read.
+    kept: dict[str, Any]
+    #: The other files its values come from (its parts' specs, the specs it extends).
+    others: tuple[LocatedYaml, ...]
+    #: The draft with its paths as the file writes them.
+    as_read: Draft
+
+
 def draft_of_spec(
     ref: str, *, package_paths: Sequence[str | Path] = (), folder: Path | None = None
-) -> tuple[Draft, World, dict[str, Any]]:
-    """The draft a spec amounts to, the robot's tree, and the top-level keys kept as read."""
+) -> ReadSpec:
+    """The draft a spec amounts to, with the robot's tree and what else it was read with.
+
+    What a draft cannot hold (a generic sensor, a camera facing another axis, a frame's
+    rotation, ``parts:``, ``extends:``) is left out of the draft: the saved text keeps it as
+    written (:mod:`robotspec.setup.round_trip`). A composed robot's parts are its tree and its
+    parts' chains, hands and sensors, each still written in its own file.
+    """
     from robotspec.compiler import resolve_spec
     from robotspec.description.load import load_description
     from robotspec.setup.source import KEPT_KEYS
@@ -106,31 +120,37 @@ def draft_of_spec(
     loaded = load_spec(resolve_spec(ref), allowed=package_paths)
     # The page opens downloaded specs too: the same fence as validate, before any file is read.
     check_package_paths(loaded, package_paths)
+    top = loaded
+    composition = None
+    if loaded.spec.parts:
+        from robotspec.compose import compose
+
+        composition = compose(loaded, package_paths=package_paths)
+        loaded = composition.loaded  # the flat spec: the parts' semantics, then the spec's own
     spec = loaded.spec
-    refused: list[RobotSpecError] = []
-    for key in ("parts", "extends"):
-        if getattr(spec, key):
-            refused.append(_refuse(loaded, (key,), f"'{key}:' (a composed robot)"))
-    if spec.description is not None and spec.description.xacro_args:
-        refused.append(_refuse(loaded, ("description", "xacro_args"), "xacro_args"))
-    for name, f in spec.files.frames.items() if spec.description is not None else ():
-        if f.rpy is not None or f.quaternion is not None:
-            refused.append(_refuse(loaded, ("description", "frames", name), "a rotated frame"))
-    for name, s in spec.sensors.items():
-        if s.type != "camera":
-            refused.append(_refuse(loaded, ("sensors", name), "a generic sensor"))
-        elif s.forward_facing_axis not in (None, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)):
-            refused.append(_refuse(loaded, ("sensors", name), "a camera facing that axis"))
-    if refused:
-        raise refused[0] if len(refused) == 1 else RobotSpecErrors(refused)
-    marks = _Marks(loaded)
+    marks = _Marks(top)
     files = spec.files
-    paths = [*(_rebase(p, loaded, None) for p in files.package_paths), *map(str, package_paths)]
-    absolute = [p if Path(p).is_absolute() else str(loaded.folder / p) for p in paths]
-    desc = load_description(
-        files.urdf, package_paths=absolute, meshes="keep", base_folder=loaded.folder
-    )
-    world = desc.world
+    if composition is not None:
+        from robotspec.description.urdf import world_from_urdf_xml
+
+        world = world_from_urdf_xml(
+            copy.deepcopy(composition.urdf),
+            composition.source,
+            resolver=composition.resolver,
+            meshes="keep",
+            issues=[],
+            checked=True,
+        )
+    else:
+        paths = [*(_rebase(p, loaded, None) for p in files.package_paths), *map(str, package_paths)]
+        absolute = [p if Path(p).is_absolute() else str(loaded.folder / p) for p in paths]
+        world = load_description(
+            files.urdf,
+            package_paths=absolute,
+            xacro_args=files.xacro_args or None,
+            meshes="keep",
+            base_folder=loaded.folder,
+        ).world
     draft = Draft(
         name=spec.name,
         urdf=_rebase(files.urdf, loaded, folder),
@@ -141,6 +161,7 @@ def draft_of_spec(
         manipulators=[],
         cameras=[],
         package_paths=[_rebase(p, loaded, folder) for p in files.package_paths],
+        xacro_args={str(k): str(v) for k, v in (files.xacro_args or {}).items()},
         states={k: dict(v) for k, v in spec.states.items()},
         notes=marks.notes(),
     )
@@ -211,8 +232,8 @@ def draft_of_spec(
             dm.fingers = {k: DraftFinger(f.root, f.tip) for k, f in m.fingers.items()}
         draft.manipulators.append(dm)
     for name, s in spec.sensors.items():
-        if s.type != "camera":  # pragma: no cover - refused above
-            continue
+        if s.type != "camera" or s.forward_facing_axis not in _AXES:
+            continue  # kept as written: the page does not edit it (the text keeps it)
         fov = s.field_of_view
         angles = None if fov is None else (fov.horizontal, fov.vertical)
         placeholder = angles == PLACEHOLDER_FOV and marks.decide(("sensors", name, "field_of_view"))
@@ -229,6 +250,10 @@ def draft_of_spec(
                 default=s.default,
             )
         )
-    raw = loaded.documents[0].data
+    raw = top.documents[0].data
     kept = {k: raw[k] for k in KEPT_KEYS if isinstance(raw, dict) and k in raw}
-    return draft, world, kept
+    # The draft as the file states it (paths as written): saving elsewhere rewrites them.
+    as_read = copy.copy(draft)
+    as_read.urdf, as_read.srdf = files.urdf, files.srdf
+    as_read.package_paths = [*files.package_paths]
+    return ReadSpec(draft, world, kept, tuple(loaded.documents[1:]), as_read)

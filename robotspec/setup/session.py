@@ -32,6 +32,7 @@ from robotspec.setup.questions import (
 from robotspec.setup.save import spec_text, write_spec
 from robotspec.setup.source import Source, open_source
 from robotspec.setup.targets import SaveFence
+from robotspec.setup.text_edit import TextEditError
 from robotspec.setup.tree import chain_joints, joint_range, subtree_joints
 from robotspec.setup.validation import Validation, validate_text
 from robotspec.spec.draft.model import (
@@ -123,6 +124,11 @@ class SetupSession:
         self._history: list[Draft] = []
         self._listeners: list[Callable[[Snapshot], None]] = []
         self._version = 0
+        #: Ordered delivery (:meth:`_publish`): the last (version, saved) delivered, and
+        #: whether a thread is delivering now.
+        self._publish_lock = threading.Lock()
+        self._delivered: tuple[int, bool] = (-1, False)
+        self._delivering = False
         #: A generated SRDF kept until save: (its name beside the spec, its text).
         self._pending_srdf: tuple[str, str] | None = None
         self._saved: tuple[str, str | None] | None = None
@@ -218,12 +224,22 @@ class SetupSession:
         def naming(staged: str) -> str:
             d = copy.copy(draft)
             d.srdf = staged
-            return spec_text(d, self.source.kept, self.source.presets)
+            return self._text(d)
 
         return validate_text(naming, at, package_paths=self.package_paths, srdf=srdf)
 
+    def _text(self, draft: Draft) -> str:
+        """The text saving writes: a spec's own text with the changes made, or the draft's."""
+        written = self.source.written
+        if written is None:
+            return spec_text(draft, self.source.kept, self.source.presets)
+        try:
+            return written.text_of(draft, self.source.presets)
+        except TextEditError as exc:
+            raise SetupError(exc.message, kind=exc.detail.kind, name=exc.detail.name) from None
+
     def _make_snapshot(self, draft: Draft) -> Snapshot:
-        text = spec_text(draft, self.source.kept, self.source.presets)
+        text = self._text(draft)
         srdf = self._srdf_of(draft)
         return Snapshot(
             self._version,
@@ -242,10 +258,39 @@ class SetupSession:
             snap = self._make_snapshot(new)
             self._history = [*self._history[-_HISTORY + 1 :], self._draft]
             self._draft, self._snapshot = new, snap
-            listeners = list(self._listeners)
-        for listener in listeners:
-            listener(snap)
+        self._publish()
         return snap.validation
+
+    def _publish(self) -> None:
+        """Tell the listeners of the newest state, states in the order they were made.
+
+        Why not each thread its own snapshot after the lock: two edits on two threads (viser
+        runs callbacks on a pool) then reach a listener in either order, and a page drew the
+        older state last (``delivered [2, 1], session at 2``). One thread delivers at a time;
+        a thread finding another delivering leaves its state to it, which delivers states until
+        it has delivered the newest (skipping none it has not passed: each is newer than the
+        last). So listeners see versions only grow, and always end on the session's state.
+        """
+        with self._publish_lock:
+            if self._delivering:
+                return
+            self._delivering = True
+        try:
+            while True:
+                with self._lock, self._publish_lock:
+                    snap = self._snapshot
+                    order = (snap.version, snap.saved)
+                    if order <= self._delivered:
+                        self._delivering = False
+                        return
+                    self._delivered = order
+                    listeners = list(self._listeners)
+                for listener in listeners:
+                    listener(snap)
+        except BaseException:
+            with self._publish_lock:
+                self._delivering = False
+            raise
 
     def undo(self) -> Validation:
         """Go back one change (nothing happens when there is none)."""
@@ -256,9 +301,7 @@ class SetupSession:
             self._version += 1
             snap = self._make_snapshot(previous)
             self._draft, self._snapshot = previous, snap
-            listeners = list(self._listeners)
-        for listener in listeners:
-            listener(snap)
+        self._publish()
         return snap.validation
 
     # ------------------------------------------------------------------ changes
@@ -624,10 +667,7 @@ class SetupSession:
             self._snapshot = Snapshot(
                 snap.version, snap.text, snap.validation, snap.questions, saved=True
             )
-            listeners = list(self._listeners)
-            saved = self._snapshot
-        for listener in listeners:
-            listener(saved)
+        self._publish()
         return target
 
 

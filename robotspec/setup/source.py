@@ -2,12 +2,11 @@
 
 A spec is read back into the draft's form, its DECIDE marks found at their parts.
 
-Why one form for both: the assistant edits a :class:`~robotspec.spec.draft.Draft` and saves it
-with the draft's writer, so the comments a draft carries survive and an answered DECIDE mark is
-simply a reason no longer there. A spec using what a draft cannot hold (``parts:``, ``extends:``,
-generic sensors, frames with a rotation) is refused with a located error rather than saved with
-parts of it lost; top-level settings the assistant does not edit (``collision``,
-``velocity_limits``, ...) are kept as read.
+Why one form for both: the assistant edits a :class:`~robotspec.spec.draft.Draft`. A URDF's
+draft is saved with the draft's writer (what ``init`` writes). A spec is saved as its own text
+with the session's changes made in it (:class:`~robotspec.setup.round_trip.SpecText`), so what a
+draft cannot hold (``parts:``, ``extends:``, generic sensors, rotated frames, comments, settings
+the page does not edit) stays exactly as written.
 """
 
 from __future__ import annotations
@@ -18,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from robotspec.model.world import World
+from robotspec.setup.round_trip import SpecText
 from robotspec.spec.draft.model import Draft
 
 __all__ = ["KEPT_KEYS", "Source", "is_spec_file", "open_source"]
@@ -44,6 +44,17 @@ class Source:
     #: The robot's own files (URDF or xacro, SRDF, meshes, the spec read), each with what it
     #: is: no save replaces one (``robotspec.setup.targets``).
     inputs: dict[Path, str] = field(default_factory=dict)
+    #: A spec's own text, which saving edits (None: a URDF's draft, written by the drafter).
+    written: SpecText | None = None
+
+
+def _text(path: Path) -> str:
+    """The spec's text, byte for byte (no newline translation), read within the YAML cap."""
+    from robotspec.files.limits import limits
+    from robotspec.files.reading import read_bounded
+
+    cap = limits().max_yaml_bytes
+    return read_bounded(path, cap=cap, cap_name="max_yaml_bytes", what="a YAML file").decode()
 
 
 def is_spec_file(ref: str) -> bool:
@@ -69,15 +80,22 @@ def open_source(
     presets = camera_presets()
     if is_spec_file(ref):
         from robotspec.compiler import resolve_spec
+        from robotspec.files.yamlio import load_yaml_text
         from robotspec.setup.from_spec import draft_of_spec
 
         folder = output.resolve().parent
-        draft, world, kept = draft_of_spec(ref, package_paths=package_paths, folder=folder)
+        read = draft_of_spec(ref, package_paths=package_paths, folder=folder)
+        draft, world = read.draft, read.world
         named = draft.srdf if draft.srdf and "://" not in draft.srdf else None
-        inputs = robot_inputs(
-            world, srdf=[named and folder / named], spec=resolve_spec(ref).absolute()
+        path = resolve_spec(ref)
+        inputs = robot_inputs(world, srdf=[named and folder / named], spec=path.absolute())
+        text = _text(path)
+        doc = load_yaml_text(text, str(path))  # checked as validate checks it
+        composed = isinstance(doc.data, dict) and bool(doc.data.get("parts"))
+        written = SpecText.read(
+            text, str(path), read.as_read, presets, others=read.others, composed=composed
         )
-        return Source(draft, world, ref, kept, presets, inputs)
+        return Source(draft, world, ref, read.kept, presets, inputs, written)
     from robotspec.spec.draft.run import draft_from_files
 
     folder = output.resolve().parent

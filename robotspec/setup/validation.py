@@ -1,21 +1,19 @@
 """Validation of the text the assistant would save, each problem placed at its part.
 
 Why the text and not the draft object: the assistant promises that what it saves validates, so it
-checks exactly what it would write, with the compiler ``robotspec validate`` runs. The text goes
-to a hidden file beside the real output, so relative references (``../urdf/robot.urdf``,
-``package_paths``) resolve as they will in the saved spec; the file is removed at once. A
-generated SRDF not yet saved is staged beside it the same way. A check leaves nothing behind: a
-folder it had to create is removed again (only a save creates folders).
+checks exactly what it would write, with the compiler ``robotspec validate`` runs. The text is
+read from memory as if it were the output file (``load_spec(text=...)``), so relative
+references (``../urdf/robot.urdf``, ``package_paths``) resolve as they will in the saved spec and
+nothing is written beside the user's files until they save. A generated SRDF not yet saved is
+staged in a private temporary folder (the compiler reads SRDFs from files), named by the checked
+text as an absolute path, and its messages name it as it will be saved.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
 import tempfile
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -113,58 +111,6 @@ def _problem(d: ErrorDetail, spec_file: str, shown: Mapping[str, str]) -> Proble
     )
 
 
-@contextmanager
-def _scratch(output: Path) -> Iterator[Path]:
-    """The output's folder, made for the check if missing and removed again after it.
-
-    Why: a check must leave nothing behind (a refused "save as" creates no folder); only a
-    save creates the folders it writes into.
-    """
-    folder = output.resolve().parent
-    missing: list[Path] = []
-    p = folder
-    while not os.path.lexists(p) and p.parent != p:
-        missing.append(p)
-        p = p.parent
-    try:
-        for m in reversed(missing):
-            m.mkdir()
-    except OSError as exc:
-        _remove(missing)
-        raise RobotSpecError(
-            f"cannot write the spec's folder: {exc.strerror or exc}", file=str(output), kind="file"
-        ) from None
-    try:
-        yield folder
-    finally:
-        _remove(missing)
-
-
-def _remove(folders: Sequence[Path]) -> None:
-    for m in folders:  # deepest first
-        with contextlib.suppress(OSError):
-            m.rmdir()
-
-
-def _stage(folder: Path, prefix: str, suffix: str, data: str, output: Path) -> Path:
-    """A file of ``data`` in ``folder``, created exclusively (nothing planted is opened)."""
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=folder)
-    except OSError as exc:
-        raise RobotSpecError(
-            f"cannot write the spec's folder: {exc.strerror or exc}", file=str(output), kind="file"
-        ) from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(data)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise RobotSpecError(
-            f"cannot write the spec's folder: {exc.strerror or exc}", file=str(output), kind="file"
-        ) from None
-    return Path(tmp)
-
-
 def validate_text(
     text: str | Callable[[str], str],
     output: Path,
@@ -175,36 +121,35 @@ def validate_text(
     """Check ``text`` as if it were the file ``output``; every error and warning, located.
 
     ``srdf``: an SRDF kept in the session, not yet saved: (its name beside the spec, its text).
-    It is staged as a hidden file for the check, and ``text`` is then a function of the staged
-    file's name (the spec naming it); messages name it as it will be saved.
+    It is staged in a private temporary folder for the check, and ``text`` is then a function
+    of the staged file's absolute path (the spec naming it); messages name it as it will be
+    saved. Nothing is written beside ``output``.
     """
-    from robotspec.compiler import check_spec
+    from robotspec.compiler.pipeline import compile_loaded
+    from robotspec.spec.load import load_spec
 
     started = time.perf_counter()
     robot = None
-    with _scratch(output) as folder:
-        staged: list[Path] = []
+    shown: dict[str, str] = {}
+    where = str(output.absolute())
+    with tempfile.TemporaryDirectory(prefix="robotspec-setup-") as private:
+        paths: list[str | Path] = [*package_paths]
+        if srdf is not None:
+            staged = Path(private) / srdf[0]
+            staged.write_text(srdf[1], encoding="utf-8")
+            shown[str(staged)] = str(output.absolute().parent / srdf[0])
+            paths.append(private)
+            spec = text(str(staged)) if callable(text) else text
+        elif isinstance(text, str):
+            spec = text
+        else:
+            raise TypeError("a spec text that names a staged SRDF needs the SRDF")
         try:
-            shown: dict[str, str] = {}
-            if srdf is not None:
-                # Not hidden: a spec may not name a hidden file (docs/security.md).
-                staged.append(_stage(folder, f"{output.stem}.setup-", ".srdf", srdf[1], output))
-                shown[str(staged[-1])] = str(folder / srdf[0])
-                spec = text(staged[-1].name) if callable(text) else text
-            elif isinstance(text, str):
-                spec = text
-            else:
-                raise TypeError("a spec text that names a staged SRDF needs the SRDF")
-            staged.append(_stage(folder, f".{output.stem}.setup-", ".yaml", spec, output))
-            tmp = str(staged[-1])
-            try:
-                result = check_spec(tmp, package_paths=package_paths)
-                details = [d for w in result.warnings for d in w.details]
-                robot = result.robot
-            except RobotSpecError as exc:
-                details = [*exc.details, *(d for w in exc.warnings for d in w.details)]
-        finally:
-            for f in staged:
-                f.unlink(missing_ok=True)
-    problems = tuple(_problem(d, tmp, shown) for d in details)
+            loaded = load_spec(where, allowed=paths, text=spec)
+            result = compile_loaded(loaded, package_paths=paths)
+            details = [d for w in result.warnings for d in w.details]
+            robot = result.robot
+        except RobotSpecError as exc:
+            details = [*exc.details, *(d for w in exc.warnings for d in w.details)]
+    problems = tuple(_problem(d, where, shown) for d in details)
     return Validation(problems, time.perf_counter() - started, robot)

@@ -1,0 +1,354 @@
+"""A change to a spec written as an edit of its text: only the lines the change needs.
+
+Why edit the text in place rather than re-render it, or round-trip it through ruamel.yaml: a
+spec kept in git is read as a diff. Re-rendering the draft (what the assistant did first) turned
+a one-number change into a 110-line diff that dropped every comment. ruamel.yaml keeps most of a
+file, but re-emits what it holds: indentation it did not detect, the spaces in a flow mapping,
+long lines and comments between keys move, so "byte-identical when nothing changed" would be a
+hope rather than a fact, and it is one more dependency. Here the file's own text is the
+state: PyYAML's safe composer (no tags constructed, aliases not expanded) gives where every node
+starts and ends, and a change replaces exactly the characters of the value it changes, deletes
+the lines of a key it removes, or inserts lines at the end of the mapping a key is added to.
+What nothing changed is never touched, so comments, key order, quoting, flow style and blank
+lines survive by construction, and no change at all is the file itself.
+
+Changes come as a diff of two plain data trees (the draft before and after, as the draft's
+writer states them): a value set, a key added (with what is missing above it), a key deleted.
+A value reached through an alias or a merge key is shared with another place: editing it would
+change both, so it is refused, as is a value the file does not hold because another file (a
+part of a composed robot, the spec it ``extends``) defines it: :class:`Elsewhere` says where.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import yaml
+
+from robotspec.errors import RobotSpecError
+from robotspec.spec.draft.render import scalar
+
+__all__ = ["Elsewhere", "TextEditError", "diff_ops", "edit_text", "remove_mark"]
+
+Path_ = tuple[str | int, ...]
+#: Where another file defines the longest prefix of a path it defines: (file, line, prefix
+#: length), or None when no other file does.
+Elsewhere = Callable[[Path_], "tuple[str, int | None, int] | None"]
+#: Sections whose entries each file may add to (a composed robot's own chain beside its parts').
+_SECTIONS = ("chains", "manipulators", "sensors", "states")
+
+_MARK = "  # DECIDE:"
+
+
+class TextEditError(RobotSpecError):
+    """A change the text of the spec cannot take (shared, defined in another file)."""
+
+
+@dataclass(frozen=True)
+class Op:
+    """One change: ``set`` a value at ``path`` (added when missing), or ``delete`` the key."""
+
+    kind: str
+    path: Path_
+    value: Any = None
+
+
+def diff_ops(old: Any, new: Any, path: Path_ = ()) -> list[Op]:
+    """The changes that make ``old`` into ``new``, as deep as both are mappings."""
+    if old == new and type(old) is type(new):
+        return []
+    if isinstance(old, Mapping) and isinstance(new, Mapping):
+        ops = [Op("delete", (*path, k)) for k in old if k not in new]
+        for k, v in new.items():
+            ops += diff_ops(old[k], v, (*path, k)) if k in old else [Op("set", (*path, k), v)]
+        return ops
+    return [Op("set", path, new)]
+
+
+# ---------------------------------------------------------------------------- rendering values
+def _number(v: float) -> str:
+    if not math.isfinite(v):
+        raise TextEditError(f"not a finite number: {v}", kind="value")
+    if v == int(v) and abs(v) < 1e15 and not isinstance(v, float):
+        return str(int(v))
+    return repr(float(v))
+
+
+def _flow(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if v is None:
+        return "null"
+    if isinstance(v, int | float):
+        return _number(v)
+    if isinstance(v, str):
+        return scalar(v)
+    if isinstance(v, Mapping):
+        return "{" + ", ".join(f"{_flow(str(k))}: {_flow(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_flow(x) for x in v) + "]"
+    raise TextEditError(f"cannot write a {type(v).__name__} in a spec", kind="value")
+
+
+def _nested(v: Any) -> bool:
+    """Whether a mapping holds mappings of mappings (written as a block, not one flow line)."""
+    return isinstance(v, Mapping) and any(
+        isinstance(x, Mapping) and any(isinstance(y, Mapping) for y in x.values())
+        for x in v.values()
+    )
+
+
+def _as_part(path: Path_) -> bool:
+    """Whether the drafter writes the mapping at ``path`` as a block (a part, a section)."""
+    if len(path) == 1:
+        return path[0] != "drive"
+    return len(path) == 2 and path[0] in ("chains", "manipulators", "sensors")
+
+
+def _block(key: Any, v: Any, indent: int, path: Path_ = ()) -> list[str]:
+    """``key: value`` at ``indent``: parts and nested mappings as blocks, leaves as one line."""
+    pad = " " * indent
+    here = (*path, key)
+    if isinstance(v, Mapping) and v and (_nested(v) or _as_part(here) or len(_flow(v)) > 90):
+        out = [f"{pad}{_flow(str(key))}:"]
+        for k, x in v.items():
+            out += _block(k, x, indent + 2, here)
+        return out
+    return [f"{pad}{_flow(str(key))}: {_flow(v)}"]
+
+
+# ---------------------------------------------------------------------------- the file's nodes
+@dataclass(frozen=True)
+class _Entry:
+    key: yaml.Node | None
+    node: yaml.Node
+    parent: yaml.Node | None
+
+
+class _Index:
+    """Every node of the text by path, once (an alias is a place it is reached again)."""
+
+    def __init__(self, text: str) -> None:
+        self.root: yaml.Node | None = yaml.compose(text, Loader=yaml.SafeLoader)
+        self.entries: dict[Path_, _Entry] = {}
+        #: Paths reached through an alias or a merge key: editing them would edit another place.
+        self.shared: set[Path_] = set()
+        if self.root is None:
+            return
+        seen: set[int] = set()
+        todo: list[tuple[Path_, _Entry]] = [((), _Entry(None, self.root, None))]
+        while todo:
+            path, entry = todo.pop()
+            self.entries[path] = entry
+            node = entry.node
+            if id(node) in seen:
+                self.shared.add(path)
+                continue
+            seen.add(id(node))
+            if isinstance(node, yaml.MappingNode):
+                for k, v in node.value:
+                    if k.tag == "tag:yaml.org,2002:merge":
+                        self.shared.add(path)  # its keys may come from elsewhere
+                        continue
+                    todo.append(((*path, self._key(k)), _Entry(k, v, node)))
+            elif isinstance(node, yaml.SequenceNode):
+                for i, v in enumerate(node.value):
+                    todo.append(((*path, i), _Entry(None, v, node)))
+
+    @staticmethod
+    def _key(k: yaml.Node) -> str:
+        return str(k.value) if isinstance(k, yaml.ScalarNode) else repr(k)
+
+    def through_shared(self, path: Path_) -> bool:
+        return any(path[:n] in self.shared for n in range(len(path) + 1))
+
+
+def _last_line(node: yaml.Node) -> int:
+    """The 0-based line of the last character a node's value takes."""
+    if isinstance(node, yaml.MappingNode | yaml.SequenceNode) and not node.flow_style:
+        items = [v for _, v in node.value] if isinstance(node, yaml.MappingNode) else node.value
+        return _last_line(items[-1]) if items else node.start_mark.line
+    end = node.end_mark
+    return end.line - 1 if end.column == 0 and end.line > node.start_mark.line else end.line
+
+
+def _indent_of(node: yaml.MappingNode) -> int:
+    return node.value[0][0].start_mark.column if node.value else node.start_mark.column
+
+
+class _Text:
+    """The spec's text being edited, indexed again after each change."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.index = _Index(text)
+
+    def _replace(self, start: int, end: int, new: str) -> None:
+        self.text = self.text[:start] + new + self.text[end:]
+        self.index = _Index(self.text)
+
+    def _line_start(self, line: int) -> int:
+        at = 0
+        for _ in range(line):
+            nl = self.text.find("\n", at)
+            if nl < 0:
+                return len(self.text)
+            at = nl + 1
+        return at
+
+    def _lines(self, first: int, last: int, new: list[str]) -> None:
+        """Replace lines ``first..last`` (inclusive; ``last = first - 1``: insert)."""
+        start, end = self._line_start(first), self._line_start(last + 1)
+        body = "".join(line + "\n" for line in new)
+        if end == len(self.text) and last >= first and not self.text.endswith("\n"):
+            body = body.rstrip("\n")
+        if start == len(self.text) and self.text and not self.text.endswith("\n"):
+            body = "\n" + body
+        self._replace(start, end, body)
+
+    def set(self, path: Path_, value: Any) -> None:
+        entries = self.index.entries
+        cut = len(path)
+        while path[:cut] not in entries:
+            cut -= 1
+        have = path[:cut]
+        entry = entries[have]
+        node = entry.node
+        if cut < len(path):  # add the missing key, with what is missing below it
+            for k in reversed(path[cut + 1 :]):
+                value = {k: value}
+            self._add(have, node, path[cut], value)
+            return
+        if isinstance(value, Mapping) and isinstance(entry.parent, yaml.MappingNode):
+            if entry.key is not None and not entry.parent.flow_style and (value and _nested(value)):
+                self._as_block(path, entry, value)
+                return
+        if isinstance(node, yaml.MappingNode | yaml.SequenceNode) and not node.flow_style:
+            self._as_block(path, entry, value)
+            return
+        self._replace(node.start_mark.index, node.end_mark.index, _flow(value))
+
+    def _as_block(self, path: Path_, entry: _Entry, value: Any) -> None:
+        """A value written as the lines below its key (its key's line and comment kept)."""
+        key, node = entry.key, entry.node
+        if key is None or not isinstance(entry.parent, yaml.MappingNode):
+            raise TextEditError("cannot rewrite a list item as a block", kind="value")
+        block = not node.flow_style if isinstance(node, yaml.CollectionNode) else False
+        indent = key.start_mark.column
+        nest = isinstance(value, Mapping) and value
+        lines = _block(path[-1], value, indent, path[:-1])[1:] if nest else []
+        if not lines:  # one flow line after all
+            self._replace(node.start_mark.index, node.end_mark.index, _flow(value))
+            return
+        last = _last_line(node)
+        if block:
+            self._lines(max(node.start_mark.line, key.start_mark.line + 1), last, lines)
+            return
+        # A flow value or scalar on the key's line: the line keeps its key and comment.
+        line_end = self.text.find("\n", node.end_mark.index)
+        line_end = len(self.text) if line_end < 0 else line_end
+        tail = self.text[node.end_mark.index : line_end]
+        start = self.text.rfind(":", key.end_mark.index, node.start_mark.index) + 1
+        rest = tail if tail.strip().startswith("#") else ""
+        self._replace(start, line_end, rest.rstrip() if rest else "")
+        self._lines(last + 1, last, lines)
+
+    def _add(self, have: Path_, node: yaml.Node, key: str | int, value: Any) -> None:
+        if isinstance(node, yaml.MappingNode) and not node.flow_style and node.value:
+            lines = _block(key, value, _indent_of(node), have)
+            self._lines(_last_line(node) + 1, _last_line(node), lines)
+            return
+        if isinstance(node, yaml.MappingNode) or (
+            isinstance(node, yaml.ScalarNode) and node.tag == "tag:yaml.org,2002:null"
+        ):
+            start, end = node.start_mark.index, node.end_mark.index
+            current = yaml.safe_load(self.text[start:end]) if end > start else None
+            merged = dict(current or {})
+            merged[key] = value
+            self.set(have, merged)
+            return
+        where = ".".join(map(str, have)) or "the spec"
+        raise TextEditError(f"cannot add '{key}' to {where}: it is not a mapping", kind="value")
+
+    def delete(self, path: Path_) -> None:
+        entry = self.index.entries.get(path)
+        if entry is None or entry.key is None:
+            return
+        parent = entry.parent
+        assert isinstance(parent, yaml.MappingNode)
+        if parent.flow_style or len(parent.value) == 1:
+            start, end = parent.start_mark.index, parent.end_mark.index
+            current = dict(yaml.safe_load(self.text[start:end]) or {})
+            current.pop(path[-1], None)
+            self.set(path[:-1], current)
+            return
+        self._lines(entry.key.start_mark.line, _last_line(entry.node), [])
+
+
+def remove_mark(text: str, path: Path_) -> str:
+    """``text`` without the ``# DECIDE:`` comment on the line of ``path``'s key."""
+    entry = _Index(text).entries.get(path)
+    if entry is None:
+        return text
+    line = (entry.key or entry.node).start_mark.line
+    t = _Text(text)
+    start = t._line_start(line)
+    end = text.find("\n", start)
+    end = len(text) if end < 0 else end
+    at = text.find(_MARK, start, end)
+    if at < 0:
+        return text
+    return text[:at] + text[end:]
+
+
+def edit_text(
+    text: str,
+    old: Any,
+    new: Any,
+    *,
+    elsewhere: Elsewhere = lambda path: None,
+    fixed: tuple[str, ...] = (),
+) -> str:
+    """``text`` with the changes from ``old`` to ``new`` (data as the spec states them) made.
+
+    ``elsewhere(path)``: where a value the text does not hold is defined (another file), which
+    refuses the change; ``fixed``: top-level keys this file may not gain or change (a composed
+    robot's ``description``). No change returns ``text`` itself.
+    """
+    t = _Text(text)
+    for op in diff_ops(old, new):
+        where = ".".join(map(str, op.path))
+        if op.path and op.path[0] in fixed:
+            raise TextEditError(
+                f"{where}: a composed robot's description is its parts; edit the parts' files",
+                kind="part",
+                name=where,
+            )
+        if t.index.through_shared(op.path):
+            raise TextEditError(
+                f"{where} is written through a YAML alias or merge key, shared with another "
+                "place; edit it in a text editor",
+                kind="part",
+                name=where,
+            )
+        have = len(op.path)
+        while op.path[:have] not in t.index.entries:
+            have -= 1
+        other = elsewhere(op.path) if have < len(op.path) else None
+        if other is not None and other[2] > have and (other[2] > 1 or op.path[0] not in _SECTIONS):
+            file, line, _ = other
+            at = f"{file}:{line}" if line is not None else file
+            raise TextEditError(
+                f"{where} is defined in {at}, not in this spec; robotspec setup edits only "
+                "the spec it opened: change it in that file",
+                kind="part",
+                name=where,
+            )
+        if op.kind == "delete":
+            t.delete(op.path)
+        else:
+            t.set(op.path, op.value)
+    return t.text

@@ -1,0 +1,179 @@
+"""robotspec setup edits a spec kept in git: only the lines a change needs, in order, in memory."""
+
+from __future__ import annotations
+
+import difflib
+import threading
+from pathlib import Path
+
+import pytest
+
+from robotspec.compiler import shipped_specs
+from robotspec.setup import SetupSession
+from robotspec.setup.session import SetupError, Snapshot
+from robotspec.setup.text_edit import edit_text
+from robotspec.shipped import package_data
+from tests.conftest import erd_robots, shared_path
+
+SPECS = package_data("specs")
+#: Every shipped spec, composed ones and parts included, by its file.
+SHIPPED = sorted([*SPECS.glob("*.yaml"), *(SPECS / "parts").glob("*.yaml")])
+#: Chromium-free bound on a wait that only catches a hang (docs/testing.md).
+WAIT = 60.0
+
+
+def _diff(a: str, b: str) -> list[str]:
+    return [
+        line
+        for line in difflib.unified_diff(a.splitlines(), b.splitlines(), lineterm="", n=0)
+        if line[:1] in "+-" and line[:3] not in ("+++", "---")
+    ]
+
+
+def _open(spec: Path | str, output: Path) -> SetupSession:
+    erd_robots()
+    paths = [shared_path("robots", "hsrb")] if "hsrb" in str(spec) else []
+    return SetupSession.open(str(spec), output=output, package_paths=paths)
+
+
+@pytest.mark.parametrize("spec", SHIPPED, ids=lambda p: p.stem)
+def test_open_and_save_of_every_shipped_spec_is_byte_identical(spec: Path, tmp_path: Path) -> None:
+    copy = tmp_path / spec.name  # saved in its own folder: the spec's paths stay as written
+    s = _open(spec, spec)
+    assert s.snapshot.text.encode() == spec.read_bytes()
+    assert s.validation.valid, [p.message for p in s.validation.errors]
+    assert not copy.exists()
+
+
+def test_the_pr2_torso_change_is_a_one_line_diff_with_every_comment_kept(tmp_path: Path) -> None:
+    src = shipped_specs()["pr2"]
+    before = src.read_text()
+    s = _open("pr2", tmp_path / "pr2.yaml")
+    assert s.set_state("torso", "mid", {"torso_lift_joint": 0.2}).valid
+    text = s.snapshot.text
+    assert _diff(before, text) == [
+        "-    mid: {torso_lift_joint: 0.15}",
+        "+    mid: {torso_lift_joint: 0.2}",
+    ]
+    assert text.count("# FIX:") == before.count("# FIX:") > 0
+    saved = s.save()
+    assert saved.read_text() == text and "Drafted by" not in text
+    assert s.undo().valid and s.snapshot.text == before  # undone: the file again, byte for byte
+
+
+def test_a_new_part_is_new_lines_in_its_mapping(tmp_path: Path) -> None:
+    before = shipped_specs()["pr2"].read_text()
+    s = _open("pr2", tmp_path / "pr2.yaml")
+    assert s.add_manipulator("left_tool", "l_wrist_roll_link", "l_gripper_palm_link").valid
+    assert s.add_chain("head", "torso_lift_link", "head_plate_frame", kind="chain").valid
+    diff = _diff(before, s.snapshot.text)
+    assert all(line.startswith("+") for line in diff), diff
+    lines = s.snapshot.text.splitlines()
+    # The chain is the last entry of chains:, the hand the last of manipulators:.
+    at = lines.index("  head:")
+    assert lines[at - 1].startswith("        r_wrist_roll_joint") and at < lines.index(
+        "manipulators:"
+    )
+    assert "  left_tool:" in lines[lines.index("manipulators:") : lines.index("sensors:")]
+    assert s.validation.valid
+    s.remove("manipulators.left_tool")
+    s.remove("chains.head")
+    assert s.snapshot.text == before
+
+
+def test_remove_drops_a_part_and_what_names_it(tmp_path: Path) -> None:
+    s = _open("pr2", tmp_path / "pr2.yaml")
+    v = s.remove("manipulators.left_gripper")
+    assert v.valid, [p.message for p in v.errors]
+    text = s.snapshot.text
+    assert "left_gripper" not in text and "right_gripper:" in text
+    assert "manipulators.left_gripper" not in s.parts()
+    v = s.remove("sensors.kinect")  # the neck loses its one sensor: validate says so, located
+    assert "kinect" not in s.snapshot.text.split("sensors:")[-1]
+    assert [p.part for p in v.errors] == ["neck"] and v.errors[0].line is not None
+    with pytest.raises(SetupError, match="no part 'wheels'"):
+        s.remove("wheels")
+    with pytest.raises(SetupError, match="no chain 'nope'"):
+        s.remove("chains.nope")
+
+
+def test_add_manipulator_on_a_chain_and_refusals(tmp_path: Path) -> None:
+    s = _open("ur5", tmp_path / "ur5.yaml")
+    s.remove("manipulators.flange")
+    v = s.add_manipulator("tool", "wrist_3_link", "tool0", chain="chains.arm")
+    assert v.valid, [p.message for p in v.errors]
+    robot = v.robot
+    assert robot is not None and robot.get_chain("arm").manipulator.name == "tool"  # type: ignore[union-attr]
+    with pytest.raises(SetupError, match="exists"):
+        s.add_manipulator("tool", "wrist_3_link", "tool0")
+    with pytest.raises(SetupError, match="no link 'wrist_9_link'"):
+        s.add_manipulator("t2", "wrist_9_link", "tool0")
+    with pytest.raises(SetupError, match="no chain 'legs'"):
+        s.add_manipulator("t3", "wrist_3_link", "tool0", chain="chains.legs")
+    assert s.snapshot.version == 2  # the refused ones made no state
+
+
+def test_a_composed_robot_opens_with_its_parts_and_refuses_edits_to_their_files(
+    tmp_path: Path,
+) -> None:
+    before = shipped_specs()["b1_ur5_allegro"].read_text()
+    s = _open("b1_ur5_allegro", tmp_path / "b1.yaml")
+    assert {"chains.ur5_arm", "manipulators.allegro_hand"} <= set(s.parts())
+    with pytest.raises(SetupError, match=r"defined in .*ur5\.yaml:\d+.*change it in that file"):
+        s.set_chain("chains.ur5_arm", tip="ur5_wrist_2_link")
+    assert s.snapshot.text == before and s.snapshot.version == 0
+    # A state of the composed robot's own is written into its own file.
+    d = _open("dual_panda", tmp_path / "dual.yaml")
+    ready = dict(d.part_states("robot")["ready"], left_panda_joint1=0.5)
+    assert d.set_state("robot", "ready", ready).valid
+    assert _diff(shipped_specs()["dual_panda"].read_text(), d.snapshot.text) == [
+        "-    left_panda_joint1: 0.0",
+        "+    left_panda_joint1: 0.5",
+    ]
+
+
+def test_generic_sensors_rotated_frames_and_xacro_args_open_and_are_kept(tmp_path: Path) -> None:
+    ur5 = shipped_specs()["ur5"].read_text()
+    spec = tmp_path / "ur5.yaml"
+    text = ur5.rstrip("\n") + (
+        "\nsensors:\n  wrist_imu: {type: generic, body: wrist_3_link}  # kept as written\n"
+    )
+    spec.write_text(text)
+    s = _open(spec, spec)
+    assert s.snapshot.text == text and s.validation.valid, s.validation.errors
+    assert s.set_state("chains.arm", "zero", {"shoulder_pan_joint": 0.0}).valid
+    assert "wrist_imu: {type: generic, body: wrist_3_link}  # kept as written" in s.snapshot.text
+
+
+def test_edit_text_sets_adds_and_deletes_only_what_changed() -> None:
+    text = "a: 1  # one\n\nb:\n  c: 'x'   # quoted\n  d: [1, 2]\ne: {f: 1}\n"
+    old = {"a": 1, "b": {"c": "x", "d": [1, 2]}, "e": {"f": 1}}
+    assert edit_text(text, old, old) == text
+    new = {"a": 2, "b": {"c": "x", "g": 3}, "e": {"f": 1, "h": 2}}
+    assert edit_text(text, old, new) == (
+        "a: 2  # one\n\nb:\n  c: 'x'   # quoted\n  g: 3\ne: {f: 1, h: 2}\n"
+    )
+
+
+def test_snapshots_reach_a_listener_in_the_order_the_session_made_them(tmp_path: Path) -> None:
+    """The old session called each thread's listeners after its lock: newest-first, [2, 1]."""
+    s = _open("ur5", tmp_path / "ur5.yaml")
+    seen: list[int] = []
+    second: list[threading.Thread] = []
+
+    def edit_two() -> None:
+        s.set_state("robot", "b", {"shoulder_pan_joint": 0.2})
+
+    def listener(snap: Snapshot) -> None:
+        if snap.version == 1 and not second:
+            # While this state is being delivered, another thread makes the next one.
+            second.append(threading.Thread(target=edit_two))
+            second[0].start()
+            second[0].join(WAIT)
+            assert not second[0].is_alive()
+        seen.append(snap.version)
+
+    s.subscribe(listener)
+    s.set_state("robot", "a", {"shoulder_pan_joint": 0.1})
+    second[0].join(WAIT)
+    assert seen == [1, 2] and s.snapshot.version == 2

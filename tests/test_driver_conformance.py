@@ -197,6 +197,14 @@ def test_11_jog_distance_and_limits(abb: SimRobot) -> None:
         target[0] = beyond
         with pytest.raises(InvalidArgumentError, match=r"joint_position\[0\] .* outside the joint"):
             abb.jog_freespace(target, v, True)
+    # Printed exactly: the next float past the limit never reads as the limit itself.
+    upper = float(abb.limits.upper[0])
+    target = q.copy()
+    target[0] = math.nextafter(upper, math.inf)
+    with pytest.raises(InvalidArgumentError) as info:
+        abb.jog_freespace(target, v, True)
+    assert f"= {float(target[0])!r} is outside the joint limits" in str(info.value)
+    assert str(info.value).endswith(f", {upper!r}]")
 
 
 def test_12_no_wait_and_retarget_smoothly(abb: SimRobot) -> None:

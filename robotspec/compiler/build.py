@@ -9,7 +9,12 @@ from __future__ import annotations
 
 from robotspec.compiler.assemble import Resolved, assemble, check_forward
 from robotspec.compiler.context import Build, moved_by, subtree_joints
-from robotspec.compiler.joints import check_states, check_velocity, srdf_state_values
+from robotspec.compiler.joints import (
+    check_controlled,
+    check_states,
+    check_velocity,
+    srdf_state_values,
+)
 from robotspec.compiler.kinematic_checks import KinematicInputs, check_kinematics
 from robotspec.compiler.part_checks import check_parts
 from robotspec.compiler.parts import (
@@ -157,16 +162,7 @@ def build_robot(b: Build, robot_class: type[AbstractRobot] = AbstractRobot) -> A
     )
     velocity = check_velocity(b, robot_joints)
     if spec.controlled_joints is not None:
-        active = {c.name for c in robot_joints if c.is_active}
-        for i, j in enumerate(spec.controlled_joints):
-            if j not in active:
-                diag.not_found(
-                    ("controlled_joints", i),
-                    "actuated joint",
-                    j,
-                    sorted(active),
-                    f"robot '{spec.name}'",
-                )
+        check_controlled(b, robot_joints, spec.controlled_joints)
     for i, body_name in enumerate(spec.collision.disabled_bodies):
         body = b.body(("collision", "disabled_bodies", i), body_name)
         if body is not None and not body.has_collision:

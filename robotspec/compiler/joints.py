@@ -3,16 +3,17 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 from robotspec.compiler.context import Build
 from robotspec.description.srdf import GroupState
 from robotspec.diagnostics import Loc
 from robotspec.errors import SrdfError
+from robotspec.exact import exact
 from robotspec.model.world import Connection
 from robotspec.semantic import JointState
 
-__all__ = ["check_states", "check_velocity", "srdf_state_values"]
+__all__ = ["check_controlled", "check_states", "check_velocity", "srdf_state_values"]
 
 
 def check_states(
@@ -67,8 +68,8 @@ def check_states(
             elif not (dof.lower - 1e-9 <= value <= dof.upper + 1e-9):
                 b.diag.error(
                     jloc,
-                    f"{value:g} is outside the limits of '{joint_name}' "
-                    f"[{dof.lower:g}, {dof.upper:g}]",
+                    f"{exact(value)} is outside the limits of '{joint_name}' "
+                    f"[{exact(dof.lower)}, {exact(dof.upper)}]",
                     name=joint_name,
                 )
                 ok = False
@@ -124,7 +125,7 @@ def check_velocity(b: Build, robot_joints: list[Connection]) -> dict[str, float]
         if v > dof.velocity:
             b.diag.warning(
                 loc,
-                f"{v:g} is above the URDF's velocity limit {dof.velocity:g} of "
+                f"{exact(v)} is above the URDF's velocity limit {exact(dof.velocity)} of "
                 f"'{j}'; limits only tighten, so it has no effect",
             )
         caps[dof.name] = v
@@ -167,3 +168,39 @@ def srdf_state_values(b: Build, gs: GroupState) -> dict[str, float]:
             )
         )
     return out
+
+
+def check_controlled(b: Build, robot_joints: list[Connection], names: Sequence[str]) -> None:
+    """``controlled_joints``: each an actuated joint of the robot, or the reason it is not.
+
+    A joint of the URDF that is a mimic, fixed or outside the robot is named as such (with the
+    leader to control instead), not as "not found": the name is right, the choice is not.
+    """
+    active = {c.name for c in robot_joints if c.is_active}
+    own = {c.name for c in robot_joints}
+    for i, j in enumerate(names):
+        if j in active:
+            continue
+        loc: Loc = ("controlled_joints", i)
+        c = b.world.get_connection_by_name(j) if b.world.has_connection(j) else None
+        if c is not None and c.mimic is not None:
+            leader = c.mimic.leader
+            b.diag.error(
+                loc,
+                f"'{j}' is a mimic joint of '{leader}' (x{exact(c.mimic.multiplier)}"
+                f"{'+' if c.mimic.offset >= 0 else ''}{exact(c.mimic.offset)}): it has no "
+                f"actuator of its own; control '{leader}' instead",
+                name=j,
+                suggestions=(leader,),
+            )
+        elif c is not None and c.is_fixed:
+            b.diag.error(loc, f"joint '{j}' is fixed; only a moving joint is controlled", name=j)
+        elif c is not None and c.name not in own and b.robot_root is not None:
+            b.diag.error(
+                loc,
+                f"joint '{j}' is not a joint of robot '{b.spec.name}' (it is not below the root "
+                f"'{b.robot_root.name}')",
+                name=j,
+            )
+        else:
+            b.diag.not_found(loc, "actuated joint", j, sorted(active), f"robot '{b.spec.name}'")

@@ -64,6 +64,7 @@ from robotspec.driver.state import (
 )
 from robotspec.driver.trajectory import JointTrajectory, TrajectoryColumns, load_trajectory
 from robotspec.errors import DriverError
+from robotspec.exact import exact
 from robotspec.model.rotations import quat_wxyz_to_matrix
 
 __all__ = ["RobotDriver"]
@@ -319,7 +320,7 @@ class RobotDriver(DriverLoop):
             for i in range(n):
                 if vmax[i] > vlim[i]:
                     raise InvalidArgumentError(
-                        f"max_velocity[{i}] is greater than joint limits ({vlim[i]:.4g})"
+                        f"max_velocity[{i}] is greater than joint limits ({exact(vlim[i])})"
                     )
             measured = self._joint_position
             if np.any(np.abs(target - measured) > self._jog_joint_limit):
@@ -331,8 +332,8 @@ class RobotDriver(DriverLoop):
             for i in range(n):
                 if not lo[i] <= target[i] <= hi[i]:
                     raise InvalidArgumentError(
-                        f"joint_position[{i}] = {target[i]:.4g} is outside the joint limits "
-                        f"[{lo[i]:.4g}, {hi[i]:.4g}]"
+                        f"joint_position[{i}] = {exact(target[i])} is outside the joint limits "
+                        f"[{exact(lo[i])}, {exact(hi[i])}]"
                     )
             ratio = self._speed_ratio
             existing = self._jog

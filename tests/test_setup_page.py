@@ -151,3 +151,21 @@ def test_parts_added_changed_and_removed_from_the_page(page: Any) -> None:
     assert s.draft().forward == (0.0, -1.0, 0.0) and "faces -y" in page._part_info.content
     page._guarded(lambda _e: page._remove_part())(_Person())
     assert "cannot be removed" in page.last_message
+
+
+def test_a_late_older_snapshot_is_not_drawn_and_one_check_runs_at_a_time(page: Any) -> None:
+    from robotspec.errors import RobotSpecError
+
+    s = page.session
+    old = s.snapshot
+    s.set_state("robot", "a", {"joint1": 0.1})
+    assert page.shown_version == s.snapshot.version == 1
+    drawn = page._problems.content, page._status.content
+    page._on_snapshot(old)  # viser's pool delivered it late: the page keeps the newer state
+    assert page.shown_version == 1 and (page._problems.content, page._status.content) == drawn
+    with page._busy_lock:
+        page._busy = True  # a check runs (from another tab)
+    with pytest.raises(RobotSpecError, match="is running"):
+        page._collisions("generate")
+    with page._busy_lock:
+        page._busy = False

@@ -104,8 +104,12 @@ class SetupPage:
         self._questions_shown: tuple[Question, ...] | None = None
         self._q_handles: list[Any] = []
         self._sliders: dict[str, Any] = {}
+        #: Whether a collision check runs; checked and set under its lock (two tabs may press).
         self._busy = False
+        self._busy_lock = threading.Lock()
         self.shown_version = -1
+        #: The (version, saved) drawn last: an older snapshot arriving late is not drawn.
+        self._shown: tuple[int, bool] = (-1, False)
         self.last_message = ""
         self._build()
         for body, handles in self.viewer.visual_meshes.items():
@@ -336,6 +340,9 @@ class SetupPage:
     # ------------------------------------------------------------------ state of the session
     def _on_snapshot(self, snap: Snapshot) -> None:
         with self._gui_lock:
+            if (snap.version, snap.saved) <= self._shown:
+                return  # every tab shows this page: never draw a state older than the one drawn
+            self._shown = (snap.version, snap.saved)
             v = snap.validation
             n_q = len(snap.questions)
             self._status.content = (
@@ -635,9 +642,10 @@ class SetupPage:
     def _collisions(self, what: str) -> None:
         from robotspec.setup.collisions import audit_session, generate_matrix, plain_audit_report
 
-        if self._busy:
-            raise RobotSpecError("the collision check is running; wait for it to finish")
-        self._busy = True
+        with self._busy_lock:
+            if self._busy:
+                raise RobotSpecError("the collision check is running; wait for it to finish")
+            self._busy = True
         samples = int(self._samples.value)
         self._progress.visible = True
         self._progress.value = 0.0
@@ -669,7 +677,8 @@ class SetupPage:
                 self._collision_text.content = f"**internal error:** {type(exc).__name__}: {exc}"
             finally:
                 self._progress.value = 100.0
-                self._busy = False
+                with self._busy_lock:
+                    self._busy = False
 
         threading.Thread(target=work, name=f"setup-{what}", daemon=True).start()
 

@@ -172,7 +172,9 @@ def mjcf_export(
     for key_name, state in _states(robot).items():
         keys.append((key_name, world.configuration(state.as_dict())))
     index = {c.name: i for i, c in enumerate(servoed)}
-    qpos_index = {j.name: i for i, j in enumerate(order)}
+    qpos_index: dict[str, int] = {}
+    for j in order:  # a free joint takes 7 entries of qpos (position, quaternion)
+        qpos_index[j.name] = sum(7 if o.kind == "free" else 1 for o in order[: order.index(j)])
     for key_name, q in keys:
         qpos = out.qpos(robot, q)
         ctrl = [qpos[qpos_index[c.name]] for c in servoed]

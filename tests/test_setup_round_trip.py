@@ -11,7 +11,7 @@ import pytest
 from robotspec.compiler import shipped_specs
 from robotspec.setup import SetupSession
 from robotspec.setup.session import SetupError, Snapshot
-from robotspec.setup.text_edit import edit_text
+from robotspec.setup.text_edit import TextEditError, edit_text
 from robotspec.shipped import package_data
 from tests.conftest import erd_robots, shared_path
 
@@ -177,3 +177,41 @@ def test_snapshots_reach_a_listener_in_the_order_the_session_made_them(tmp_path:
     s.set_state("robot", "a", {"shoulder_pan_joint": 0.1})
     second[0].join(WAIT)
     assert seen == [1, 2] and s.snapshot.version == 2
+
+
+def test_edit_text_empties_a_block_keeps_line_breaks_and_refuses_aliases() -> None:
+    text = "a:\n  b: 1  # gone with b\n# kept\nc: 2\n"
+    assert edit_text(text, {"a": {"b": 1}, "c": 2}, {"a": {}, "c": 2}) == "a: {}\n# kept\nc: 2\n"
+    crlf = "a: 1\r\nb:\r\n  c: 2\r\n"
+    out = edit_text(crlf, {"a": 1, "b": {"c": 2}}, {"a": 1, "b": {"c": 2, "d": 3}})
+    assert out == "a: 1\r\nb:\r\n  c: 2\r\n  d: 3\r\n"
+    shared = "base: &arm {root: a, tip: b}\nchains:\n  left: *arm\n"
+    data = {"base": {"root": "a", "tip": "b"}, "chains": {"left": {"root": "a", "tip": "b"}}}
+    changed = {"base": data["base"], "chains": {"left": {"root": "a", "tip": "c"}}}
+    with pytest.raises(TextEditError, match="chains.left.tip is written through a YAML alias"):
+        edit_text(shared, data, changed)
+
+
+def test_keeping_a_guess_removes_its_mark_and_nothing_else(tmp_path: Path) -> None:
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    draft = SetupSession.open(str(urdf), output=tmp_path / "xarm.yaml")
+    spec = draft.save()
+    before = spec.read_text()
+    s = SetupSession.open(str(spec), output=spec)
+    assert s.snapshot.text == before
+    s.answer("drive")
+    diff = _diff(before, s.snapshot.text)
+    assert len(diff) == 2 and diff[0].startswith("-drive:") and "DECIDE" in diff[0]
+    assert diff[1] == diff[0][:1].replace("-", "+") + diff[0][1:].split("  # DECIDE:")[0]
+
+
+def test_validation_writes_nothing_beside_the_users_files(tmp_path: Path) -> None:
+    urdf = erd_robots() / "xarm_description" / "urdf" / "xarm7.urdf"
+    s = SetupSession.open(str(urdf), output=tmp_path / "xarm.yaml")
+    s.set_state("robot", "a", {"joint1": 0.1})
+    name, v = s.keep_srdf('<?xml version="1.0"?>\n<robot name="UF_ROBOT"/>\n')
+    assert v.valid, [p.message for p in v.errors]
+    s.set_state("robot", "b", {"joint1": 0.2})
+    assert list(tmp_path.iterdir()) == []  # neither the spec nor the kept SRDF, nor a scratch
+    s.save()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([name, "xarm.yaml"])

@@ -138,16 +138,16 @@ class _Index:
         self.shared: set[Path_] = set()
         if self.root is None:
             return
-        seen: set[int] = set()
+        first: dict[int, Path_] = {}  # each node's first path: an alias reaches it again
         todo: list[tuple[Path_, _Entry]] = [((), _Entry(None, self.root, None))]
         while todo:
             path, entry = todo.pop()
             self.entries[path] = entry
             node = entry.node
-            if id(node) in seen:
-                self.shared.add(path)
+            if id(node) in first:
+                self.shared.update((path, first[id(node)]))  # the anchor's place and the alias's
                 continue
-            seen.add(id(node))
+            first[id(node)] = path
             if isinstance(node, yaml.MappingNode):
                 for k, v in node.value:
                     if k.tag == "tag:yaml.org,2002:merge":
@@ -173,6 +173,13 @@ def _last_line(node: yaml.Node) -> int:
         return _last_line(items[-1]) if items else node.start_mark.line
     end = node.end_mark
     return end.line - 1 if end.column == 0 and end.line > node.start_mark.line else end.line
+
+
+def _eol(text: str, at: int) -> int:
+    """Where the line holding ``at`` ends, before its line break (LF or CR LF)."""
+    end = text.find("\n", at)
+    end = len(text) if end < 0 else end
+    return end - 1 if end > at and text[end - 1] == "\r" else end
 
 
 def _indent_of(node: yaml.MappingNode) -> int:
@@ -202,11 +209,12 @@ class _Text:
     def _lines(self, first: int, last: int, new: list[str]) -> None:
         """Replace lines ``first..last`` (inclusive; ``last = first - 1``: insert)."""
         start, end = self._line_start(first), self._line_start(last + 1)
-        body = "".join(line + "\n" for line in new)
+        nl = "\r\n" if "\r\n" in self.text else "\n"  # the file's own line breaks
+        body = "".join(line + nl for line in new)
         if end == len(self.text) and last >= first and not self.text.endswith("\n"):
-            body = body.rstrip("\n")
+            body = body.removesuffix(nl)
         if start == len(self.text) and self.text and not self.text.endswith("\n"):
-            body = "\n" + body
+            body = nl + body
         self._replace(start, end, body)
 
     def set(self, path: Path_, value: Any) -> None:
@@ -241,15 +249,19 @@ class _Text:
         nest = isinstance(value, Mapping) and value
         lines = _block(path[-1], value, indent, path[:-1])[1:] if nest else []
         if not lines:  # one flow line after all
-            self._replace(node.start_mark.index, node.end_mark.index, _flow(value))
+            if block:  # the block's lines go; the value follows its key
+                colon = self.text.find(":", key.end_mark.index)
+                end = _eol(self.text, self._line_start(_last_line(node)))
+                self._replace(colon + 1, end, " " + _flow(value))
+            else:
+                self._replace(node.start_mark.index, node.end_mark.index, _flow(value))
             return
         last = _last_line(node)
         if block:
             self._lines(max(node.start_mark.line, key.start_mark.line + 1), last, lines)
             return
         # A flow value or scalar on the key's line: the line keeps its key and comment.
-        line_end = self.text.find("\n", node.end_mark.index)
-        line_end = len(self.text) if line_end < 0 else line_end
+        line_end = _eol(self.text, node.end_mark.index)
         tail = self.text[node.end_mark.index : line_end]
         start = self.text.rfind(":", key.end_mark.index, node.start_mark.index) + 1
         rest = tail if tail.strip().startswith("#") else ""
@@ -296,8 +308,7 @@ def remove_mark(text: str, path: Path_) -> str:
     line = (entry.key or entry.node).start_mark.line
     t = _Text(text)
     start = t._line_start(line)
-    end = text.find("\n", start)
-    end = len(text) if end < 0 else end
+    end = _eol(text, start)
     at = text.find(_MARK, start, end)
     if at < 0:
         return text

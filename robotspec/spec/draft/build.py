@@ -14,6 +14,7 @@ from robotspec.description.srdf import Srdf
 from robotspec.model.entities import Body
 from robotspec.model.world import World
 from robotspec.spec.draft.base import own_base, own_drive, wheel_joints
+from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.hands import (
     Gripper,
     facing_quaternion,
@@ -96,7 +97,13 @@ class Drafter:
     """One drafting run; each method fills one part of ``self.draft``."""
 
     def __init__(
-        self, world: World, srdf: Srdf | None, name: str, urdf: str, srdf_ref: str | None
+        self,
+        world: World,
+        srdf: Srdf | None,
+        name: str,
+        urdf: str,
+        srdf_ref: str | None,
+        facts: FileFacts | None = None,
     ) -> None:
         self.world = world
         self.srdf = srdf
@@ -124,6 +131,7 @@ class Drafter:
                     kind, vj.name, vj.parent_frame, f"the SRDF's virtual joint '{vj.name}'"
                 )
         self.tree = Tree(world, root)
+        self.facts = self.tree.memo["facts"] = facts or FileFacts()  # read before any guess
         # Found once, on the tree's poses (one forward kinematics for the whole draft).
         self.wheels = wheel_joints(world, self.tree.poses)
         if own is not None:
@@ -521,10 +529,19 @@ def _fixed_above(world: World, body: Body) -> bool:
 
 
 def draft_spec(
-    world: World, *, urdf_ref: str, srdf: Srdf | None, srdf_ref: str | None, name: str
+    world: World,
+    *,
+    urdf_ref: str,
+    srdf: Srdf | None,
+    srdf_ref: str | None,
+    name: str,
+    facts: FileFacts | None = None,
 ) -> Draft:
-    """Decide what the files say and what a person must; see the module docstring."""
-    d = Drafter(world, srdf, name, urdf_ref, srdf_ref)
+    """Decide what the files say and what a person must; see the module docstring.
+
+    ``facts``: what the URDF states beyond its tree (Gazebo sensors, transmissions).
+    """
+    d = Drafter(world, srdf, name, urdf_ref, srdf_ref, facts)
     chains = d.chains()
     d.draft.chains = [c for c, _ in chains]
     if srdf is not None:

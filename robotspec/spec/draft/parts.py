@@ -19,6 +19,7 @@ from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
 from robotspec.spec.draft.naming import unique
 from robotspec.spec.draft.sensors import find_cameras, find_neck
 from robotspec.spec.draft.srdf_groups import state_values
+from robotspec.spec.draft.stated_cameras import fill_stated
 from robotspec.spec.draft.tree import words
 
 if TYPE_CHECKING:
@@ -35,6 +36,13 @@ def add_sensors(d: Drafter) -> None:
     name_of: dict[str, str] = {}
     for seen in found:
         cam = DraftCamera(unique(seen.name, d.names), seen.body.name, seen.optical)
+        if seen.doubt is not None:
+            cam.decide.append(seen.doubt)
+        if seen.stated is not None:  # a Gazebo sensor states it
+            fill_stated(cam, seen.stated, z_ahead=_looks_along_z(d, seen.body))
+            draft.cameras.append(cam)
+            name_of[cam.body] = cam.name
+            continue
         if not seen.optical:
             if _looks_along_z(d, seen.body):
                 cam.looks_along_z = True

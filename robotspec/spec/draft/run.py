@@ -11,6 +11,7 @@ from pathlib import Path
 
 from robotspec.description.load import Description, load_description
 from robotspec.spec.draft.build import draft_spec
+from robotspec.spec.draft.facts import read_facts
 from robotspec.spec.draft.model import Draft
 from robotspec.spec.draft.paths import portable_ref, relative_path
 
@@ -88,6 +89,7 @@ def draft_from_files(
         srdf=desc.srdf,
         srdf_ref=None if srdf is None else ref(srdf),
         name=name or desc.world.name,
+        facts=read_facts(desc.urdf_xml),
     )
     for given in package_paths:
         if Path(given).is_dir():

@@ -17,7 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from robotspec.model.entities import Body, Connection
+from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.limbs import HEAD_WORDS
+from robotspec.spec.draft.stated_cameras import StatedCamera, stated_cameras
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = ["CameraFound", "NeckFound", "find_cameras", "find_neck"]
@@ -38,11 +40,17 @@ _STEM = re.compile(r"(_optical)?(_frame|_link)?$")
 
 @dataclass(frozen=True)
 class CameraFound:
-    """A camera: its device name, the frame it sees from, and whether that frame is optical."""
+    """A camera: its device name, the frame it sees from, and whether that frame is optical.
+
+    ``stated``: the Gazebo sensor that makes it a fact (None for a camera found by its name or
+    rotation). ``doubt``: why a found camera is a question although its frame looks like one.
+    """
 
     name: str
     body: Body
     optical: bool
+    stated: StatedCamera | None = None
+    doubt: str | None = None
 
 
 @dataclass(frozen=True)
@@ -77,9 +85,18 @@ def find_cameras(tree: Tree) -> list[CameraFound]:
 
 def _find_cameras(tree: Tree) -> list[CameraFound]:
     world = tree.world
+    facts = tree.memo.get("facts")
+    facts = facts if isinstance(facts, FileFacts) else FileFacts()
+    # What the files state first: each Gazebo camera device, on the frame it publishes in.
+    devices, channels = stated_cameras(tree, facts)
+    stated = [CameraFound(s.name, s.body, s.optical, s) for s in devices]
+    # A link a Gazebo sensor is on is that sensor's (a laser, an IMU, a camera's mount).
+    taken = channels | {
+        world.get_body_by_name(link).index for link in facts.sensor_links if world.has_body(link)
+    }
     found: list[CameraFound] = []
     for b in world.bodies:
-        if b.index not in tree.inside or b is tree.root:
+        if b.index not in tree.inside or b is tree.root or b.index in taken:
             continue
         # Whole tokens too: 'd435_link' splits into 'd' and '435' as words.
         w = words(b.name) | set(re.split(r"[^a-z0-9]+", b.name.lower()))
@@ -98,7 +115,7 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
     # is extended by it. Optical frames first: 'camera_link' and its child
     # 'camera_color_optical_frame' are one camera, on the optical frame; of a device's
     # channels, the colour one.
-    kept: list[CameraFound] = []
+    kept: list[CameraFound] = list(stated)
     order = sorted(
         found,
         key=lambda c: (not c.optical, len(c.name), not words(c.name) & _COLOUR, c.body.index),
@@ -119,6 +136,13 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
         # A body frame named as a camera, rigid with an optical frame, is that camera's link.
         optical_here = any(k.optical and _rigid_root(tree, k.body) is carrier for k in kept)
         dup = dup or (not cam.optical and optical_here)
+        if not dup and stated:
+            cam = CameraFound(
+                cam.name,
+                cam.body,
+                cam.optical,
+                doubt="a camera by its frame, though no Gazebo sensor of the URDF simulates it",
+            )
         if not dup:
             kept.append(cam)
     kept.sort(key=lambda c: c.body.index)

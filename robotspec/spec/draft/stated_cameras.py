@@ -1,0 +1,261 @@
+"""The frames a URDF's Gazebo camera sensors see from: cameras the files state, not guesses.
+
+A Gazebo camera looks along +x of its sensor frame (the ``reference`` link moved by the sensor's
+``<pose>``). Its images are published in the frame its plugin names, by ROS convention an optical
+frame (z forward); when it names none, the optical frame under its link is the camera (the
+frame a person writes in a spec), and when there is none either, the link itself, with the axis
+Gazebo looks along. One device, one camera: PR2's stereo pair names one frame from two sensors,
+and a RealSense's colour, depth and infrared sensors sit a few centimetres apart on one mount;
+the colour channel is the camera.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from robotspec.description.gazebo import GazeboCamera
+from robotspec.model.entities import Body
+from robotspec.model.rotations import rpy_to_matrix
+from robotspec.spec.draft.facts import FileFacts
+from robotspec.spec.draft.model import DraftCamera
+from robotspec.spec.draft.tree import Tree, words
+
+__all__ = ["StatedCamera", "fill_stated", "stated_cameras"]
+
+#: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
+_OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+#: Words naming a channel of an RGB-D device.
+_CHANNELS = frozenset({"color", "colour", "rgb", "depth", "ir", "infra", "infrared", "ired"})
+_COLOUR = frozenset({"color", "colour", "rgb"})
+#: How far apart (m) the channels of one device may be (a RealSense's are 1.5 to 5 cm).
+DEVICE_SPAN = 0.1
+#: Fixed joints searched below a sensor's link for its optical frame.
+_OPTICAL_DEPTH = 3
+#: The cosine within which a frame's axis is the camera's view (8 degrees).
+_ALONG = 0.99
+
+
+@dataclass(frozen=True)
+class StatedCamera:
+    """A Gazebo camera resolved to a frame of the tree.
+
+    ``optical``: it looks along +z of ``body``; otherwise along ``axis`` (in ``body``'s frame).
+    ``how``: which rule chose the frame (written into the draft as its source). ``doubt``: why
+    the axis is still a question (the plugin names the sensor's own x-forward link as if it
+    were an optical frame), else None.
+    """
+
+    name: str
+    body: Body
+    fact: GazeboCamera
+    optical: bool
+    axis: tuple[float, float, float]
+    how: str
+    doubt: str | None = None
+
+
+def _channel_words(text: str) -> set[str]:
+    ws = words(text) | set(re.split(r"[^a-z0-9]+", text.lower()))
+    # 'ired1', 'infra2', 'color1': a channel word with a number after it.
+    return {w.rstrip("0123456789") for w in ws} & _CHANNELS
+
+
+def _rep103(tree: Tree, body: Body) -> bool:
+    c = tree.world.parent_connection(body)
+    return c is not None and c.is_fixed and bool(np.allclose(c.origin[:3, :3], _OPTICAL, atol=1e-3))
+
+
+def _rigid_group(tree: Tree, link: Body) -> list[Body]:
+    """Frames fixed to ``link``: up to three fixed joints above it, and below those."""
+    world = tree.world
+    tops = [link]
+    for _ in range(_OPTICAL_DEPTH):
+        c = world.parent_connection(tops[-1])
+        if c is None or not c.is_fixed or tops[-1] is tree.root:
+            break
+        tops.append(world.bodies[c.parent])
+    out = list(tops)
+    level = list(tops)
+    for _ in range(_OPTICAL_DEPTH):
+        nxt = []
+        for b in level:
+            for k in world.child_bodies(b):
+                c = world.parent_connection(k)
+                if c is not None and c.is_fixed and k not in out:
+                    nxt.append(k)
+        out += nxt
+        level = nxt
+    return out
+
+
+def _optical_near(tree: Tree, link: Body, view: np.ndarray, at: np.ndarray) -> Body | None:
+    """The frame fixed to ``link`` whose +z is the sensor's view, where the sensor is.
+
+    Below the link (an optical child) or above it (HSR-B's optical camera link carrying an
+    x-forward ``*_gazebo_frame``). Of several, the nearest (to the millimetre; a RealSense's
+    channels are centimetres apart, each its own sensor's; the left infrared and depth frames
+    coincide), then one below the link, then one named for colour, then one rotated as REP 103
+    says.
+    """
+    found: list[tuple[float, int, int, int, int, Body]] = []
+    for k in _rigid_group(tree, link):
+        pose = tree.poses[k.index]
+        if float(pose[:3, 2] @ view) < _ALONG:
+            continue
+        far = float(np.linalg.norm(pose[:3, 3] - at))
+        if far > DEVICE_SPAN:
+            continue
+        channel = _channel_words(k.name)
+        rank = 0 if channel & _COLOUR else 2 if channel else 1
+        below = 0 if tree.world.is_ancestor(link, k) else 1  # the link's own optical child
+        found.append((round(far, 3), below, rank, 0 if _rep103(tree, k) else 1, k.index, k))
+    return min(found, key=lambda f: f[:5])[5] if found else None
+
+
+def _device_frame(tree: Tree, body: Body, view: np.ndarray) -> Body | None:
+    """The device's own optical frame beside a channel's (TIAGo's 'xtion_optical_frame').
+
+    Why: a URDF that gives an RGB-D device an optical frame of its own, named as the channel's
+    without the channel word and looking the same way, means that frame as the camera (the specs
+    written for such robots name it); the colour channel sits a centimetre or two beside it.
+    """
+    world = tree.world
+    parts = re.split(r"([^A-Za-z0-9]+)", body.name)
+    kept = [p for p in parts if p.lower().rstrip("0123456789") not in _CHANNELS]
+    if len(kept) == len(parts):
+        return None
+    name = re.sub(r"[^A-Za-z0-9]{2,}", "_", "".join(kept)).strip("_")
+    if name == body.name or not world.has_body(name):
+        return None
+    other = world.get_body_by_name(name)
+    if other.index not in tree.inside or _rigid_root(tree, other) is not _rigid_root(tree, body):
+        return None
+    pose = tree.poses[other.index]
+    far = float(np.linalg.norm(pose[:3, 3] - tree.poses[body.index][:3, 3]))
+    return other if far <= DEVICE_SPAN and float(pose[:3, 2] @ view) > _ALONG else None
+
+
+def _resolve(tree: Tree, g: GazeboCamera) -> StatedCamera | None:
+    world = tree.world
+    if not world.has_body(g.link):
+        return None
+    link = world.get_body_by_name(g.link)
+    if link.index not in tree.inside:
+        return None
+    pose = tree.poses[link.index]
+    view = pose[:3, :3] @ rpy_to_matrix(*g.pose[3:])[:, 0]
+    at = (pose @ np.array([*g.pose[:3], 1.0]))[:3]
+    named = g.frame is not None and world.has_body(g.frame)
+    body: Body | None = None
+    if named and g.frame is not None:
+        body = world.get_body_by_name(g.frame)
+        if body.index not in tree.inside:
+            body = None
+    how = f"its plugin's frame '{g.frame}'"
+    if body is None:
+        body = _optical_near(tree, link, view, at)
+        how = f"the optical frame at its link '{g.link}'"
+    if body is None:
+        body, how = link, f"its link '{g.link}' (a Gazebo camera looks along +x)"
+    device = _device_frame(tree, body, view)
+    if device is not None:
+        body, how = device, f"{how}, its device's own frame '{device.name}'"
+    d = tree.poses[body.index][:3, :3].T @ view
+    axis = (round(float(d[0]), 4), round(float(d[1]), 4), round(float(d[2]), 4))
+    doubt = None
+    # A sensor put on an optical frame itself looks along its x in Gazebo; the frame says +z.
+    optical = float(d[2]) > _ALONG or (_rep103(tree, body) and "optical" in words(body.name))
+    if not optical and named and body is link and float(d[0]) > _ALONG:
+        # The plugin publishes images in the sensor's own link as if it were an optical frame.
+        doubt = (
+            f"the Gazebo sensor '{g.name}' looks along +x of '{body.name}', and its plugin"
+            " publishes images in it as in an optical frame (+z)"
+        )
+    name = re.sub(r"(_optical)?(_frame|_link)?$", "", body.name) or body.name
+    return StatedCamera(name, body, g, optical, axis, f"the Gazebo sensor '{g.name}': {how}", doubt)
+
+
+def _rigid_root(tree: Tree, body: Body) -> Body:
+    world = tree.world
+    b = body
+    while True:
+        c = world.parent_connection(b)
+        if c is None or not c.is_fixed or b is tree.root:
+            return b
+        b = world.bodies[c.parent]
+
+
+def _one_device(tree: Tree, a: StatedCamera, b: StatedCamera) -> bool:
+    """Whether two sensors are channels of one device (or one camera named twice)."""
+    if a.body is b.body or a.fact.link == b.fact.link:
+        return True
+    # Channels by their frames' names: a stereo depth camera (Go1's five) is a device alone.
+    if not (_channel_words(a.body.name) and _channel_words(b.body.name)):
+        return False
+    if _rigid_root(tree, a.body) is not _rigid_root(tree, b.body):
+        return False
+    far = tree.poses[a.body.index][:3, 3] - tree.poses[b.body.index][:3, 3]
+    return float(np.linalg.norm(far)) <= DEVICE_SPAN
+
+
+def _preference(c: StatedCamera) -> tuple[int, int]:
+    channel = _channel_words(c.body.name) | _channel_words(c.fact.name)
+    if channel & _COLOUR:
+        return (0, 0)
+    return (1 if not channel else 2, 0 if c.optical else 1)
+
+
+def stated_cameras(tree: Tree, facts: FileFacts) -> tuple[list[StatedCamera], set[int]]:
+    """One camera per device the Gazebo sensors simulate, in file order; its colour channel.
+
+    Also the indices of every body a sensor resolved to, the channels left out included: none
+    of them is another camera.
+    """
+    resolved = [r for g in facts.cameras if (r := _resolve(tree, g)) is not None]
+    devices: list[list[StatedCamera]] = []
+    for r in resolved:
+        home = next((d for d in devices if any(_one_device(tree, r, o) for o in d)), None)
+        if home is None:
+            devices.append([r])
+        else:
+            home.append(r)
+    out = []
+    for device in devices:
+        order = sorted(range(len(device)), key=lambda i: (*_preference(device[i]), i))
+        out.append(device[order[0]])
+    return out, {r.body.index for r in resolved}
+
+
+def fill_stated(cam: DraftCamera, s: StatedCamera, *, z_ahead: bool) -> None:
+    """What the Gazebo sensor states, written into the drafted camera ``cam``.
+
+    The frame and the axis are facts (no DECIDE mark), and so are the angles when the sensor
+    gives its field of view and image size (the vertical angle from the pixels, square pixels).
+    ``z_ahead``: whether the frame's z axis points the way the robot faces, which settles a
+    plugin that names its sensor's own x-forward link as an optical frame.
+    """
+    g = s.fact
+    size = f", {g.width}x{g.height} px" if g.width and g.height else ""
+    cam.source = s.how + size
+    h, v = g.horizontal_fov, g.vertical_fov
+    if h is not None and v is not None and 0.0 < h < math.pi and 0.0 < v < math.pi:
+        cam.field_of_view = (round(h, 5), round(v, 5))
+    if s.optical:
+        return
+    if s.doubt is not None:
+        if z_ahead:
+            cam.looks_along_z = True
+            cam.decide.append(f"{s.doubt}; its z axis points the way the robot faces")
+        else:
+            cam.decide.append(s.doubt)
+        return
+    x, y, z = s.axis
+    if z > _ALONG:
+        cam.looks_along_z = True
+    elif x < _ALONG:
+        norm = math.sqrt(x * x + y * y + z * z)
+        cam.axis = (round(x / norm, 4), round(y / norm, 4), round(z / norm, 4))

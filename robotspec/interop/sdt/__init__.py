@@ -17,8 +17,6 @@ import warnings
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from robotspec.errors import RobotSpecError
-
 if TYPE_CHECKING:
     from robotspec.semantic import AbstractRobot
 
@@ -33,17 +31,13 @@ class SdtBridgeWarning(UserWarning):
 
 
 def sdt_api() -> ModuleType:
-    """SDT's names the bridge uses, or a RobotSpecError saying how to install SDT."""
+    """SDT's names the bridge uses, or a RobotSpecError naming what is missing (``.install``)."""
     try:
         from robotspec.interop.sdt import _api
     except ImportError as exc:
-        raise RobotSpecError(
-            f"the semantic digital twin cannot be imported ({exc}): "
-            f"pip install 'robotspec[sdt]' (semantic-digital-twin {SDT_VERSION}.*; "
-            "see docs/sdt.md for what SDT itself fails to install)",
-            kind="dependency",
-            name="semantic_digital_twin",
-        ) from exc
+        from robotspec.interop.sdt.install import import_error
+
+        raise import_error(exc, tested=SDT_VERSION) from exc
     return _api
 
 

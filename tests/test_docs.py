@@ -11,11 +11,16 @@ docs/examples/, so commands read as if run from the repository root):
 
 ``<!-- file: NAME -->`` before a block writes its text to NAME first (later blocks use it);
 ``<!-- no-run: REASON -->`` skips a block and must give a reason. Commands naming the HSR-B need
-the shared robot files beside the checkout and are skipped without them.
+the shared robot files beside the checkout and are skipped without them. ``<!-- needs: sdt -->``
+blocks need the semantic digital twin: they run in CI's SDT stage (``.ci/run`` runs this page's
+test there, ``ROBOTSPEC_REQUIRE_SDT=1``: a missing SDT fails), with the SDT tests' stand-ins
+(``tests/sdt_support.py``), and are skipped with the reason elsewhere.
 """
 
 from __future__ import annotations
 
+import importlib.util
+import os
 import re
 import shlex
 import shutil
@@ -26,6 +31,8 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import SHARED, erd_robots
+from tests.sdt_support import REASON as SDT_REASON
+from tests.sdt_support import require_sdt, stand_in_cylinder
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 PAGES = sorted(DOCS.glob("*.md"))
@@ -65,6 +72,18 @@ def blocks(page: Path) -> Iterator[Block]:
             end += 1
         yield Block(m.group(1), "\n".join(lines[i + 1 : end]) + "\n", i + 1, marks)
         i = end + 1
+
+
+def _sdt_ready(folder: Path, monkeypatch: pytest.MonkeyPatch) -> bool:
+    """SDT importable, with the SDT tests' stand-ins in place; False where it is not installed."""
+    if importlib.util.find_spec("semantic_digital_twin") is None:
+        if os.environ.get("ROBOTSPEC_REQUIRE_SDT"):  # CI's SDT stage: never a skip
+            pytest.fail(f"ROBOTSPEC_REQUIRE_SDT is set but {SDT_REASON}")
+        return False
+    require_sdt()
+    folder.mkdir(parents=True, exist_ok=True)
+    stand_in_cylinder(folder, monkeypatch)
+    return True
 
 
 def _is_spec(text: str) -> bool:
@@ -126,11 +145,20 @@ def test_examples_run(
     monkeypatch.setenv("NO_COLOR", "1")
     monkeypatch.delenv("ROBOTSPEC_VERBOSE", raising=False)
     skipped: list[str] = []
+    sdt_skipped: list[str] = []
+    sdt_ready: bool | None = None
     for b in blocks(page):
         where = f"{page.name}:{b.line}"
         if "no-run" in b.marks:
             assert b.marks["no-run"], f"{where}: <!-- no-run: REASON --> needs a reason"
             continue
+        if "needs" in b.marks:
+            assert b.marks["needs"] == "sdt", f"{where}: <!-- needs: sdt --> is the one need"
+            if sdt_ready is None:
+                sdt_ready = _sdt_ready(tmp_path.parent / f"{tmp_path.name}-sdt", monkeypatch)
+            if not sdt_ready:
+                sdt_skipped.append(where)
+                continue
         if "file" in b.marks:
             (tmp_path / b.marks["file"]).parent.mkdir(parents=True, exist_ok=True)
             (tmp_path / b.marks["file"]).write_text(b.text, encoding="utf-8")
@@ -167,5 +195,10 @@ def test_examples_run(
                     check_spec(spec)
                 except RobotSpecError as exc:
                     pytest.fail(f"{where}: the spec does not compile:\n{exc}")
+    reasons = []
     if skipped:
-        pytest.skip(f"needs {HSRB_PACKAGES} for: {'; '.join(skipped)}")
+        reasons.append(f"needs {HSRB_PACKAGES} for: {'; '.join(skipped)}")
+    if sdt_skipped:
+        reasons.append(f"{SDT_REASON}; the blocks at {', '.join(sdt_skipped)} need it")
+    if reasons:
+        pytest.skip("; ".join(reasons))

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from robotspec.cli.options import PackagePath
+from robotspec.cli.physics import Physics
 
 if TYPE_CHECKING:
     from robotspec.driver.robot_info import RobotInfo
@@ -25,22 +26,33 @@ DEMO_REACH = 0.3
 DEMO_RETURN_SLACK = 2.5
 
 
+def demo_positions(info: RobotInfo) -> tuple[list[float], list[float]]:
+    """Where the demo starts and ends (home, within the limits) and where it jogs to."""
+    home, target = [], []
+    for j in info.joint_info:
+        lim = j.joint_limits
+        h = min(max(lim.home, lim.lower), lim.upper)
+        home.append(h)
+        target.append(h + DEMO_REACH * (0.5 * (lim.lower + lim.upper) - h))
+    return home, target
+
+
 def demo_scenario(info: RobotInfo) -> str:
     """A short scenario for any exported chain: jog toward mid-range, then a trajectory home.
 
     Why generated: the demo must work for every robot robotspec ships, whatever its joints.
     Each call carries its expected outcome, so the demo also shows a scenario check passing.
     """
-    home, target, speed = [], [], []
-    shortest = 0.0
-    for j in info.joint_info:
-        lim = j.joint_limits
-        h = min(max(lim.home, lim.lower), lim.upper)
-        mid = 0.5 * (lim.lower + lim.upper)
-        home.append(h)
-        target.append(h + DEMO_REACH * (mid - h))
-        speed.append(0.5 * lim.velocity)
-        shortest = max(shortest, abs(target[-1] - home[-1]) / lim.velocity)
+    home, target = demo_positions(info)
+    speed = [0.5 * j.joint_limits.velocity for j in info.joint_info]
+    shortest = (
+        max(
+            abs(t - h) / j.joint_limits.velocity
+            for h, t, j in zip(home, target, info.joint_info, strict=True)
+        )
+        if info.joint_info
+        else 0.0
+    )
     duration = round(max(1.0, DEMO_RETURN_SLACK * shortest), 1)
 
     def vec(v: list[float]) -> str:
@@ -79,8 +91,33 @@ def demo(
         ),
     ] = None,
     package_path: PackagePath = None,
+    physics: Annotated[
+        Physics,
+        typer.Option(
+            "--physics",
+            help="What moves the arm: the kinematic profile (default) or MuJoCo under position "
+            "servos following it (the mujoco extra).",
+        ),
+    ] = Physics.kinematic,
+    gravity_compensation: Annotated[
+        bool | None,
+        typer.Option(
+            "--gravity-compensation/--no-gravity-compensation",
+            help="With --physics mujoco: cancel gravity on every body (default: only when a "
+            "joint's effort cannot hold its links at the demo's positions).",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Validate a robot's spec, show its chains, then drive its arm in simulation."""
+    if gravity_compensation is not None and physics is not Physics.mujoco:
+        raise typer.BadParameter(
+            "--gravity-compensation needs --physics mujoco", param_hint="--gravity-compensation"
+        )
+    if physics is Physics.mujoco:
+        from robotspec.driver.mujoco_model import require_mujoco
+
+        require_mujoco()  # before any work: one line saying what to install
     from robotspec.cli.chain_table import print_chains
     from robotspec.cli.driving import run_driver
     from robotspec.cli.validation_report import report_validation
@@ -109,8 +146,17 @@ def demo(
     for note in exported.notes:
         sys.stderr.write(f"note: {note}\n")
     info = exported.info
+    plant = None
+    flags = ""
+    if physics is Physics.mujoco:
+        from robotspec.cli.demo_physics import demo_plant
+
+        plant, compensated = demo_plant(
+            compiled, robot, chain, package_path or (), info, gravity_compensation
+        )
+        flags = " --physics mujoco" + (" --gravity-compensation" if compensated else "")
     with tempfile.TemporaryDirectory(prefix="robotspec-demo-") as tmp:
         script = Path(tmp) / "demo.yaml"
         write_file(script, demo_scenario(info), under=Path(tmp))  # a new file, no link followed
-        head(f"robotspec drive --spec {robot} --chain {chain} --script <generated>")
-        run_driver(info, f"{robot}_{chain}", script=script)
+        head(f"robotspec drive --spec {robot} --chain {chain}{flags} --script <generated>")
+        run_driver(info, f"{robot}_{chain}", script=script, plant=plant)

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from robotspec.cli.options import PackagePath
+from robotspec.cli.physics import Physics
 
 #: This module's commands; robotspec.cli.app adds them to the root app.
 app = typer.Typer()
@@ -52,6 +54,21 @@ def drive(
         typer.Option("--virtual-time", help="Run on a simulated clock, as fast as possible."),
     ] = False,
     package_path: PackagePath = None,
+    physics: Annotated[
+        Physics,
+        typer.Option(
+            "--physics",
+            help="What moves the arm: the kinematic profile (default) or MuJoCo under position "
+            "servos following it (needs --spec and the mujoco extra).",
+        ),
+    ] = Physics.kinematic,
+    gravity_compensation: Annotated[
+        bool,
+        typer.Option(
+            "--gravity-compensation",
+            help="With --physics mujoco: cancel gravity on every body (a counterbalanced arm).",
+        ),
+    ] = False,
     serve: Annotated[
         bool,
         typer.Option("--serve", help="Serve the robot over Robot Raconteur (loopback only)."),
@@ -78,6 +95,16 @@ def drive(
         raise typer.BadParameter("give either --sim or --spec, not both")
     if spec is not None and chain is None:
         raise typer.BadParameter("--spec needs --chain NAME")
+    if physics is Physics.mujoco and spec is None:
+        raise typer.BadParameter(
+            "--physics mujoco needs --spec SPEC --chain NAME: a RobotInfo file has no model "
+            "for MuJoCo to simulate",
+            param_hint="--physics",
+        )
+    if gravity_compensation and physics is not Physics.mujoco:
+        raise typer.BadParameter(
+            "--gravity-compensation needs --physics mujoco", param_hint="--gravity-compensation"
+        )
     from robotspec.driver.statelog import LOG_SUFFIXES
 
     if log is not None and log.suffix.lower() not in LOG_SUFFIXES:
@@ -100,10 +127,23 @@ def drive(
 
     from robotspec.cli.driving import drive_target, run_driver
 
-    info, fallback_name = drive_target(sim, spec, chain, package_path)
+    plant = None
+    if physics is Physics.mujoco:
+        from robotspec.cli.physics import physics_target
+
+        assert spec is not None and chain is not None  # checked above
+        target = physics_target(
+            spec, chain, package_path or (), gravity_compensation=gravity_compensation
+        )
+        for note in target.exported.notes:
+            sys.stderr.write(f"note: {note}\n")
+        info, fallback_name, plant = target.exported.info, f"{spec}_{chain}", target.plant
+    else:
+        info, fallback_name = drive_target(sim, spec, chain, package_path)
     run_driver(
         info,
         fallback_name,
+        plant=plant,
         rate=rate,
         duration=duration,
         script=script,

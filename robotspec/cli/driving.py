@@ -18,6 +18,7 @@ from types import FrameType
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from robotspec.driver.mujoco_model import PlantModel
     from robotspec.driver.robot_info import RobotInfo
     from robotspec.driver.state import RobotState
 
@@ -132,10 +133,13 @@ def run_driver(
     public: bool = False,
     node_name: str | None = None,
     state_dir: Path | None = None,
+    plant: PlantModel | None = None,
 ) -> None:
     """Run the simulated robot until the scenario ends, ``duration`` passes or Ctrl-C.
 
-    Raises the scenario's mismatches (located at the script) after printing the summary.
+    With ``plant`` the arm is MuJoCo's (:class:`~robotspec.driver.mujoco_plant.MujocoSimRobot`),
+    else the kinematic simulation's. Raises the scenario's mismatches (located at the script)
+    after printing the summary.
     """
     from robotspec.driver.clock import RealClock, SimClock
     from robotspec.driver.script import load_scenario, mismatch_errors, run_scenario
@@ -145,7 +149,15 @@ def run_driver(
 
     scenario = load_scenario(script) if script is not None else None
     clock = SimClock() if virtual_time else RealClock()
-    driver = SimRobot(info, clock=clock, update_period=1.0 / rate)
+    if plant is None:
+        driver: SimRobot = SimRobot(info, clock=clock, update_period=1.0 / rate)
+        where = "in simulation"
+    else:
+        from robotspec.driver.mujoco_plant import MujocoSimRobot
+
+        driver = MujocoSimRobot(info, plant, clock=clock, update_period=1.0 / rate)
+        gravity = "gravity compensated" if plant.gravity_compensation else "gravity on"
+        where = f"on MuJoCo physics ({gravity})"
     signals = _StopSignals()
     statelog = None
     if log is not None:
@@ -165,7 +177,7 @@ def run_driver(
     name = info.device_info.device.name or fallback_name
     sys.stderr.write(
         f"driving {name} ({len(info.joint_info)} joints, {len(info.chains)} "
-        f"chain{'s' if len(info.chains) != 1 else ''}) in simulation at {rate:g} Hz"
+        f"chain{'s' if len(info.chains) != 1 else ''}) {where} at {rate:g} Hz"
         f"{' (virtual time)' if virtual_time else ''}; Ctrl-C stops\n"
     )
     results = []

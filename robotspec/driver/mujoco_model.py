@@ -1,0 +1,268 @@
+"""The MuJoCo model a physics-backed driver steps: the robot's MJCF export, one chain free.
+
+Why a model of its own and not the exported file as it is: the driver commands one chain, and
+everything else must stay where the robot's default configuration puts it. Joints of other
+chains that have a position servo hold their default keyframe through it (``ctrl``); joints
+without one (a mobile base's planar or floating drive, passive joints) would drift under the
+arm's reaction forces or fall under gravity, so they are welded: removed when their default
+value is zero (the body then sits where the MJCF places it, exactly), held by a joint equality
+at their default value otherwise. A free joint is always removed (the export places its body at
+the default pose). The keyframes go (their ``qpos`` no longer fits the welded model); the plant
+sets the default configuration by joint name.
+
+Everything happens in memory: the XML is edited with lxml and the meshes are handed to
+MuJoCo as bytes (``MjModel.from_xml_string(xml, assets)``); nothing is written to disk.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from lxml import etree
+
+from robotspec.arrays import F64
+from robotspec.errors import RobotSpecError
+from robotspec.export.mjcf import MjcfExport
+from robotspec.export.mjcf_bodies import nums
+from robotspec.semantic import AbstractRobot
+
+__all__ = [
+    "MUJOCO_INSTALL",
+    "PlantModel",
+    "Shortfall",
+    "holding_shortfalls",
+    "plant_model",
+    "require_mujoco",
+]
+
+#: What a user without MuJoCo is told to run.
+MUJOCO_INSTALL = "pip install 'robotspec[mujoco]'"
+
+
+def require_mujoco(feature: str = "--physics mujoco") -> None:
+    """Raise a RobotSpecError naming the extra to install when MuJoCo cannot be imported.
+
+    Why up front: a user asking for physics without the extra gets one line saying what to
+    install, before any robot is compiled, not a traceback.
+    """
+    if importlib.util.find_spec("mujoco") is None:
+        raise RobotSpecError(
+            f"{feature} needs MuJoCo; install it with `{MUJOCO_INSTALL}`",
+            kind="dependency",
+            name="mujoco",
+        )
+
+
+@dataclass(frozen=True)
+class PlantModel:
+    """A compiled MuJoCo model with the chain's joints and servos found by name.
+
+    Attributes:
+        model: the ``mujoco.MjModel``.
+        qpos0: the robot's default configuration as the model's ``qpos`` (chain at default).
+        ctrl0: the servos' targets at the default configuration.
+        joint_qpos: per chain joint, its address in ``qpos``.
+        joint_dof: per chain joint, its address in ``qvel`` (and the ``qfrc_*`` arrays).
+        actuator: per chain joint, the index of its position servo.
+        kp: per chain joint, its servo's stiffness (N m/rad or N/m).
+        kv: per chain joint, its servo's damping (N m s/rad or N s/m).
+        welded: the joints welded (removed or held by an equality), in the export's order.
+        gravity_compensation: whether every body's gravity is cancelled (``gravcomp``).
+    """
+
+    model: Any
+    qpos0: F64
+    ctrl0: F64
+    joint_qpos: tuple[int, ...]
+    joint_dof: tuple[int, ...]
+    actuator: tuple[int, ...]
+    kp: F64
+    kv: F64
+    welded: tuple[str, ...]
+    gravity_compensation: bool
+
+
+def _weld_joints(
+    root: etree._Element, keep: set[str], values: dict[str, float], free: set[str]
+) -> list[str]:
+    """Weld every joint of ``root`` not in ``keep`` (see the module docstring); their names."""
+    welded: list[str] = []
+    held: list[tuple[str, float]] = []
+    for joint in list(root.iter("joint", "freejoint")):
+        parent = joint.getparent()
+        name = joint.get("name", "")
+        if parent is None or parent.tag != "body" or name in keep:
+            continue
+        welded.append(name)
+        if name in free or values.get(name, 0.0) == 0.0:
+            parent.remove(joint)
+        else:
+            held.append((name, values[name]))
+    removed = {n for n in welded if n not in dict(held)}
+    equality = root.find("equality")
+    if equality is not None:
+        for eq in list(equality):
+            if eq.tag != "joint":
+                continue
+            first, second = eq.get("joint1", ""), eq.get("joint2")
+            if first in removed:
+                equality.remove(eq)
+            elif second is not None and second in removed:
+                # the leader is welded: the follower holds its default value
+                del eq.attrib["joint2"]
+                eq.set("polycoef", nums((values.get(first, 0.0), 0.0, 0.0, 0.0, 0.0)))
+    if held:
+        if equality is None:
+            equality = etree.SubElement(root, "equality")
+        for name, value in held:
+            etree.SubElement(equality, "joint", joint1=name, polycoef=nums((value, 0, 0, 0, 0)))
+    actuators = root.find("actuator")
+    if actuators is not None:
+        for act in list(actuators):
+            if act.get("joint") in removed:
+                actuators.remove(act)
+    return welded
+
+
+def plant_model(
+    robot: AbstractRobot,
+    export: MjcfExport,
+    chain_joints: Sequence[str],
+    initial: Sequence[float] | F64 | None = None,
+    *,
+    gravity_compensation: bool = False,
+) -> PlantModel:
+    """The MuJoCo model of ``export`` with ``chain_joints`` free and the rest as described above.
+
+    ``initial`` is the chain's starting configuration (default: the robot's default
+    configuration, as every other degree of freedom). ``gravity_compensation`` cancels gravity
+    on every body (``gravcomp``, as ``mjcf_export(..., gravity_compensation=True)`` does), so
+    one export serves both. Raises a
+    RobotSpecError naming the joint when a chain joint has no position servo in the export.
+    """
+    import mujoco  # type: ignore[import-untyped, unused-ignore]
+
+    world = robot.world
+    q = world.default_configuration().copy()
+    dof_index = {d.name: d.index for d in world.degrees_of_freedom}
+    start = [q[dof_index[n]] if n in dof_index else 0.0 for n in chain_joints]
+    for name, value in zip(chain_joints, start if initial is None else initial, strict=True):
+        if name not in dof_index:
+            raise RobotSpecError(
+                f"the chain's joint '{name}' is not a degree of freedom of {robot.name}",
+                kind="joint",
+                name=name,
+            )
+        q[dof_index[name]] = float(value)
+    values: dict[str, float] = {}
+    free: set[str] = set()
+    for j in export.joints:
+        if j.kind == "free":
+            free.add(j.name)
+        else:
+            values[j.name] = j.multiplier * float(q[j.dof]) + j.offset
+    servoed = set(export.actuated)
+    missing = [n for n in chain_joints if n not in servoed]
+    if missing:
+        raise RobotSpecError(
+            f"the chain's joint '{missing[0]}' has no position servo in the MJCF export "
+            "(only commanded 1-DOF joints get one); --physics mujoco drives servoed joints only",
+            kind="joint",
+            name=missing[0],
+        )
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+    root = etree.fromstring(export.xml.encode(), parser)
+    keyframe = root.find("keyframe")
+    if keyframe is not None:
+        root.remove(keyframe)
+    # Kept: the chain, every servoed joint (it holds its target) and mimic followers of a kept
+    # leader (their equality moves them).
+    keep = set(chain_joints) | servoed
+    for eq in root.iter("joint"):
+        if eq.getparent() is not None and eq.getparent().tag == "equality":  # type: ignore[union-attr]
+            if eq.get("joint2") in keep:
+                keep.add(eq.get("joint1", ""))
+    welded = _weld_joints(root, keep, values, free)
+    if gravity_compensation:
+        for body in root.iter("body"):
+            body.set("gravcomp", "1")
+    assets = {rel: produce() for rel, produce in export.meshes}
+    model = mujoco.MjModel.from_xml_string(etree.tostring(root, encoding="unicode"), assets)
+    # The controller's feed-forward may put a servo's target beyond a joint limit (a joint held
+    # at its limit against gravity); the joint's own range still stops the arm there.
+    model.actuator_ctrllimited[:] = 0
+    qpos0 = np.array(model.qpos0, dtype=np.float64)
+    ctrl0 = np.zeros(model.nu)
+    act_of_joint = {int(model.actuator_trnid[a, 0]): a for a in range(model.nu)}
+    for name, value in values.items():
+        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if jid < 0:
+            continue
+        qpos0[model.jnt_qposadr[jid]] = value
+        if jid in act_of_joint:
+            ctrl0[act_of_joint[jid]] = value
+    ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in chain_joints]
+    actuator = tuple(act_of_joint[j] for j in ids)
+    kp = np.array([model.actuator_gainprm[a, 0] for a in actuator], dtype=np.float64)
+    kv = np.array([-model.actuator_biasprm[a, 2] for a in actuator], dtype=np.float64)
+    return PlantModel(
+        model=model,
+        qpos0=qpos0,
+        ctrl0=ctrl0,
+        joint_qpos=tuple(int(model.jnt_qposadr[j]) for j in ids),
+        joint_dof=tuple(int(model.jnt_dofadr[j]) for j in ids),
+        actuator=actuator,
+        kp=kp,
+        kv=kv,
+        welded=tuple(welded),
+        gravity_compensation=bool(np.any(model.body_gravcomp > 0.0)),
+    )
+
+
+@dataclass(frozen=True)
+class Shortfall:
+    """A chain joint whose servo cannot hold its links against gravity at some configuration."""
+
+    joint: str
+    #: the static torque (N m) or force (N) gravity needs at the worst configuration checked
+    needed: float
+    #: the servo's force limit (the URDF effort), same unit
+    effort: float
+    #: "N m" for a hinge, "N" for a slide
+    unit: str
+
+
+def holding_shortfalls(
+    plant: PlantModel, chain_joints: Sequence[str], configurations: Sequence[Sequence[float]]
+) -> list[Shortfall]:
+    """The chain joints whose effort is below the static torque gravity needs, worst first.
+
+    Why: a robot whose URDF leaves out a counterbalance (the PR2's shoulder springs) sags under
+    physics with its stated effort; ``robotspec demo`` turns gravity compensation on for it and
+    says why, instead of failing its scenario.
+    """
+    import mujoco  # type: ignore[import-untyped, unused-ignore]
+
+    model = plant.model
+    data = mujoco.MjData(model)
+    worst: dict[str, Shortfall] = {}
+    for q in configurations:
+        data.qpos[:] = plant.qpos0
+        data.qpos[list(plant.joint_qpos)] = q
+        data.qvel[:] = 0.0
+        mujoco.mj_forward(model, data)
+        for i, name in enumerate(chain_joints):
+            a = plant.actuator[i]
+            if not model.actuator_forcelimited[a]:
+                continue
+            effort = float(model.actuator_forcerange[a, 1])
+            dof = plant.joint_dof[i]
+            needed = abs(float(data.qfrc_bias[dof] - data.qfrc_gravcomp[dof]))
+            if needed > effort and (name not in worst or needed > worst[name].needed):
+                slide = model.jnt_type[model.dof_jntid[dof]] == mujoco.mjtJoint.mjJNT_SLIDE
+                worst[name] = Shortfall(name, needed, effort, "N" if slide else "N m")
+    return sorted(worst.values(), key=lambda s: s.effort - s.needed)

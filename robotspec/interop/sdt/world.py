@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from robotspec.errors import RobotSpecError
+from robotspec.interop.sdt.failures import mesh_failure
 from robotspec.model.entities import ConnectionType
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
 from robotspec.model.world import World
@@ -96,8 +97,11 @@ def sdt_world(world: World, *, drive: str, prefix: str | None = None) -> Any:
     out.name = prefix
     try:
         _fill(sdt, out, world, drive, pname)
-    except RuntimeError as exc:
-        if "resources" not in str(exc):
+    except Exception as exc:
+        failure = mesh_failure(exc)  # SDT's mesh step failed: name it and the mesh file
+        if failure is not None:
+            raise failure from exc
+        if not isinstance(exc, RuntimeError) or "resources" not in str(exc):
             raise
         # SDT's wheel lacks its resources/ folder; its Bullet collision sync loads
         # resources/obj/cylinder.obj for every cylinder of a world (docs/sdt.md).

@@ -10,18 +10,40 @@ spec back into SDT's classes.
 What a spec cannot say is reported, one line each, in :attr:`Migration.notes`: an end effector
 of a single finger (a generic manipulator; more than two fingers are a ``type: hand``), a velocity
 limit SDT *raises* (robotspec's limits only tighten), a state of a kind robotspec has no name for.
+
+Only what the class states is written (issue 32): the drive comes from the robot's files (SDT's
+class only says the base moves; :mod:`~robotspec.interop.sdt.migrate_facts`), arm sides are the
+geometry's (SDT's own guess kept as a note where it differs), hardware interfaces sit on the
+joints that move (a mimic's leader, never the mimic), and values SDT derives (an end effector's
+front-facing axis, computed from its orientation) are left for robotspec to derive.
 """
 
 from __future__ import annotations
 
 import os
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from robotspec.errors import RobotSpecError
+from robotspec.interop.sdt.migrate_facts import drive_fact
+from robotspec.interop.sdt.migrate_parts import (
+    base_root_note,
+    build,
+    finger_names,
+    forward_of,
+    hardware_leaders,
+    name_of,
+    part_kind,
+    part_name,
+    side_notes,
+    spec_states,
+    vector3,
+)
+
+if TYPE_CHECKING:
+    from robotspec.description.load import Description
 
 __all__ = ["Migration", "import_class", "migrate_files", "render", "spec_from_sdt"]
 
@@ -34,109 +56,21 @@ class Migration:
     notes: tuple[str, ...]
 
 
-def _snake(name: str) -> str:
-    return re.sub(r"(?<=[a-z0-9])(?=[A-Z])|(?<=[A-Z])(?=[A-Z][a-z])", "_", name).lower()
-
-
-def _part_name(part: Any, robot_class: type) -> str:
-    """``PR2LeftGripper`` of robot ``PR2`` -> ``left_gripper``."""
-    name = type(part).__name__
-    prefix = robot_class.__name__
-    if name.startswith(prefix) and len(name) > len(prefix):
-        name = name[len(prefix) :]
-    return _snake(name)
-
-
-def _finger_names(names: list[str]) -> list[str]:
-    """Finger part names without the words all share (``left_hand_index`` -> ``index``)."""
-    words = [n.split("_") for n in names]
-    if len(words) < 2:
-        return names
-    lead = 0
-    while all(len(w) > lead + 1 and w[lead] == words[0][lead] for w in words):
-        lead += 1
-    trail = 0
-    while all(len(w) > lead + trail + 1 and w[-1 - trail] == words[0][-1 - trail] for w in words):
-        trail += 1
-    return ["_".join(w[lead : len(w) - trail]) for w in words]
-
-
-def _n(entity: Any) -> str:
-    return str(entity.name.name)
-
-
-def _vector(v: Any) -> list[float]:
-    return [round(float(x), 9) + 0.0 for x in v.to_np()[:3]]
-
-
-def _kind(part: Any, sdt: Any) -> str | None:
-    for kind in ("MobileBase", "Torso", "Neck", "Arm", "EndEffector", "Finger", "Camera"):
-        if isinstance(part, getattr(sdt.parts, kind)):
-            return kind
-    return "Sensor" if isinstance(part, sdt.parts.Sensor) else None
-
-
-def _states(states: list[Any], notes: list[str], where: str) -> dict[str, Any]:
-    """SDT joint states as spec states: on the joints that move (a mimic's leader).
-
-    A value SDT sets on a mimic joint is the leader's ``(value - offset) / multiplier``. When
-    SDT sets two mimics of one leader to values that disagree, the one within the leader's
-    limits is kept and the disagreement noted.
-    """
-    out: dict[str, dict[str, float]] = {}
-    for s in states:
-        if s.state_type is None:
-            notes.append(f"{where}: state '{_n(s)}' has no kind; left out")
-            continue
-        candidates: dict[str, list[float]] = {}
-        dofs: dict[str, Any] = {}
-        for c, value in zip(s.connections, s.target_values, strict=True):
-            leader = str(c.raw_dof.name.name)
-            dofs[leader] = c.raw_dof
-            candidates.setdefault(leader, []).append((float(value) - c.offset) / c.multiplier + 0.0)
-        joints: dict[str, float] = {}
-        for leader, values in candidates.items():
-            limits = dofs[leader].limits
-            lo, hi = limits.lower.position, limits.upper.position
-            inside = [
-                v
-                for v in values
-                if (lo is None or v >= lo - 1e-9) and (hi is None or v <= hi + 1e-9)
-            ]
-            joints[leader] = (inside or values)[0]
-            if len(set(values)) > 1:
-                notes.append(
-                    f"{where}.{s.state_type.name.lower()}: SDT sets joints that follow "
-                    f"'{leader}' to disagreeing values (as {sorted(set(values))} of it); "
-                    f"kept {joints[leader]}"
-                )
-        out[s.state_type.name.lower()] = joints
-    return out
-
-
-def _build(cls: Any, world: Any) -> tuple[Any, dict[str, float | None]]:
-    """SDT's ``from_world`` without its collision rules; the velocity limits before it."""
-    root = world.get_body_in_branch_by_name(world.root, cls._get_root_body_name())
-    before: dict[str, float | None] = {}
-    with world.modify_world():
-        robot = cls(root=root)
-        robot.setup_robot_part_semantic_annotations()
-        world.add_semantic_annotation_recursively(robot)
-        for c in robot._one_dof_connections:
-            before[_n(c)] = c.raw_dof.limits.upper.velocity
-        for part in robot._robot_parts:
-            part.setup_hardware_interfaces()
-        robot._setup_velocity_limits()
-    return robot, before
-
-
 def spec_from_sdt(
-    cls: type, world: Any, *, urdf: str, srdf: str | None = None, name: str | None = None
+    cls: type,
+    world: Any,
+    *,
+    urdf: str,
+    srdf: str | None = None,
+    name: str | None = None,
+    files: Description | None = None,
 ) -> Migration:
     """The spec of SDT robot class ``cls`` on ``world`` (SDT's world of the robot's files).
 
     ``urdf`` and ``srdf`` are written into the spec's ``description`` as given (paths or
     ``package://`` URIs, as the spec will find them). The world is changed: the robot is added.
+    ``files``: robotspec's model of the same files (the drive and arm sides are read off it);
+    loaded from ``urdf`` and ``srdf`` (``ROS_PACKAGE_PATH`` for packages) when not given.
     """
     from robotspec.interop.sdt import sdt_api
 
@@ -149,7 +83,7 @@ def spec_from_sdt(
         )
     notes: list[str] = []
     try:
-        robot, before = _build(cls, world)
+        robot, before = build(cls, world)
     except Exception as exc:  # SDT's own lookups (a body its class names, a part it expects)
         raise RobotSpecError(
             f"SDT's class {cls.__name__} cannot be built on this robot's world: "
@@ -157,47 +91,55 @@ def spec_from_sdt(
             kind="class",
             name=cls.__name__,
         ) from exc
-    left = robot.get_left_arm_if_specified()
-    right = robot.get_right_arm_if_specified()
+    if files is None:
+        from robotspec.description.load import load_description
+
+        files = load_description(urdf, srdf=srdf)
     spec: dict[str, Any] = {"robotspec": 1, "name": name or cls.__name__}
     spec["description"] = {"urdf": urdf, **({"srdf": srdf} if srdf else {})}
-    spec["root"] = _n(robot.root)
+    spec["root"] = name_of(robot.root)
+    base = next((p for p in robot._robot_parts if part_kind(p, sdt) == "MobileBase"), None)
+    forward = (1.0, 0.0, 0.0) if base is None else forward_of(base)
+    if forward != (1.0, 0.0, 0.0):
+        spec["forward"] = list(forward)
+    drive = drive_fact(files.world, files.srdf, spec["root"], moves=base is not None)
+    if drive.spec is not None:
+        spec["drive"] = drive.spec
+    if drive.note is not None:
+        notes.append(drive.note)
+    if base is not None:
+        notes.extend(base_root_note(robot, base, sdt))
     chains: dict[str, Any] = {}
     manipulators: dict[str, Any] = {}
     sensors: dict[str, Any] = {}
-    names = {id(p): _part_name(p, cls) for p in robot._robot_parts}
+    names = {id(p): part_name(p, cls) for p in robot._robot_parts}
     for part in robot._robot_parts:
-        kind = _kind(part, sdt)
+        kind = part_kind(part, sdt)
         pname = names[id(part)]
-        states = _states(part.setup_joint_states(), notes, pname)
+        states = spec_states(part.setup_joint_states(), notes, pname)
         carried = [names[id(s)] for s in getattr(part, "sensors", [])]
-        if kind == "MobileBase":
-            spec["drive"] = {"type": "omni"}
-        elif kind == "Torso":
-            spec["torso"] = {"root": _n(part.root), "tip": _n(part.tip), "states": states}
+        if kind == "Torso":
+            spec["torso"] = {"root": name_of(part.root), "tip": name_of(part.tip), "states": states}
         elif kind == "Neck":
             spec["neck"] = {
-                "root": _n(part.root),
-                "tip": _n(part.tip),
+                "root": name_of(part.root),
+                "tip": name_of(part.tip),
                 "sensors": carried,
                 "states": states,
             }
         elif kind == "Arm":
-            chain: dict[str, Any] = {"root": _n(part.root), "tip": _n(part.tip)}
+            chain: dict[str, Any] = {"root": name_of(part.root), "tip": name_of(part.tip)}
             if part.end_effector is not None:
                 chain["manipulator"] = names[id(part.end_effector)]
-            if part is left or part is right:
-                chain["side"] = "left" if part is left else "right"
             chain.update({"sensors": carried, "states": states})
             chains[pname] = chain
         elif kind == "EndEffector":
             q = part.front_facing_orientation.to_np()
             m: dict[str, Any] = {
                 "type": "generic",
-                "root": _n(part.root),
-                "tool_frame": _n(part.tool_frame),
+                "root": name_of(part.root),
+                "tool_frame": name_of(part.tool_frame),
                 "front_facing_orientation": [float(x) for x in q[:4]],
-                "front_facing_axis": _vector(part.front_facing_axis),
                 "states": states,
             }
             fingers = list(getattr(part, "fingers", []))
@@ -205,21 +147,21 @@ def spec_from_sdt(
                 thumb = part.thumb
                 (other,) = [f for f in fingers if f is not thumb]
                 m["type"] = "parallel_gripper"
-                m["thumb"] = {"root": _n(thumb.root), "tip": _n(thumb.tip)}
-                m["finger"] = {"root": _n(other.root), "tip": _n(other.tip)}
+                m["thumb"] = {"root": name_of(thumb.root), "tip": name_of(thumb.tip)}
+                m["finger"] = {"root": name_of(other.root), "tip": name_of(other.tip)}
             elif len(fingers) > 2:
                 thumb = part.thumb
                 m["type"] = "hand"
-                m["thumb"] = {"root": _n(thumb.root), "tip": _n(thumb.tip)}
-                short = _finger_names([names.get(id(f)) or _n(f.root) for f in fingers])
+                m["thumb"] = {"root": name_of(thumb.root), "tip": name_of(thumb.tip)}
+                short = finger_names([names.get(id(f)) or name_of(f.root) for f in fingers])
                 named: dict[str, Any] = {}
                 for f, key in zip(fingers, short, strict=True):
                     if f is thumb:
                         continue
-                    key = key if key != "thumb" else _n(f.root)
+                    key = key if key != "thumb" else name_of(f.root)
                     while key in named:
                         key += "_"
-                    named[key] = {"root": _n(f.root), "tip": _n(f.tip)}
+                    named[key] = {"root": name_of(f.root), "tip": name_of(f.tip)}
                 m["fingers"] = named
             elif fingers:
                 notes.append(
@@ -231,8 +173,8 @@ def spec_from_sdt(
             fov = part.field_of_view
             sensors[pname] = {
                 "type": "camera",
-                "body": _n(part.root),
-                "forward_facing_axis": _vector(part.forward_facing_axis),
+                "body": name_of(part.root),
+                "forward_facing_axis": vector3(part.forward_facing_axis),
                 "field_of_view": {
                     "vertical": float(fov.vertical_angle),
                     "horizontal": float(fov.horizontal_angle),
@@ -242,27 +184,26 @@ def spec_from_sdt(
                 "default": bool(part.default_camera),
             }
         elif kind == "Sensor":
-            sensors[pname] = {"type": "generic", "body": _n(part.root)}
+            sensors[pname] = {"type": "generic", "body": name_of(part.root)}
+    notes.extend(side_notes(robot, chains, names, files, spec["root"], forward))
     for key, value in (("chains", chains), ("manipulators", manipulators), ("sensors", sensors)):
         if value:
             spec[key] = value
-    hardware = sorted(
-        {_n(c) for c in robot.connections if getattr(c, "has_hardware_interface", False)}
-    )
+    hardware = hardware_leaders(robot, notes)
     if hardware:
         spec["controlled_joints"] = hardware
     limits: dict[str, float] = {}
     for c in robot._one_dof_connections:
-        after, was = c.raw_dof.limits.upper.velocity, before.get(_n(c))
+        after, was = c.raw_dof.limits.upper.velocity, before.get(name_of(c))
         if c.raw_dof.name.name != c.name.name or after is None or after == was:
             continue  # a mimic joint (its leader carries the limit), or unchanged
         if was is not None and after > was:
             notes.append(
-                f"velocity limit of '{_n(c)}': SDT raises it from {was} to {after}; "
+                f"velocity limit of '{name_of(c)}': SDT raises it from {was} to {after}; "
                 "robotspec's limits only tighten, so the URDF's stays"
             )
             continue
-        limits[_n(c)] = float(after)
+        limits[name_of(c)] = float(after)
     if limits:
         common = max(set(limits.values()), key=list(limits.values()).count)
         spec["velocity_limits"] = {
@@ -321,8 +262,8 @@ def migrate_files(
 
     sdt_api()  # SDT missing: say how to install it, before its class cannot be imported
     cls = import_class(target)
-    world = load_description(urdf, package_paths=package_paths, base_folder=Path.cwd()).world
-    sdt = sdt_world(world, drive="fixed")
+    files = load_description(urdf, srdf=srdf, package_paths=package_paths, base_folder=Path.cwd())
+    sdt = sdt_world(files.world, drive="fixed")
 
     def named(file: str) -> str:
         if "://" in file:
@@ -330,7 +271,9 @@ def migrate_files(
         path = Path(file).resolve()
         return os.path.relpath(path, folder) if path.is_relative_to(folder) else str(path)
 
-    return spec_from_sdt(cls, sdt, urdf=named(urdf), srdf=None if srdf is None else named(srdf))
+    return spec_from_sdt(
+        cls, sdt, urdf=named(urdf), srdf=None if srdf is None else named(srdf), files=files
+    )
 
 
 def render(migration: Migration, *, source: str) -> str:

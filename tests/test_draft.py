@@ -118,7 +118,10 @@ def test_pr2_imu_and_laser_are_not_cameras_and_stereo_is_one_camera(tmp_path: Pa
 
 def test_tiago_without_srdf_torso_neck_differential_hand(tmp_path: Path) -> None:
     d, _ = _draft("tiago_description/robots/tiago.urdf", None, tmp_path)
-    assert [(c.name, c.root, c.tip) for c in d.chains] == [("arm", "torso_lift_link", "arm_7_link")]
+    # The arm ends at its flange, one fixed joint past arm_7_link (issue 30).
+    assert [(c.name, c.root, c.tip) for c in d.chains] == [
+        ("arm", "torso_lift_link", "arm_tool_link")
+    ]
     (hand,) = d.manipulators
     # Five fingers: a hand, not a parallel gripper; its tool frame is in its own subtree.
     assert not hand.is_gripper and hand.name == "hand"
@@ -415,11 +418,11 @@ def test_legs_coded_fore_and_hind_say_which_way_the_robot_faces(tmp_path: Path) 
     d, text = _draft("quadruped_description/urdf/quadruped.urdf", None, tmp_path)
     assert d.forward == (0.0, 1.0, 0.0) and "DECIDE" in text.split("forward:")[1].split("\n")[0]
     legs = {c.name: c.tip for c in d.chains}
-    assert legs == {
-        "front_left_leg": "FL_shank",
-        "front_right_leg": "FR_shank",
-        "hind_left_leg": "BL_shank",
-        "hind_right_leg": "BR_shank",
+    assert legs == {  # each ends at its foot's contact frame, fixed past the shank (issue 30)
+        "front_left_leg": "FL_contact",
+        "front_right_leg": "FR_contact",
+        "hind_left_leg": "BL_contact",
+        "hind_right_leg": "BR_contact",
     }
     assert d.drive is not None and d.drive.type == "floating"
 

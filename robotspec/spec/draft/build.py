@@ -59,6 +59,7 @@ from robotspec.spec.draft.srdf_groups import (
     group_chains,
     group_notes,
 )
+from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = ["Drafter", "draft_spec"]
@@ -305,7 +306,6 @@ class Drafter:
                 :3, 3
             ] / 2
             local = np.linalg.inv(tree.poses[gripper.root.index]) @ np.append(mid, 1.0)
-            xyz = (round(float(local[0]), 4), round(float(local[1]), 4), round(float(local[2]), 4))
             if float(np.linalg.norm(local[:3])) < ON_ROOT:
                 # The gripper's own link sits between its finger tips (Fetch's 'gripper_link'):
                 # it is the tool frame the URDF has, not a new one at the same place.
@@ -315,7 +315,7 @@ class Drafter:
                 frame = DraftFrame(
                     tool_name,
                     gripper.root.name,
-                    xyz,
+                    between_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip)),
                     "the URDF has no tool frame: between the finger tips in the default pose",
                 )
         elif hand is not None and (center := hand_center(tree, top)) is not None:
@@ -331,6 +331,12 @@ class Drafter:
             # the URDF gives the hand, whatever its name.
             tool_name = marks[0].name
             decide.append(f"the tool frame '{tool_name}': the one frame fixed on the hand")
+        elif hand is None and (flange := flange_offset(tree, top)) is not None:
+            tool_name = unique("flange", self.names | set(world.body_names))
+            frame = DraftFrame(tool_name, top.name, flange, f"the URDF has no tool frame: {FLANGE}")
+        elif hand is None and (up := world.parent_connection(top)) is not None and up.is_fixed:
+            tool_name = top.name  # the flange link the chain ends at, past its last joint
+            decide.append(f"the tool frame '{tool_name}': the link past the arm's last joint")
         else:
             tool_name = top.name
             decide.append("no tool frame link found; add one under description.frames")

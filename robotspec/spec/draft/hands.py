@@ -10,7 +10,7 @@ Two jaws in series, the second hanging on the first (a WSG-50's), are a parallel
 branch beside the finger carriage that no joint couples to it (a motor's horn) is not a finger.
 
 Tool frames are searched only in the manipulator's own subtree, so two arms never share one; a
-hand without one gets a frame proposed between its tips.
+hand without one gets a frame proposed between its tips (``tool_frames``, re-exported here).
 """
 
 from __future__ import annotations
@@ -21,9 +21,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from robotspec.model.entities import Body
-from robotspec.model.world import World
 from robotspec.spec.draft.limbs import FINGER_WORDS, HAND_WORDS, is_named
 from robotspec.spec.draft.model import DraftFinger
+from robotspec.spec.draft.tool_frames import (
+    bare_fixed_leaf,
+    find_tool_frame,
+    hand_center,
+    is_named_tcp,
+    own_geometry,
+)
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = [
@@ -36,26 +42,6 @@ __all__ = [
     "hand_joints",
     "is_named_tcp",
 ]
-
-#: How tool frames are usually named, best first: (substring of the name, or a whole word).
-TOOL_HINTS: tuple[str, ...] = (
-    "tool_frame",
-    "tcp",
-    "grasping_frame",
-    "grasp_frame",
-    "gripper_frame",
-    "grasp",
-    "tool0",
-    "end_effector",
-    "endeffector",
-    "ee_link",
-    "eef",
-    "ee",
-    "endpoint",
-    "tool_link",
-    "tool",
-    "flange",
-)
 
 
 @dataclass(frozen=True)
@@ -90,19 +76,9 @@ def _finger_tip(tree: Tree, branch: Body) -> Body:
     # A bare frame the URDF fixes at the end of the last phalanx is the tip it names (Ability's
     # 'index_tip', D'Claw's 'link_f1_head'): the only thing hanging there, nothing below it.
     kids = world.child_bodies(tip)
-    if len(kids) == 1 and _bare_fixed_leaf(world, kids[0]):
+    if len(kids) == 1 and bare_fixed_leaf(world, kids[0]):
         return kids[0]
     return tip
-
-
-def _bare_fixed_leaf(world: World, body: Body) -> bool:
-    c = world.parent_connection(body)
-    return (
-        c is not None
-        and c.is_fixed
-        and not world.child_bodies(body)
-        and not (body.collisions or body.visuals)
-    )
 
 
 def _dofs(tree: Tree, branch: Body) -> set[int]:
@@ -132,7 +108,7 @@ def _jaws(tree: Tree, hand: Body) -> Gripper | None:
         return None
     j1, j2 = passed
     jaw1, jaw2 = world.bodies[j1.child], world.bodies[j2.child]
-    if j1.type != j2.type or not (_own_geometry(jaw1) and _own_geometry(jaw2)):
+    if j1.type != j2.type or not (own_geometry(jaw1) and own_geometry(jaw2)):
         return None
     named = any(is_named(b.name, FINGER_WORDS | HAND_WORDS) for b in (jaw1, jaw2))
     if j1.type.value != "prismatic" and not named:
@@ -148,10 +124,6 @@ def _jaws(tree: Tree, hand: Body) -> Gripper | None:
         decide=decide,
         found="two jaws, one hanging on the other,",
     )
-
-
-def _own_geometry(body: Body) -> bool:
-    return bool(body.collisions or body.visuals)
 
 
 def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | None:
@@ -301,6 +273,12 @@ def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
 
         thumb_i = max(range(len(at)), key=apart)
         decide = "the thumb is the finger whose base lies off the row of the others'"
+        alone = _alone_on_a_side(tree, body, branches)
+        if alone is not None and _no_clear_row(at):
+            # Bases on a circle (D'Claw's three fingers): no row; the one opposing the others
+            # across the palm is the thumb.
+            thumb_i = alone
+            decide = "the thumb is the finger alone on its side of the palm, opposing the others"
     fingers: dict[str, DraftFinger] = {}
     count = 0
     for i, k in enumerate(branches):
@@ -320,6 +298,31 @@ def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
     return out
 
 
+#: Off-row distances closer than this ratio tell no row of fingers from a thumb.
+ROW_RATIO = 1.25
+
+
+def _no_clear_row(at: list[np.ndarray]) -> bool:
+    """Whether no base lies clearly farther off the others' row than the next one does."""
+    offs = sorted(
+        (_off_line(p, at[:i] + at[i + 1 :]) for i, p in enumerate(at)),
+        reverse=True,
+    )
+    return len(offs) >= 2 and offs[0] < ROW_RATIO * offs[1]
+
+
+def _alone_on_a_side(tree: Tree, split: Body, branches: list[Body]) -> int | None:
+    """The one branch whose base lies on the other side of the palm's x-z plane (its y sign)."""
+    inv = np.linalg.inv(tree.poses[split.index])
+    ys = [float((inv @ tree.poses[k.index])[1, 3]) for k in branches]
+    for sign in (1.0, -1.0):
+        side = [i for i, y in enumerate(ys) if sign * y > 1e-3]
+        rest = [i for i, y in enumerate(ys) if sign * y < -1e-3]
+        if len(side) == 1 and len(rest) == len(ys) - 1:
+            return side[0]
+    return None
+
+
 def _line_residual(points: list[np.ndarray]) -> float:
     """How far ``points`` are from lying on one line (the spread across their principal axis)."""
     pts = np.asarray(points)
@@ -334,118 +337,6 @@ def _off_line(p: np.ndarray, others: list[np.ndarray]) -> float:
     _, _, vt = np.linalg.svd(pts - centre)
     d = p - centre
     return float(np.linalg.norm(d - (d @ vt[0]) * vt[0]))
-
-
-def _matches(hint: str, name: tuple[str, set[str]]) -> bool:
-    """Whether a name (lower-cased, and its words) holds a hint: inside it, or as a word."""
-    if "_" in hint or len(hint) > 4:
-        return hint in name[0]
-    return hint in name[1]
-
-
-def _named_as(name: str) -> tuple[str, set[str]]:
-    return name.lower(), words(name)
-
-
-#: Names a URDF gives its TCP: a bare frame so named is a tool frame the files decide.
-TCP_NAMES: tuple[str, ...] = (
-    "tool_frame",
-    "tcp",
-    "grasping_frame",
-    "grasp_frame",
-    "tool0",
-    "end_effector_link",
-    "ee_link",
-)
-
-
-def is_named_tcp(world: World, body: Body) -> bool:
-    """Whether ``body`` is a bare frame (a leaf without geometry, on a fixed joint) named a TCP."""
-    c = world.parent_connection(body)
-    if c is None or not c.is_fixed or world.child_bodies(body) or _own_geometry(body):
-        return False
-    name = _named_as(body.name)
-    return any(_matches(hint, name) for hint in TCP_NAMES)
-
-
-def find_tool_frame(
-    tree: Tree,
-    top: Body,
-    exclude: frozenset[int] = frozenset(),
-    prefer: Body | None = None,
-    leaf: bool = False,
-) -> Body | None:
-    """The best-named tool frame in ``top``'s subtree (``exclude``: bodies of other parts).
-
-    Of equally named frames, one hanging from ``prefer`` (where the fingers split) wins: the
-    TCP sits between the fingers, the flange above them (Interbotix's 'ee_gripper_link' beside
-    'ee_arm_link'). ``leaf``: only frames without children count.
-    """
-    world = tree.world
-    candidates = [b for b in world.subtree(top) if b.index not in exclude]
-    if leaf:  # frames only (a TCP), never a link carrying fingers
-        candidates = [b for b in candidates if not world.child_bodies(b)]
-    near = set() if prefer is None else {b.index for b in world.subtree(prefer)}
-    # The link's name, or its fixed joint's (Baxter's 'right_gripper' hangs on 'right_endpoint').
-    names: dict[int, list[tuple[str, set[str]]]] = {}
-    for b in candidates:
-        c = world.parent_connection(b)
-        names[b.index] = [_named_as(b.name)]
-        if c is not None and c.is_fixed:
-            names[b.index].append(_named_as(c.name))
-    for hint in TOOL_HINTS:
-        hits = [b for b in candidates if any(_matches(hint, n) for n in names[b.index])]
-        if hits:
-            # A TCP is a frame (a leaf), not a link carrying fingers ('fingers_link' on 'ee_bar').
-            return min(
-                hits,
-                key=lambda b: (
-                    b.index not in near,
-                    bool(world.child_bodies(b)),
-                    world.depth(b),
-                    b.index,
-                ),
-            )
-    # Last: a bare frame named as the gripper (iCub's 'l_gripper' below 'l_hand').
-    bare = [
-        b
-        for b in candidates
-        if "gripper" in names[b.index][0][1]
-        and not world.child_bodies(b)
-        and not _own_geometry(b)
-        and (c := world.parent_connection(b)) is not None
-        and c.is_fixed
-    ]
-    return min(bare, key=lambda b: (world.depth(b), b.index)) if bare else None
-
-
-def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:
-    """Between a hand's finger tips in the default pose, in ``top``'s frame (``None``: no tips).
-
-    The tips are the leaves with geometry below ``top``; a tool frame proposed there is a guess.
-    """
-    world = tree.world
-    tips = [
-        b
-        for b in world.subtree(top)
-        if b is not top and not world.child_bodies(b) and _own_geometry(b)
-    ]
-    if not tips:  # tips the URDF names as bare frames at the fingers' ends (Ability's '*_tip')
-        tips = [
-            b
-            for b in world.subtree(top)
-            if b is not top
-            and _bare_fixed_leaf(world, b)
-            and (up := world.parent_connection(b)) is not None
-            and up.parent != top.index  # on a finger, not on the hand itself
-            and (c := world.parent_connection(world.bodies[up.parent])) is not None
-            and not c.is_fixed
-        ]
-    if not tips:
-        return None
-    mid = np.mean([tree.poses[b.index][:3, 3] for b in tips], axis=0)
-    local = np.linalg.inv(tree.poses[top.index]) @ np.append(mid, 1.0)
-    return (round(float(local[0]), 4), round(float(local[1]), 4), round(float(local[2]), 4))
 
 
 def hand_joints(tree: Tree, top: Body) -> frozenset[str]:

@@ -15,9 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from robotspec.model.entities import Body, Connection
+from robotspec.model.world import World
 from robotspec.spec.draft.tree import Segment, Tree, words
 
-__all__ = ["Limb", "find_limbs", "hand_cut", "hand_span", "is_named"]
+__all__ = ["Limb", "beside_branch", "chain_end", "find_limbs", "hand_cut", "hand_span", "is_named"]
 
 HAND_WORDS = frozenset({"gripper", "hand", "palm", "eef", "jaw", "claw", "effector"})
 FINGER_WORDS = frozenset(
@@ -115,7 +116,7 @@ def _hand_joint(tree: Tree, c: Connection) -> bool:
     return bool(named & HAND_WORDS) and not named & (AXIS_WORDS | ARM_WORDS)
 
 
-def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
+def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Limb | None:
     world = tree.world
     cut = hand_cut(tree, seg)
     # The joint that moves the hand is the arm's last (a wrist roll turning 'gripper_link').
@@ -139,7 +140,7 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     if reach < MIN_LIMB_LENGTH:
         return None
     # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.
-    root = seg.start
+    root = seg.start if base is None else base
     top = world.parent_connection(seg.bodies[0])
     if root.index == tree.root.index and words(root.name) & WORLD_WORDS and top and top.is_fixed:
         root = seg.bodies[0]
@@ -164,9 +165,11 @@ def _limb(tree: Tree, seg: Segment, low: float) -> Limb | None:
     grounded = hand is None and z_tip - low < FOOT_CLEARANCE and z_root - z_tip > LEG_DROP
     if legs_named or grounded:
         why = "its links are named as a leg's" if legs_named else "it ends on the ground"
+        tip = chain_end(tree, tip, None)
         return Limb("leg", root, tip, None, joints, seg, f"{len(actuated)} joints; {why}")
     ends = f"a hand at '{hand.name}'" if hand is not None else "the end of the branch"
     why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"
+    tip = chain_end(tree, tip, hand)
     return Limb("arm", root, tip, hand, joints, seg, why)
 
 
@@ -189,10 +192,96 @@ def find_limbs(tree: Tree) -> list[Limb]:
     world = tree.world
     low = tree.lowest_z()
     limbs: list[Limb] = []
+    ending = {s.end.index: s for s in tree.segments}
     for seg in tree.segments:
         if any(world.is_ancestor(lb.tip, seg.start) for lb in limbs):
             continue  # inside a hand (fingers) or hanging below a limb's end
-        limb = _limb(tree, seg, low)
+        above = ending.get(seg.start.index)
+        joined = above is not None and _beside_heads(tree, above, seg)
+        if above is not None and joined:
+            # A shoulder that also turns a camera head (Sawyer's 'head' on 'right_l0'): the
+            # run above the branch is the arm's first joint, not a torso.
+            seg = Segment(above.start, above.bodies + seg.bodies, above.joints + seg.joints)
+        # Joined, it starts at its own base: the link above its first joint, not above mounts.
+        base = world.bodies[seg.joints[0].parent] if joined else None
+        limb = _limb(tree, seg, low, base)
         if limb is not None:
             limbs.append(limb)
     return limbs
+
+
+#: Most joints of a run above a branch that still make an arm's shoulder (a camera head beside).
+MAX_SHOULDER_JOINTS = 2
+
+
+def _beside_heads(tree: Tree, above: Segment, seg: Segment) -> bool:
+    """Whether ``seg`` continues ``above``: every other branch where they meet is a camera head.
+
+    Why: a head mounted on an arm's first link (Sawyer's) splits the arm's run in two; the run
+    above the split (one or two turning joints, no lift: a lift is a torso) is the shoulder.
+    """
+    if not 1 <= len(above.actuated) <= MAX_SHOULDER_JOINTS:
+        return False
+    if any(c.type.value not in ("revolute", "continuous") for c in above.joints):
+        return False
+    others = [s for s in tree.segments if s.start is seg.start and s is not seg]
+    if not others or len(others) + 1 != len(tree.moving_children(seg.start)):
+        return False
+    if _pan_tilt(tree, seg):
+        return False
+    return all(len(s.actuated) <= 3 and _pan_tilt(tree, s) for s in others)
+
+
+#: Words of a link that ends a chain past its last joint (a flange, a tool, a foot).
+END_WORDS = frozenset({"flange", "tool", "tool0", "ee", "eef", "tcp", "foot", "sole", "toe"})
+#: How far off the last joint's axis (m) a fixed child may sit and still be on it.
+ON_AXIS = 1e-3
+
+
+def chain_end(tree: Tree, tip: Body, hand: Body | None) -> Body:
+    """Where a chain ends: the flange, tool or foot link one fixed joint past its last joint.
+
+    Why: a chain ends at the link a tool or the ground is met on (``docs/getting-started.md``:
+    Panda's ``panda_link8``), not one fixed joint short at the last moving link. One step:
+    toward the hand when there is one (never the hand itself), else to the fixed child below
+    which nothing moves (never into a finger); of several, the only one on the last joint's
+    axis, else the only one named as an end. Otherwise the last moving link.
+    """
+    world = tree.world
+    up = world.parent_connection(tip)
+    axis = None if up is None or up.is_fixed else np.asarray(up.axis, dtype=np.float64)
+    kids = [k for k in world.child_bodies(tip) if (c := world.parent_connection(k)) and c.is_fixed]
+    if hand is not None:
+        nxt = next((k for k in kids if world.is_ancestor(k, hand)), None)
+        return tip if nxt is None or nxt is hand else nxt
+    kids = [k for k in kids if not tree.moves_below(k)]
+    return _pick_end(tree, kids, axis) or tip
+
+
+def _pick_end(tree: Tree, kids: list[Body], axis: np.ndarray | None) -> Body | None:
+    """The fixed child a chain ends at: the only one, the one on the axis, or the one named so."""
+    if len(kids) <= 1:
+        return kids[0] if kids else None
+    if axis is not None:
+        on_axis = []
+        for k in kids:
+            c = tree.world.parent_connection(k)
+            assert c is not None
+            at = c.origin[:3, 3]
+            off = at - float(at @ axis) * axis
+            if float(np.linalg.norm(off)) < ON_AXIS and float(np.linalg.norm(at)) > ON_AXIS:
+                on_axis.append(k)
+        if len(on_axis) == 1:
+            return on_axis[0]
+    named = [k for k in kids if words(k.name) & END_WORDS]
+    return named[0] if len(named) == 1 else None
+
+
+def beside_branch(world: World, body: Body, tip: Body | str) -> bool:
+    """Whether a moving branch leaves ``body`` off the path down to ``tip`` (a head beside it)."""
+    for k in world.child_bodies(body):
+        if world.is_ancestor(k, tip):
+            continue
+        if any(not c.is_fixed for b in world.subtree(k) if (c := world.parent_connection(b))):
+            return True
+    return False

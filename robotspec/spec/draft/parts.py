@@ -14,7 +14,7 @@ import numpy as np
 
 from robotspec.model.entities import Body
 from robotspec.model.world import World
-from robotspec.spec.draft.limbs import HEAD_WORDS
+from robotspec.spec.draft.limbs import HEAD_WORDS, beside_branch
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
 from robotspec.spec.draft.naming import unique
 from robotspec.spec.draft.sensors import find_cameras, find_neck
@@ -269,7 +269,11 @@ def add_states(d: Drafter) -> None:
 def _first_moving(world: World, chain: DraftChain) -> Body:
     """The body below a chain's first moving joint (what the chain carries starts there)."""
     conns = world.compute_chain_of_connections(chain.root, chain.tip)
-    first = next((c for c in conns if not c.is_fixed), conns[-1] if conns else None)
+    moving = [c for c in conns if not c.is_fixed]
+    first = moving[0] if moving else (conns[-1] if conns else None)
+    # A head turned beside the chain on its first link (Sawyer's) is not what the chain carries.
+    if len(moving) > 1 and beside_branch(world, world.bodies[moving[0].child], chain.tip):
+        first = moving[1]
     return world.get_body_by_name(chain.tip) if first is None else world.bodies[first.child]
 
 

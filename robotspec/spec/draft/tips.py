@@ -1,0 +1,172 @@
+"""Where a link really ends: the far end of its geometry, for tool frames a draft proposes.
+
+Why: a joint's origin is where a link is hinged, not where it ends. A finger's joint sits at its
+base, several centimetres short of the pad; an arm's last joint sits at the wrist, not at the
+flange a tool is bolted to. A tool frame "between the finger tips" or "on the flange" is only
+where it says when it is put at the far end of the links' collision geometry (their visual
+geometry when they have none), measured along the way the hand reaches.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from robotspec.errors import RobotSpecError
+from robotspec.model.entities import Body
+from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
+from robotspec.spec.draft.tree import Tree
+
+__all__ = ["FLANGE", "MESH_PATH", "between_tips", "far_end", "flange_offset", "shape_points"]
+
+#: The key of ``Tree.memo`` holding how to find a mesh file from its URI (``None``: not found).
+MESH_PATH = "mesh_path"
+
+F64 = npt.NDArray[np.float64]
+
+#: Why a flange frame is where it is (the draft's ``# from`` note).
+FLANGE = "the far end of the last link, on its joint's axis (a flange)"
+#: Points around a cylinder's rim (enough for its far end along any direction, to 2 %).
+RIM = 16
+#: A link whose geometry reaches less than this past its origin (m) has no far end to speak of.
+MIN_REACH = 1e-3
+
+
+def shape_points(shape: Shape, find: Callable[[str], str | None] | None = None) -> F64:
+    """Points bounding one shape, in its body's frame (N x 3); none for an unreadable mesh.
+
+    Why points rather than a box: the far end along a direction is the largest projection of
+    the points, exact for boxes and meshes, close for round shapes. ``find`` locates a mesh
+    the description kept as a URI only (the drafter loads without resolving meshes).
+    """
+    g = shape.geometry
+    local: F64
+    if isinstance(g, Box):
+        half = np.asarray(g.size, dtype=np.float64) / 2
+        signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+        local = signs * half
+    elif isinstance(g, Sphere):
+        local = np.vstack([np.eye(3), -np.eye(3)]) * g.radius
+    elif isinstance(g, Cylinder | Capsule):
+        t = np.linspace(0.0, 2 * np.pi, RIM, endpoint=False)
+        ring = np.stack([np.cos(t), np.sin(t), np.zeros_like(t)], axis=1) * g.radius
+        cap = g.radius if isinstance(g, Capsule) else 0.0
+        ends = [ring + [0.0, 0.0, z] for z in (-g.length / 2, g.length / 2)]
+        tips = np.array([[0.0, 0.0, -g.length / 2 - cap], [0.0, 0.0, g.length / 2 + cap]])
+        local = np.vstack([*ends, tips])
+    elif isinstance(g, Mesh) and (path := g.path or (find(g.uri) if find else None)):
+        from robotspec.files.meshes import read_triangles
+
+        try:
+            vertices, _ = read_triangles(path)
+        except RobotSpecError:
+            return np.zeros((0, 3))
+        local = vertices * np.asarray(g.scale, dtype=np.float64)
+    else:
+        return np.zeros((0, 3))
+    homo = np.hstack([local, np.ones((len(local), 1))])
+    out: F64 = (np.asarray(shape.origin, dtype=np.float64) @ homo.T).T[:, :3]
+    return out
+
+
+def _finder(tree: Tree) -> Callable[[str], str | None]:
+    """How this draft finds a mesh from its URI: the one in ``tree.memo``, else one made here.
+
+    Made once per draft, from the URDF's own place (its folder and the packages around it);
+    a mesh it cannot find, or finds outside the allowed folders, is no geometry (``None``).
+    """
+    find = tree.memo.get(MESH_PATH)
+    if find is None:
+        from robotspec.files.packages import PackageResolver
+
+        source = tree.world.source
+        resolver = PackageResolver.create(source) if source else None
+        here = None if not source else Path(source).parent
+
+        def find(uri: str) -> str | None:
+            if resolver is None:
+                return None
+            try:
+                path = resolver.resolve(uri, relative_to=here)
+            except RobotSpecError:
+                return None
+            return str(path) if path.is_file() else None
+
+        tree.memo[MESH_PATH] = find
+    out: Callable[[str], str | None] = find
+    return out
+
+
+def _body_points(tree: Tree, body: Body) -> F64:
+    shapes = body.collisions or body.visuals
+    parts = [shape_points(s, _finder(tree)) for s in shapes]
+    parts = [p for p in parts if len(p)]
+    return np.vstack(parts) if parts else np.zeros((0, 3))
+
+
+def far_end(tree: Tree, body: Body, direction: F64) -> F64:
+    """Where ``body`` ends along ``direction`` (world frame, default pose): a world point.
+
+    The point is the body's origin moved along ``direction`` to its geometry's farthest extent
+    (never backwards); sideways it stays on the origin, so two fingers' far ends keep the
+    midpoint between them on the hand's axis.
+    """
+    pose = tree.poses[body.index]
+    origin: F64 = np.asarray(pose[:3, 3], dtype=np.float64)
+    n = float(np.linalg.norm(direction))
+    points = _body_points(tree, body)
+    if n < 1e-9 or not len(points):
+        return origin
+    d = direction / n
+    world_pts = (pose[:3, :3] @ points.T).T + origin
+    reach = float(np.max((world_pts - origin) @ d))
+    return origin + max(reach, 0.0) * d
+
+
+def flange_offset(tree: Tree, tip: Body) -> tuple[float, float, float] | None:
+    """Where a bare arm's flange is on its last link: the far end of it along the last axis.
+
+    Why: an arm with nothing mounted and no flange link (a bare KUKA iiwa) still needs a tool
+    frame, and the one a user would bolt a tool to is the end face of the last link, on the
+    axis of the joint that turns it. ``None`` when the link has no geometry reaching out there.
+    """
+    c = tree.world.parent_connection(tip)
+    if c is None or c.is_fixed:
+        return None
+    axis = np.asarray(c.axis, dtype=np.float64)
+    points = _body_points(tree, tip)
+    if not len(points) or float(np.linalg.norm(axis)) < 1e-9:
+        return None
+    axis = axis / np.linalg.norm(axis)
+    along = points @ axis
+    # The end face is on the side away from the joint's parent link (the arm reaches out that
+    # way); where the parent lies beside the axis, on the side the link reaches farther.
+    back = -c.origin[:3, :3].T @ c.origin[:3, 3]  # the parent's origin, in the tip's frame
+    ahead, behind = float(np.max(along)), float(-np.min(along))
+    lean = float(back @ axis)
+    if abs(lean) > MIN_REACH:
+        reach, sign = (ahead, 1.0) if lean < 0 else (behind, -1.0)
+    else:
+        reach, sign = (ahead, 1.0) if ahead >= behind else (behind, -1.0)
+    if reach < MIN_REACH:
+        return None
+    x, y, z = (round(float(v), 4) for v in sign * reach * axis)
+    return (x + 0.0, y + 0.0, z + 0.0)
+
+
+def between_tips(tree: Tree, root: Body, tips: Sequence[Body]) -> tuple[float, float, float]:
+    """Between the far ends of finger tips, in ``root``'s frame (default pose).
+
+    The way the hand reaches is from ``root`` to the tips' origins; each tip is moved out
+    along it to where its geometry ends (the pads, not the finger joints).
+    """
+    at = [np.asarray(tree.poses[t.index][:3, 3], dtype=np.float64) for t in tips]
+    mid = np.mean(at, axis=0)
+    reach = mid - tree.poses[root.index][:3, 3]
+    ends = np.mean([far_end(tree, t, reach) for t in tips], axis=0)
+    local = np.linalg.inv(tree.poses[root.index]) @ np.append(ends, 1.0)
+    x, y, z = (round(float(v), 4) for v in local[:3])
+    return (x + 0.0, y + 0.0, z + 0.0)

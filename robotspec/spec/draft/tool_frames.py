@@ -1,0 +1,187 @@
+"""Which frame is a manipulator's tool frame: the one the URDF names, or one it implies.
+
+Why its own module: a tool frame is read from the files before anything is guessed. A bare
+frame named as a TCP (``tool0``, ``*_tcp``, ``grasp_frame``...) is the files' answer; a bare
+frame on the joint a hand's fingers mimic is the hand's TCP (NAO's ``l_gripper``); names
+weaker than these are questions; a hand with none gets a frame proposed between its tips,
+at the far ends of their geometry (``tips.between_tips``).
+"""
+
+from __future__ import annotations
+
+from robotspec.model.entities import Body, Connection
+from robotspec.model.world import World
+from robotspec.spec.draft.tips import between_tips
+from robotspec.spec.draft.tree import Tree, words
+
+__all__ = [
+    "TCP_NAMES",
+    "TOOL_HINTS",
+    "bare_fixed_leaf",
+    "find_tool_frame",
+    "hand_center",
+    "is_named_tcp",
+    "own_geometry",
+]
+
+#: How tool frames are usually named, best first: (substring of the name, or a whole word).
+TOOL_HINTS: tuple[str, ...] = (
+    "tool_frame",
+    "tcp",
+    "grasping_frame",
+    "grasp_frame",
+    "gripper_frame",
+    "grasp",
+    "tool0",
+    "end_effector",
+    "endeffector",
+    "ee_link",
+    "eef",
+    "ee",
+    "endpoint",
+    "tool_link",
+    "tool",
+    "flange",
+)
+
+
+def bare_fixed_leaf(world: World, body: Body) -> bool:
+    """Whether ``body`` is a frame: a leaf on a fixed joint, without geometry."""
+    c = world.parent_connection(body)
+    return (
+        c is not None
+        and c.is_fixed
+        and not world.child_bodies(body)
+        and not (body.collisions or body.visuals)
+    )
+
+
+def own_geometry(body: Body) -> bool:
+    """Whether ``body`` itself has a shape (visual or collision)."""
+    return bool(body.collisions or body.visuals)
+
+
+def _matches(hint: str, name: tuple[str, set[str]]) -> bool:
+    """Whether a name (lower-cased, and its words) holds a hint: inside it, or as a word."""
+    if "_" in hint or len(hint) > 4:
+        return hint in name[0]
+    return hint in name[1]
+
+
+def _named_as(name: str) -> tuple[str, set[str]]:
+    return name.lower(), words(name)
+
+
+#: Names a URDF gives its TCP: a bare frame so named is a tool frame the files decide.
+TCP_NAMES: tuple[str, ...] = (
+    "tool_frame",
+    "tcp",
+    "grasping_frame",
+    "grasp_frame",
+    "tool0",
+    "end_effector_link",
+    "ee_link",
+)
+
+
+def is_named_tcp(world: World, body: Body) -> bool:
+    """Whether ``body`` is a bare frame (a leaf without geometry, on a fixed joint) named a TCP."""
+    c = world.parent_connection(body)
+    if c is None or not c.is_fixed or world.child_bodies(body) or own_geometry(body):
+        return False
+    name = _named_as(body.name)
+    return any(_matches(hint, name) for hint in TCP_NAMES)
+
+
+def find_tool_frame(
+    tree: Tree,
+    top: Body,
+    exclude: frozenset[int] = frozenset(),
+    prefer: Body | None = None,
+    leaf: bool = False,
+) -> Body | None:
+    """The best-named tool frame in ``top``'s subtree (``exclude``: bodies of other parts).
+
+    Of equally named frames, one hanging from ``prefer`` (where the fingers split) wins: the
+    TCP sits between the fingers, the flange above them (Interbotix's 'ee_gripper_link' beside
+    'ee_arm_link'). ``leaf``: only frames without children count.
+    """
+    world = tree.world
+    candidates = [b for b in world.subtree(top) if b.index not in exclude]
+    if leaf:  # frames only (a TCP), never a link carrying fingers
+        candidates = [b for b in candidates if not world.child_bodies(b)]
+    near = set() if prefer is None else {b.index for b in world.subtree(prefer)}
+    # The link's name, or its fixed joint's (Baxter's 'right_gripper' hangs on 'right_endpoint').
+    names: dict[int, list[tuple[str, set[str]]]] = {}
+    for b in candidates:
+        c = world.parent_connection(b)
+        names[b.index] = [_named_as(b.name)]
+        if c is not None and c.is_fixed:
+            names[b.index].append(_named_as(c.name))
+    for hint in TOOL_HINTS:
+        hits = [b for b in candidates if any(_matches(hint, n) for n in names[b.index])]
+        if hits:
+            # A TCP is a frame (a leaf), not a link carrying fingers ('fingers_link' on 'ee_bar').
+            return min(
+                hits,
+                key=lambda b: (
+                    b.index not in near,
+                    bool(world.child_bodies(b)),
+                    world.depth(b),
+                    b.index,
+                ),
+            )
+    # Last: a bare frame named as the gripper (iCub's 'l_gripper' below 'l_hand'), fixed or
+    # turned by the joint the fingers mimic (NAO's 'l_gripper' on 'LHand': the hand's TCP).
+    bare = [
+        b
+        for b in candidates
+        if "gripper" in names[b.index][0][1]
+        and not world.child_bodies(b)
+        and not own_geometry(b)
+        and (c := world.parent_connection(b)) is not None
+        and (c.is_fixed or _leads_fingers(world, c, top))
+    ]
+    return min(bare, key=lambda b: (world.depth(b), b.index)) if bare else None
+
+
+def _leads_fingers(world: World, c: Connection, top: Body) -> bool:
+    """Whether ``c`` is an active joint that joints of other branches below ``top`` mimic.
+
+    Why: a hand driven by one motor is often modelled as a bare link on the motor's joint, the
+    fingers mimicking it; that link is a frame (no geometry, nothing below), not a finger.
+    """
+    if not c.is_active:
+        return False
+    return any(
+        o.is_mimic and set(o.dofs) & set(c.dofs)
+        for b in world.subtree(top)
+        if (o := world.parent_connection(b)) is not None and o is not c
+    )
+
+
+def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:
+    """Between a hand's finger tips in the default pose, in ``top``'s frame (``None``: no tips).
+
+    The tips are the leaves with geometry below ``top``; a tool frame proposed there is a guess.
+    """
+    world = tree.world
+    tips = [
+        b
+        for b in world.subtree(top)
+        if b is not top and not world.child_bodies(b) and own_geometry(b)
+    ]
+    if not tips:  # tips the URDF names as bare frames at the fingers' ends (Ability's '*_tip')
+        tips = [
+            b
+            for b in world.subtree(top)
+            if b is not top
+            and bare_fixed_leaf(world, b)
+            and (up := world.parent_connection(b)) is not None
+            and up.parent != top.index  # on a finger, not on the hand itself
+            and (c := world.parent_connection(world.bodies[up.parent])) is not None
+            and not c.is_fixed
+        ]
+    if not tips:
+        return None
+    return between_tips(tree, top, tips)  # at the far ends of the tips' geometry

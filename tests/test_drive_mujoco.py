@@ -1,0 +1,215 @@
+"""The driver on MuJoCo physics: MuJoCo is the oracle of what the arm did.
+
+On simulated time (every run the same numbers, whatever the machine's load): a jog arrives within
+the driver's own 1e-4 rad with the arm under gravity; the joint torques are the servos' forces,
+non-zero under gravity and near zero with it compensated; an e-stop holds the arm where it was
+against gravity and motion resumes after a reset; a trajectory ends on its last waypoint; joints
+outside the chain stay at the default configuration (a mobile base welded); the demo's scenario
+passes under ``--physics mujoco`` on the PR2 (gravity compensated, as the demo decides) and the
+Panda. Robots: the shipped Panda and PR2 with example-robot-data's files. Skipped without
+MuJoCo (the ``mujoco`` extra).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from robotspec.driver.clock import SimClock
+from tests.conftest import erd_robots
+from tests.test_cli import run
+
+mujoco = pytest.importorskip("mujoco", reason="the plant is MuJoCo (pip install '.[mujoco]')")
+
+from robotspec.cli.physics import PhysicsTarget, physics_target, replant  # noqa: E402
+from robotspec.driver.mujoco_plant import MujocoSimRobot  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def panda() -> PhysicsTarget:
+    erd_robots()
+    return physics_target("panda", "arm")
+
+
+@pytest.fixture(scope="module")
+def pr2() -> PhysicsTarget:
+    erd_robots()
+    return physics_target("pr2", "right_arm", gravity_compensation=True)
+
+
+def _driver(target: PhysicsTarget) -> MujocoSimRobot:
+    robot = MujocoSimRobot(target.exported.info, target.plant, clock=SimClock())
+    robot.step()
+    robot.step()
+    return robot
+
+
+def _jog_target(robot: MujocoSimRobot, reach: float = 0.3) -> np.ndarray:
+    lim = robot.limits
+    q0 = robot.sim_position
+    return q0 + reach * (0.5 * (lim.lower + lim.upper) - q0)
+
+
+def test_a_jog_arrives_under_gravity_with_real_torques(panda: PhysicsTarget) -> None:
+    robot = _driver(panda)
+    target = _jog_target(robot)
+    robot.command_mode = "jog"
+    robot.jog_freespace(target, 0.5 * robot.limits.velocity, wait=True)
+    st = robot.robot_state
+    # the driver's arrival rule held on MuJoCo's measured state: within 1e-4 rad and at rest
+    assert np.max(np.abs(st.joint_position - target)) <= 1e-4
+    assert np.max(np.abs(st.joint_velocity)) <= 1e-3
+    assert np.array_equal(st.joint_position, robot.measured_position)
+    # the reported torques are the servos' forces, holding the arm against gravity
+    assert np.array_equal(st.joint_effort, robot.measured_effort)
+    shoulder = robot.joint_names.index("panda_joint2")
+    assert abs(st.joint_effort[shoulder]) > 5.0, st.joint_effort
+    data = robot.plant_data
+    dof = panda.plant.joint_dof[shoulder]
+    assert st.joint_effort[shoulder] == pytest.approx(data.qfrc_bias[dof], rel=1e-3, abs=1e-3)
+
+
+def test_physics_on_simulated_time_gives_the_same_numbers(panda: PhysicsTarget) -> None:
+    runs = []
+    for _ in range(2):
+        robot = _driver(panda)
+        robot.command_mode = "jog"
+        robot.jog_freespace(_jog_target(robot), 0.5 * robot.limits.velocity, wait=True)
+        st = robot.robot_state
+        runs.append((st.seqno, st.joint_position.tobytes(), st.joint_effort.tobytes()))
+    assert runs[0] == runs[1]
+
+
+def test_gravity_compensated_arm_needs_almost_no_torque(pr2: PhysicsTarget) -> None:
+    robot = _driver(pr2)
+    target = _jog_target(robot)
+    robot.command_mode = "jog"
+    robot.jog_freespace(target, 0.5 * robot.limits.velocity, wait=True)
+    robot.run_for(0.5)
+    st = robot.robot_state
+    assert np.max(np.abs(st.joint_position - target)) <= 1e-4
+    assert np.max(np.abs(st.joint_effort)) < 1e-3, st.joint_effort
+    # the same arm under gravity: the shoulder needs more than its 30 N m and saturates
+    heavy = _driver(replant(pr2, gravity_compensation=False))
+    heavy.run_for(1.0)
+    shoulder = heavy.joint_names.index("r_shoulder_lift_joint")
+    assert heavy.robot_state.joint_effort[shoulder] == pytest.approx(-30.0)
+    assert heavy.robot_state.joint_position[shoulder] > 0.3  # sagged from 0
+
+
+def test_joints_outside_the_chain_hold_their_default(pr2: PhysicsTarget) -> None:
+    assert pr2.plant.welded == ("world_joint/x", "world_joint/y", "world_joint/theta")
+    robot = _driver(pr2)
+    model, data = pr2.plant.model, robot.plant_data
+    before = data.qpos.copy()
+    robot.command_mode = "jog"
+    robot.jog_freespace(_jog_target(robot), robot.limits.velocity, wait=True)
+    chain = set(pr2.plant.joint_qpos)
+    others = [i for i in range(model.nq) if i not in chain]
+    assert np.max(np.abs(data.qpos[others] - before[others])) < 1e-3
+    torso = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "torso_lift_joint")
+    assert data.qpos[model.jnt_qposadr[torso]] == pytest.approx(
+        pr2.plant.qpos0[model.jnt_qposadr[torso]], abs=1e-4
+    )
+
+
+def test_an_estop_holds_the_arm_against_gravity(panda: PhysicsTarget) -> None:
+    robot = _driver(panda)
+    target = _jog_target(robot, reach=0.6)
+    robot.command_mode = "jog"
+    robot.jog_freespace(target, 0.5 * robot.limits.velocity, wait=False)
+    robot.run_for(0.4)
+    moving = np.max(np.abs(robot.robot_state.joint_velocity))
+    assert moving > 0.05
+    robot.inject_fault("estop")
+    robot.run_for(0.3)  # the servos stop the arm where the e-stop found it
+    held = robot.robot_state.joint_position.copy()
+    robot.run_for(2.0)
+    st = robot.robot_state
+    assert np.max(np.abs(st.joint_position - held)) < 1e-4
+    assert np.max(np.abs(st.joint_velocity)) < 1e-3
+    assert abs(st.joint_effort[robot.joint_names.index("panda_joint2")]) > 5.0  # holding
+    assert np.max(np.abs(robot.sim_position - held)) < 1e-3  # the reference waits there
+    # once the operator releases the e-stop the arm moves again, from where it stopped
+    robot.clear_fault("estop")
+    robot.run_for(0.1)
+    robot.command_mode = "halt"
+    robot.command_mode = "jog"
+    robot.jog_freespace(target, 0.5 * robot.limits.velocity, wait=True)
+    assert np.max(np.abs(robot.robot_state.joint_position - target)) <= 1e-4
+
+
+def test_a_trajectory_ends_on_its_last_waypoint(panda: PhysicsTarget) -> None:
+    from robotspec.driver.trajectory import JointTrajectory
+
+    robot = _driver(panda)
+    # from the reference: the Panda's home sits on joint 4's limit, and the measured arm a few
+    # micro-radians beyond it (MuJoCo's limits are soft), which a waypoint may not be
+    q0 = robot.sim_position
+    q1 = _jog_target(robot, reach=0.4)
+    robot.command_mode = "trajectory"
+    times = np.linspace(0.0, 4.0, 41)
+    out_and_back = np.sin(np.pi * times / 4.0) ** 2  # there at 2 s, back at 4 s, smoothly
+    traj = JointTrajectory.from_arrays(times, q0 + np.outer(out_and_back, q1 - q0))
+    statuses = list(robot.execute_trajectory(traj))
+    assert statuses[-1].action_status.name == "complete"
+    robot.run_for(0.2)
+    assert np.max(np.abs(robot.robot_state.joint_position - q0)) < 1e-4
+
+
+@pytest.mark.parametrize(
+    ("robot", "chain", "extra"),
+    [("pr2", "right_arm", ["--gravity-compensation"]), ("panda", "arm", [])],
+)
+def test_the_demo_scenario_passes_under_physics(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, robot: str, chain: str, extra: list[str]
+) -> None:
+    erd_robots()
+    from robotspec.cli.demo_cmd import demo_scenario
+    from robotspec.export.robotinfo import export_spec_chain
+
+    script = tmp_path / "demo.yaml"
+    script.write_text(demo_scenario(export_spec_chain(robot, chain).info))
+    code, out, err = run(
+        capsys,
+        "drive",
+        "--spec",
+        robot,
+        "--chain",
+        chain,
+        "--physics",
+        "mujoco",
+        *extra,
+        "--script",
+        str(script),
+        "--virtual-time",
+    )
+    assert code == 0, out + err
+    assert out.splitlines()[-1] == "scenario: 8 of 8 steps as expected"
+    gravity = "gravity compensated" if extra else "gravity on"
+    assert f"on MuJoCo physics ({gravity}) at 100 Hz (virtual time)" in err
+
+
+def test_the_demo_compensates_gravity_only_where_an_effort_cannot_hold_the_arm(
+    capsys: pytest.CaptureFixture[str], pr2: PhysicsTarget
+) -> None:
+    from robotspec.cli.demo_physics import demo_plant
+
+    info = pr2.exported.info
+    plant, compensated = demo_plant(pr2.robot, "pr2", "right_arm", (), info, None)
+    assert compensated and plant.gravity_compensation
+    err = capsys.readouterr().err
+    assert "note: r_shoulder_lift_joint needs 52.1 N m to hold the arm against gravity, its " in err
+    assert "its effort is 30 N m" in err
+    plant, compensated = demo_plant(pr2.robot, "pr2", "right_arm", (), info, False)
+    assert not compensated and not plant.gravity_compensation
+
+
+def test_the_demo_leaves_gravity_on_for_an_arm_that_holds_itself(panda: PhysicsTarget) -> None:
+    from robotspec.cli.demo_cmd import demo_positions
+    from robotspec.driver.mujoco_model import holding_shortfalls
+
+    positions = demo_positions(panda.exported.info)
+    assert holding_shortfalls(panda.plant, panda.joint_names, positions) == []

@@ -1,8 +1,9 @@
-"""The spec as the assistant writes it: the draft's own writer, then what was kept as read.
+"""A URDF's draft as the assistant writes it (the draft's own writer), and the atomic write.
 
 Why the draft's writer: it is what ``robotspec init`` writes, so a saved spec reads like a
 draft (its header, its ``# from`` notes, the DECIDE marks still open) and answered marks are
-simply gone. Keys the assistant does not edit follow, as read from the input spec.
+simply gone. A spec the assistant opened is not written here but edited in its own text
+(:mod:`robotspec.setup.round_trip`).
 """
 
 from __future__ import annotations

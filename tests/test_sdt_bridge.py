@@ -169,12 +169,16 @@ def test_the_world_copy_keeps_the_classes() -> None:
 
 
 def test_the_robot_is_named_by_its_spec_not_its_class() -> None:
+    from semantic_digital_twin.robots.pr2 import PR2
+
     robot, sdt_robot = _robot("pr2")
-    assert type(sdt_robot).__name__.startswith("PR2_")  # the class: name and digest
+    assert type(sdt_robot) is PR2  # the spec names SDT's own class (sdt: {class: PR2})
+    part = type(sdt_robot.mobile_base).__name__
+    assert part.startswith("PR2_MobileBase_")  # the parts' classes: name and digest
     assert sdt_robot.name.name == robot.name == "PR2"  # SDT's own PR2 is "PR2"
     states = {str(s.name) for p in sdt_robot._robot_parts for s in p.joint_states}
     assert "left_arm_park" in {s.name.name for p in sdt_robot._robot_parts for s in p.joint_states}
-    assert not any(type(sdt_robot).__name__[-10:] in s for s in states)  # no digest in them
+    assert not any(part[-10:] in s for s in states)  # no digest in them
     arm = sdt_robot.get_left_arm_if_specified()
     assert arm.name.name == robot.left_arm.name
 
@@ -190,7 +194,7 @@ def test_another_install_with_an_empty_cache_reads_the_pickle_and_history(
     from tests.test_sdt_recipe import pr2_elsewhere
 
     _, sdt_robot = _robot("pr2")
-    cls = type(sdt_robot)
+    cls = type(sdt_robot.mobile_base)  # a generated class (the robot's is SDT's own PR2)
     assert pickle.loads(pickle.dumps(cls)) is cls
     blocks = sdt_robot._world._model_manager.model_modification_blocks
     history = tmp_path / "history.json"
@@ -221,7 +225,8 @@ warnings.simplefilter("ignore")
 here = load("pr2", package_paths=[{str(elsewhere)!r}])
 assert here.world.source.startswith({str(elsewhere)!r}), here.world.source
 built = to_sdt(here)
-print(type(robot) is cls, type(built) is cls, robot.name.name, len(robot._robot_parts))
+print(type(robot.mobile_base) is cls, type(built.mobile_base) is cls, robot.name.name,
+      len(robot._robot_parts))
 """
     env = {**os.environ, "ROBOTSPEC_SDT_CLASSES": str(empty)}
     out = subprocess.run(
@@ -326,7 +331,8 @@ def test_class_store_keeps_the_recipe_where_asked(tmp_path: Path) -> None:
     robot, built = _robot("pr2")
     again = to_sdt(robot, class_store=tmp_path)
     assert type(again) is type(built)
-    assert [p.name for p in tmp_path.iterdir()] == [f"{type(built).__name__[-10:]}.json"]
+    digest = type(built.mobile_base).__name__[-10:]
+    assert [p.name for p in tmp_path.iterdir()] == [f"{digest}.json"]
 
 
 def test_a_hand_has_sdts_fingers_with_its_thumb() -> None:

@@ -41,8 +41,17 @@ def sdt_api() -> ModuleType:
     return _api
 
 
-def to_sdt(robot: AbstractRobot, *, class_store: str | os.PathLike[str] | None = None) -> Any:
-    """``robot`` as SDT's ``AbstractRobot`` (built by SDT's own ``from_world``) in a new World.
+def to_sdt(
+    robot: AbstractRobot,
+    *,
+    class_store: str | os.PathLike[str] | None = None,
+    sdt_class: type | None = None,
+) -> Any:
+    """``robot`` as SDT's ``AbstractRobot`` in a new World.
+
+    Its class is the one ``sdt_class`` or the spec's ``sdt: {class: ...}`` names (``PR2``,
+    ``Stretch``: coraplex's robot-specific motions then apply), else one generated for it,
+    built by SDT's own ``from_world``.
 
     The world holds robotspec's bodies, joints, limits (velocity limits as tightened by the
     spec) and the base drive; the robot's parts are SDT's kinds, with robotspec's sides,
@@ -54,15 +63,27 @@ def to_sdt(robot: AbstractRobot, *, class_store: str | os.PathLike[str] | None =
     that meets the classes by their path alone (a world history replayed, SDT's ORM);
     default ``$ROBOTSPEC_SDT_CLASSES``, and without it nothing is written: the classes live
     in memory and pickle with their recipe (docs/sdt.md, "Where class recipes are kept").
+
+    ``sdt_class``: the SDT robot class the robot is an instance of (a concrete dataclass
+    subclass of SDT's ``AbstractRobot``, your own or SDT's); default the spec's ``sdt:
+    {class: ...}``, and without either a class generated for the robot. With a class, PyCRAM
+    and coraplex treat the robot as that robot (its alternative motions apply); its parts are
+    still robotspec's (docs/sdt.md, "Which SDT robot it is").
     """
     from robotspec.interop.sdt.classes import remember, robot_class
+    from robotspec.interop.sdt.identity import build, checked_class, fit, named_class
     from robotspec.interop.sdt.recipe import robot_recipe
     from robotspec.interop.sdt.world import sdt_world
 
     recipe = robot_recipe(robot)
+    own: type | None = None
+    if sdt_class is not None or robot.sdt_class is not None:
+        api = sdt_api()
+        own = checked_class(api, sdt_class or named_class(robot.sdt_class or ""))
+        recipe = fit(recipe, own)
     for note in recipe.left_out:
         warnings.warn(f"{robot.name}: {note}", SdtBridgeWarning, stacklevel=2)
-    cls = robot_class(recipe)
+    cls = robot_class(recipe) if own is None else None
     try:
         remember(recipe, class_store)
     except OSError as exc:  # this process works without it; a fresh one cannot rebuild
@@ -74,7 +95,10 @@ def to_sdt(robot: AbstractRobot, *, class_store: str | os.PathLike[str] | None =
             stacklevel=2,
         )
     world = sdt_world(robot.world, drive=robot.drive_type)
-    sdt_robot = cls.from_world(world)  # type: ignore[attr-defined]
+    if own is not None:
+        sdt_robot = build(sdt_api(), own, recipe, world)
+    else:
+        sdt_robot = cls.from_world(world)  # type: ignore[union-attr]
     if recipe.extra_hardware_joints:
         with world.modify_world():
             for name in recipe.extra_hardware_joints:

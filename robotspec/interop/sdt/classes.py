@@ -33,8 +33,9 @@ from typing import Any
 
 from robotspec.errors import RobotSpecError
 from robotspec.interop.sdt.recipe import PartRecipe, RobotRecipe
+from robotspec.interop.sdt.rules import setup_collision_rules
 
-__all__ = ["class_store", "remember", "robot_class"]
+__all__ = ["class_store", "part_classes", "remember", "robot_class"]
 
 _MODULE = sys.modules[__name__]
 _BUILT: dict[str, type] = {}
@@ -285,10 +286,20 @@ def robot_class(recipe: RobotRecipe) -> type:
         return _robot_class(sdt_api(), recipe, name, digest)
 
 
+def part_classes(recipe: RobotRecipe) -> dict[str, list[type]]:
+    """The classes of the robot's own slots (``mobile_base``, ``arms``, ...): built once."""
+    from robotspec.interop.sdt import sdt_api
+
+    with _LOCK:
+        return _part_classes(sdt_api(), recipe, recipe.digest())
+
+
+def _part_classes(sdt: Any, recipe: RobotRecipe, digest: str) -> dict[str, list[type]]:
+    return {slot: [_part_class(sdt, p, recipe, digest) for p in ps] for slot, ps in recipe.children}
+
+
 def _robot_class(sdt: Any, recipe: RobotRecipe, name: str, digest: str) -> type:
-    built = {
-        slot: [_part_class(sdt, p, recipe, digest) for p in ps] for slot, ps in recipe.children
-    }
+    built = _part_classes(sdt, recipe, digest)
     upper, sides = _upper_mixins(sdt, built)
 
     def get_ros_file_path(cls: Any) -> str:
@@ -301,35 +312,7 @@ def _robot_class(sdt: Any, recipe: RobotRecipe, name: str, digest: str) -> type:
         """Nothing to do: the world already holds robotspec's (tightened) velocity limits."""
 
     def _setup_collision_rules(self: Any) -> None:
-        world = self._world
-
-        def body(n: str) -> Any:
-            return world.get_body_in_branch_by_name(self.root, n)
-
-        # SDT counts a body as colliding only above its size thresholds (a 1 mm box is not);
-        # like SDT's own SRDF reader, pairs with a body it does not count are left out.
-        pairs = [(body(a), body(b)) for a, b in recipe.disabled_pairs]
-        rule = sdt.SelfCollisionMatrixRule(
-            allowed_collision_pairs={
-                sdt.CollisionCheck.create_and_validate(a, b)
-                for a, b in pairs
-                if a.has_collision() and b.has_collision()
-            },
-            allowed_collision_bodies={body(n) for n in recipe.disabled_bodies},
-        )
-        world.collision_manager.add_ignore_collision_rule(rule)
-        if recipe.collisions_disabled:
-            return
-        distances = {
-            "buffer_zone_distance": recipe.buffer_zone_distance,
-            "violated_distance": recipe.violated_distance,
-        }
-        world.collision_manager.extend_default_rules(
-            [
-                sdt.AvoidExternalCollisions(robot=self, **distances),
-                sdt.AvoidSelfCollisions(robot=self, **distances),
-            ]
-        )
+        setup_collision_rules(sdt, recipe, self)
 
     namespace: dict[str, Any] = {
         "get_ros_file_path": classmethod(get_ros_file_path),

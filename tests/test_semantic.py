@@ -161,6 +161,11 @@ def test_tighten_velocity_limits_refuses_bad_input(fresh_pr2: PR2) -> None:
         robot.tighten_dof_velocity_limits_of_1dof_connections({"l_gripper_tool_joint": 0.1})
     with pytest.raises(NotFoundError):  # the drive is not one of the robot's 1-DOF joints
         robot.tighten_dof_velocity_limits_of_1dof_connections({drive: 0.1})
+    with pytest.raises(
+        KinematicsError,
+        match="'l_gripper_r_finger_joint' is a mimic joint of 'l_gripper_l_finger_joint'",
+    ):
+        robot.tighten_dof_velocity_limits_of_1dof_connections({"l_gripper_r_finger_joint": 0.1})
     for bad in (0.0, -1.0, math.nan, math.inf):
         with pytest.raises(KinematicsError):
             robot.tighten_dof_velocity_limits_of_1dof_connections({"head_pan_joint": bad})

@@ -265,6 +265,13 @@ class AbstractRobot:
         self._register(chain)
 
     # --------------------------------------------------------------------- limits, SRDF
+    def _mimic_of(self, name: str) -> str | None:
+        """The leader of the robot's joint ``name`` if it is a mimic joint, else None."""
+        for c in self.connections:
+            if c.name == name and c.mimic is not None:
+                return c.mimic.leader
+        return None
+
     def tighten_dof_velocity_limits_of_1dof_connections(
         self, new_limits: Mapping[Connection | str, float]
     ) -> None:
@@ -274,6 +281,13 @@ class AbstractRobot:
         for key, value in new_limits.items():
             name = key if isinstance(key, str) else key.name
             if name not in own:
+                mimic = self._mimic_of(name)
+                if mimic is not None:  # the name is right; the joint has no motion of its own
+                    raise KinematicsError(
+                        f"'{name}' is a mimic joint of '{mimic}'; limit '{mimic}' instead",
+                        name=name,
+                        suggestions=(mimic,),
+                    )
                 raise NotFoundError("actuated 1-DOF joint", name, own, where=f"robot '{self.name}'")
             if not (value > 0 and math.isfinite(value)):
                 raise KinematicsError(

@@ -99,20 +99,19 @@ def test_gravity_compensated_arm_needs_almost_no_torque(pr2: PhysicsTarget) -> N
     assert heavy.robot_state.joint_position[shoulder] > 0.3  # sagged from 0
 
 
-def test_joints_outside_the_chain_hold_their_default(pr2: PhysicsTarget) -> None:
-    assert pr2.plant.welded == ("world_joint/x", "world_joint/y", "world_joint/theta")
+def test_joints_outside_the_chain_are_welded_at_their_default(pr2: PhysicsTarget) -> None:
+    # every PR2 joint outside the right arm is at zero by default: all removed, the base too
+    model = pr2.plant.model
+    assert model.nq == model.nv == 7 and model.nu == 7
+    assert {"world_joint/x", "torso_lift_joint", "l_shoulder_pan_joint"} <= set(pr2.plant.welded)
     robot = _driver(pr2)
-    model, data = pr2.plant.model, robot.plant_data
-    before = data.qpos.copy()
     robot.command_mode = "jog"
     robot.jog_freespace(_jog_target(robot), robot.limits.velocity, wait=True)
-    chain = set(pr2.plant.joint_qpos)
-    others = [i for i in range(model.nq) if i not in chain]
-    assert np.max(np.abs(data.qpos[others] - before[others])) < 1e-3
-    torso = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "torso_lift_joint")
-    assert data.qpos[model.jnt_qposadr[torso]] == pytest.approx(
-        pr2.plant.qpos0[model.jnt_qposadr[torso]], abs=1e-4
-    )
+    data = robot.plant_data
+    torso = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "torso_lift_link")
+    poses = pr2.robot.kinematics.forward(pr2.robot.world.default_configuration())
+    index = pr2.robot.world.get_body_by_name("torso_lift_link").index
+    assert np.allclose(data.xpos[torso], poses[index][:3, 3], atol=1e-12)
 
 
 def test_an_estop_holds_the_arm_against_gravity(panda: PhysicsTarget) -> None:
@@ -213,3 +212,21 @@ def test_the_demo_leaves_gravity_on_for_an_arm_that_holds_itself(panda: PhysicsT
 
     positions = demo_positions(panda.exported.info)
     assert holding_shortfalls(panda.plant, panda.joint_names, positions) == []
+
+
+def test_a_servo_outside_the_chain_holds_its_default_under_gravity() -> None:
+    # the dual Panda's right joint 4 defaults to -1.5708: not weldable in place, so its servo
+    # holds it while the left arm moves (every other right-arm joint is at zero: welded)
+    erd_robots()
+    target = physics_target("dual_panda", "left_arm")
+    model = target.plant.model
+    assert "right_panda_joint1" in target.plant.welded
+    assert "right_panda_joint4" not in target.plant.welded
+    robot = _driver(target)
+    robot.command_mode = "jog"
+    robot.jog_freespace(_jog_target(robot), 0.5 * robot.limits.velocity, wait=True)
+    robot.run_for(0.5)
+    j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "right_panda_joint4")
+    assert robot.plant_data.qpos[model.jnt_qposadr[j]] == pytest.approx(-1.5708, abs=1e-4)
+    a = next(a for a in range(model.nu) if model.actuator_trnid[a, 0] == j)
+    assert abs(robot.plant_data.actuator_force[a]) > 1.0  # holding the forearm up

@@ -1,14 +1,16 @@
 """The MuJoCo model a physics-backed driver steps: the robot's MJCF export, one chain free.
 
 Why a model of its own and not the exported file as it is: the driver commands one chain, and
-everything else must stay where the robot's default configuration puts it. Joints of other
-chains that have a position servo hold their default keyframe through it (``ctrl``); joints
-without one (a mobile base's planar or floating drive, passive joints) would drift under the
-arm's reaction forces or fall under gravity, so they are welded: removed when their default
-value is zero (the body then sits where the MJCF places it, exactly), held by a joint equality
-at their default value otherwise. A free joint is always removed (the export places its body at
-the default pose). The keyframes go (their ``qpos`` no longer fits the welded model); the plant
-sets the default configuration by joint name.
+everything else must stay where the robot's default configuration puts it. Joints outside the
+chain (and outside its mimic followers) are welded where they can be exactly: a joint whose
+default value is zero is removed (its body then sits where the MJCF places it), as is a free
+joint (the export places its body at the default pose). One with another default value keeps
+its position servo, which holds its default keyframe target (``ctrl``); without a servo (a
+passive joint) a joint equality holds it there. Why weld rather than leave it all to the
+servos: a mobile base's planar or floating drive has no servo and would drift under the arm's
+reaction forces or fall under gravity, and every welded degree of freedom is one MuJoCo no
+longer integrates (the PR2's right arm: 7 instead of 30). The keyframes go (their ``qpos`` no
+longer fits the welded model); the plant sets the default configuration by joint name.
 
 Everything happens in memory: the XML is edited with lxml and the meshes are handed to
 MuJoCo as bytes (``MjModel.from_xml_string(xml, assets)``); nothing is written to disk.
@@ -87,9 +89,17 @@ class PlantModel:
 
 
 def _weld_joints(
-    root: etree._Element, keep: set[str], values: dict[str, float], free: set[str]
+    root: etree._Element,
+    keep: set[str],
+    servoed: set[str],
+    values: dict[str, float],
+    free: set[str],
 ) -> list[str]:
-    """Weld every joint of ``root`` not in ``keep`` (see the module docstring); their names."""
+    """Weld the joints of ``root`` not in ``keep`` (see the module docstring); their names.
+
+    A joint at zero (and a free joint) is removed; a servoed one elsewhere is left to its servo;
+    any other is held by a joint equality at its default value.
+    """
     welded: list[str] = []
     held: list[tuple[str, float]] = []
     for joint in list(root.iter("joint", "freejoint")):
@@ -97,11 +107,13 @@ def _weld_joints(
         name = joint.get("name", "")
         if parent is None or parent.tag != "body" or name in keep:
             continue
-        welded.append(name)
         if name in free or values.get(name, 0.0) == 0.0:
             parent.remove(joint)
+        elif name in servoed:
+            continue
         else:
             held.append((name, values[name]))
+        welded.append(name)
     removed = {n for n in welded if n not in dict(held)}
     equality = root.find("equality")
     if equality is not None:
@@ -179,14 +191,21 @@ def plant_model(
     keyframe = root.find("keyframe")
     if keyframe is not None:
         root.remove(keyframe)
-    # Kept: the chain, every servoed joint (it holds its target) and mimic followers of a kept
-    # leader (their equality moves them).
-    keep = set(chain_joints) | servoed
-    for eq in root.iter("joint"):
-        if eq.getparent() is not None and eq.getparent().tag == "equality":  # type: ignore[union-attr]
-            if eq.get("joint2") in keep:
-                keep.add(eq.get("joint1", ""))
-    welded = _weld_joints(root, keep, values, free)
+    # Kept: the chain and the mimic followers of a kept leader (their equality moves them).
+    keep = set(chain_joints)
+    couplings = [
+        (eq.get("joint1", ""), eq.get("joint2"))
+        for eq in root.iterfind("equality/joint")
+        if eq.get("joint2") is not None
+    ]
+    grown = True
+    while grown:
+        grown = False
+        for follower, leader in couplings:
+            if leader in keep and follower not in keep:
+                keep.add(follower)
+                grown = True
+    welded = _weld_joints(root, keep, servoed, values, free)
     if gravity_compensation:
         for body in root.iter("body"):
             body.set("gravcomp", "1")

@@ -17,7 +17,8 @@ Panda's shoulder: 8 mrad) and lags ``2 v / omega`` behind a moving one, and no w
 ever arrive within the driver's 1e-4 rad. Gravity compensation (MuJoCo's ``gravcomp``, the
 ``--gravity-compensation`` option) cancels gravity on the bodies instead; the feed-forward then
 leaves it out. A joint whose effort cannot hold its links saturates and sags, as the real one
-would.
+would. Servos outside the chain (joints the plant model did not weld) hold their default
+targets with the same bias feed-forward.
 
 E-stop, drive error, disabled drives and a frozen controller hold the arm where it was measured
 when the stop came (the reference jumps there; the servos hold it against gravity, like a
@@ -89,6 +90,15 @@ class MujocoSimRobot(SimRobot):
         self._act = np.array(plant.actuator, dtype=np.intp)
         self._kv_over_kp = plant.kv / plant.kp
         self._inv_kp = 1.0 / plant.kp
+        # The servos outside the chain hold their default targets, with the same bias feed-forward.
+        chain = set(plant.actuator)
+        held = [a for a in range(model.nu) if a not in chain]
+        self._held = np.array(held, dtype=np.intp)
+        self._held_dof = np.array(
+            [model.jnt_dofadr[model.actuator_trnid[a, 0]] for a in held], dtype=np.intp
+        )
+        self._held_ctrl = np.array(plant.ctrl0[held], dtype=np.float64)
+        self._held_inv_kp = np.array([1.0 / model.actuator_gainprm[a, 0] for a in held])
         data.qpos[:] = plant.qpos0
         data.qpos[self._qadr] = self._q
         data.ctrl[:] = plant.ctrl0
@@ -165,9 +175,13 @@ class MujocoSimRobot(SimRobot):
         dadr, act = self._dadr, self._act
         velocity_ff = self._kv_over_kp * vref
         delta = ref1 - ref0
+        held, held_dof = self._held, self._held_dof
         for k in range(1, n + 1):
             bias = data.qfrc_bias[dadr] - data.qfrc_gravcomp[dadr]
             data.ctrl[act] = ref0 + (k / n) * delta + velocity_ff + bias * self._inv_kp
+            if held.size:
+                bias = data.qfrc_bias[held_dof] - data.qfrc_gravcomp[held_dof]
+                data.ctrl[held] = self._held_ctrl + bias * self._held_inv_kp
             mujoco.mj_step(model, data)
         self.substeps += n
 

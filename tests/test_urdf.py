@@ -53,6 +53,10 @@ def test_small_arm_structure() -> None:
 @pytest.mark.parametrize(
     ("text", "message"),
     [
+        (  # printed exactly: 1.0000001 > 1 must not read as "1 is greater than 1"
+            ARM.replace('lower="-1" upper="1"', 'lower="1.0000001" upper="1"'),
+            "robot.urdf:8: error: joint 'shoulder': limit lower 1.0000001 is greater than upper 1",
+        ),
         (
             ARM.replace('<robot name="arm">', "<robot>"),
             "robot.urdf:1: error: <robot> has no name attribute",

@@ -26,6 +26,7 @@ from robotspec.errors import (
     RobotSpecError,
     raise_collected,
 )
+from robotspec.exact import exact
 from robotspec.files.xmlsafe import line_of
 from robotspec.model.geometry import Matrix
 from robotspec.model.rotations import rpy_to_matrix
@@ -362,7 +363,8 @@ class _Walk:
             if jtype in ("revolute", "prismatic") and lower is not None and upper is not None:
                 if lower > upper:
                     self.error(
-                        f"joint '{name}': limit lower {lower:g} is greater than upper {upper:g}",
+                        f"joint '{name}': limit lower {exact(lower)} is greater than upper "
+                        f"{exact(upper)}",
                         limit,
                         kind="joint",
                         name=name,

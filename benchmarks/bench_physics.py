@@ -7,13 +7,12 @@ Measured in one process, one run:
 
 * export: ``mjcf_export`` of the compiled robot (meshes converted to binary STL in memory), then
   MuJoCo compiling the plant model from the text and the mesh bytes
-  (:func:`robotspec.driver.mujoco_model.plant_model`), the work ``drive --physics mujoco`` does
+  (``robotspec.driver.mujoco_model.plant_model``), the work ``drive --physics mujoco`` does
   before its first step; the robot's compile is not counted (the kinematic driver needs it too);
 * real-time factor: the same workload, jogs out toward mid-range and back (``wait=True``) until
-  ``--seconds`` of simulated time, at 100 Hz on a :class:`~robotspec.driver.clock.SimClock` (as
-  fast as the CPU goes), on :class:`~robotspec.driver.sim.SimRobot` and on
-  :class:`~robotspec.driver.mujoco_plant.MujocoSimRobot`, taking turns each round; the factor is
-  simulated seconds per wall second (median of the rounds);
+  ``--seconds`` of simulated time, at 100 Hz on a ``SimClock`` (as fast as the CPU goes), on
+  ``SimRobot`` and on ``MujocoSimRobot``, taking turns each round; the factor is simulated
+  seconds per wall second (median of the rounds);
 * the physics run's figures: MuJoCo steps per driver period, the jog's end error (measured, the
   driver's arrival rule is 1e-4 rad) and the largest joint torque (the servos' forces).
 

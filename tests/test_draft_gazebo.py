@@ -167,22 +167,27 @@ def test_transmissions_and_ros2_control_say_which_joints_are_driven() -> None:
     assert plugin.kind == "differential" and plugin.wheels == ("left_drive", "right_drive")
 
 
-def test_pr2_cameras_are_the_frames_its_gazebo_plugins_name(tmp_path: Path) -> None:
-    # Seven camera sensors, five devices: each stereo pair names one optical frame.
+def test_pr2_cameras_are_where_its_gazebo_sensors_are(tmp_path: Path) -> None:
+    # Seven camera sensors, each a camera: a stereo pair's two sensors are two cameras, each on
+    # the optical frame where it is (the pair's 'wide_stereo_optical_frame', which both plugins
+    # name, coincides with the left one's and is not a camera of its own).
     from .conftest import shared_path
 
     pr2 = shared_path("robots", "pr2")
     d, _ = draft_from_files(str(pr2 / "pr2.urdf"), None, folder=tmp_path, package_paths=[pr2])
-    stated = {c.body: c for c in d.cameras if c.source is not None}
-    assert set(stated) == {
+    cams = {c.body: c for c in d.cameras}
+    assert set(cams) == {
         "high_def_optical_frame",
-        "wide_stereo_optical_frame",
-        "narrow_stereo_optical_frame",
+        "wide_stereo_l_stereo_camera_optical_frame",
+        "wide_stereo_r_stereo_camera_optical_frame",
+        "narrow_stereo_l_stereo_camera_optical_frame",
+        "narrow_stereo_r_stereo_camera_optical_frame",
         "l_forearm_cam_optical_frame",
         "r_forearm_cam_optical_frame",
     }
-    assert all(c.optical and not c.decide for c in stated.values())
-    assert stated["wide_stereo_optical_frame"].field_of_view == (1.5708, 1.287)
+    assert all(c.optical and not c.decide and c.source for c in cams.values())
+    assert cams["wide_stereo_l_stereo_camera_optical_frame"].field_of_view == (1.5708, 1.287)
+    assert "its plugin's frame" in (cams["high_def_optical_frame"].source or "")
 
 
 def test_hsrb_cameras_are_the_optical_links_above_their_gazebo_frames(tmp_path: Path) -> None:
@@ -200,3 +205,56 @@ def test_hsrb_cameras_are_the_optical_links_above_their_gazebo_frames(tmp_path: 
         "hand_camera_frame",
     }
     assert all(c.optical and not c.decide and c.source for c in d.cameras)
+
+
+def _wheel(name: str, y: float, parent: str = "base_link") -> str:
+    # No geometry: neither its name nor its shape says 'wheel'; only the transmission does.
+    return (
+        f'<link name="{name}"/><joint name="{name}_joint" type="continuous">'
+        f'<parent link="{parent}"/><child link="{name}"/><origin xyz="0 {y} 0.05"/>'
+        '<axis xyz="0 1 0"/></joint>'
+    )
+
+
+def _velocity(joint: str) -> str:
+    return (
+        f'<transmission name="{joint}_tr"><joint name="{joint}"><hardwareInterface>'
+        "hardware_interface/VelocityJointInterface</hardwareInterface></joint></transmission>"
+    )
+
+
+def test_a_base_whose_transmissions_drive_two_of_four_wheels_is_differential(
+    tmp_path: Path,
+) -> None:
+    # Two driven wheels and two free ones (MiR's shape): the transmissions say which are driven.
+    body = "".join(
+        [
+            _wheel("drive_l", 0.2),
+            _wheel("drive_r", -0.2),
+            _wheel("front_wheel", 0.1),  # wheels by their names
+            _wheel("rear_wheel", -0.1),
+            _velocity("drive_l_joint"),
+            _velocity("drive_r_joint"),
+            '<transmission name="t"><joint name="front_wheel_joint"/></transmission>',
+            _velocity("rear_wheel_joint").replace("Velocity", "Effort"),
+        ]
+    )
+    d = _draft(_urdf(tmp_path, body), tmp_path)
+    assert d.drive is not None and d.drive.type == "differential"
+    assert d.drive.source == "the URDF's transmissions"
+    assert d.drive.decide is not None and d.drive.decide.startswith("2 of 4 wheel joints")
+    assert d.manipulators == [] and d.chains == []  # wheels, not a gripper's fingers
+
+
+def test_a_gazebo_drive_plugin_states_the_drive(tmp_path: Path) -> None:
+    plugin = (
+        '<gazebo><plugin filename="libgazebo_ros_planar_move.so" name="move"/></gazebo>'
+        '<gazebo><plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">'
+        "<left_joint>drive_l_joint</left_joint><right_joint>drive_r_joint</right_joint>"
+        "</plugin></gazebo>"
+    )
+    body = _wheel("drive_l", 0.2) + _wheel("drive_r", -0.2) + plugin
+    d = _draft(_urdf(tmp_path, body), tmp_path)
+    # The first plugin moving the base: planar_move (omni), stated, no question left.
+    assert d.drive is not None and (d.drive.type, d.drive.decide) == ("omni", None)
+    assert d.drive.source == "the Gazebo drive plugin 'libgazebo_ros_planar_move.so'"

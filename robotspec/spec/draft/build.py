@@ -14,6 +14,7 @@ from robotspec.description.srdf import Srdf
 from robotspec.model.entities import Body
 from robotspec.model.world import World
 from robotspec.spec.draft.base import own_base, own_drive, wheel_joints
+from robotspec.spec.draft.driven import stated_wheels
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.hands import (
     Gripper,
@@ -134,7 +135,7 @@ class Drafter:
         self.tree = Tree(world, root)
         self.facts = self.tree.memo["facts"] = facts or FileFacts()  # read before any guess
         # Found once, on the tree's poses (one forward kinematics for the whole draft).
-        self.wheels = wheel_joints(world, self.tree.poses)
+        self.wheels = stated_wheels(self.tree, self.facts, wheel_joints(world, self.tree.poses))
         if own is not None:
             drive = own_drive(world, own, self.wheels)
         self.limbs = find_limbs(self.tree)

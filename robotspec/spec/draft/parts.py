@@ -14,6 +14,7 @@ import numpy as np
 
 from robotspec.model.entities import Body
 from robotspec.model.world import World
+from robotspec.spec.draft.driven import stated_drive
 from robotspec.spec.draft.limbs import HEAD_WORDS, beside_branch
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
 from robotspec.spec.draft.naming import unique
@@ -220,7 +221,10 @@ def add_drive(d: Drafter) -> None:
     legs = [c for c in draft.chains if c.role == "leg"]
     rotors = [c for c in joints if words(c.name) & {"rotor", "propeller", "prop"}]
     movable = d.tree.root is world.root
-    if wheels and movable:
+    stated = stated_drive(d.tree, d.facts, wheels) if wheels and movable else None
+    if stated is not None:  # what the transmissions or a Gazebo drive plugin say
+        draft.drive = stated
+    elif wheels and movable:
         kind = "differential" if len(wheels) == 2 else "omni"
         why = f"{len(wheels)} wheel joints" + (f", {len(casters)} steered casters" * bool(casters))
         draft.drive = DraftDrive(kind, None, None, "the URDF tree", f"{why}: {kind}?")

@@ -33,7 +33,9 @@ _CHANNELS = frozenset({"color", "colour", "rgb", "depth", "ir", "infra", "infrar
 _COLOUR = frozenset({"color", "colour", "rgb"})
 #: How far apart (m) the channels of one device may be (a RealSense's are 1.5 to 5 cm).
 DEVICE_SPAN = 0.1
-#: Fixed joints searched below a sensor's link for its optical frame.
+#: How near (m) a frame must be to the sensor to be where it sees from.
+SPOT = 0.01
+#: Fixed joints searched above and below a sensor's link for its optical frame.
 _OPTICAL_DEPTH = 3
 #: The cosine within which a frame's axis is the camera's view (8 degrees).
 _ALONG = 0.99
@@ -92,27 +94,29 @@ def _rigid_group(tree: Tree, link: Body) -> list[Body]:
     return out
 
 
-def _optical_near(tree: Tree, link: Body, view: np.ndarray, at: np.ndarray) -> Body | None:
-    """The frame fixed to ``link`` whose +z is the sensor's view, where the sensor is.
+def _optical_at(
+    tree: Tree, link: Body, view: np.ndarray, at: np.ndarray, named: Body | None
+) -> Body | None:
+    """The frame fixed to ``link``, where the sensor is, whose +z is the sensor's view.
 
     Below the link (an optical child) or above it (HSR-B's optical camera link carrying an
-    x-forward ``*_gazebo_frame``). Of several, the nearest (to the millimetre; a RealSense's
-    channels are centimetres apart, each its own sensor's; the left infrared and depth frames
-    coincide), then one below the link, then one named for colour, then one rotated as REP 103
-    says.
+    x-forward ``*_gazebo_frame``). Of several in one place: one below the link, the sensor's
+    own (a RealSense's left infrared and depth frames coincide; PR2's left stereo camera and
+    the pair's frame too), then the plugin's frame, then one named for colour, then one
+    rotated as REP 103 says.
     """
-    found: list[tuple[float, int, int, int, int, Body]] = []
+    found: list[tuple[int, int, int, int, int, Body]] = []
     for k in _rigid_group(tree, link):
         pose = tree.poses[k.index]
         if float(pose[:3, 2] @ view) < _ALONG:
             continue
-        far = float(np.linalg.norm(pose[:3, 3] - at))
-        if far > DEVICE_SPAN:
+        if float(np.linalg.norm(pose[:3, 3] - at)) > SPOT:
             continue
         channel = _channel_words(k.name)
         rank = 0 if channel & _COLOUR else 2 if channel else 1
-        below = 0 if tree.world.is_ancestor(link, k) else 1  # the link's own optical child
-        found.append((round(far, 3), below, rank, 0 if _rep103(tree, k) else 1, k.index, k))
+        below = 0 if tree.world.is_ancestor(link, k) else 1
+        rep = 0 if _rep103(tree, k) else 1
+        found.append((below, 0 if k is named else 1, rank, rep, k.index, k))
     return min(found, key=lambda f: f[:5])[5] if found else None
 
 
@@ -149,17 +153,19 @@ def _resolve(tree: Tree, g: GazeboCamera) -> StatedCamera | None:
     pose = tree.poses[link.index]
     view = pose[:3, :3] @ rpy_to_matrix(*g.pose[3:])[:, 0]
     at = (pose @ np.array([*g.pose[:3], 1.0]))[:3]
-    named = g.frame is not None and world.has_body(g.frame)
-    body: Body | None = None
-    if named and g.frame is not None:
-        body = world.get_body_by_name(g.frame)
-        if body.index not in tree.inside:
-            body = None
-    how = f"its plugin's frame '{g.frame}'"
-    if body is None:
-        body = _optical_near(tree, link, view, at)
-        how = f"the optical frame at its link '{g.link}'"
-    if body is None:
+    named: Body | None = None
+    if g.frame is not None and world.has_body(g.frame):
+        named = world.get_body_by_name(g.frame)
+        named = named if named.index in tree.inside else None
+    # Where the sensor is, an optical frame looking its way is the camera; the plugin's frame
+    # elsewhere (PR2's 'wide_stereo_optical_frame', between the pair) names the device's.
+    body = _optical_at(tree, link, view, at, named)
+    how = f"the optical frame where it is on '{g.link}'"
+    if body is not None and body is named:
+        how = f"its plugin's frame '{named.name}'"
+    elif body is None and named is not None:
+        body, how = named, f"its plugin's frame '{named.name}'"
+    elif body is None:
         body, how = link, f"its link '{g.link}' (a Gazebo camera looks along +x)"
     device = _device_frame(tree, body, view)
     if device is not None:
@@ -169,7 +175,7 @@ def _resolve(tree: Tree, g: GazeboCamera) -> StatedCamera | None:
     doubt = None
     # A sensor put on an optical frame itself looks along its x in Gazebo; the frame says +z.
     optical = float(d[2]) > _ALONG or (_rep103(tree, body) and "optical" in words(body.name))
-    if not optical and named and body is link and float(d[0]) > _ALONG:
+    if not optical and named is link and float(d[0]) > _ALONG:
         # The plugin publishes images in the sensor's own link as if it were an optical frame.
         doubt = (
             f"the Gazebo sensor '{g.name}' looks along +x of '{body.name}', and its plugin"
@@ -212,8 +218,8 @@ def _preference(c: StatedCamera) -> tuple[int, int]:
 def stated_cameras(tree: Tree, facts: FileFacts) -> tuple[list[StatedCamera], set[int]]:
     """One camera per device the Gazebo sensors simulate, in file order; its colour channel.
 
-    Also the indices of every body a sensor resolved to, the channels left out included: none
-    of them is another camera.
+    Also the indices of every body a sensor resolved to or its plugin names, the channels left
+    out included: none of them is another camera.
     """
     resolved = [r for g in facts.cameras if (r := _resolve(tree, g)) is not None]
     devices: list[list[StatedCamera]] = []
@@ -227,7 +233,13 @@ def stated_cameras(tree: Tree, facts: FileFacts) -> tuple[list[StatedCamera], se
     for device in devices:
         order = sorted(range(len(device)), key=lambda i: (*_preference(device[i]), i))
         out.append(device[order[0]])
-    return out, {r.body.index for r in resolved}
+    world = tree.world
+    named = {
+        world.get_body_by_name(g.frame).index
+        for g in facts.cameras
+        if g.frame and world.has_body(g.frame)
+    }
+    return out, {r.body.index for r in resolved} | named
 
 
 def fill_stated(cam: DraftCamera, s: StatedCamera, *, z_ahead: bool) -> None:

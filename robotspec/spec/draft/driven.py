@@ -1,0 +1,77 @@
+"""Wheels and the drive as a URDF's control blocks state them (transmissions, drive plugins).
+
+Why: a wheel is known by its name or its shape (``base.wheel_joints``), but a continuous joint
+commanded in velocity only, turning about a level axis and carrying nothing that moves, is a
+wheel whatever its name and mesh; and which wheels are driven decides the drive better than
+their count: MiR's two driven wheels among six (four on casters) make a differential base, a
+Scout's four driven wheels on one axle direction a skid-steered (differential) one. A Gazebo
+drive plugin (``diff_drive``, ``skid_steer_drive``, ``planar_move``, gz-sim's ``DiffDrive``,
+``MecanumDrive``) states the kind itself: no question left.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robotspec.model.entities import Connection, ConnectionType
+from robotspec.spec.draft.facts import FileFacts
+from robotspec.spec.draft.model import DraftDrive
+from robotspec.spec.draft.tree import Tree
+
+__all__ = ["stated_drive", "stated_wheels"]
+
+#: The cosine within which two wheel axes are one direction (an axle), or an axis is level.
+_PARALLEL = 0.99
+_LEVEL = 0.3
+
+
+def _driven_wheel(tree: Tree, c: Connection) -> bool:
+    """A continuous joint about a level axis below which nothing moves."""
+    if c.type is not ConnectionType.CONTINUOUS or tree.moves_below(tree.world.bodies[c.child]):
+        return False
+    return abs(float(tree.axis_in_root(c)[2])) < _LEVEL
+
+
+def stated_wheels(tree: Tree, facts: FileFacts, found: list[Connection]) -> list[Connection]:
+    """``found`` and the wheels the files state: drive plugins' wheels, velocity-only joints."""
+    world = tree.world
+    names = {c.name for c in found}
+    extra: list[Connection] = []
+    plugin_wheels = {w for d in facts.actuation.drives for w in d.wheels}
+    for c in world.connections:
+        if c.name in names or c.is_fixed or c.is_mimic:
+            continue
+        said = c.name in plugin_wheels or facts.actuation.velocity_only(c.name)
+        if said and _driven_wheel(tree, c):
+            extra.append(c)
+    return [*found, *extra]
+
+
+def _one_axle_direction(tree: Tree, wheels: list[Connection]) -> bool:
+    axes = [tree.axis_in_root(c) for c in wheels]
+    first = axes[0] / (np.linalg.norm(axes[0]) or 1.0)
+    return all(abs(float(a @ first)) / (np.linalg.norm(a) or 1.0) > _PARALLEL for a in axes)
+
+
+def stated_drive(tree: Tree, facts: FileFacts, wheels: list[Connection]) -> DraftDrive | None:
+    """The drive the files state (a Gazebo drive plugin) or their driven wheels suggest.
+
+    None when they say nothing about the wheels (the count of wheels decides, as before).
+    """
+    world = tree.world
+    for plugin in facts.actuation.drives:
+        if all(world.has_connection(w) for w in plugin.wheels):
+            return DraftDrive(plugin.kind, source=f"the Gazebo drive plugin '{plugin.plugin}'")
+    names = {c.name for c in wheels}
+    driven = [c for c in wheels if facts.actuation.velocity_only(c.name)]
+    if not driven or len(driven) == len(names) == 2:
+        return None
+    if _one_axle_direction(tree, driven):
+        kind = "differential"
+        why = (
+            f"{len(driven)} of {len(wheels)} wheel joints driven in velocity, on parallel axles:"
+            f" differential{' (skid steer)' if len(driven) > 2 else ''}? (mecanum wheels: omni)"
+        )
+    else:
+        kind, why = "omni", f"{len(driven)} wheel joints driven in velocity, axles turned: omni?"
+    return DraftDrive(kind, source="the URDF's transmissions", decide=why)

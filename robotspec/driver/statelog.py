@@ -117,6 +117,7 @@ class StateLog:
             "flags": int(st.flags),
             "joint_position": st.joint_position.tolist(),
             "joint_velocity": st.joint_velocity.tolist(),
+            "joint_effort": st.joint_effort.tolist(),
             "position_command": st.position_command.tolist(),
             "velocity_command": st.velocity_command.tolist(),
             "kin_chain_tcp": [

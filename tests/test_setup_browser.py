@@ -264,14 +264,14 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         _click_tree(d, "link_eef")  # a pick in the tree: the link list and the robot follow
         _wait("the tree's pick", lambda: page.selected == page._link.value == "link_eef")
         t0 = time.perf_counter()
-        _click_text(d, "tip = picked link")
-        _wait("the error shown", lambda: "not below the chain's tip" in body.text)
+        _click_text(d, "root = picked link")  # the arm's root at its tip: an empty chain
+        _wait("the error shown", lambda: "is empty" in body.text)
         change_to_shown = time.perf_counter() - t0
         assert "invalid" in body.text
         _shot(d, "setup-invalid.png")
-        _choose(d, page._link, "link7")
-        _click_text(d, "tip = picked link")
-        _wait("valid again", lambda: "✔ valid" in body.text and "not below" not in body.text)
+        _choose(d, page._link, "link_base")
+        _click_text(d, "root = picked link")
+        _wait("valid again", lambda: "✔ valid" in body.text and "is empty" not in body.text)
 
         # A named state by sliders: the arm's joints at mid-range, saved as "park".
         _tab(d, "States")

@@ -53,8 +53,8 @@ def test_the_page_serves_and_its_controls_edit_the_spec(page: Any, tmp_path: Pat
     page._select_part("chains.arm")
     assert page._f_chain.visible and not page._f_hand.visible
     page.select("link_eef")
-    page._set_chain(tip=page._pick())
-    assert "the spec is now invalid" in page.last_message and "not below" in page.last_message
+    page._set_chain(root=page._pick())
+    assert "the spec is now invalid" in page.last_message and "is empty" in page.last_message
     assert "✖ invalid" in page._status.content and "chains.arm" in page._problems.content
     page._after(s.undo(), "undone")
     assert "✔ valid" in page._status.content

@@ -77,10 +77,11 @@ def test_xarm_questions_answered_and_saved_validate(tmp_path: Path, capsys) -> N
 
 def test_a_change_that_breaks_the_spec_shows_the_validators_message(tmp_path: Path) -> None:
     s = _xarm(tmp_path)
-    v = s.set_chain("chains.arm", tip="link_eef")
+    v = s.set_chain("chains.arm", root="link_eef", tip="link3")  # root and tip swapped
     assert not v.valid
     (err,) = v.at("chains.arm")
-    assert "not below the chain's tip 'link_eef'" in err.message and err.line is not None
+    assert "root 'link_eef' is not an ancestor of tip 'link3'" in err.message
+    assert err.line is not None
     with pytest.raises(SetupError, match="not saved: the spec has 1 error"):
         s.save()
     assert not (tmp_path / "xarm.yaml").exists()
@@ -218,13 +219,15 @@ def test_the_robots_facing_is_set_and_read_back(tmp_path: Path) -> None:
     assert "forward: [0, 1, 0]\n" in third.snapshot.text
 
 
-def test_tiago_a_camera_model_guessed_by_name_is_a_question(tmp_path: Path) -> None:
+def test_tiago_a_camera_model_chosen_as_a_preset(tmp_path: Path) -> None:
     urdf = erd_robots() / "tiago_description" / "robots" / "tiago.urdf"
     s = SetupSession.open(str(urdf), output=tmp_path / "tiago.yaml")
-    cams = [q for q in s.snapshot.questions if q.part.startswith("sensors.")]
-    assert cams and all("preset: kinect_v1" in q.alternatives for q in cams)
+    cams = [c.name for c in s.draft().cameras]
+    assert cams
     for q in s.snapshot.questions:
-        s.answer(q.id, "preset: kinect_v1" if q in cams else KEEP)
+        s.answer(q.id, KEEP)
+    for cam in cams:
+        assert s.set_camera(f"sensors.{cam}", preset="kinect_v1").valid
     assert not s.snapshot.questions and s.validation.valid
     text = s.save().read_text()
     assert "preset: kinect_v1" in text and "DECIDE: " not in text.split("delete the mark.")[1]

@@ -1,0 +1,89 @@
+"""The page's check & save tab: validate's problems, undo, the collision matrix, save."""
+
+from __future__ import annotations
+
+import html
+import sys
+import threading
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+from robotspec.errors import RobotSpecError
+from robotspec.setup.collisions import AuditReport
+from robotspec.setup.page_base import PageBase
+
+__all__ = ["CheckTab"]
+
+
+class CheckTab(PageBase):
+    """The check & save tab of :class:`~robotspec.setup.page.SetupPage`."""
+
+    _audit_report: AuditReport | None
+    _busy: bool
+    _busy_lock: threading.Lock
+
+    def _build_check(self, gui: Any) -> None:
+        self._problems = gui.add_markdown("")
+        self._button(gui, "undo", lambda: self._after(self.session.undo(), "undone"))
+        with gui.add_folder("self-collision matrix"):
+            self._samples = gui.add_number("samples", 2000, min=100, max=1_000_000, step=100)
+            self._button(gui, "generate collision matrix", lambda: self._collisions("generate"))
+            self._button(gui, "audit the SRDF", lambda: self._collisions("audit"))
+            self._progress = gui.add_progress_bar(0.0, visible=False)
+            self._collision_text = gui.add_markdown(
+                "The generated SRDF stays here until *save*, which writes it beside the spec "
+                "(never over the robot's own SRDF)."
+            )
+        self._save_path = gui.add_text("save as", str(self.session.output))
+        where = ", ".join(f"`{html.escape(str(f))}`" for f in self.session.fence.folders)
+        gui.add_markdown(f"<small>save as writes inside {where} only</small>")
+        self._button(gui, "save", self._save)
+
+    def _collisions(self, what: str) -> None:
+        from robotspec.setup.collisions import audit_session, generate_matrix, plain_audit_report
+
+        with self._busy_lock:
+            if self._busy:
+                raise RobotSpecError("the collision check is running; wait for it to finish")
+            self._busy = True
+        samples = int(self._samples.value)
+        self._progress.visible = True
+        self._progress.value = 0.0
+        self._collision_text.content = f"{what}: running..."
+        last = [0.0]
+
+        def progress(done: int, total: int) -> None:
+            now = time.monotonic()
+            if now - last[0] > 0.2 or done >= total:
+                last[0] = now
+                self._progress.value = 100.0 * done / max(total, 1)
+
+        def work() -> None:
+            try:
+                if what == "generate":
+                    r = generate_matrix(self.session, samples=samples, progress=progress)
+                    self._collision_text.content = r.summary
+                else:
+                    report = self._audit_report or plain_audit_report
+                    ok, text = audit_session(
+                        self.session, samples=samples, progress=progress, report=report
+                    )
+                    head = "every entry is right" if ok else "**some entries are wrong**"
+                    self._collision_text.content = f"{head}\n\n```\n{text}\n```"
+            except RobotSpecError as exc:
+                self._collision_text.content = f"**error:** {html.escape(exc.message)}"
+            except Exception as exc:  # noqa: BLE001 - a bug must not end the server
+                traceback.print_exc(file=sys.stderr)
+                self._collision_text.content = f"**internal error:** {type(exc).__name__}: {exc}"
+            finally:
+                self._progress.value = 100.0
+                with self._busy_lock:
+                    self._busy = False
+
+        threading.Thread(target=work, name=f"setup-{what}", daemon=True).start()
+
+    def _save(self) -> None:
+        path = self.session.save(Path(str(self._save_path.value)).expanduser())
+        self.say(f"saved **{html.escape(str(path))}**; `robotspec validate {path}` accepts it")

@@ -7,7 +7,7 @@ Measured in one process, one run:
 
 * export: ``mjcf_export`` of the compiled robot (meshes converted to binary STL in memory), then
   MuJoCo compiling the plant model from the text and the mesh bytes
-  (``robotspec.driver.mujoco_model.plant_model``), the work ``drive --physics mujoco`` does
+  (``robotspec.export.physics_model.plant_model``), the work ``drive --physics mujoco`` does
   before its first step; the robot's compile is not counted (the kinematic driver needs it too);
 * real-time factor: the same workload, jogs out toward mid-range and back (``wait=True``) until
   ``--seconds`` of simulated time, at 100 Hz on a ``SimClock`` (as fast as the CPU goes), on
@@ -71,10 +71,10 @@ def main() -> None:
         sys.exit("needs MuJoCo: pip install 'robotspec[mujoco]'")
     from robotspec.compiler import compile_robot, resolve_spec
     from robotspec.driver.clock import SimClock
-    from robotspec.driver.mujoco_model import plant_model
     from robotspec.driver.mujoco_plant import MujocoSimRobot
     from robotspec.driver.sim import SimRobot
     from robotspec.export.mjcf import mjcf_export
+    from robotspec.export.physics_model import plant_model
     from robotspec.export.robotinfo import export_robot_chain
     from robotspec.export.urdf import joined_urdf
     from robotspec.spec.load import load_spec

@@ -58,7 +58,8 @@ def physics_target(
     Raises a RobotSpecError naming ``pip install 'robotspec[mujoco]'`` without MuJoCo, before
     anything is compiled.
     """
-    from robotspec.driver.mujoco_model import plant_model, require_mujoco
+    from robotspec.driver.mujoco_model import require_mujoco
+    from robotspec.export.physics_model import plant_model
 
     require_mujoco()
     from robotspec.compiler import compile_robot, resolve_spec
@@ -82,7 +83,7 @@ def physics_target(
 
 def replant(target: PhysicsTarget, *, gravity_compensation: bool) -> PhysicsTarget:
     """The same target with gravity compensation on or off (the export is reused)."""
-    from robotspec.driver.mujoco_model import plant_model
+    from robotspec.export.physics_model import plant_model
 
     plant = plant_model(
         target.robot,

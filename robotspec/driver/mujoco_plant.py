@@ -51,7 +51,7 @@ class MujocoSimRobot(SimRobot):
 
     Args:
         robot_info: the robot (its joints are the plant's chain joints, in order).
-        plant: the MuJoCo model (:func:`~robotspec.driver.mujoco_model.plant_model`).
+        plant: the MuJoCo model (:func:`~robotspec.export.physics_model.plant_model`).
         clock, update_period, initial_position, homing_speed, command_timeout: as
             :class:`SimRobot`.
     """

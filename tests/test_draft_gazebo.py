@@ -258,3 +258,20 @@ def test_a_gazebo_drive_plugin_states_the_drive(tmp_path: Path) -> None:
     # The first plugin moving the base: planar_move (omni), stated, no question left.
     assert d.drive is not None and (d.drive.type, d.drive.decide) == ("omni", None)
     assert d.drive.source == "the Gazebo drive plugin 'libgazebo_ros_planar_move.so'"
+
+
+def test_thousands_of_camera_sensors_are_bounded_work(tmp_path: Path) -> None:
+    # A hostile file: 2,000 camera sensors on 50 links. Devices are grouped pairwise, so only
+    # the first MAX_SENSORS are read; the draft's own thread does bounded work.
+    import time
+
+    from robotspec.spec.draft.stated_cameras import MAX_SENSORS
+
+    links = "".join(
+        _link(f"cam{i}") + _fixed(f"j{i}", "base_link", f"cam{i}", f"{i} 0 0") for i in range(50)
+    )
+    sensors = "".join(_sensor(f"cam{i % 50}", "camera") for i in range(2_000))
+    start = time.thread_time()
+    d = _draft(_urdf(tmp_path, links + sensors), tmp_path)
+    assert time.thread_time() - start < 60.0  # CPU of this thread only; quadratic is minutes
+    assert len(d.cameras) == 50 and MAX_SENSORS < 2_000  # one per link

@@ -33,6 +33,8 @@ _CHANNELS = frozenset({"color", "colour", "rgb", "depth", "ir", "infra", "infrar
 _COLOUR = frozenset({"color", "colour", "rgb"})
 #: How far apart (m) the channels of one device may be (a RealSense's are 1.5 to 5 cm).
 DEVICE_SPAN = 0.1
+#: Camera sensors read per robot (a robot has tens; grouping devices compares pairs of them).
+MAX_SENSORS = 256
 #: How near (m) a frame must be to the sensor to be where it sees from.
 SPOT = 0.01
 #: Fixed joints searched above and below a sensor's link for its optical frame.
@@ -221,7 +223,8 @@ def stated_cameras(tree: Tree, facts: FileFacts) -> tuple[list[StatedCamera], se
     Also the indices of every body a sensor resolved to or its plugin names, the channels left
     out included: none of them is another camera.
     """
-    resolved = [r for g in facts.cameras if (r := _resolve(tree, g)) is not None]
+    sensors = facts.cameras[:MAX_SENSORS]
+    resolved = [r for g in sensors if (r := _resolve(tree, g)) is not None]
     devices: list[list[StatedCamera]] = []
     for r in resolved:
         home = next((d for d in devices if any(_one_device(tree, r, o) for o in d)), None)
@@ -236,7 +239,7 @@ def stated_cameras(tree: Tree, facts: FileFacts) -> tuple[list[StatedCamera], se
     world = tree.world
     named = {
         world.get_body_by_name(g.frame).index
-        for g in facts.cameras
+        for g in sensors
         if g.frame and world.has_body(g.frame)
     }
     return out, {r.body.index for r in resolved} | named

@@ -48,7 +48,12 @@ def test_sdts_pr2_class_becomes_a_spec_that_gives_it_back(
     migration = spec_from_sdt(HAND_WRITTEN, world, urdf=str(urdf), srdf=str(srdf))
     spec = migration.spec
     assert set(spec["chains"]) == {"left_arm", "right_arm"}
-    assert spec["chains"]["left_arm"]["side"] == "left"
+    # Only what SDT's class states: sides by geometry (SDT's agree, so nothing is noted and no
+    # `side` written), the drive the SRDF's planar virtual joint states (left to the compiler),
+    # no front-facing axis beside the orientation SDT derives it from.
+    assert not any("side" in c for c in spec["chains"].values())
+    assert "drive" not in spec
+    assert "front_facing_axis" not in spec["manipulators"]["left_gripper"]
     assert spec["manipulators"]["left_gripper"]["thumb"]["root"] == "l_gripper_l_finger_link"
     assert len(spec["controlled_joints"]) == 17
     assert spec["velocity_limits"]["default"] == 1.0
@@ -162,7 +167,7 @@ def test_a_hand_of_four_fingers_migrates_as_a_hand() -> None:
     robot = compile_robot("b1_ur5_allegro")
     cls = robot_class(robot_recipe(robot))
     world = sdt_world(robot.world, drive=robot.drive_type)
-    migration = spec_from_sdt(cls, world, urdf="b1_ur5_allegro.urdf")
+    migration = spec_from_sdt(cls, world, urdf="b1_ur5_allegro.urdf", files=robot.world)
     (hand,) = migration.spec["manipulators"].values()
     assert hand["type"] == "hand"
     assert hand["thumb"] == {"root": "allegro_link_12.0", "tip": "allegro_link_15.0_tip"}

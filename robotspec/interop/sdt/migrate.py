@@ -41,6 +41,7 @@ from robotspec.interop.sdt.migrate_parts import (
     spec_states,
     vector3,
 )
+from robotspec.model.world import World
 
 if TYPE_CHECKING:
     from robotspec.description.load import Description
@@ -63,14 +64,15 @@ def spec_from_sdt(
     urdf: str,
     srdf: str | None = None,
     name: str | None = None,
-    files: Description | None = None,
+    files: Description | World | None = None,
 ) -> Migration:
     """The spec of SDT robot class ``cls`` on ``world`` (SDT's world of the robot's files).
 
     ``urdf`` and ``srdf`` are written into the spec's ``description`` as given (paths or
     ``package://`` URIs, as the spec will find them). The world is changed: the robot is added.
-    ``files``: robotspec's model of the same files (the drive and arm sides are read off it);
-    loaded from ``urdf`` and ``srdf`` (``ROS_PACKAGE_PATH`` for packages) when not given.
+    ``files``: robotspec's model of the same files (the drive and arm sides are read off it),
+    or its world alone (a composed robot: no SRDF); loaded from ``urdf`` and ``srdf``
+    (``ROS_PACKAGE_PATH`` for packages) when not given.
     """
     from robotspec.interop.sdt import sdt_api
 
@@ -95,6 +97,7 @@ def spec_from_sdt(
         from robotspec.description.load import load_description
 
         files = load_description(urdf, srdf=srdf)
+    model, model_srdf = (files, None) if isinstance(files, World) else (files.world, files.srdf)
     spec: dict[str, Any] = {"robotspec": 1, "name": name or cls.__name__}
     spec["description"] = {"urdf": urdf, **({"srdf": srdf} if srdf else {})}
     spec["root"] = name_of(robot.root)
@@ -102,7 +105,7 @@ def spec_from_sdt(
     forward = (1.0, 0.0, 0.0) if base is None else forward_of(base)
     if forward != (1.0, 0.0, 0.0):
         spec["forward"] = list(forward)
-    drive = drive_fact(files.world, files.srdf, spec["root"], moves=base is not None)
+    drive = drive_fact(model, model_srdf, spec["root"], moves=base is not None)
     if drive.spec is not None:
         spec["drive"] = drive.spec
     if drive.note is not None:
@@ -185,7 +188,7 @@ def spec_from_sdt(
             }
         elif kind == "Sensor":
             sensors[pname] = {"type": "generic", "body": name_of(part.root)}
-    notes.extend(side_notes(robot, chains, names, files, spec["root"], forward))
+    notes.extend(side_notes(robot, chains, names, model, spec["root"], forward))
     for key, value in (("chains", chains), ("manipulators", manipulators), ("sensors", sensors)):
         if value:
             spec[key] = value

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 from robotspec.interop.sdt.migrate_facts import arm_offsets, geometric_left
 
 if TYPE_CHECKING:
-    from robotspec.description.load import Description
+    from robotspec.model.world import World
 
 __all__ = [
     "base_root_note",
@@ -191,7 +191,7 @@ def side_notes(
     robot: Any,
     chains: dict[str, Any],
     names: dict[int, str],
-    files: Description,
+    world: World,
     root: str,
     forward: tuple[float, float, float],
 ) -> list[str]:
@@ -206,7 +206,7 @@ def side_notes(
         return []
     left, right = _sdt_side(robot, "left"), _sdt_side(robot, "right")
     ends = [(name_of(a.root), name_of(a.tip)) for a in arms]
-    geo = geometric_left(arm_offsets(files.world, root, ends, forward))
+    geo = geometric_left(arm_offsets(world, root, ends, forward))
     label = [names[id(a)] for a in arms]
     if geo is None:
         if left is None or right is None or left is right:

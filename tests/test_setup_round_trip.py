@@ -132,17 +132,62 @@ def test_a_composed_robot_opens_with_its_parts_and_refuses_edits_to_their_files(
     ]
 
 
-def test_generic_sensors_rotated_frames_and_xacro_args_open_and_are_kept(tmp_path: Path) -> None:
-    ur5 = shipped_specs()["ur5"].read_text()
-    spec = tmp_path / "ur5.yaml"
-    text = ur5.rstrip("\n") + (
-        "\nsensors:\n  wrist_imu: {type: generic, body: wrist_3_link}  # kept as written\n"
-    )
-    spec.write_text(text)
-    s = _open(spec, spec)
-    assert s.snapshot.text == text and s.validation.valid, s.validation.errors
-    assert s.set_state("chains.arm", "zero", {"shoulder_pan_joint": 0.0}).valid
-    assert "wrist_imu: {type: generic, body: wrist_3_link}  # kept as written" in s.snapshot.text
+_XACRO = """<?xml version="1.0"?>
+<robot name="stick" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:arg name="length" default="0.5"/>
+  <link name="base"/>
+  <link name="upper"/>
+  <link name="tip"/>
+  <joint name="shoulder" type="revolute">
+    <parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <joint name="elbow" type="revolute">
+    <origin xyz="0 0 $(arg length)"/>
+    <parent link="upper"/><child link="tip"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+</robot>
+"""
+
+_STICK = """robotspec: 1
+name: Stick  # a xacro robot with arguments, a rotated frame and a generic sensor
+description:
+  urdf: stick.urdf.xacro
+  xacro_args: {length: '0.25'}
+  frames:
+    tool: {parent: tip, xyz: [0, 0, 0.1], rpy: [0.0, 1.5707963, 0.0]}  # turned
+root: base
+drive: {type: fixed}
+
+chains:
+  arm:
+    root: base
+    tip: tip
+    manipulator: tool
+manipulators:
+  tool: {type: generic, root: tip, tool_frame: tool}
+sensors:
+  wrist_imu: {type: generic, body: tip}  # kept as written
+"""
+
+
+def test_xacro_args_rotated_frames_and_generic_sensors_open_and_are_kept(tmp_path: Path) -> None:
+    (tmp_path / "stick.urdf.xacro").write_text(_XACRO)
+    spec = tmp_path / "stick.yaml"
+    spec.write_text(_STICK)
+    s = SetupSession.open(str(spec), output=spec)
+    assert s.snapshot.text == _STICK and s.validation.valid, s.validation.errors
+    assert "sensors.wrist_imu" not in s.parts()  # not a camera: kept, not edited in the page
+    assert s.set_state("chains.arm", "bent", {"shoulder": 0.0, "elbow": 0.5}).valid
+    assert _diff(_STICK, s.snapshot.text) == [
+        "+    states:",
+        "+      bent: {shoulder: 0, elbow: 0.5}",
+    ]
+    robot = s.validation.robot
+    assert robot is not None and robot.world.has_body("tool")
+    s.save()
+    assert spec.read_text() == s.snapshot.text
 
 
 def test_edit_text_sets_adds_and_deletes_only_what_changed() -> None:

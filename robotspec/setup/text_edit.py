@@ -105,6 +105,8 @@ def _as_part(path: Path_) -> bool:
     """Whether the drafter writes the mapping at ``path`` as a block (a part, a section)."""
     if len(path) == 1:
         return path[0] != "drive"
+    if path[-1] in ("states", "fingers", "frames"):
+        return True  # one line per entry
     return len(path) == 2 and path[0] in ("chains", "manipulators", "sensors")
 
 

@@ -25,10 +25,19 @@ from robotspec.collision import meshcore
 from robotspec.model import _kincore_py as kin_py
 from robotspec.model import kincore
 from robotspec.model.kinematics import Kinematics
-from tests.test_driver_export import run_cli
 
 ROOT = Path(__file__).resolve().parents[1]
 FAKE = "robotspec_test_stale_core"
+
+
+def run_cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    """Run ``robotspec ARGV`` in-process; returns (exit code, stdout, stderr)."""
+    from robotspec.cli.app import app
+    from robotspec.cli.output import run_app
+
+    code = run_app(app, list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
 
 
 def _fake_core(monkeypatch: pytest.MonkeyPatch, **attrs: Any) -> None:
@@ -88,6 +97,8 @@ def test_the_real_core_is_refused_when_its_number_moves(
     [("robotspec/model/_kincore.c", kincore), ("robotspec/collision/_meshcore.c", meshcore)],
 )
 def test_the_c_sources_state_the_python_sides_number(source: str, side: ModuleType) -> None:
+    if not (ROOT / source).is_file():
+        pytest.skip(f"reads the C sources; {source} is not beside the tests (an installed wheel)")
     text = (ROOT / source).read_text(encoding="utf-8")
     found = re.findall(r"^#define \w+_INTERFACE (\d+)$", text, flags=re.MULTILINE)
     assert found == [str(side.INTERFACE)], f"{source}: bump its INTERFACE with {side.__name__}'s"
@@ -98,6 +109,8 @@ def test_the_kernels_include_no_python_or_numpy_header() -> None:
         "robotspec/model/_kincore_kernels.h",
         "robotspec/collision/_meshcore_kernels.h",
     ):
+        if not (ROOT / kernels).is_file():
+            pytest.skip(f"reads the C sources; {kernels} is not beside the tests (a wheel's run)")
         text = (ROOT / kernels).read_text(encoding="utf-8")
         includes = re.findall(r"^#include\s*[<\"]([^>\"]+)", text, flags=re.MULTILINE)
         assert includes and all(h.split("/")[0] in _C_HEADERS for h in includes), includes

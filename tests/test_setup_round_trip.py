@@ -119,12 +119,16 @@ def test_a_composed_robot_opens_with_its_parts_and_refuses_edits_to_their_files(
     before = shipped_specs()["b1_ur5_allegro"].read_text()
     s = _open("b1_ur5_allegro", tmp_path / "b1.yaml")
     assert {"chains.ur5_arm", "manipulators.allegro_hand"} <= set(s.parts())
+    origin = s.part_origin("chains.ur5_arm")
+    assert origin is not None and origin.split(":")[0].endswith("ur5.yaml")
+    assert s.part_origin("drive") is None
     with pytest.raises(SetupError, match=r"defined in .*ur5\.yaml:\d+.*change it in that file"):
         s.set_chain("chains.ur5_arm", tip="ur5_wrist_2_link")
     assert s.snapshot.text == before and s.snapshot.version == 0
     # A state of the composed robot's own is written into its own file.
     d = _open("dual_panda", tmp_path / "dual.yaml")
     ready = dict(d.part_states("robot")["ready"], left_panda_joint1=0.5)
+    assert d.part_origin("chains.left_arm") is not None and d.part_origin("states") is None
     assert d.set_state("robot", "ready", ready).valid
     assert _diff(shipped_specs()["dual_panda"].read_text(), d.snapshot.text) == [
         "-    left_panda_joint1: 0.0",

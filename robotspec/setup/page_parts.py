@@ -6,6 +6,7 @@ session's draft to show the chosen part.
 
 from __future__ import annotations
 
+import html
 from typing import Any
 
 from robotspec.errors import RobotSpecError
@@ -117,6 +118,9 @@ class PartsTab(PageBase):
             self._drive.value = d.drive.type
             if facing is not None:
                 self._forward.value = facing
+        origin = self.session.part_origin(part)
+        if origin is not None:
+            lines.append(f"defined in `{html.escape(origin)}`: edit it there")
         lines += [problem_line(p) for p in self.session.validation.at(part)]
         self._part_info.content = "  \n".join(lines)
 

@@ -28,6 +28,18 @@ __all__ = ["SpecText", "data_of", "open_marks"]
 Path_ = tuple[str | int, ...]
 
 
+def _top_paths(text: str) -> set[Path_]:
+    """The part paths (``("chains", "arm")``, ``("torso",)``) the text itself writes."""
+    data = yaml.safe_load(text)
+    out: set[Path_] = set()
+    if isinstance(data, dict):
+        for key, value in data.items():
+            out.add((str(key),))
+            if isinstance(value, dict):
+                out.update((str(key), str(k)) for k in value)
+    return out
+
+
 def data_of(draft: Draft, presets: tuple[str, ...] = ()) -> Any:
     """The draft as the spec's data, stated by the draft's writer (parsed back, safely)."""
     return yaml.safe_load(render_draft(draft, presets=presets))
@@ -90,6 +102,17 @@ class SpecText:
                     line, _ = doc.marks[path[:n]]
                     return doc.file, line, n
         return None
+
+    def defined_in(self, part: str) -> str | None:
+        """``file:line`` of the other file defining ``part`` (``chains.X``), if not this one."""
+        path = tuple(part.split(".", 1))
+        if path[0] == "drive" or path in _top_paths(self.text):
+            return None
+        other = self.elsewhere(path)
+        if other is None or other[2] < len(path):
+            return None
+        file, line, _ = other
+        return f"{file}:{line}" if line is not None else file
 
     def text_of(self, draft: Draft, presets: tuple[str, ...] = ()) -> str:
         """The file's text with every change from the draft as read to ``draft``.

@@ -121,6 +121,15 @@ class SetupSession(PartEdits):
         out += [f"sensors.{c.name}" for c in d.cameras]
         return tuple(out)
 
+    def part_origin(self, part: str) -> str | None:
+        """Where another file (a composed robot's part, an extended spec) defines ``part``.
+
+        Such a part is shown, and its changes are refused with that place: the assistant edits
+        only the spec it opened. None: the opened spec (or the draft) holds it.
+        """
+        written = self.source.written
+        return None if written is None else written.defined_in(part)
+
     def part_joints(self, part: str) -> tuple[str, ...]:
         """The joints a part's states name: a chain's from root to tip, a hand's below its root."""
         with self._lock:

@@ -29,11 +29,21 @@ import types
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from robotspec.errors import RobotSpecError
 from robotspec.interop.sdt.recipe import PartRecipe, RobotRecipe
 from robotspec.interop.sdt.rules import setup_collision_rules
+
+if TYPE_CHECKING:
+    # Not used here: krrood resolves the type hints SDT's classes import only for type
+    # checking by parsing the imports of each class's module, this one first for a generated
+    # class; found here, they cost one parse of this file instead of a re-parse of every
+    # module in the class's hierarchy per name (about half a second per first to_sdt).
+    from krrood.entity_query_language.explanation.explanation import (  # noqa: F401
+        InferenceExplanation,
+    )
+    from semantic_digital_twin.world import World  # noqa: F401
 
 __all__ = ["class_store", "part_classes", "remember", "robot_class"]
 
@@ -123,7 +133,13 @@ def _make(
         if after_init is not None:
             after_init(self)
 
-    namespace = {**namespace, "_robotspec_recipe": recipe, "__post_init__": __post_init__}
+    namespace = {
+        **namespace,
+        "__module__": __name__,  # already while SDT's __init_subclass__ resolves its hints
+        "__qualname__": name,
+        "_robotspec_recipe": recipe,
+        "__post_init__": __post_init__,
+    }
     cls = types.new_class(
         name, bases, {"metaclass": _metaclass(sdt_meta)}, lambda ns: ns.update(namespace)
     )

@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     # checking by parsing the imports of each class's module, this one first for a generated
     # class; found here, they cost one parse of this file instead of a re-parse of every
     # module in the class's hierarchy per name (about half a second per first to_sdt).
-    from krrood.entity_query_language.explanation.explanation import (  # noqa: F401
+    from krrood.entity_query_language.explanation.explanation import (  # type: ignore[import-not-found, unused-ignore]  # noqa: F401
         InferenceExplanation,
     )
     from semantic_digital_twin.world import World  # noqa: F401

@@ -23,6 +23,8 @@ Modules, one job each:
 * :mod:`~robotspec.driver.loop` -- the loop, its timing and the timestep pipeline;
 * :mod:`~robotspec.driver.robot_driver` -- the driver base class: the seed's client API;
 * :mod:`~robotspec.driver.sim` -- the simulated robot with injectable faults;
+* :mod:`~robotspec.driver.mujoco_plant` -- the simulated robot on MuJoCo physics (the
+  ``mujoco`` extra), :mod:`~robotspec.driver.mujoco_model` the model it steps;
 * :mod:`~robotspec.driver.script` -- YAML scenarios of client calls with expected outcomes.
 
 Nothing here is imported by ``robotspec`` itself, so the CLI starts fast.

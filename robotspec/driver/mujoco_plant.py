@@ -42,6 +42,7 @@ from robotspec.driver.mujoco_model import PlantModel
 from robotspec.driver.robot_info import RobotInfo
 from robotspec.driver.sim import SimRobot
 from robotspec.driver.state import EstopSource
+from robotspec.errors import RobotSpecError
 
 __all__ = ["MujocoSimRobot"]
 
@@ -78,7 +79,10 @@ class MujocoSimRobot(SimRobot):
         import mujoco  # type: ignore[import-untyped, unused-ignore]
 
         if len(plant.actuator) != self._joint_count:
-            raise ValueError("the plant's chain and the RobotInfo's joints differ in number")
+            raise RobotSpecError(
+                f"the plant drives {len(plant.actuator)} joints, the RobotInfo has "
+                f"{self._joint_count}: build the plant from the same chain"
+            )
         self._mujoco = mujoco
         self._plant = plant
         model = plant.model

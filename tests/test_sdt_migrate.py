@@ -53,6 +53,7 @@ def test_sdts_pr2_class_becomes_a_spec_that_gives_it_back(
     # no front-facing axis beside the orientation SDT derives it from.
     assert not any("side" in c for c in spec["chains"].values())
     assert "drive" not in spec
+    assert spec["sdt"] == {"class": "PR2"}  # to_sdt's robot is an instance of SDT's PR2
     assert "front_facing_axis" not in spec["manipulators"]["left_gripper"]
     assert spec["manipulators"]["left_gripper"]["thumb"]["root"] == "l_gripper_l_finger_link"
     assert len(spec["controlled_joints"]) == 17

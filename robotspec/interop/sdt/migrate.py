@@ -42,6 +42,7 @@ from robotspec.interop.sdt.migrate_parts import (
     vector3,
 )
 from robotspec.model.world import World
+from robotspec.spec.sdt import SDT_ROBOT_CLASSES
 
 if TYPE_CHECKING:
     from robotspec.description.load import Description
@@ -99,6 +100,10 @@ def spec_from_sdt(
         files = load_description(urdf, srdf=srdf)
     model, model_srdf = (files, None) if isinstance(files, World) else (files.world, files.srdf)
     spec: dict[str, Any] = {"robotspec": 1, "name": name or cls.__name__}
+    if SDT_ROBOT_CLASSES.get(cls.__name__) == cls.__module__.rpartition(".")[2] and (
+        cls.__module__.startswith("semantic_digital_twin.robots.")
+    ):  # SDT's own class: to_sdt's robot is an instance of it (coraplex's motions apply)
+        spec["sdt"] = {"class": cls.__name__}
     spec["description"] = {"urdf": urdf, **({"srdf": srdf} if srdf else {})}
     spec["root"] = name_of(robot.root)
     base = next((p for p in robot._robot_parts if part_kind(p, sdt) == "MobileBase"), None)

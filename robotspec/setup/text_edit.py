@@ -292,7 +292,8 @@ class _Text:
         if entry is None or entry.key is None:
             return
         parent = entry.parent
-        assert isinstance(parent, yaml.MappingNode)
+        if not isinstance(parent, yaml.MappingNode):  # pragma: no cover - keys live in mappings
+            raise TextEditError(f"cannot delete {path[-1]!r}: not a key", kind="value")
         if parent.flow_style or len(parent.value) == 1:
             start, end = parent.start_mark.index, parent.end_mark.index
             current = dict(yaml.safe_load(self.text[start:end]) or {})

@@ -128,6 +128,14 @@ class MujocoSimRobot(SimRobot):
         return self._data
 
     @property
+    def sim_position(self) -> F64:
+        """The reference: where the kinematic profile has the arm, the servos' target (a copy).
+
+        The arm itself is :attr:`measured_position` (what the state reports).
+        """
+        return self._q.copy()
+
+    @property
     def measured_position(self) -> F64:
         """The chain's joint positions as MuJoCo has them now (a copy)."""
         return np.array(self._data.qpos[self._qadr], dtype=np.float64)

@@ -205,6 +205,11 @@ def test_hsrb_cameras_are_the_optical_links_above_their_gazebo_frames(tmp_path: 
         "hand_camera_frame",
     }
     assert all(c.optical and not c.decide and c.source for c in d.cameras)
+    # Two wheels driven in velocity on a turntable (base_roll_joint): omnidirectional.
+    assert d.drive is not None and (d.drive.type, d.drive.source) == (
+        "omni",
+        "the URDF's transmissions",
+    )
 
 
 def _wheel(name: str, y: float, parent: str = "base_link") -> str:

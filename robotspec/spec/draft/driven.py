@@ -4,7 +4,8 @@ Why: a wheel is known by its name or its shape (``base.wheel_joints``), but a co
 commanded in velocity only, turning about a level axis and carrying nothing that moves, is a
 wheel whatever its name and mesh; and which wheels are driven decides the drive better than
 their count: MiR's two driven wheels among six (four on casters) make a differential base, a
-Scout's four driven wheels on one axle direction a skid-steered (differential) one. A Gazebo
+Scout's four driven wheels on one axle direction a skid-steered (differential) one, HSR-B's two
+on a turntable an omnidirectional one. A Gazebo
 drive plugin (``diff_drive``, ``skid_steer_drive``, ``planar_move``, gz-sim's ``DiffDrive``,
 ``MecanumDrive``) states the kind itself: no question left.
 """
@@ -47,6 +48,15 @@ def stated_wheels(tree: Tree, facts: FileFacts, found: list[Connection]) -> list
     return [*found, *extra]
 
 
+def _steered(tree: Tree, c: Connection) -> bool:
+    """Whether a joint moves the wheel's axle (HSR-B's turntable, a steered caster)."""
+    world = tree.world
+    above = world.bodies[c.parent]
+    if above is tree.root or not world.is_ancestor(tree.root, above):
+        return False
+    return any(not k.is_fixed for k in world.compute_chain_of_connections(tree.root, above))
+
+
 def _one_axle_direction(tree: Tree, wheels: list[Connection]) -> bool:
     axes = [tree.axis_in_root(c) for c in wheels]
     first = axes[0] / (np.linalg.norm(axes[0]) or 1.0)
@@ -66,7 +76,10 @@ def stated_drive(tree: Tree, facts: FileFacts, wheels: list[Connection]) -> Draf
     driven = [c for c in wheels if facts.actuation.velocity_only(c.name)]
     if not driven or len(driven) == len(names) == 2:
         return None
-    if _one_axle_direction(tree, driven):
+    if any(_steered(tree, c) for c in driven):
+        kind = "omni"
+        why = f"{len(driven)} wheel joints driven in velocity on a turning base: omni?"
+    elif _one_axle_direction(tree, driven):
         kind = "differential"
         why = (
             f"{len(driven)} of {len(wheels)} wheel joints driven in velocity, on parallel axles:"

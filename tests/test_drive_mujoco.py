@@ -243,3 +243,20 @@ def test_a_servo_outside_the_chain_holds_its_default_under_gravity() -> None:
     assert robot.plant_data.qpos[model.jnt_qposadr[j]] == pytest.approx(-1.5708, abs=1e-4)
     a = next(a for a in range(model.nu) if model.actuator_trnid[a, 0] == j)
     assert abs(robot.plant_data.actuator_force[a]) > 1.0  # holding the forearm up
+
+
+def test_a_stalled_loop_is_a_pause_for_the_physics(pr2: PhysicsTarget) -> None:
+    # a loop thread preempted for 0.05 to 2 s (a loaded machine): the jog still arrives, and
+    # MuJoCo never integrated more than the driver's capped step (no lurch after a stall)
+    from tests.driver_support import StallingClock
+
+    clock = StallingClock({0.3: 0.05, 0.6: 2.0, 0.9: 0.5})
+    robot = MujocoSimRobot(pr2.exported.info, pr2.plant, clock=clock)
+    robot.step()
+    robot.step()
+    target = _jog_target(robot)
+    robot.command_mode = "jog"
+    robot.jog_freespace(target, 0.5 * robot.limits.velocity, wait=True)
+    assert np.max(np.abs(robot.robot_state.joint_position - target)) <= 1e-4
+    simulated = robot.substeps * pr2.plant.model.opt.timestep
+    assert simulated < robot._stopwatch_ellapsed_s() - 2.0  # the stalls were not simulated

@@ -74,11 +74,12 @@ def test_a_new_part_is_new_lines_in_its_mapping(tmp_path: Path) -> None:
     assert all(line.startswith("+") for line in diff), diff
     lines = s.snapshot.text.splitlines()
     # The chain is the last entry of chains:, the hand the last of manipulators:.
-    at = lines.index("  head:")
+    at = lines.index("  head:  # from robotspec setup")  # the drafter's lines, its notes too
     assert lines[at - 1].startswith("        r_wrist_roll_joint") and at < lines.index(
         "manipulators:"
     )
-    assert "  left_tool:" in lines[lines.index("manipulators:") : lines.index("sensors:")]
+    tools = lines[lines.index("manipulators:") : lines.index("sensors:")]
+    assert "  left_tool:  # from robotspec setup" in tools
     assert s.validation.valid
     s.remove("manipulators.left_tool")
     s.remove("chains.head")
@@ -268,3 +269,24 @@ def test_validation_writes_nothing_beside_the_users_files(tmp_path: Path) -> Non
     assert list(tmp_path.iterdir()) == []  # neither the spec nor the kept SRDF, nor a scratch
     s.save()
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([name, "xarm.yaml"])
+
+
+def test_a_new_camera_keeps_its_open_question_in_the_saved_file(tmp_path: Path) -> None:
+    before = shipped_specs()["ur5"].read_text()
+    out = tmp_path / "ur5.yaml"
+    s = _open("ur5", out)
+    assert s.add_camera("wrist_cam", "wrist_3_link").valid
+    assert [q.id for q in s.snapshot.questions] == ["sensors.wrist_cam.field_of_view"]
+    diff = _diff(before, s.snapshot.text)
+    assert all(line.startswith("+") for line in diff) and diff[0] == "+sensors:"
+    assert "# DECIDE: the camera's angles" in diff[-1]
+    s.save()
+    again = SetupSession.open(str(out), output=out)  # the question is still the file's
+    assert [q.id for q in again.snapshot.questions] == ["sensors.wrist_cam.field_of_view"]
+    again.answer("sensors.wrist_cam.field_of_view", "preset: realsense_d435")
+    assert _diff(out.read_text(), again.snapshot.text) == [
+        "-    field_of_view: {horizontal: 1.0, vertical: 0.75}  # DECIDE: the camera's angles; "
+        "or replace this line with 'preset: NAME' (kinect_v1, xtion_pro_live, realsense_d435, "
+        "generic_optical)",
+        "+    preset: realsense_d435",
+    ]

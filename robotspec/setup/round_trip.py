@@ -120,12 +120,14 @@ class SpecText:
         Raises :class:`~robotspec.setup.text_edit.TextEditError` for a change the file cannot
         take (a value another file defines, one shared through an alias).
         """
+        written = render_draft(draft, presets=presets)
         text = edit_text(
             self.text,
             self.base,
-            data_of(draft, presets),
+            yaml.safe_load(written),
             elsewhere=self.elsewhere,
             fixed=("description",) if self.composed else (),
+            written=written,
         )
         for path in sorted(self.base_marks - open_marks(draft), key=str):
             text = remove_mark(text, path)

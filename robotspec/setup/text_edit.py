@@ -191,9 +191,32 @@ def _indent_of(node: yaml.MappingNode) -> int:
 class _Text:
     """The spec's text being edited, indexed again after each change."""
 
-    def __init__(self, text: str) -> None:
+    def __init__(self, text: str, model: _Index | None = None, model_text: str | None = None):
         self.text = text
         self.index = _Index(text)
+        #: The new data as the drafter writes it: a new part's lines come from there.
+        self._model, self._model_text = model, model_text
+
+    def _model_lines(self, path: Path_, value: Any, indent: int) -> list[str] | None:
+        """The lines of a new part ``path: value`` as the drafter writes them, at ``indent``.
+
+        Only when they state exactly ``value`` (a section the drafter writes whole may hold
+        entries this file does not gain).
+        """
+        if self._model is None or self._model_text is None or not _as_part(path):
+            return None
+        entry = self._model.entries.get(path)
+        if entry is None or entry.key is None:
+            return None
+        first, last = entry.key.start_mark.line, _last_line(entry.node)
+        lines = self._model_text.splitlines()[first : last + 1]
+        shift = entry.key.start_mark.column
+        if any(line[:shift].strip() for line in lines):
+            return None  # not a block of its own
+        lines = [line[shift:] for line in lines]
+        if yaml.safe_load("\n".join(lines)) != {path[-1]: value}:
+            return None
+        return [" " * indent + line if line.strip() else "" for line in lines]
 
     def _replace(self, start: int, end: int, new: str) -> None:
         self.text = self.text[:start] + new + self.text[end:]
@@ -272,7 +295,9 @@ class _Text:
 
     def _add(self, have: Path_, node: yaml.Node, key: str | int, value: Any) -> None:
         if isinstance(node, yaml.MappingNode) and not node.flow_style and node.value:
-            lines = _block(key, value, _indent_of(node), have)
+            indent = _indent_of(node)
+            lines = self._model_lines((*have, key), value, indent)
+            lines = lines or _block(key, value, indent, have)
             self._lines(_last_line(node) + 1, _last_line(node), lines)
             return
         if isinstance(node, yaml.MappingNode) or (
@@ -325,14 +350,16 @@ def edit_text(
     *,
     elsewhere: Elsewhere = lambda path: None,
     fixed: tuple[str, ...] = (),
+    written: str | None = None,
 ) -> str:
     """``text`` with the changes from ``old`` to ``new`` (data as the spec states them) made.
 
     ``elsewhere(path)``: where a value the text does not hold is defined (another file), which
     refuses the change; ``fixed``: top-level keys this file may not gain or change (a composed
-    robot's ``description``). No change returns ``text`` itself.
+    robot's ``description``); ``written``: ``new`` as the drafter writes it, whose lines (and
+    comments: ``# from``, ``# DECIDE:``) a new part takes. No change returns ``text`` itself.
     """
-    t = _Text(text)
+    t = _Text(text, None if written is None else _Index(written), written)
     for op in diff_ops(old, new):
         where = ".".join(map(str, op.path))
         if op.path and op.path[0] in fixed:

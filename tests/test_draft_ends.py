@@ -171,3 +171,32 @@ def test_ur5e_ends_at_its_flange_and_its_tool_frame_is_tool0(tmp_path: Path) -> 
     assert len(arm.joints) == 6
     (tool,) = d.manipulators
     assert tool.tool_frame == "tool0"
+
+
+def test_a_vertical_lift_at_the_top_of_an_arm_is_a_torso(tmp_path: Path) -> None:
+    # HSR-B's shape: a prismatic lift, then the arm's turning joints, in one run.
+    parts = [_link("base"), _link("lift")]
+    parts.append(_joint("lift_joint", "base", "lift", "prismatic", "0 0 0.3", "0 0 1"))
+    parts += _arm("arm_", "lift", n=4, first_xyz="0.1 0 0.1")
+    d = _draft(tmp_path, "lifted", parts)
+    (arm,) = d.chains
+    assert arm.root == "lift" and "lift_joint" not in arm.joints and len(arm.joints) == 4
+    assert d.torso is not None and d.torso.joints == {"lift_joint"}
+
+
+def test_a_one_jaw_gripper_is_the_hand_not_the_arms_last_joint(tmp_path: Path) -> None:
+    # Darwin-OP's shape: the wrist link is the fixed jaw and carries the moving jaw beside a
+    # fixed leaf at the fixed jaw's end.
+    parts = [_link("base"), *_arm("", "base", n=4)]
+    parts += [_link("gripper_fix"), _joint("wrist", "link4", "gripper_fix", xyz="0 0 0.1")]
+    parts += [
+        _link("gripper_mov", size=0.02),
+        _joint("jaw", "gripper_fix", "gripper_mov", xyz="0.01 0 0.05", axis="1 0 0"),
+        _link("gripper_fix_end", size=0.01),
+        _joint("jaw_end", "gripper_fix", "gripper_fix_end", "fixed", "-0.01 0 0.06"),
+    ]
+    d = _draft(tmp_path, "one_jaw", parts)
+    (arm,) = d.chains
+    assert arm.tip == "gripper_fix" and "jaw" not in arm.joints and len(arm.joints) == 5
+    (m,) = d.manipulators
+    assert (m.root, m.tool_frame) == ("gripper_fix", "gripper_fix_end")

@@ -155,3 +155,77 @@ def test_finger_tips_far_ends_lie_past_their_joints_on_the_panda(tmp_path: Path)
     # Its last link's far end along joint 7's axis: the flange at about 10.7 cm (link8).
     flange = flange_offset(tree, world.get_body_by_name("panda_link7"))
     assert flange is not None and abs(flange[2]) > 0.05
+
+
+def test_a_rigid_hand_gets_a_flange_the_way_its_forearm_reaches(tmp_path: Path) -> None:
+    # Booster T1's shape: the elbow turns a rigid forearm-and-hand link reaching along y.
+    parts = _arm(3)
+    parts += [
+        _link("left_hand_link", "0.04 0.2 0.04", at="0 0.1 0"),
+        _joint("elbow_yaw", "link3", "left_hand_link", xyz="0 0.05 0", axis="0 0 1"),
+    ]
+    d = _draft(tmp_path, "rigid_hand", parts)
+    (m,) = d.manipulators
+    (frame,) = d.frames
+    assert m.tool_frame == frame.name and frame.parent == "left_hand_link"
+    assert frame.xyz == (0.0, 0.2, 0.0)
+
+
+def test_a_finger_ends_at_its_bare_tip_frame_beside_a_decorative_pad(tmp_path: Path) -> None:
+    # HSR-B's shape: the distal link carries a bare tip frame and a pad with a look only.
+    parts = _gripper("0.01 0.01 0.04", "0 0 0.02")
+    for side in ("left", "right"):
+        finger = f"{side}_finger"
+        pad = f'<link name="{side}_pad"><visual><geometry><sphere radius="0.005"/></geometry>'
+        parts += [
+            pad + "</visual></link>",
+            _joint(f"{side}_pad_joint", finger, f"{side}_pad", "fixed", "0 0 0.03"),
+            _bare(f"{side}_tip_frame"),
+            _joint(f"{side}_tip_joint", finger, f"{side}_tip_frame", "fixed", "0 0 0.04"),
+        ]
+    (m,) = _draft(tmp_path, "padded", parts).manipulators
+    assert m.thumb is not None and m.finger is not None
+    assert {m.thumb.tip, m.finger.tip} == {"left_tip_frame", "right_tip_frame"}
+
+
+def test_a_linkage_gripper_s_four_branches_are_two_sides_by_where_they_start(
+    tmp_path: Path,
+) -> None:
+    # Robotiq's shape: an outer and an inner knuckle a side, all moved by one motor; the outer
+    # finger's pad reaches farther out than the inner knuckles.
+    parts = [_link("base", "0.08 0.04 0.04")]
+    for side, sign in (("left", -1), ("right", 1)):
+        mimic = "" if side == "left" else '<mimic joint="left_outer_joint"/>'
+        lead = '<mimic joint="left_outer_joint"/>'
+        parts += [
+            _link(f"{side}_outer", "0.01 0.01 0.03"),
+            _joint(
+                f"{side}_outer_joint",
+                "base",
+                f"{side}_outer",
+                xyz=f"0 {sign * 0.03} 0.05",
+                axis="1 0 0",
+                extra=mimic,
+            ),  # fmt: skip
+            _link(f"{side}_pad", "0.01 0.01 0.02"),
+            _joint(
+                f"{side}_pad_joint",
+                f"{side}_outer",
+                f"{side}_pad",
+                "fixed",
+                f"0 {-sign * 0.01} 0.09",
+            ),  # fmt: skip
+            _link(f"{side}_inner", "0.01 0.01 0.01"),
+            _joint(
+                f"{side}_inner_joint",
+                "base",
+                f"{side}_inner",
+                xyz=f"0 {sign * 0.013} 0.06",
+                axis="1 0 0",
+                extra=lead,
+            ),  # fmt: skip
+        ]
+    (m,) = _draft(tmp_path, "linkage", parts).manipulators
+    assert m.is_gripper
+    assert m.thumb is not None and m.finger is not None
+    assert {m.thumb.tip, m.finger.tip} == {"left_pad", "right_pad"}

@@ -332,8 +332,9 @@ class Drafter:
             # the URDF gives the hand, whatever its name.
             tool_name = marks[0].name
             decide.append(f"the tool frame '{tool_name}': the one frame fixed on the hand")
-        elif hand is None and (flange := flange_offset(tree, top)) is not None:
-            tool_name = unique("flange", self.names | set(world.body_names))
+        elif not tree.moves_below(top) and (flange := flange_offset(tree, top)) is not None:
+            flange_name = "flange" if name == "tool" else f"{name}_flange"
+            tool_name = unique(flange_name, self.names | set(world.body_names))
             frame = DraftFrame(tool_name, top.name, flange, f"the URDF has no tool frame: {FLANGE}")
         elif hand is None and (up := world.parent_connection(top)) is not None and up.is_fixed:
             tool_name = top.name  # the flange link the chain ends at, past its last joint

@@ -70,14 +70,15 @@ def _finger_tip(tree: Tree, branch: Body) -> Body:
     world = tree.world
     inside = world.subtree(branch)
     moved = [b for b in inside if (c := world.parent_connection(b)) is not None and not c.is_fixed]
-    # A fixed tip link with geometry is the finger's tip (Baxter's 'r_gripper_l_finger_tip').
-    solid = [b for b in inside if b.collisions or b.visuals]
+    # A fixed tip link with geometry is the finger's tip (Baxter's 'r_gripper_l_finger_tip');
+    # collision geometry first: a leaf with a look only is a decoration (HSR-B's vacuum pad).
+    solid = [b for b in inside if b.collisions] or [b for b in inside if b.visuals]
     tip = max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
     # A bare frame the URDF fixes at the end of the last phalanx is the tip it names (Ability's
-    # 'index_tip', D'Claw's 'link_f1_head'): the only thing hanging there, nothing below it.
-    kids = world.child_bodies(tip)
-    if len(kids) == 1 and bare_fixed_leaf(world, kids[0]):
-        return kids[0]
+    # 'index_tip', D'Claw's 'link_f1_head'): the only bare leaf hanging there.
+    bare = [k for k in world.child_bodies(tip) if bare_fixed_leaf(world, k)]
+    if len(bare) == 1 and all(not world.child_bodies(k) for k in world.child_bodies(tip)):
+        return bare[0]
     return tip
 
 
@@ -150,6 +151,16 @@ def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | N
     if any("thumb" in b.name.lower() for k in branches for b in world.subtree(k)):
         return None  # a one-motor hand with a thumb and three fingers (Romeo's) is a hand
     inv = np.linalg.inv(tree.poses[root.index])
+    # First by where the branches start: two on each side of the hand's middle, along the line
+    # the four bases spread on (a linkage's inner and outer links, Robotiq's).
+    bases = np.array([(inv @ tree.poses[k.index])[:3, 3] for k in branches])
+    centred = bases - bases.mean(axis=0)
+    spread = np.linalg.svd(centred)[2][0]
+    along = centred @ spread
+    if np.all(np.abs(along) > 1e-4) and int(np.sum(along > 0)) == 2:
+        return [[k for k, v in zip(branches, along, strict=True) if v < 0]] + [
+            [k for k, v in zip(branches, along, strict=True) if v > 0]
+        ]
     at = {b.index: (inv @ tree.poses[_finger_tip(tree, b).index])[:3, 3] for b in branches}
     pairs = [(a, b) for i, a in enumerate(branches) for b in branches[i + 1 :]]
     a, b = max(pairs, key=lambda p: float(np.linalg.norm(at[p[0].index] - at[p[1].index])))

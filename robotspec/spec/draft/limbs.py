@@ -119,6 +119,9 @@ def _hand_joint(tree: Tree, c: Connection) -> bool:
 def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Limb | None:
     world = tree.world
     cut = hand_cut(tree, seg)
+    jaw = cut is not None and _one_jaw(tree, seg, cut)
+    if cut is not None and jaw:
+        cut -= 1  # the moving jaw is the hand's; the link carrying both jaws is the hand
     # The joint that moves the hand is the arm's last (a wrist roll turning 'gripper_link').
     into_hand = None if cut is None else world.parent_connection(seg.bodies[cut])
     upto = None if cut is None else cut + int(into_hand is not None and not into_hand.is_fixed)
@@ -136,7 +139,7 @@ def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Lim
     palm = cut is None and bodies[-1] is seg.end and len(tree.moving_children(seg.end)) >= 2
     if len(actuated) < fewest or _named(bodies[:-1] if palm else bodies, FINGER_WORDS):
         return None
-    reach = tree.length(seg, upto)
+    reach = tree.length(seg, None if jaw else upto)  # with its jaw, as far as it reaches
     if reach < MIN_LIMB_LENGTH:
         return None
     # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.
@@ -144,6 +147,10 @@ def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Lim
     top = world.parent_connection(seg.bodies[0])
     if root.index == tree.root.index and words(root.name) & WORLD_WORDS and top and top.is_fixed:
         root = seg.bodies[0]
+    lifts = _lifts(tree, actuated)
+    if lifts and len(actuated) - lifts >= MIN_LIMB_JOINTS:
+        # A lift under the arm (HSR-B's arm lift) is a torso: the arm starts on top of it.
+        root, actuated = world.bodies[actuated[lifts - 1].child], actuated[lifts:]
     tip = world.bodies[actuated[-1].child]
     hand: Body | None = None
     if cut is not None:
@@ -171,6 +178,43 @@ def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Lim
     why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"
     tip = chain_end(tree, tip, hand)
     return Limb("arm", root, tip, hand, joints, seg, why)
+
+
+def _lifts(tree: Tree, actuated: list[Connection]) -> int:
+    """How many of a run's first joints lift it: prismatic along the vertical, in a row."""
+    n = 0
+    for c in actuated:
+        if c.type.value != "prismatic" or abs(float(tree.axis_in_root(c)[2])) < VERTICAL:
+            break
+        n += 1
+    return n
+
+
+#: How vertical a lift's axis is (the cosine of its angle to z, in the default pose).
+VERTICAL = 0.9
+
+
+def _one_jaw(tree: Tree, seg: Segment, cut: int) -> bool:
+    """Whether the hand found at ``cut`` is a gripper's one moving jaw (Darwin-OP's).
+
+    Why: such a jaw hangs, with nothing below it, on a link that also carries the fixed jaw (a
+    fixed leaf with geometry reaching at least as far out); the joint turning it is the
+    gripper's, not the arm's last, and the link carrying both jaws is the hand.
+    """
+    world = tree.world
+    jaw = seg.bodies[cut]
+    c = world.parent_connection(jaw)
+    if cut == 0 or jaw is not seg.end or world.child_bodies(jaw) or c is None or c.is_fixed:
+        return False
+    carrier = seg.bodies[cut - 1]
+    hinge = float(np.linalg.norm(c.origin[:3, 3]))
+    for k in world.child_bodies(carrier):
+        f = world.parent_connection(k)
+        if k is jaw or f is None or not f.is_fixed or world.child_bodies(k):
+            continue
+        if k.collisions and float(np.linalg.norm(f.origin[:3, 3])) >= hinge:
+            return True
+    return False
 
 
 #: Words of a camera's frames (a run carrying one and nothing else is a neck, not an arm).

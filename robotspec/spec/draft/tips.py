@@ -28,7 +28,7 @@ MESH_PATH = "mesh_path"
 F64 = npt.NDArray[np.float64]
 
 #: Why a flange frame is where it is (the draft's ``# from`` note).
-FLANGE = "the far end of the last link, on its joint's axis (a flange)"
+FLANGE = "the far end of the last link, the way the arm reaches (a flange)"
 #: Points around a cylinder's rim (enough for its far end along any direction, to 2 %).
 RIM = 16
 #: A link whose geometry reaches less than this past its origin (m) has no far end to speak of.
@@ -127,11 +127,12 @@ def far_end(tree: Tree, body: Body, direction: F64) -> F64:
 
 
 def flange_offset(tree: Tree, tip: Body) -> tuple[float, float, float] | None:
-    """Where a bare arm's flange is on its last link: the far end of it along the last axis.
+    """Where a bare arm's flange is on its last link: the far end of it, the way the arm reaches.
 
-    Why: an arm with nothing mounted and no flange link (a bare KUKA iiwa) still needs a tool
-    frame, and the one a user would bolt a tool to is the end face of the last link, on the
-    axis of the joint that turns it. ``None`` when the link has no geometry reaching out there.
+    Why: an arm with nothing mounted and no flange link (a bare KUKA iiwa, a humanoid's rigid
+    hand link) still needs a tool frame, and the one a user would bolt a tool to is the end
+    face of the last link: along the last joint's axis or the way its offset points, whichever
+    the link's geometry reaches farther along. ``None`` when it has no geometry out there.
     """
     c = tree.world.parent_connection(tip)
     if c is None or c.is_fixed:
@@ -141,19 +142,17 @@ def flange_offset(tree: Tree, tip: Body) -> tuple[float, float, float] | None:
     if not len(points) or float(np.linalg.norm(axis)) < 1e-9:
         return None
     axis = axis / np.linalg.norm(axis)
-    along = points @ axis
-    # The end face is on the side away from the joint's parent link (the arm reaches out that
-    # way); where the parent lies beside the axis, on the side the link reaches farther.
-    back = -c.origin[:3, :3].T @ c.origin[:3, 3]  # the parent's origin, in the tip's frame
-    ahead, behind = float(np.max(along)), float(-np.min(along))
-    lean = float(back @ axis)
-    if abs(lean) > MIN_REACH:
-        reach, sign = (ahead, 1.0) if lean < 0 else (behind, -1.0)
-    else:
-        reach, sign = (ahead, 1.0) if ahead >= behind else (behind, -1.0)
+    out = c.origin[:3, :3].T @ c.origin[:3, 3]  # the last offset, in the tip's frame
+    ways = [axis, -axis]
+    if float(np.linalg.norm(out)) >= MIN_REACH:
+        ways.append(out / np.linalg.norm(out))
+    # The way the link reaches farthest: its axis (a wrist roll, Panda's and iiwa's last
+    # link) or its offset (an elbow turning a rigid forearm and hand, Booster T1's).
+    way = max(ways, key=lambda w: float(np.max(points @ w)))
+    reach = float(np.max(points @ way))
     if reach < MIN_REACH:
         return None
-    x, y, z = (round(float(v), 4) for v in sign * reach * axis)
+    x, y, z = (round(float(v), 4) for v in reach * way)
     return (x + 0.0, y + 0.0, z + 0.0)
 
 

@@ -9,6 +9,8 @@ at the far ends of their geometry (``tips.between_tips``).
 
 from __future__ import annotations
 
+import numpy as np
+
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
 from robotspec.spec.draft.tips import between_tips
@@ -19,6 +21,7 @@ __all__ = [
     "TOOL_HINTS",
     "bare_fixed_leaf",
     "find_tool_frame",
+    "fixed_jaw",
     "hand_center",
     "is_named_tcp",
     "own_geometry",
@@ -142,7 +145,37 @@ def find_tool_frame(
         and (c := world.parent_connection(b)) is not None
         and (c.is_fixed or _leads_fingers(world, c, top))
     ]
-    return min(bare, key=lambda b: (world.depth(b), b.index)) if bare else None
+    if bare:
+        return min(bare, key=lambda b: (world.depth(b), b.index))
+    return fixed_jaw(world, top) if top.index not in exclude else None
+
+
+def fixed_jaw(world: World, hand: Body) -> Body | None:
+    """A one-jaw gripper's fixed jaw: the fixed leaf with geometry beside its one moving jaw.
+
+    Why: a gripper of one moving jaw (Darwin-OP's) closes it onto a fixed jaw; the fixed jaw's
+    frame, reaching at least as far out as the moving jaw's hinge, is where it grasps. Only
+    when the hand carries these two and nothing else.
+    """
+    kids = world.child_bodies(hand)
+    moving = [k for k in kids if (c := world.parent_connection(k)) is not None and not c.is_fixed]
+    if len(moving) != 1 or world.child_bodies(moving[0]):
+        return None
+    hinge = world.parent_connection(moving[0])
+    assert hinge is not None
+    out = float(np.linalg.norm(hinge.origin[:3, 3]))
+    jaws = [
+        k
+        for k in kids
+        if k is not moving[0]
+        and k.collisions
+        and not world.child_bodies(k)
+        and (c := world.parent_connection(k)) is not None
+        and c.is_fixed
+        and float(np.linalg.norm(c.origin[:3, 3])) >= out
+    ]
+    # Nothing else hangs on the hand (a gripper's linkage, fingertips: a hand of another kind).
+    return jaws[0] if len(jaws) == 1 and len(kids) == 2 else None
 
 
 def _leads_fingers(world: World, c: Connection, top: Body) -> bool:

@@ -145,7 +145,7 @@ def test_a_drafted_hand_reads_back_into_the_setup_draft(tmp_path: Path) -> None:
     out = tmp_path / "allegro.yaml"
     assert run_app(app, ["init", str(urdf), "-o", str(out)]) == 0
     assert "type: hand" in out.read_text(encoding="utf-8")
-    draft, _, _ = draft_of_spec(str(out))
+    draft = draft_of_spec(str(out)).draft
     (hand,) = draft.manipulators
     assert hand.is_hand and hand.thumb is not None and hand.thumb.root == "link_12.0"
     assert {f.root for f in hand.fingers.values()} == {"link_0.0", "link_4.0", "link_8.0"}
@@ -160,7 +160,7 @@ def test_the_setup_asks_about_a_drafted_hand_as_a_hand(tmp_path: Path) -> None:
     urdf = erd_robots() / "allegro_hand_description/urdf/allegro_right_hand.urdf"
     out = tmp_path / "allegro.yaml"
     assert run_app(app, ["init", str(urdf), "-o", str(out)]) == 0
-    draft, _, _ = draft_of_spec(str(out))
+    draft = draft_of_spec(str(out)).draft
     (q,) = [q for q in questions_of(draft) if q.part == "manipulators.hand"]
     assert q.guess.startswith("a hand of 4 fingers") and "make it generic" in q.choices
 

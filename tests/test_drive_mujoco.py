@@ -144,9 +144,13 @@ def test_a_trajectory_ends_on_its_last_waypoint(panda: PhysicsTarget) -> None:
     from robotspec.driver.trajectory import JointTrajectory
 
     robot = _driver(panda)
-    # from the reference: the Panda's home sits on joint 4's limit, and the measured arm a few
-    # micro-radians beyond it (MuJoCo's limits are soft), which a waypoint may not be
-    q0 = robot.sim_position
+    robot.run_for(0.5)
+    # From the state a client reads: the Panda's home sits on joint 4's limit and MuJoCo's
+    # limits are soft (the arm sinks micro-radians past it under gravity); the state reports
+    # it at the limit, so a trajectory starting there is not refused as outside the limits.
+    q0 = robot.robot_state.joint_position.copy()
+    lim = robot.limits
+    assert np.all(q0 >= lim.lower) and np.all(q0 <= lim.upper)
     q1 = _jog_target(robot, reach=0.4)
     robot.command_mode = "trajectory"
     times = np.linspace(0.0, 4.0, 41)
@@ -260,3 +264,16 @@ def test_a_stalled_loop_is_a_pause_for_the_physics(pr2: PhysicsTarget) -> None:
     assert np.max(np.abs(robot.robot_state.joint_position - target)) <= 1e-4
     simulated = robot.substeps * pr2.plant.model.opt.timestep
     assert simulated < robot._stopwatch_ellapsed_s() - 2.0  # the stalls were not simulated
+
+
+def test_a_joint_pressed_past_its_soft_limit_is_reported_at_the_limit(
+    panda: PhysicsTarget,
+) -> None:
+    """MuJoCo's limits are soft: the state a client reads stays within the joint limits."""
+    robot = _driver(panda)
+    i = robot.joint_names.index("panda_joint4")
+    data = robot.plant_data
+    data.qpos[panda.plant.joint_qpos[i]] = robot.limits.upper[i] + 0.02  # pushed past the stop
+    robot.step()
+    assert data.qpos[panda.plant.joint_qpos[i]] > robot.limits.upper[i]  # MuJoCo: still past
+    assert robot.robot_state.joint_position[i] == robot.limits.upper[i]  # reported at the stop

@@ -198,11 +198,19 @@ class MujocoSimRobot(SimRobot):
         self.substeps += n
 
     def _read_feedback(self, now: float) -> None:
-        """Step the plant, then report what MuJoCo measured (unless feedback is lost)."""
+        """Step the plant, then report what MuJoCo measured (unless feedback is lost).
+
+        Positions are reported within the joint limits: MuJoCo's limits are soft constraints,
+        so a link pressed against its stop (the Panda's fourth joint at home, under gravity)
+        sits a few microradians past it, and a client that starts a trajectory from the state
+        it reads would have its first waypoint refused as outside the limits. A real
+        controller's encoders read against a hard stop; the soft overlap is the simulator's.
+        """
         super()._read_feedback(now)
         if self._feedback_lost:
             return
         data = self._data
-        self._joint_position[:] = data.qpos[self._qadr]
+        lim = self._limits
+        self._joint_position[:] = np.clip(data.qpos[self._qadr], lim.lower, lim.upper)
         self._joint_velocity[:] = data.qvel[self._dadr]
         self._joint_effort[:] = data.actuator_force[self._act]

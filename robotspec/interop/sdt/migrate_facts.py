@@ -77,7 +77,8 @@ def drive_fact(world: World, srdf: Srdf | None, root: str, *, moves: bool) -> Dr
         None,
         f"drive: SDT's class gives the robot a mobile base, but its files do not say how it "
         f"moves ({found}, no planar or floating joint or SRDF virtual joint above '{root}'); "
-        "none written: add `drive: {type: omni | differential | floating}` if it moves",
+        "none written: add `drive: {type: omni | differential | floating}` if it moves "
+        "(to_sdt builds SDT's mobile base only for a robot with a drive)",
     )
 
 

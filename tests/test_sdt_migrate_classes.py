@@ -138,3 +138,24 @@ def test_hsrb_torso_mimic_hands_its_interface_to_its_leader(
     controlled = migration.spec["controlled_joints"]
     assert "arm_lift_joint" in controlled and "torso_lift_joint" not in controlled
     assert "drive" not in migration.spec  # the SRDF's planar virtual joint, read by the compiler
+
+
+def test_the_migrated_stretch_is_sdts_stretch_on_a_differential_drive(tmp_path: Path) -> None:
+    # With SDT's own faults taken out (its made-up camera heights: FK's instead; the arm's park
+    # state on the lift, a torso joint), the spec compiles and to_sdt gives an instance of
+    # SDT's Stretch class driving differentially, as coraplex's Stretch motions expect.
+    from semantic_digital_twin.robots.stretch import Stretch
+    from semantic_digital_twin.world_description.connections import DifferentialDrive
+
+    from robotspec.compiler import compile_robot
+    from robotspec.interop.sdt import to_sdt
+
+    urdf = _pycram("stretch_description.urdf")
+    spec = _migrate("stretch:Stretch", urdf, tmp_path).spec
+    for camera in spec["sensors"].values():
+        camera.pop("minimal_height"), camera.pop("maximal_height")
+    del spec["chains"]["arm"]["states"]["park"]["joint_lift"]
+    path = tmp_path / "stretch.yaml"
+    assert _validate_errors(spec, path, urdf) == []
+    robot = to_sdt(compile_robot(path, package_paths=[urdf.parent]))
+    assert type(robot) is Stretch and isinstance(robot.drive, DifferentialDrive)

@@ -16,6 +16,9 @@
  * eps exceeds margin plus its own tolerance (the caller's choice).
  *
  * Poses are row-major 4x4 (numpy's layout). Trees live in one capsule per checker.
+ *
+ * This file is the glue (arguments, the capsule, numpy results), on CPython's limited API
+ * (setup.py); the trees and proofs are in _meshcore_kernels.h, which includes no Python header.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -180,7 +183,6 @@ static const MeshSet *set_of(PyObject *cap) {
     return PyCapsule_GetPointer(cap, "robotspec.meshset");
 }
 
-
 /*
  * apart(set, poses (N, G, 4, 4), rows (K,), pairs (K,), g1 (Q,), g2 (Q,), eps) -> uint8 (K,)
  * Candidate c is (sample rows[c], geometry pair pairs[c] = (g1, g2)); poses are the geometries'
@@ -327,7 +329,6 @@ static PyObject *py_apart_one(PyObject *self, PyObject *args) {
 }
 
 /* ------------------------------------------------------------------------ points on a mesh */
-
 
 /*
  * on_surface(set, poses (N, G, 4, 4), row, g, point (3,), tol) -> bool

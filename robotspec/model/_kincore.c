@@ -15,6 +15,9 @@
  * large batch is split over Python threads by robotspec/model/kincore.py, each slice one call
  * that runs with the GIL released. An accelerator only: robotspec/model/_kincore_py.py gives the
  * same answers in numpy when this file could not be built.
+ *
+ * This file is the glue (arguments, tables in capsules, numpy results), on CPython's limited API
+ * (setup.py); the arithmetic is in _kincore_kernels.h, which includes no Python or numpy header.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -99,7 +102,6 @@ static PyArrayObject *as_config(PyObject *obj, int ndim, Py_ssize_t width) {
     return a;
 }
 
-
 /* The table in a capsule made by this module's constructor, else NULL with a TypeError naming it
  * (PyCapsule_GetPointer's own error is a ValueError about capsules, which the caller never made;
  * the numpy fallback raises this same TypeError for anything but its own tables). */
@@ -118,7 +120,6 @@ static void *table(PyObject *cap, const char *name, const char *what) {
     ((const Geoms *)table((cap), "robotspec.geoms", "a geometry table (from geoms())"))
 
 /* ------------------------------------------------------------------------------- the tree */
-
 
 static void tree_free(PyObject *capsule) {
     Tree *t = PyCapsule_GetPointer(capsule, "robotspec.tree");
@@ -220,7 +221,6 @@ static PyObject *py_tree(PyObject *self, PyObject *args) {
     return cap;
 }
 
-
 static PyObject *py_fk(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj;
     if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
@@ -247,7 +247,6 @@ static PyObject *py_fk(PyObject *self, PyObject *args) {
     Py_DECREF(q);
     return (PyObject *)out;
 }
-
 
 /* The caller's out array when it is one the core may write as native float64 poses (N, B, 4, 4):
  * TypeError for the wrong type, byte order or alignment, ValueError for the wrong shape. */
@@ -386,7 +385,6 @@ static PyObject *py_chain(PyObject *self, PyObject *args) {
     return cap;
 }
 
-
 static PyObject *py_chain_fk(PyObject *self, PyObject *args) {
     PyObject *cap, *qobj;
     if (!PyArg_ParseTuple(args, "OO", &cap, &qobj)) return NULL;
@@ -442,38 +440,7 @@ static PyObject *py_chain_jacobian(PyObject *self, PyObject *args) {
         Py_XDECREF((PyObject *)out);
         return out == NULL ? NULL : PyErr_NoMemory();
     }
-    double t[16], u[16], tip[16];
-    identity(t);
-    for (Py_ssize_t i = 0; i < c->n; i++) {
-        mul34(t, c->pre + 16 * i, u);
-        const double *a = c->axis + 3 * i;
-        for (int r = 0; r < 3; r++) {
-            z[3 * i + r] = u[4 * r] * a[0] + u[4 * r + 1] * a[1] + u[4 * r + 2] * a[2];
-            p[3 * i + r] = u[4 * r + 3];
-        }
-        apply_motion(u, (int)c->kind[i], a, qv[c->dof[i]] * c->mul[i] + c->off[i]);
-        memcpy(t, u, 12 * sizeof(double));
-    }
-    mul34(t, c->post, tip);
-    double *j = PyArray_DATA(out);
-    const Py_ssize_t w = c->n_cols;
-    for (Py_ssize_t i = 0; i < c->n; i++) {
-        const double *zi = z + 3 * i, *pi = p + 3 * i, m = c->mul[i];
-        const Py_ssize_t k = c->col[i];
-        if (c->kind[i] == KIND_REVOLUTE) {
-            const double dx = tip[3] - pi[0], dy = tip[7] - pi[1], dz = tip[11] - pi[2];
-            j[0 * w + k] += m * (zi[1] * dz - zi[2] * dy);
-            j[1 * w + k] += m * (zi[2] * dx - zi[0] * dz);
-            j[2 * w + k] += m * (zi[0] * dy - zi[1] * dx);
-            j[3 * w + k] += m * zi[0];
-            j[4 * w + k] += m * zi[1];
-            j[5 * w + k] += m * zi[2];
-        } else {
-            j[0 * w + k] += m * zi[0];
-            j[1 * w + k] += m * zi[1];
-            j[2 * w + k] += m * zi[2];
-        }
-    }
+    chain_jacobian_run(c, qv, z, p, PyArray_DATA(out));
     if (z != zbuf) free(z);
     if (p != pbuf) free(p);
     Py_DECREF(q);
@@ -538,7 +505,6 @@ static PyObject *py_geoms(PyObject *self, PyObject *args) {
     return cap;
 }
 
-
 /*
  * broad(geoms, body_poses (N, B, 4, 4) or (B, 4, 4), margin, mask or None)
  *   -> (rows int64 (K,), pairs int64 (K,), geometry poses (N, G, 4, 4))
@@ -586,43 +552,10 @@ static PyObject *py_broad(PyObject *self, PyObject *args) {
         for (npy_intp s = 0; s < n && !failed; s++) {
             const double *bs = bp + s * g->n_body * 16;
             double *gs = gv + s * g->n_geom * 16;
-            for (Py_ssize_t i = 0; i < g->n_geom; i++) {
-                const double *b = bs + 16 * g->body[i];
-                double *o = gs + 16 * i;
-                mul34(b, g->body_T_geom + 16 * i, o);
-                last_row(o);
-                const double *c = g->center + 3 * i, *h = g->half + 3 * i;
-                for (int a = 0; a < 3; a++) {
-                    const double *row = b + 4 * a;
-                    double cen = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + row[3];
-                    double hw = fabs(row[0]) * h[0] + fabs(row[1]) * h[1] + fabs(row[2]) * h[2];
-                    lo[3 * i + a] = cen - hw - margin;
-                    hi[3 * i + a] = cen + hw;
-                }
-            }
+            geoms_place(g, bs, gs, margin, lo, hi);
             for (Py_ssize_t k = 0; k < g->n_pair; k++) {
                 if (mv != NULL && !mv[k]) continue;
-                const int64_t i = g->g1[k], j = g->g2[k];
-                int apart = 0;
-                for (int a = 0; a < 3 && !apart; a++) {
-                    apart = !(lo[3 * i + a] <= hi[3 * j + a] && lo[3 * j + a] <= hi[3 * i + a]);
-                }
-                if (apart) continue;
-                /* Box frames: the body pose with the box centre as origin. */
-                double fa[16], fb[16], ha[3], hb[3];
-                const double *ba = bs + 16 * g->body[i], *bb = bs + 16 * g->body[j];
-                memcpy(fa, ba, 12 * sizeof(double));
-                memcpy(fb, bb, 12 * sizeof(double));
-                const double *ca = g->center + 3 * i, *cb = g->center + 3 * j;
-                for (int a = 0; a < 3; a++) {
-                    fa[4 * a + 3] = ba[4 * a] * ca[0] + ba[4 * a + 1] * ca[1] +
-                                    ba[4 * a + 2] * ca[2] + ba[4 * a + 3];
-                    fb[4 * a + 3] = bb[4 * a] * cb[0] + bb[4 * a + 1] * cb[1] +
-                                    bb[4 * a + 2] * cb[2] + bb[4 * a + 3];
-                    ha[a] = g->half[3 * i + a] + margin / 2.0;
-                    hb[a] = g->half[3 * j + a] + margin / 2.0;
-                }
-                if (obb_separated(fa, ha, fb, hb)) continue;
+                if (!pair_may_touch(g, bs, margin, lo, hi, k)) continue;
                 if ((size_t)nk == cap_k) {
                     cap_k *= 2;
                     int64_t *r2 = realloc(rows, sizeof(int64_t) * cap_k);

@@ -208,7 +208,6 @@ static void fk_run_batch(const Tree *t, const double *q, ptrdiff_t n, double *ou
 #endif
 }
 
-
 /*
  * A chain program: T = pre[0] m_0(q) pre[1] m_1(q) ... pre[n-1] m_{n-1}(q) post, where pre[i]
  * holds the fixed transforms before elementary motion i; col[i] is the Jacobian column motion i
@@ -232,6 +231,41 @@ static void chain_run(const Chain *c, const double *qv, double *o) {
     last_row(o);
 }
 
+/* The chain's Jacobian (6 x n_cols, row-major, zeroed by the caller) at qv into j; z and p hold
+ * 3 * n doubles each (every motion's world axis and origin). */
+static void chain_jacobian_run(const Chain *c, const double *qv, double *z, double *p, double *j) {
+    double t[16], u[16], tip[16];
+    identity(t);
+    for (ptrdiff_t i = 0; i < c->n; i++) {
+        mul34(t, c->pre + 16 * i, u);
+        const double *a = c->axis + 3 * i;
+        for (int r = 0; r < 3; r++) {
+            z[3 * i + r] = u[4 * r] * a[0] + u[4 * r + 1] * a[1] + u[4 * r + 2] * a[2];
+            p[3 * i + r] = u[4 * r + 3];
+        }
+        apply_motion(u, (int)c->kind[i], a, qv[c->dof[i]] * c->mul[i] + c->off[i]);
+        memcpy(t, u, 12 * sizeof(double));
+    }
+    mul34(t, c->post, tip);
+    const ptrdiff_t w = c->n_cols;
+    for (ptrdiff_t i = 0; i < c->n; i++) {
+        const double *zi = z + 3 * i, *pi = p + 3 * i, m = c->mul[i];
+        const ptrdiff_t k = c->col[i];
+        if (c->kind[i] == KIND_REVOLUTE) {
+            const double dx = tip[3] - pi[0], dy = tip[7] - pi[1], dz = tip[11] - pi[2];
+            j[0 * w + k] += m * (zi[1] * dz - zi[2] * dy);
+            j[1 * w + k] += m * (zi[2] * dx - zi[0] * dz);
+            j[2 * w + k] += m * (zi[0] * dy - zi[1] * dx);
+            j[3 * w + k] += m * zi[0];
+            j[4 * w + k] += m * zi[1];
+            j[5 * w + k] += m * zi[2];
+        } else {
+            j[0 * w + k] += m * zi[0];
+            j[1 * w + k] += m * zi[1];
+            j[2 * w + k] += m * zi[2];
+        }
+    }
+}
 
 /*
  * Geometries (each on a body, with a body-frame box) and the geometry pairs to test. The broad
@@ -272,6 +306,53 @@ static int obb_separated(const double *a, const double *ha, const double *b, con
         }
     }
     return 0;
+}
+
+/* One sample's geometry poses (n_geom x 16) from its body poses bs into gs, and each
+ * geometry's world-aligned bounds: lo (less the margin) and hi, 3 doubles per geometry. */
+static void geoms_place(const Geoms *g, const double *bs, double *gs, double margin, double *lo,
+                        double *hi) {
+    for (ptrdiff_t i = 0; i < g->n_geom; i++) {
+        const double *b = bs + 16 * g->body[i];
+        double *o = gs + 16 * i;
+        mul34(b, g->body_T_geom + 16 * i, o);
+        last_row(o);
+        const double *c = g->center + 3 * i, *h = g->half + 3 * i;
+        for (int a = 0; a < 3; a++) {
+            const double *row = b + 4 * a;
+            double cen = row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + row[3];
+            double hw = fabs(row[0]) * h[0] + fabs(row[1]) * h[1] + fabs(row[2]) * h[2];
+            lo[3 * i + a] = cen - hw - margin;
+            hi[3 * i + a] = cen + hw;
+        }
+    }
+}
+
+/* 1 when pair k may come within the margin at the sample whose body poses are bs (bounds lo, hi
+ * from geoms_place): the bounds overlap and no axis of the two oriented boxes parts them. */
+static int pair_may_touch(const Geoms *g, const double *bs, double margin, const double *lo,
+                          const double *hi, ptrdiff_t k) {
+    const int64_t i = g->g1[k], j = g->g2[k];
+    int apart = 0;
+    for (int a = 0; a < 3 && !apart; a++) {
+        apart = !(lo[3 * i + a] <= hi[3 * j + a] && lo[3 * j + a] <= hi[3 * i + a]);
+    }
+    if (apart) return 0;
+    /* Box frames: the body pose with the box centre as origin. */
+    double fa[16], fb[16], ha[3], hb[3];
+    const double *ba = bs + 16 * g->body[i], *bb = bs + 16 * g->body[j];
+    memcpy(fa, ba, 12 * sizeof(double));
+    memcpy(fb, bb, 12 * sizeof(double));
+    const double *ca = g->center + 3 * i, *cb = g->center + 3 * j;
+    for (int a = 0; a < 3; a++) {
+        fa[4 * a + 3] = ba[4 * a] * ca[0] + ba[4 * a + 1] * ca[1] + ba[4 * a + 2] * ca[2] +
+                        ba[4 * a + 3];
+        fb[4 * a + 3] = bb[4 * a] * cb[0] + bb[4 * a + 1] * cb[1] + bb[4 * a + 2] * cb[2] +
+                        bb[4 * a + 3];
+        ha[a] = g->half[3 * i + a] + margin / 2.0;
+        hb[a] = g->half[3 * j + a] + margin / 2.0;
+    }
+    return !obb_separated(fa, ha, fb, hb);
 }
 
 #endif /* ROBOTSPEC_KINCORE_KERNELS_H */

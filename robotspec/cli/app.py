@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from robotspec.cli import (
+    annotate_cmd,
     collisions_cmd,
     demo_cmd,
     doctor_cmd,
@@ -63,6 +64,7 @@ for _module in (  # in the order a user meets them: check, look, start, write, d
     migrate_cmd,
     misc_cmd,
     export_cmd,
+    annotate_cmd,
     collisions_cmd,
     render_cmd,
     drive_cmd,

@@ -8,6 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from robotspec.compiler import check_spec
 from robotspec.description.load import load_description
@@ -229,3 +230,25 @@ def test_a_linkage_gripper_s_four_branches_are_two_sides_by_where_they_start(
     assert m.is_gripper
     assert m.thumb is not None and m.finger is not None
     assert {m.thumb.tip, m.finger.tip} == {"left_pad", "right_pad"}
+
+
+def test_stl_vertices_are_read_without_trimesh_as_trimesh_reads_them(tmp_path: Path) -> None:
+    from robotspec.errors import RobotSpecError
+    from robotspec.files.meshes import read_triangles
+    from robotspec.spec.draft.tips import mesh_vertices
+
+    ascii_stl = tmp_path / "tri.stl"
+    ascii_stl.write_text(
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+        "vertex 0 2 0.5\nendloop\nendfacet\nendsolid t\n"
+    )
+    assert mesh_vertices(str(ascii_stl)).max(axis=0).tolist() == [1.0, 2.0, 0.5]
+    bad = tmp_path / "bad.stl"
+    bad.write_text("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 nan\nendsolid t\n")
+    with pytest.raises(RobotSpecError, match="finite"):
+        mesh_vertices(str(bad))
+    meshes = erd_robots() / "g1_description" / "meshes"
+    for stl in sorted(meshes.glob("*.STL"))[:5]:  # binary STL files
+        mine, theirs = mesh_vertices(str(stl)), read_triangles(str(stl))[0]
+        assert np.allclose(mine.min(axis=0), theirs.min(axis=0))
+        assert np.allclose(mine.max(axis=0), theirs.max(axis=0))

@@ -9,6 +9,8 @@ geometry when they have none), measured along the way the hand reaches.
 
 from __future__ import annotations
 
+import re
+import struct
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -20,10 +22,20 @@ from robotspec.model.entities import Body
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
 from robotspec.spec.draft.tree import Tree
 
-__all__ = ["FLANGE", "MESH_PATH", "between_tips", "far_end", "flange_offset", "shape_points"]
+__all__ = [
+    "FLANGE",
+    "MESH_PATH",
+    "between_tips",
+    "far_end",
+    "flange_offset",
+    "mesh_vertices",
+    "shape_points",
+]
 
 #: The key of ``Tree.memo`` holding how to find a mesh file from its URI (``None``: not found).
 MESH_PATH = "mesh_path"
+#: The key of ``Tree.memo`` holding the points of each body read so far (by body index).
+BODY_POINTS = "body_points"
 
 F64 = npt.NDArray[np.float64]
 
@@ -58,10 +70,8 @@ def shape_points(shape: Shape, find: Callable[[str], str | None] | None = None) 
         tips = np.array([[0.0, 0.0, -g.length / 2 - cap], [0.0, 0.0, g.length / 2 + cap]])
         local = np.vstack([*ends, tips])
     elif isinstance(g, Mesh) and (path := g.path or (find(g.uri) if find else None)):
-        from robotspec.files.meshes import read_triangles
-
         try:
-            vertices, _ = read_triangles(path)
+            vertices = mesh_vertices(path)
         except RobotSpecError:
             return np.zeros((0, 3))
         local = vertices * np.asarray(g.scale, dtype=np.float64)
@@ -70,6 +80,48 @@ def shape_points(shape: Shape, find: Callable[[str], str | None] | None = None) 
     homo = np.hstack([local, np.ones((len(local), 1))])
     out: F64 = (np.asarray(shape.origin, dtype=np.float64) @ homo.T).T[:, :3]
     return out
+
+
+_STL_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
+
+
+def mesh_vertices(path: str) -> F64:
+    """A mesh file's vertices (unscaled); an STL read here, other formats by ``read_triangles``.
+
+    Why a reader of its own for STL: only the vertices are needed, and trimesh's import alone
+    costs ``init`` about 0.7 s of CPU; STL, the usual collision format, is read with numpy
+    under the same caps (file size, triangles) and refusals (non-finite vertices).
+    """
+    from robotspec.files.limits import limits
+    from robotspec.files.meshes import read_mesh_bytes, read_triangles
+
+    if not path.lower().endswith(".stl"):
+        return read_triangles(path)[0]
+    data = read_mesh_bytes(path)
+    cap = limits().max_mesh_triangles
+    if len(data) >= 84:
+        (count,) = struct.unpack_from("<I", data, 80)
+        if len(data) == 84 + 50 * count:  # binary: 12 floats and 2 bytes a triangle
+            if count > cap:
+                raise RobotSpecError("mesh has too many triangles", file=path, kind="mesh")
+            rows = np.frombuffer(data, dtype=np.uint8, offset=84).reshape(count, 50)
+            floats = rows[:, :48].copy().view("<f4").reshape(count, 12)
+            vertices = floats[:, 3:].reshape(-1, 3).astype(np.float64)
+            return _finite(vertices, path)
+    found = _STL_VERTEX.findall(data)
+    if len(found) > 3 * cap:
+        raise RobotSpecError("mesh has too many triangles", file=path, kind="mesh")
+    try:
+        vertices = np.array(found, dtype=np.float64).reshape(-1, 3)
+    except ValueError:
+        raise RobotSpecError("cannot read mesh: a vertex is no number", file=path) from None
+    return _finite(vertices, path)
+
+
+def _finite(vertices: F64, path: str) -> F64:
+    if not len(vertices) or not np.all(np.isfinite(vertices)):
+        raise RobotSpecError("mesh has no finite vertices", file=path, kind="mesh")
+    return vertices
 
 
 def _finder(tree: Tree) -> Callable[[str], str | None]:
@@ -101,10 +153,14 @@ def _finder(tree: Tree) -> Callable[[str], str | None]:
 
 
 def _body_points(tree: Tree, body: Body) -> F64:
-    shapes = body.collisions or body.visuals
-    parts = [shape_points(s, _finder(tree)) for s in shapes]
-    parts = [p for p in parts if len(p)]
-    return np.vstack(parts) if parts else np.zeros((0, 3))
+    """Points bounding a body's collision geometry (else its visual), each body read once."""
+    known: dict[int, F64] = tree.memo.setdefault(BODY_POINTS, {})
+    if body.index not in known:
+        shapes = body.collisions or body.visuals
+        parts = [shape_points(s, _finder(tree)) for s in shapes]
+        parts = [p for p in parts if len(p)]
+        known[body.index] = np.vstack(parts) if parts else np.zeros((0, 3))
+    return known[body.index]
 
 
 def far_end(tree: Tree, body: Body, direction: F64) -> F64:

@@ -74,6 +74,7 @@ def mjcf_cmd(
     out = annotate_mjcf(robot, model, mapping=mapping, excludes=excludes, output=output)
     inputs.update(spec_inputs(path, package_paths=package_path or (), robot=robot))
     write_file(output, out.xml, force=force, inputs=inputs)
+    site_error = out.check_file(output)  # the file as written, read back by MuJoCo
     for note in out.notes:
         sys.stderr.write(f"note: {note}\n")
     how = ", ".join(
@@ -94,6 +95,6 @@ def mjcf_cmd(
     )
     sites = ", ".join(f"{s.name} on {s.body}" for s in out.sites) or "none"
     sys.stderr.write(
-        f"wrote {output}: sites {sites} (within {out.site_error:.1g} m of the tool frames), "
+        f"wrote {output}: sites {sites} (within {site_error:.1g} m of the tool frames, read back), "
         f"{plural(len(out.cameras), 'camera')}, {plural(len(out.keys), 'keyframe')}{excluded}\n"
     )

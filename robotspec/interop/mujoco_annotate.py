@@ -14,9 +14,10 @@ Nothing of theirs is changed: a name already taken gets a ``_robotspec`` suffix 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -71,6 +72,8 @@ class Annotation:
     site_error: float
     body_error: float
     notes: tuple[str, ...]
+    #: Measure ``site_error`` again on the written file, read back by MuJoCo (m).
+    check_file: Callable[[Path], float] = field(repr=False, compare=False)
 
 
 def _states(robot: AbstractRobot) -> dict[str, JointState]:
@@ -199,11 +202,16 @@ class _Annotator:
         return b
 
     # ------------------------------------------------------------------ kinematics
-    def qpos(self, q: F64) -> F64:
-        """Their ``qpos`` for our configuration: matched joints set, the others at qpos0."""
+    def qpos(self, q: F64, only: set[int] | None = None) -> F64:
+        """Their ``qpos`` for our configuration: matched joints set, the others at qpos0.
+
+        ``only``: set just the joints driven by these DOFs (a named state's), the rest at qpos0.
+        """
         out = np.array(self.their.qpos0, dtype=np.float64)
         for m in self.joints.pairs:
             c = self.world.get_connection_by_name(m.ours)
+            if only is not None and c.dofs[0] not in only:
+                continue
             value = float(q[c.dofs[0]])
             if c.mimic is not None:
                 value = c.mimic.multiplier * value + c.mimic.offset
@@ -336,10 +344,12 @@ def annotate_mjcf(
         cameras.append(
             Placed(their.add_camera(cam.name, body, pose, fovy, a.notes), body, cam.name)
         )
-    keys = [
-        their.add_key(key, a.qpos(robot.world.configuration(state.as_dict())), a.notes)
-        for key, state in _states(robot).items()
-    ]
+    keys = []
+    for key, state in _states(robot).items():
+        values = state.as_dict()
+        dofs = {robot.world.get_degree_of_freedom_by_name(n).index for n in values}
+        qpos = a.qpos(robot.world.configuration(values), only=dofs)
+        keys.append(their.add_key(key, qpos, a.notes))
     added: list[tuple[str, str]] = []
     if excludes:
         for pair in sorted(tuple(sorted(p)) for p in robot.disabled_collision_pairs if len(p) == 2):
@@ -349,14 +359,24 @@ def annotate_mjcf(
                 continue  # a body below an unmatched joint: their model has no such body
             if their.add_exclude(ends[0], ends[1]):
                 added.append((ends[0], ends[1]))
-    site_error = their.site_error(targets, qs, a.qpos, robot, a.root, a.pairs[a.root], fit)
+
+    def measure(model: Any = None) -> float:
+        root = a.pairs[a.root]
+        return their.site_error(targets, qs, a.qpos, robot, a.root, root, fit, model)
+
+    site_error = measure()
     if site_error > TOLERANCE:
         raise RobotSpecError(  # pragma: no cover - the fit proved it; a bug if it fails
             f"a site added to {their.shown} is {site_error:.3g} m from its tool frame",
             file=their.shown,
             kind="site",
         )
-    xml = their.to_xml(output)
+    xml = their.to_xml(output, a.notes)
+
+    def check_file(path: Path) -> float:
+        """The site error measured on the written file, read back by MuJoCo."""
+        return measure(read_model(path).model)
+
     return Annotation(
         xml=xml,
         joints=a.joints,
@@ -369,4 +389,5 @@ def annotate_mjcf(
         site_error=site_error,
         body_error=fit.worst,
         notes=tuple(a.notes),
+        check_file=check_file,
     )

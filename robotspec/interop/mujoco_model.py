@@ -9,7 +9,6 @@ is replaced.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -18,7 +17,9 @@ import numpy as np
 
 from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError, missing_file
+from robotspec.export.mjcf_bodies import nums
 from robotspec.interop.mujoco_fit import FrameFit, inverse
+from robotspec.interop.mujoco_xml import Edit, site_edit, write_edits
 from robotspec.model.rotations import matrix_to_quat_wxyz
 
 if TYPE_CHECKING:
@@ -85,6 +86,7 @@ class TheirModel:
         self.qpos0 = np.array(model.qpos0, dtype=np.float64)
         self._data = mujoco.MjData(model)
         self._ctrl_noted = False
+        self.edits: list[Edit] = []
 
     # ------------------------------------------------------------------ reading
     def body_poses(self, qpos: F64, model: Any = None, data: Any = None) -> dict[str, F64]:
@@ -119,17 +121,17 @@ class TheirModel:
     def add_site(self, wanted: str, body: str, pose: F64, notes: list[str]) -> str:
         """A site named after ``wanted`` at ``pose`` in their ``body``."""
         n = self._free("site", wanted, [s.name for s in self.spec.sites], notes)
-        self._body(body).add_site(
-            name=n, pos=pose[:3, 3], quat=matrix_to_quat_wxyz(pose[:3, :3]), size=[0.005, 0, 0]
-        )
+        quat = matrix_to_quat_wxyz(pose[:3, :3])
+        self._body(body).add_site(name=n, pos=pose[:3, 3], quat=quat)
+        self.edits.append(site_edit("site", body, n, pose[:3, 3], quat))
         return n
 
     def add_camera(self, wanted: str, body: str, pose: F64, fovy: float, notes: list[str]) -> str:
         """A camera (MuJoCo's look along -z) at ``pose`` in ``body``, ``fovy`` in degrees."""
         n = self._free("camera", wanted, [c.name for c in self.spec.cameras], notes)
-        self._body(body).add_camera(
-            name=n, pos=pose[:3, 3], quat=matrix_to_quat_wxyz(pose[:3, :3]), fovy=fovy
-        )
+        quat = matrix_to_quat_wxyz(pose[:3, :3])
+        self._body(body).add_camera(name=n, pos=pose[:3, 3], quat=quat, fovy=fovy)
+        self.edits.append(site_edit("camera", body, n, pose[:3, 3], quat, fovy=fovy))
         return n
 
     def servo_ctrl(self, qpos: F64, notes: list[str] | None) -> F64:
@@ -164,8 +166,11 @@ class TheirModel:
         ctrl = self.servo_ctrl(qpos, None if self._ctrl_noted else notes)
         self._ctrl_noted = True
         key = self.spec.add_key(name=n, qpos=qpos)
+        attrib = [("name", n), ("qpos", nums(qpos))]
         if self.model.nu:
             key.ctrl = ctrl
+            attrib.append(("ctrl", nums(ctrl)))
+        self.edits.append(Edit("key", None, tuple(attrib)))
         return n
 
     def add_exclude(self, first: str, second: str) -> bool:
@@ -176,6 +181,7 @@ class TheirModel:
             if {e.bodyname1, e.bodyname2} == {first, second}:
                 return False
         self.spec.add_exclude(bodyname1=first, bodyname2=second)
+        self.edits.append(Edit("exclude", None, (("body1", first), ("body2", second))))
         return True
 
     # ------------------------------------------------------------------ checking, writing
@@ -188,10 +194,15 @@ class TheirModel:
         our_root: int,
         their_root: str,
         fit: FrameFit,
+        model: Any = None,
     ) -> float:
-        """The largest distance (m) of an added site from its tool frame, on the compiled result."""
+        """The largest distance (m) of an added site from its tool frame.
+
+        ``model``: a compiled model to measure (the written file, read back); by default the
+        edited ``MjSpec`` compiled.
+        """
         try:
-            model = self.spec.compile()
+            model = model or self.spec.compile()
         except ValueError as exc:  # pragma: no cover - MuJoCo accepted the model before
             raise RobotSpecError(
                 f"MuJoCo refuses the annotated model: {exc}", file=self.shown
@@ -211,13 +222,6 @@ class TheirModel:
                 worst = max(worst, float(np.linalg.norm(site[:3] - want[:3, 3])))
         return worst
 
-    def to_xml(self, output: Path | None) -> str:
-        """The edited model as MJCF; asset folders re-pointed when ``output`` is elsewhere."""
-        here = self.path.resolve().parent
-        if output is not None and Path(output).resolve().parent != here:
-            there = Path(output).resolve().parent
-            for attr in ("meshdir", "texturedir"):
-                value = getattr(self.spec, attr)
-                if not os.path.isabs(value or "."):
-                    setattr(self.spec, attr, os.path.relpath(here / (value or "."), there))
-        return str(self.spec.to_xml())
+    def to_xml(self, output: Path | None, notes: list[str]) -> str:
+        """Their file's text with the added elements (see :mod:`robotspec.interop.mujoco_xml`)."""
+        return write_edits(self.path, self.edits, output, notes)

@@ -290,3 +290,14 @@ def test_a_new_camera_keeps_its_open_question_in_the_saved_file(tmp_path: Path) 
         "generic_optical)",
         "+    preset: realsense_d435",
     ]
+
+
+def test_a_new_part_in_a_section_that_lost_its_only_entry_keeps_the_drafters_lines(
+    tmp_path: Path,
+) -> None:
+    s = _open("pr2", tmp_path / "pr2.yaml")
+    s.add_camera("cam1", "head_plate_frame")
+    s.remove("sensors.kinect")  # sensors: held only the kinect in the file
+    text = s.snapshot.text
+    assert "sensors:\n  cam1:\n    type: camera\n" in text
+    assert "field_of_view: {horizontal: 1.0, vertical: 0.75}  # DECIDE: the camera's angles" in text

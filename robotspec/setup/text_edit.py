@@ -271,8 +271,16 @@ class _Text:
             raise TextEditError("cannot rewrite a list item as a block", kind="value")
         block = not node.flow_style if isinstance(node, yaml.CollectionNode) else False
         indent = key.start_mark.column
-        nest = isinstance(value, Mapping) and value
-        lines = _block(path[-1], value, indent, path[:-1])[1:] if nest else []
+        lines: list[str] = []
+        if (
+            isinstance(value, Mapping)
+            and value
+            and len(_block(path[-1], value, indent, path[:-1])) > 1
+        ):
+            for k, v in value.items():  # each entry as the drafter writes it, if it is a part
+                lines += self._model_lines((*path, k), v, indent + 2) or _block(
+                    k, v, indent + 2, path
+                )
         if not lines:  # one flow line after all
             if block:  # the block's lines go; the value follows its key
                 colon = self.text.find(":", key.end_mark.index)

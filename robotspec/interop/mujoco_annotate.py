@@ -128,8 +128,12 @@ class _Annotator:
         for key, state in _states(self.robot).items():
             for name in state.as_dict():
                 needed.setdefault(name, f"of state '{key}'")
+        matched = self.joints.ours_of()
+        free = [j for j in self.their.joints if j not in matched]
         errors = [
-            unmatched_error("joint", n, role, self.their.joints, self.prefixes, self.their.shown)
+            unmatched_error(
+                "joint", n, role, self.their.joints, free, self.prefixes, self.their.shown
+            )
             for n, role in needed.items()
             if n not in theirs
         ]

@@ -123,10 +123,12 @@ def fit_frames(ours: Mapping[str, Sequence[F64]], theirs: Mapping[str, Sequence[
 
     Both map a body key to its pose relative to the matched root at the same configurations,
     the first of which defines the offsets. The identity root offset is tried first, then the
-    solved one; the better fit is returned (the caller judges it against :data:`TOLERANCE`).
+    solved one; the one with fewer misfit bodies (then the smaller misfit) is returned, so a
+    wrong joint shows as the bodies below it (the caller judges against :data:`TOLERANCE`).
     """
     first = _fit_with(np.eye(4), ours, theirs)
     if first.worst <= TOLERANCE:
         return first
     second = _fit_with(_solve_root(ours, theirs), ours, theirs)
-    return second if second.worst < first.worst else first
+    better = (len(second.failing()), second.worst) < (len(first.failing()), first.worst)
+    return second if better else first

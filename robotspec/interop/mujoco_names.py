@@ -168,12 +168,21 @@ def check_map(
 
 
 def unmatched_error(
-    kind: str, ours: str, role: str, theirs: Sequence[str], prefixes: tuple[str, str], model: str
+    kind: str,
+    ours: str,
+    role: str,
+    theirs: Sequence[str],
+    free: Sequence[str],
+    prefixes: tuple[str, str],
+    model: str,
 ) -> RobotSpecError:
-    """Our ``kind`` ``ours`` (needed as ``role``) has no match: name their closest names."""
+    """Our ``kind`` ``ours`` (needed as ``role``) has no match: name their likeliest names.
+
+    Their names still unmatched (``free``) come first, as only one of them can be it.
+    """
     pt, po = prefixes
     probe = pt + ours[len(po) :] if po and ours.startswith(po) else ours
-    suggestions = closest_names(probe, theirs) or closest_names(ours, theirs)
+    suggestions = closest_names(probe, free) or tuple(free[:3]) or closest_names(probe, theirs)
     near = (
         f"; closest in the model: {', '.join(repr(s) for s in suggestions)}" if suggestions else ""
     )

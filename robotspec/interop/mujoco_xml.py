@@ -15,6 +15,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 from lxml import etree
 
 from robotspec.errors import RobotSpecError
@@ -33,9 +34,15 @@ class Edit:
     attrib: tuple[tuple[str, str], ...]
 
 
+def _clean(values: object) -> str:
+    rounded = np.round(np.asarray(values, dtype=np.float64), 12) + 0.0  # + 0.0: no "-0"
+    return nums([float(v) for v in rounded])
+
+
 def site_edit(tag: str, body: str, name: str, pos: object, quat: object, **extra: float) -> Edit:
     """A site or camera in ``body`` at ``pos``/``quat`` (full precision), with ``extra``."""
-    attrib = [("name", name), ("pos", nums(pos)), ("quat", nums(quat))]  # type: ignore[arg-type]
+    # Rounded at 1e-12 (m, or of a unit quaternion): FK's last-bit noise is no information.
+    attrib = [("name", name), ("pos", _clean(pos)), ("quat", _clean(quat))]
     attrib += [(k, num(v)) for k, v in extra.items()]
     return Edit(tag, body, tuple(attrib))
 

@@ -2,12 +2,18 @@
 
 from __future__ import annotations
 
+import copy
 import difflib
+import random
 import shutil
 import threading
 from pathlib import Path
+from typing import Any
 
 import pytest
+import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robotspec.compiler import shipped_specs
 from robotspec.setup import SetupSession
@@ -301,3 +307,40 @@ def test_a_new_part_in_a_section_that_lost_its_only_entry_keeps_the_drafters_lin
     text = s.snapshot.text
     assert "sensors:\n  cam1:\n    type: camera\n" in text
     assert "field_of_view: {horizontal: 1.0, vertical: 0.75}  # DECIDE: the camera's angles" in text
+
+
+def _mutate(data: dict[str, Any], rng: random.Random) -> dict[str, Any]:
+    """``data`` with a few keys set, added or deleted, at any depth."""
+    out = copy.deepcopy(data)
+    values: list[Any] = [1.5, "x y", {"root": "a", "tip": "b"}, [1, 2], {"s": {"j": 0.1}}, {}]
+
+    def walk(d: dict[str, Any]) -> None:
+        for _ in range(rng.randint(1, 3)):
+            if not d:
+                return
+            k = rng.choice(list(d))
+            r = rng.random()
+            if r < 0.2 and len(d) > 1:
+                del d[k]
+            elif r < 0.4:
+                d[f"new_{rng.randint(0, 99)}"] = copy.deepcopy(rng.choice(values))
+            elif r < 0.6:
+                d[k] = copy.deepcopy(rng.choice([0.25, "name", [0.0, 1.0], {"q": 1}, {}]))
+            elif isinstance(d[k], dict):
+                walk(d[k])
+
+    walk(out)
+    return out
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), which=st.integers(0, len(SHIPPED) - 1))
+def test_edit_text_states_exactly_the_new_data(seed: int, which: int) -> None:
+    """Whatever changes, the edited text reads as the new data; what did not change stays."""
+    text = SHIPPED[which].read_text()
+    old = yaml.safe_load(text)
+    new = _mutate(old, random.Random(seed))
+    out = edit_text(text, old, new)
+    assert yaml.safe_load(out) == new
+    if new == old:
+        assert out == text

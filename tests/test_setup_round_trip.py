@@ -344,3 +344,39 @@ def test_edit_text_states_exactly_the_new_data(seed: int, which: int) -> None:
     assert yaml.safe_load(out) == new
     if new == old:
         assert out == text
+
+
+def test_what_the_page_changes_reads_back_as_the_same_draft(tmp_path: Path) -> None:
+    """Random session edits on the PR2: the saved text, reopened, is the session's draft."""
+    from robotspec.setup.round_trip import data_of
+
+    rng = random.Random(7)
+    s = _open("pr2", tmp_path / "pr2.yaml")
+    links = list(s.world.body_names)
+    out = tmp_path / "check.yaml"
+    for step in range(12):
+        part = rng.choice(s.parts())
+        try:
+            match rng.choice(("state", "chain", "remove", "add", "camera", "answer", "undo")):
+                case "state":
+                    joints = s.part_joints("robot")[step : step + 2]
+                    s.set_state("robot", rng.choice("ab"), dict.fromkeys(joints, 0.1 * step))
+                case "chain" if part.partition(".")[0] in ("chains", "torso", "neck"):
+                    s.set_chain(part, tip=rng.choice(links), kind=rng.choice((None, "leg")))
+                case "remove" if part != "drive":
+                    s.remove(part)
+                case "add":
+                    s.add_manipulator(f"h{step}", rng.choice(links), rng.choice(links))
+                case "camera":
+                    s.add_camera(f"cam{step}", rng.choice(links))
+                case "answer" if s.snapshot.questions:
+                    q = rng.choice(s.snapshot.questions)
+                    s.answer(q.id, rng.choice(q.choices))
+                case "undo":
+                    s.undo()
+        except SetupError:
+            continue
+        out.write_text(s.snapshot.text)
+        again = SetupSession.open(str(out), output=out)
+        assert data_of(again.draft()) == data_of(s.draft())
+        assert [q.id for q in again.snapshot.questions] == [q.id for q in s.snapshot.questions]

@@ -248,3 +248,32 @@ def test_cli_exit_codes(
         "error: robotspec annotate mjcf needs MuJoCo; install it with "
         "`pip install 'robotspec[mujoco]'`\n"
     )
+
+
+def _without_fingers(tree: Any) -> None:
+    for el in list(tree.iter("joint", "equality")):
+        if el.tag == "equality" or "finger" in el.get("name", ""):
+            el.getparent().remove(el)
+
+
+def test_a_model_without_the_part_says_so(tmp_path: Path, panda: AbstractRobot) -> None:
+    path = foreign(tmp_path, "panda", "robot0_", _without_fingers)
+    with pytest.raises(RobotSpecError) as err:
+        annotate_mjcf(panda, path)
+    assert err.value.message.endswith(
+        "each joint of the model is matched to another one of the robot, so the model has no "
+        "such part (an arm without its gripper?)"
+    )
+
+
+def test_a_looser_tolerance_accepts_a_rounded_model(tmp_path: Path, panda: AbstractRobot) -> None:
+    def round_joint2(tree: Any) -> None:  # a mount rounded by hand, as robosuite's 0.924
+        body = next(b for b in tree.iter("body") if b.get("name") == "robot0_panda_link3")
+        body.set("quat", "0.7072 0.7070 0 0")
+
+    path = foreign(tmp_path, "panda", "robot0_", round_joint2)
+    with pytest.raises(RobotSpecError) as err:
+        annotate_mjcf(panda, path)
+    assert "does not move as the robot's" in err.value.message
+    out = annotate_mjcf(panda, path, tolerance=1e-3)
+    assert 1e-6 < out.body_error <= 1e-3 and out.site_error <= 1e-3

@@ -42,6 +42,14 @@ def mjcf_cmd(
             "--excludes", help="Add the disabled collision pairs as <exclude> of matched bodies."
         ),
     ] = False,
+    tolerance: Annotated[
+        float,
+        typer.Option(
+            "--tolerance",
+            help="How far (m, rad) their bodies and the sites may stray from the robot's "
+            "kinematics (a hand-rounded model needs more than the default).",
+        ),
+    ] = 1e-6,
     force: Force = False,
     package_path: PackagePath = None,
 ) -> None:
@@ -71,7 +79,9 @@ def mjcf_cmd(
     result = check_spec(path, package_paths=package_path or ())
     robot = result.robot
     assert robot is not None
-    out = annotate_mjcf(robot, model, mapping=mapping, excludes=excludes, output=output)
+    out = annotate_mjcf(
+        robot, model, mapping=mapping, excludes=excludes, output=output, tolerance=tolerance
+    )
     inputs.update(spec_inputs(path, package_paths=package_path or (), robot=robot))
     write_file(output, out.xml, force=force, inputs=inputs)
     site_error = out.check_file(output)  # the file as written, read back by MuJoCo

@@ -101,7 +101,14 @@ def _camera_frame(camera: Camera) -> F64:
 class _Annotator:
     """One annotation: the robot, their model, the matches and the proved offsets."""
 
-    def __init__(self, robot: AbstractRobot, their: TheirModel, mapping: Mapping[str, str]):
+    def __init__(
+        self,
+        robot: AbstractRobot,
+        their: TheirModel,
+        mapping: Mapping[str, str],
+        tolerance: float = TOLERANCE,
+    ):
+        self.tolerance = tolerance
         self.robot, self.world, self.their = robot, robot.world, their
         self.notes: list[str] = []
         our_joints = [c.name for c in self.world.connections if c.type in _MOVING]
@@ -257,7 +264,7 @@ class _Annotator:
 
     def diagnose(self, fit: FrameFit, qs: list[F64]) -> RobotSpecError:
         """Name the joint that makes the first failing body (nearest the root) misfit."""
-        bad = fit.failing()
+        bad = fit.failing(self.tolerance)
         index = {self.world.bodies[b].name: b for b in self.pairs}
         first = min(bad, key=lambda k: (len(self._ancestors(index[k])), index[k]))
         body = index[first]
@@ -268,7 +275,7 @@ class _Annotator:
         err = fit.errors[first]
         for c in chain:  # nearest the body first: does flipping it make the body fit?
             flipped = self._flip(c.name, qs)
-            if flipped.errors.get(first, math.inf) <= TOLERANCE:
+            if flipped.errors.get(first, math.inf) <= self.tolerance:
                 return RobotSpecError(
                     f"joint '{theirs[c.name]}' of {self.their.shown} turns the opposite way to "
                     f"the robot's '{c.name}' (body '{self.pairs[body]}' off by {err:.3g} m/rad; "
@@ -295,7 +302,7 @@ class _Annotator:
             qpos = self.qpos(q)
             qpos[adr] = -qpos[adr]
             poses.append(self.their.body_poses(qpos))
-        return fit_frames(*self.relative(qs, poses))
+        return fit_frames(*self.relative(qs, poses), self.tolerance)
 
 
 def annotate_mjcf(
@@ -307,19 +314,29 @@ def annotate_mjcf(
     output: Path | None = None,
     samples: int = 8,
     seed: int = 0,
+    tolerance: float = TOLERANCE,
 ) -> Annotation:
     """Add ``robot``'s tool sites, cameras, named states (and excluded pairs) to ``model``.
 
     ``mapping`` is ``{their name: our name}`` for what names cannot match; ``output`` the file
     the result will be written to (mesh folders are re-pointed when it is in another folder).
+    ``tolerance`` (m, and rad): how far a matched body may stray from a rigid re-framing of
+    ours, and a site from its tool frame; a hand-rounded model (robosuite's ``0.924``
+    quaternion) needs a looser one than the default 1e-6.
     Raises a RobotSpecError naming the unmatched joint with its closest names, a joint turning
     the other way, or MuJoCo's own complaint about the model.
     """
     their = read_model(model)
-    a = _Annotator(robot, their, mapping or {})
+    if not (math.isfinite(tolerance) and tolerance > 0.0):
+        raise RobotSpecError(
+            f"the tolerance must be a positive number of metres, not {tolerance}",
+            kind="option",
+            name="--tolerance",
+        )
+    a = _Annotator(robot, their, mapping or {}, tolerance)
     qs = a.configurations(samples, seed)
-    fit = fit_frames(*a.relative(qs, [their.body_poses(a.qpos(q)) for q in qs]))
-    if fit.failing():
+    fit = fit_frames(*a.relative(qs, [their.body_poses(a.qpos(q)) for q in qs]), tolerance)
+    if fit.failing(tolerance):
         raise a.diagnose(fit, qs)
     fk0 = robot.kinematics.forward(qs[0])
     root_inv = inverse(fk0[a.root])
@@ -369,7 +386,7 @@ def annotate_mjcf(
         return their.site_error(targets, qs, a.qpos, robot, a.root, root, fit, model)
 
     site_error = measure()
-    if site_error > TOLERANCE:
+    if site_error > tolerance:
         raise RobotSpecError(  # pragma: no cover - the fit proved it; a bug if it fails
             f"a site added to {their.shown} is {site_error:.3g} m from its tool frame",
             file=their.shown,

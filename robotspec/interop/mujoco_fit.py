@@ -118,17 +118,25 @@ def _fit_with(
     return FrameFit(root, offsets, errors)
 
 
-def fit_frames(ours: Mapping[str, Sequence[F64]], theirs: Mapping[str, Sequence[F64]]) -> FrameFit:
+def fit_frames(
+    ours: Mapping[str, Sequence[F64]],
+    theirs: Mapping[str, Sequence[F64]],
+    tolerance: float = TOLERANCE,
+) -> FrameFit:
     """The offsets that make ``theirs`` (poses relative to their root) equal ``ours``.
 
     Both map a body key to its pose relative to the matched root at the same configurations,
     the first of which defines the offsets. The identity root offset is tried first, then the
     solved one; the one with fewer misfit bodies (then the smaller misfit) is returned, so a
-    wrong joint shows as the bodies below it (the caller judges against :data:`TOLERANCE`).
+    wrong joint shows as the bodies below it (the caller judges against ``tolerance``).
     """
     first = _fit_with(np.eye(4), ours, theirs)
-    if first.worst <= TOLERANCE:
+    if first.worst <= tolerance:
         return first
     second = _fit_with(_solve_root(ours, theirs), ours, theirs)
-    better = (len(second.failing()), second.worst) < (len(first.failing()), first.worst)
+    fails = (
+        (len(second.failing(tolerance)), second.worst),
+        (len(first.failing(tolerance)), first.worst),
+    )
+    better = fails[0] < fails[1]
     return second if better else first

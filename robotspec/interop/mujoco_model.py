@@ -138,6 +138,7 @@ class TheirModel:
         """Each position servo's target at ``qpos``; other actuators 0 (noted once)."""
         m, mj = self.model, self.mj
         ctrl = np.zeros(m.nu)
+        others: list[str] = []
         for a in range(m.nu):
             gain, bias = m.actuator_gainprm[a], m.actuator_biasprm[a]
             servo = (
@@ -152,12 +153,13 @@ class TheirModel:
                 if m.actuator_ctrllimited[a]:
                     value = float(np.clip(value, *m.actuator_ctrlrange[a]))
                 ctrl[a] = value
-            elif notes is not None:
-                n = self.mj.mj_id2name(m, self.mj.mjtObj.mjOBJ_ACTUATOR, a) or f"#{a}"
-                notes.append(
-                    f"actuator '{n}' is not a position servo on one joint: its ctrl in the "
-                    "added keyframes is 0"
-                )
+            else:
+                others.append(mj.mj_id2name(m, mj.mjtObj.mjOBJ_ACTUATOR, a) or f"#{a}")
+        if others and notes is not None:
+            notes.append(
+                f"{', '.join(repr(n) for n in others)}: not a position servo on one joint, "
+                "so ctrl is 0 in the added keyframes"
+            )
         return ctrl
 
     def add_key(self, wanted: str, qpos: F64, notes: list[str]) -> str:

@@ -187,6 +187,14 @@ def unmatched_error(
         f"; closest in the model: {', '.join(repr(s) for s in suggestions)}" if suggestions else ""
     )
     hint = f" (add --map {suggestions[0] if suggestions else 'THEIRS'}={ours})"
+    if not free:
+        near, hint = (
+            "",
+            (
+                f": each {kind} of the model is matched to another one of the robot, so the model "
+                "has no such part (an arm without its gripper?)"
+            ),
+        )
     return RobotSpecError(
         f"{kind} '{ours}' ({role}) has no {kind} of the same name in {model}{near}{hint}",
         file=model,

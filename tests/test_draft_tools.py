@@ -252,3 +252,16 @@ def test_stl_vertices_are_read_without_trimesh_as_trimesh_reads_them(tmp_path: P
         mine, theirs = mesh_vertices(str(stl)), read_triangles(str(stl))[0]
         assert np.allclose(mine.min(axis=0), theirs.min(axis=0))
         assert np.allclose(mine.max(axis=0), theirs.max(axis=0))
+
+
+def test_a_bare_frame_between_the_finger_tips_is_the_tcp_whatever_its_name(
+    tmp_path: Path,
+) -> None:
+    # A frame named as nothing known ('pinch_point') on the hand's axis, just past the pads;
+    # a camera mount beside the hand is off that axis and no tool frame.
+    parts = _gripper("0.01 0.01 0.06", "0 0 0.03")
+    parts += [_bare("pinch_point"), _joint("pinch", "hand", "pinch_point", "fixed", "0 0 0.09")]
+    parts += [_bare("mount"), _joint("mount_joint", "hand", "mount", "fixed", "0.05 0 0.02")]
+    d = _draft(tmp_path, "pinch", parts)
+    (m,) = d.manipulators
+    assert m.tool_frame == "pinch_point" and not d.frames

@@ -61,6 +61,7 @@ from robotspec.spec.draft.srdf_groups import (
     group_notes,
 )
 from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset
+from robotspec.spec.draft.tool_frames import fixed_jaw, frame_at_tips
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = ["Drafter", "draft_spec"]
@@ -300,7 +301,11 @@ class Drafter:
             # A bare frame named as a TCP is the files' answer (no question); other names and
             # links are guesses. (Above the hand: said already.)
             if not decide and not is_named_tcp(world, tool):
-                decide.append(f"the tool frame '{tool.name}' by its name")
+                jaw = tool is fixed_jaw(world, top)  # a one-jaw gripper's: by where it is
+                decide.append(
+                    f"the tool frame '{tool.name}' "
+                    + ("at the fixed jaw's end" if jaw else "by its name")
+                )
         elif gripper is not None:
             tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))
             mid = (tree.poses[gripper.thumb_tip.index] + tree.poses[gripper.finger_tip.index])[
@@ -312,6 +317,9 @@ class Drafter:
                 # it is the tool frame the URDF has, not a new one at the same place.
                 tool_name = gripper.root.name
                 decide.append(f"the tool frame '{tool_name}': between the finger tips")
+            elif at := frame_at_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip)):
+                tool_name = at.name  # a bare frame the URDF puts between the tips
+                decide.append(f"the tool frame '{tool_name}': a frame between the finger tips")
             else:
                 frame = DraftFrame(
                     tool_name,

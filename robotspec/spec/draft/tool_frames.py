@@ -13,7 +13,7 @@ import numpy as np
 
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
-from robotspec.spec.draft.tips import between_tips
+from robotspec.spec.draft.tips import between_tips, far_end
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = [
@@ -22,6 +22,7 @@ __all__ = [
     "bare_fixed_leaf",
     "find_tool_frame",
     "fixed_jaw",
+    "frame_at_tips",
     "hand_center",
     "is_named_tcp",
     "own_geometry",
@@ -218,3 +219,39 @@ def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:
     if not tips:
         return None
     return between_tips(tree, top, tips)  # at the far ends of the tips' geometry
+
+
+#: How far off the line from a gripper's root through its tips' far ends a frame may lie (m).
+OFF_AXIS = 0.01
+#: How far beyond the tips' far ends a frame between the fingers may lie (m).
+BEYOND_TIPS = 0.03
+
+
+def frame_at_tips(tree: Tree, root: Body, tips: tuple[Body, Body]) -> Body | None:
+    """A bare frame the URDF puts between a gripper's finger tips, whatever its name.
+
+    Why structure first: a TCP is often named as nothing this module knows (a
+    'pinch_point', a 'grasp_center'); a frame fixed on the gripper (not on a finger) that lies
+    on the gripper's axis between the fingers' bases and just beyond their far ends is one.
+    """
+    world = tree.world
+    on_fingers = {b.index for t in tips for b in world.ancestors(t)} - {
+        b.index for b in world.ancestors(root)
+    }
+    here = np.asarray(tree.poses[root.index][:3, 3], dtype=np.float64)
+    way = np.mean([tree.poses[t.index][:3, 3] for t in tips], axis=0) - here
+    ends = np.mean([far_end(tree, t, way) for t in tips], axis=0)  # the pads, not the joints
+    reach = float(np.linalg.norm(ends - here))
+    if reach < OFF_AXIS:
+        return None
+    axis = (ends - here) / reach
+    found = []
+    for b in world.subtree(root):
+        c = world.parent_connection(b)
+        if b is root or c is None or not bare_fixed_leaf(world, b) or c.parent in on_fingers:
+            continue
+        d = np.asarray(tree.poses[b.index][:3, 3], dtype=np.float64) - here
+        along = float(d @ axis)
+        if float(np.linalg.norm(d - along * axis)) <= OFF_AXIS and 0 < along <= reach + BEYOND_TIPS:
+            found.append(b)
+    return found[0] if len(found) == 1 else None

@@ -65,7 +65,9 @@ def _body(root: etree._Element, name: str, shown: str) -> etree._Element:
 
 def _section(root: etree._Element, tag: str) -> etree._Element:
     found = root.find(tag)
-    return found if found is not None else etree.SubElement(root, tag)
+    if found is None:
+        found = _append(root, tag, {})
+    return found
 
 
 def _repoint(root: etree._Element, here: Path, there: Path, notes: list[str]) -> None:
@@ -95,17 +97,25 @@ def _repoint(root: etree._Element, here: Path, there: Path, notes: list[str]) ->
     )
 
 
-def _append(parent: etree._Element, tag: str, attrib: dict[str, str]) -> None:
+def _indent_of(el: etree._Element) -> str:
+    """A line break and the indentation ``el`` itself sits at."""
+    prev, up = el.getprevious(), el.getparent()
+    space = prev.tail if prev is not None else (up.text if up is not None else None)
+    return "\n" + (space or "\n").rsplit("\n", 1)[-1]
+
+
+def _append(parent: etree._Element, tag: str, attrib: dict[str, str]) -> etree._Element:
     """``<tag>`` as the last child of ``parent``, indented like its siblings."""
     el = etree.Element(tag, attrib)
     if len(parent):
         last = parent[-1]
         el.tail, last.tail = last.tail, parent.text
     else:
-        outer = parent.tail or "\n"
+        outer = _indent_of(parent)
         parent.text = outer + "  "
         el.tail = outer
     parent.append(el)
+    return el
 
 
 def write_edits(path: Path, edits: list[Edit], output: Path | None, notes: list[str]) -> str:

@@ -253,8 +253,8 @@ def test_init_without_srdf_guesses_chains_and_tool(
     urdf = shared_path("robots", "ur5e", "ur5e.urdf")
     # The URDF lies outside the spec's project: the user allows its folder, as init says.
     data = _init(capsys, tmp_path / "ur5e.yaml", str(urdf), allow=(urdf.parent,))
-    assert data["chains"] == {
-        "arm": {"root": "base_link", "tip": "wrist_3_link", "manipulator": "tool"}
+    assert data["chains"] == {  # the arm ends at its flange, past wrist_3_link (issue 30)
+        "arm": {"root": "base_link", "tip": "flange", "manipulator": "tool"}
     }
     assert data["manipulators"]["tool"]["tool_frame"] == "tool0"  # type: ignore[index]
     assert data["drive"] == {"type": "fixed"}

@@ -72,9 +72,7 @@ def diff_ops(old: Any, new: Any, path: Path_ = ()) -> list[Op]:
 def _number(v: float) -> str:
     if not math.isfinite(v):
         raise TextEditError(f"not a finite number: {v}", kind="value")
-    if v == int(v) and abs(v) < 1e15 and not isinstance(v, float):
-        return str(int(v))
-    return repr(float(v))
+    return str(v) if isinstance(v, int) else repr(float(v))  # as YAML reads it back
 
 
 def _flow(v: Any) -> str:
@@ -341,14 +339,11 @@ def remove_mark(text: str, path: Path_) -> str:
     entry = _Index(text).entries.get(path)
     if entry is None:
         return text
-    line = (entry.key or entry.node).start_mark.line
-    t = _Text(text)
-    start = t._line_start(line)
+    mark = (entry.key or entry.node).start_mark
+    start = mark.index - mark.column  # the line's start
     end = _eol(text, start)
     at = text.find(_MARK, start, end)
-    if at < 0:
-        return text
-    return text[:at] + text[end:]
+    return text if at < 0 else text[:at] + text[end:]
 
 
 def edit_text(

@@ -31,6 +31,7 @@ mujoco = pytest.importorskip("mujoco", reason="annotating needs MuJoCo (pip inst
 URDFS = {
     "panda": "panda_description/urdf/panda.urdf",
     "ur5": "ur_description/urdf/ur5_robot.urdf",
+    "pr2": "pr2_description/urdf/pr2.urdf",
 }
 
 
@@ -47,6 +48,7 @@ def foreign(tmp: Path, robot: str, prefix: str, edit: Any = None, name: str = "m
     for el in root.iter("mimic"):
         el.set("joint", prefix + el.get("joint", ""))
     spec = mujoco.MjSpec.from_string(etree.tostring(root, encoding="unicode"))
+    spec.compiler.balanceinertia = True  # the PR2's sensor mount breaks the triangle rule
     spec.compile()
     xml = spec.to_xml()
     if edit is not None:
@@ -277,3 +279,30 @@ def test_a_looser_tolerance_accepts_a_rounded_model(tmp_path: Path, panda: Abstr
     assert "does not move as the robot's" in err.value.message
     out = annotate_mjcf(panda, path, tolerance=1e-3)
     assert 1e-6 < out.body_error <= 1e-3 and out.site_error <= 1e-3
+
+
+def test_cameras_look_where_the_spec_says(tmp_path: Path) -> None:
+    """The PR2's camera (on a frame MuJoCo fused away) at its frame, looking along its axis."""
+    pr2 = compile_robot("pr2")
+    path = foreign(tmp_path, "pr2", "")
+    out_path = tmp_path / "annotated.xml"
+    out = annotate_mjcf(pr2, path, output=out_path)
+    out_path.write_text(out.xml)
+    assert [c.of for c in out.cameras] == [c.name for c in pr2.cameras] != []
+    model = mujoco.MjModel.from_xml_path(str(out_path))
+    data = mujoco.MjData(model)
+    drive = set(pr2.drive.dofs) if pr2.drive is not None else set()
+    for q in _random(pr2, 4, seed=5):
+        q[list(drive)] = 0.0  # their model has no base joint: the base stays at the origin
+        data.qpos[:] = _qpos(model, pr2, q, "")
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_camlight(model, data)
+        poses = pr2.kinematics.forward(q)
+        for cam in pr2.cameras:
+            c = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, cam.name)
+            frame = poses[cam.root.index]
+            assert np.allclose(data.cam_xpos[c], frame[:3, 3], atol=1e-6, rtol=0)
+            looks = -data.cam_xmat[c].reshape(3, 3)[:, 2]  # MuJoCo's cameras look along -z
+            assert looks @ (frame[:3, :3] @ cam.forward_facing_axis) == pytest.approx(1.0)
+            fovy = math.degrees(cam.field_of_view.vertical_angle)
+            assert model.cam_fovy[c] == pytest.approx(fovy, abs=1e-9)

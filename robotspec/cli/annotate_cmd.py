@@ -105,6 +105,7 @@ def mjcf_cmd(
     )
     sites = ", ".join(f"{s.name} on {s.body}" for s in out.sites) or "none"
     sys.stderr.write(
-        f"wrote {output}: sites {sites} (within {site_error:.1g} m of the tool frames, read back), "
-        f"{plural(len(out.cameras), 'camera')}, {plural(len(out.keys), 'keyframe')}{excluded}\n"
+        f"wrote {output}: sites {sites}, {plural(len(out.cameras), 'camera')}, "
+        f"{plural(len(out.keys), 'keyframe')}{excluded}; read back, the sites and cameras are "
+        f"within {site_error:.1g} m/rad of the spec's frames\n"
     )

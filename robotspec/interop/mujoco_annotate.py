@@ -56,8 +56,9 @@ class Placed:
 class Annotation:
     """The annotated MJCF and what was matched, added and measured.
 
-    ``site_error`` is the largest distance (m) between a site of the compiled result and
-    robotspec's tool frame, over the verification configurations; ``body_error`` the largest
+    ``site_error`` is the largest misfit (distance in m, or angle in rad) between an added
+    site or camera of the compiled result and where robotspec's kinematics puts it (tool
+    frame, camera frame), over the verification configurations; ``body_error`` the largest
     misfit of a matched body (m or rad) once the constant offsets are taken out.
     """
 
@@ -350,21 +351,21 @@ def annotate_mjcf(
         )
 
     sites: list[Placed] = []
-    targets: list[tuple[str, int, F64]] = []
+    targets: list[tuple[str, str, int, F64]] = []
     for m in robot.manipulators:
         tool = m.tool_frame
         body, pose = local(tool.index, fk0[tool.index])
         name = their.add_site(tool.name, body, pose, a.notes)
         sites.append(Placed(name, body, tool.name))
-        targets.append((name, tool.index, np.eye(4)))
+        targets.append(("site", name, tool.index, np.eye(4)))
     cameras: list[Placed] = []
     for cam in robot.cameras:
         frame = fk0[cam.root.index] @ _camera_frame(cam)
         body, pose = local(cam.root.index, frame)
         fovy = math.degrees(cam.field_of_view.vertical_angle)
-        cameras.append(
-            Placed(their.add_camera(cam.name, body, pose, fovy, a.notes), body, cam.name)
-        )
+        name = their.add_camera(cam.name, body, pose, fovy, a.notes)
+        cameras.append(Placed(name, body, cam.name))
+        targets.append(("camera", name, cam.root.index, _camera_frame(cam)))
     keys = []
     for key, state in _states(robot).items():
         values = state.as_dict()
@@ -388,7 +389,7 @@ def annotate_mjcf(
     site_error = measure()
     if site_error > tolerance:
         raise RobotSpecError(  # pragma: no cover - the fit proved it; a bug if it fails
-            f"a site added to {their.shown} is {site_error:.3g} m from its tool frame",
+            f"a site or camera added to {their.shown} is {site_error:.3g} m/rad from its frame",
             file=their.shown,
             kind="site",
         )

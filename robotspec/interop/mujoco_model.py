@@ -18,7 +18,7 @@ import numpy as np
 from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError, missing_file
 from robotspec.export.mjcf_bodies import nums
-from robotspec.interop.mujoco_fit import FrameFit, inverse
+from robotspec.interop.mujoco_fit import FrameFit, inverse, pose_error
 from robotspec.interop.mujoco_xml import Edit, site_edit, write_edits
 from robotspec.model.rotations import matrix_to_quat_wxyz
 
@@ -189,7 +189,7 @@ class TheirModel:
     # ------------------------------------------------------------------ checking, writing
     def site_error(
         self,
-        targets: Sequence[tuple[str, int, F64]],
+        targets: Sequence[tuple[str, str, int, F64]],
         qs: Sequence[F64],
         qpos: Callable[[F64], F64],
         robot: AbstractRobot,
@@ -198,7 +198,7 @@ class TheirModel:
         fit: FrameFit,
         model: Any = None,
     ) -> float:
-        """The largest distance (m) of an added site from its tool frame.
+        """The largest misfit (m, or rad) of an added site or camera from where the spec puts it.
 
         ``model``: a compiled model to measure (the written file, read back); by default the
         edited ``MjSpec`` compiled.
@@ -217,11 +217,19 @@ class TheirModel:
             theirs = self.body_poses(qpos(q), model, data)
             t_root = inverse(theirs[their_root])
             o_root = inverse(fk[our_root])
-            for name, body, frame in targets:
-                i = self.mj.mj_name2id(model, self.mj.mjtObj.mjOBJ_SITE, name)
-                site = t_root @ np.append(data.site_xpos[i], 1.0)
+            self.mj.mj_camlight(model, data)  # camera poses (mj_kinematics leaves them out)
+            for kind, name, body, frame in targets:
+                pose = np.eye(4)
+                if kind == "site":
+                    i = self.mj.mj_name2id(model, self.mj.mjtObj.mjOBJ_SITE, name)
+                    pose[:3, :3] = np.asarray(data.site_xmat[i]).reshape(3, 3)
+                    pose[:3, 3] = data.site_xpos[i]
+                else:
+                    i = self.mj.mj_name2id(model, self.mj.mjtObj.mjOBJ_CAMERA, name)
+                    pose[:3, :3] = np.asarray(data.cam_xmat[i]).reshape(3, 3)
+                    pose[:3, 3] = data.cam_xpos[i]
                 want = back @ o_root @ fk[body] @ frame
-                worst = max(worst, float(np.linalg.norm(site[:3] - want[:3, 3])))
+                worst = max(worst, pose_error(t_root @ pose, want))
         return worst
 
     def to_xml(self, output: Path | None, notes: list[str]) -> str:

@@ -306,3 +306,23 @@ def test_cameras_look_where_the_spec_says(tmp_path: Path) -> None:
             assert looks @ (frame[:3, :3] @ cam.forward_facing_axis) == pytest.approx(1.0)
             fovy = math.degrees(cam.field_of_view.vertical_angle)
             assert model.cam_fovy[c] == pytest.approx(fovy, abs=1e-9)
+
+
+def test_another_folder_and_an_include(tmp_path: Path, panda: AbstractRobot) -> None:
+    def meshdir(tree: Any) -> None:
+        tree.find("compiler").set("meshdir", "assets")
+
+    path = foreign(tmp_path, "panda", "robot0_", meshdir)
+    out = annotate_mjcf(panda, path, output=tmp_path / "sub" / "out.xml")
+    compiler = etree.fromstring(out.xml.encode()).find("compiler")
+    assert compiler.get("meshdir") == "../assets" and compiler.get("texturedir") == ".."
+    assert any("re-pointed to .." in n for n in out.notes)
+
+    scene = tmp_path / "scene.xml"  # Menagerie's scene.xml includes the robot's file
+    scene.write_text('<mujoco model="scene">\n  <include file="model.xml"/>\n</mujoco>\n')
+    with pytest.raises(RobotSpecError) as err:
+        annotate_mjcf(panda, scene)
+    assert err.value.message == (
+        "body 'robot0_panda_link7' is not written in this file (it comes from an <include> or "
+        "an attached model): annotate the file that defines it"
+    )

@@ -9,6 +9,7 @@ is replaced.
 
 from __future__ import annotations
 
+import importlib.util
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -25,16 +26,22 @@ from robotspec.model.rotations import matrix_to_quat_wxyz
 if TYPE_CHECKING:
     from robotspec.semantic import AbstractRobot
 
-__all__ = ["TheirModel", "read_model"]
+__all__ = ["MUJOCO_INSTALL", "TheirModel", "read_model"]
+
+#: What a user without MuJoCo is told to run (the same words as the physics driver's).
+MUJOCO_INSTALL = "pip install 'robotspec[mujoco]'"
 
 _SUFFIX = "_robotspec"
 
 
 def read_model(path: Path) -> TheirModel:
     """Read and compile ``path`` with MuJoCo; its complaint becomes a RobotSpecError."""
-    from robotspec.driver.mujoco_model import require_mujoco
-
-    require_mujoco("robotspec annotate mjcf")
+    if importlib.util.find_spec("mujoco") is None:  # the driver's require_mujoco, one room up
+        raise RobotSpecError(
+            f"robotspec annotate mjcf needs MuJoCo; install it with `{MUJOCO_INSTALL}`",
+            kind="dependency",
+            name="mujoco",
+        )
     import mujoco  # type: ignore[import-untyped, unused-ignore]
 
     if not Path(path).is_file():

@@ -17,7 +17,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "robotspec"
 
 #: The stack, bottom first. A room may import rooms of lower floors and its own room only.
 FLOORS: tuple[tuple[str, ...], ...] = (
-    ("errors", "shipped", "arrays", "accel"),
+    ("errors", "shipped", "arrays", "accel", "exact"),
     ("diagnostics",),
     ("files",),
     ("model",),
@@ -32,7 +32,7 @@ FLOORS: tuple[tuple[str, ...], ...] = (
 )
 #: Rooms beside the stack, with the only rooms they may use.
 BESIDE: dict[str, frozenset[str]] = {
-    "driver": frozenset({"errors", "arrays", "files", "model"}),
+    "driver": frozenset({"errors", "arrays", "exact", "files", "model"}),
     "service": frozenset({"errors", "arrays", "driver"}),
 }
 #: Which rooms of the stack may use a room beside it (the outputs and the CLI).

@@ -200,3 +200,26 @@ def test_a_one_jaw_gripper_is_the_hand_not_the_arms_last_joint(tmp_path: Path) -
     assert arm.tip == "gripper_fix" and "jaw" not in arm.joints and len(arm.joints) == 5
     (m,) = d.manipulators
     assert (m.root, m.tool_frame) == ("gripper_fix", "gripper_fix_end")
+
+
+def test_a_head_whose_eyes_turn_is_a_neck_not_an_arm_with_a_gripper(tmp_path: Path) -> None:
+    # A 3-joint head splitting into two eyes, each turning a camera: no fingers there.
+    parts = [_link("torso", size=0.3), _link("neck_1"), _link("neck_2"), _link("head")]
+    parts += [
+        _joint("neck_pitch", "torso", "neck_1", xyz="0 0 0.3", axis="0 1 0"),
+        _joint("neck_roll", "neck_1", "neck_2", xyz="0 0 0.05", axis="1 0 0"),
+        _joint("neck_yaw", "neck_2", "head", xyz="0 0 0.05", axis="0 0 1"),
+    ]
+    for side, y in (("left", "0.03"), ("right", "-0.03")):
+        eye, frame = f"{side}_eye", f"{side}_camera_optical_frame"
+        parts += [
+            _link(eye, size=0.02),
+            _joint(f"{side}_eye_pan", "head", eye, xyz=f"0.05 {y} 0.05", axis="0 0 1"),
+            _link(frame, ""),
+            f'<joint name="{side}_cam" type="fixed"><parent link="{eye}"/>'
+            f'<child link="{frame}"/><origin rpy="-1.5708 0 -1.5708"/></joint>',
+        ]
+    d = _draft(tmp_path, "eyes", parts)
+    assert not d.chains and not d.manipulators
+    assert d.neck is not None and d.neck.joints == {"neck_pitch", "neck_roll", "neck_yaw"}
+    assert len(d.cameras) == 2

@@ -31,6 +31,7 @@ from robotspec.spec.draft.limbs import (
     HAND_WORDS,
     MAX_HAND_SPAN,
     Limb,
+    eyes,
     find_limbs,
     hand_span,
     is_named,
@@ -432,6 +433,8 @@ class Drafter:
             split = kids[0]
         if len(wrist) > MAX_WRIST:
             split, wrist = root, []
+        if eyes(tree, split):
+            return None  # a head's eyes, each carrying a camera: no hand
         gripper, _ = find_gripper(tree, split)
         # Wheels (continuous joints about a level axis turning a wheel's shape) are never fingers.
         wheels = {c.child for c in self.wheels}

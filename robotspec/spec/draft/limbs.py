@@ -18,7 +18,16 @@ from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
 from robotspec.spec.draft.tree import Segment, Tree, words
 
-__all__ = ["Limb", "beside_branch", "chain_end", "find_limbs", "hand_cut", "hand_span", "is_named"]
+__all__ = [
+    "Limb",
+    "beside_branch",
+    "chain_end",
+    "eyes",
+    "find_limbs",
+    "hand_cut",
+    "hand_span",
+    "is_named",
+]
 
 HAND_WORDS = frozenset({"gripper", "hand", "palm", "eef", "jaw", "claw", "effector"})
 FINGER_WORDS = frozenset(
@@ -162,6 +171,8 @@ def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Lim
         if max(hand_span(tree, k) for k in branches) > MAX_HAND_SPAN:
             return None  # limbs branch off here: a trunk (simple_humanoid's waist), not an arm
         hand = seg.end
+    if hand is not None and eyes(tree, hand):
+        return None  # a head whose cameras turn on their own (eyes): not a hand's fingers
     if hand is None and _named(bodies, HEAD_WORDS) and not _named(bodies, ARM_WORDS):
         return None  # a head (see sensors.find_neck)
     if hand is None and len(actuated) <= 3 and _pan_tilt(tree, seg):
@@ -219,6 +230,27 @@ def _one_jaw(tree: Tree, seg: Segment, cut: int) -> bool:
 
 #: Words of a camera's frames (a run carrying one and nothing else is a neck, not an arm).
 LOOK_WORDS = frozenset({"camera", "cam", "optical", "rgb", "rgbd", "depth", "stereo", "kinect"})
+
+
+def eyes(tree: Tree, hand: Body) -> bool:
+    """Whether every moving branch below where ``hand`` splits carries a camera and no finger.
+
+    Why: a head whose eyes turn on their own (iCub's, a humanoid's stereo pair) splits into
+    branches like a hand into fingers; the cameras they carry say they are eyes.
+    """
+    world = tree.world
+    body = hand
+    while len(kids := tree.moving_children(body)) == 1:
+        body = kids[0]
+    if len(kids) < 2:
+        return False
+    for k in kids:
+        inside = world.subtree(k)
+        if not any(words(b.name) & LOOK_WORDS for b in inside):
+            return False
+        if any(is_named(b.name, FINGER_WORDS | HAND_WORDS) for b in inside):
+            return False
+    return True
 
 
 def _pan_tilt(tree: Tree, seg: Segment) -> bool:

@@ -18,7 +18,7 @@ import numpy as np
 
 from robotspec.model.entities import Body, Connection
 from robotspec.spec.draft.facts import FileFacts
-from robotspec.spec.draft.limbs import HEAD_WORDS
+from robotspec.spec.draft.limbs import HEAD_WORDS, eyes
 from robotspec.spec.draft.stated_cameras import StatedCamera, stated_cameras
 from robotspec.spec.draft.tree import Tree, words
 
@@ -180,7 +180,8 @@ def find_neck(tree: Tree, cameras: list[CameraFound], limb_tops: list[Body]) -> 
     world = tree.world
     best: tuple[int, float, NeckFound] | None = None
     for seg in tree.segments:
-        if tree.moving_children(seg.end) or not seg.joints:
+        # A head whose eyes turn on their own ends where they split (limbs.eyes).
+        if (tree.moving_children(seg.end) and not eyes(tree, seg.end)) or not seg.joints:
             continue
         # The run's last revolute joints (HSR-B's head sits on a lift that mimics the arm's).
         joints: list[Connection] = []

@@ -53,7 +53,13 @@ SAME_FLOOR_ALLOWED: frozenset[tuple[str, str]] = frozenset(
 #: robot hands itself to a room above it. ``AbstractRobot.to_pinocchio()`` is the entry point
 #: pinocchio users look for on a robot (issue 20); the work is the interop room's.
 UPWARD_METHODS: frozenset[tuple[str, str]] = frozenset(
-    {("robotspec.semantic.robot", "robotspec.interop.pinocchio")}
+    {
+        ("robotspec.semantic.robot", "robotspec.interop.pinocchio"),
+        # ``robotspec.accel.accelerated()`` / ``report()`` answer for every compiled core (issue
+        # 34 names that entry point); each core's choice lives with the room that owns it.
+        ("robotspec.accel", "robotspec.collision"),
+        ("robotspec.accel", "robotspec.model"),
+    }
 )
 #: Rooms that are the package's faces, not floors: they may import anything.
 FACES = frozenset({"__init__", "__main__"})

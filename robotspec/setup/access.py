@@ -132,6 +132,8 @@ class PageAccess:
             if reason is not None:
                 return connection.respond(http.HTTPStatus.FORBIDDEN, f"robotspec setup: {reason}\n")
             response = viser_handler(connection, request) if viser_handler is not None else None
+            if response is not None and response.status_code == 200:
+                _add_page_additions(response)
             query = parse_qs(urlsplit(request.path).query)
             if response is not None and query.get("token") and response.status_code == 200:
                 # The address with the token was opened: the page's websocket presents the
@@ -142,6 +144,24 @@ class PageAccess:
             return response
 
         return process
+
+
+def _add_page_additions(response: Response) -> None:
+    """The page's HTML with the keyboard and screen-reader additions (``setup/page_a11y.py``)."""
+    if not response.headers.get("Content-Type", "").startswith("text/html"):
+        return
+    import gzip
+
+    from robotspec.setup.page_a11y import add_to_page
+
+    zipped = response.headers.get("Content-Encoding", "identity") == "gzip"
+    page = gzip.decompress(response.body) if zipped else response.body
+    added = add_to_page(page)
+    if added is page:
+        return
+    response.body = gzip.compress(added, compresslevel=6) if zipped else added
+    del response.headers["Content-Length"]  # websockets' Headers adds, never replaces
+    response.headers["Content-Length"] = str(len(response.body))
 
 
 def start_guarded(access: PageAccess, start: Callable[[], T], stop: Callable[[T], None]) -> T:

@@ -36,6 +36,9 @@ __all__ = ["SELECTED_COLOUR", "SetupPage"]
 
 #: The picked link, drawn apart from every part colour.
 SELECTED_COLOUR = (230, 20, 20)
+#: The page's brand colour (#0d47a1): viser draws buttons in a lighter shade of it, which white
+#: text still reads on at 4.5:1 or more (viser's own blue gives 3.6:1, a lighter brand 3.4:1).
+BRAND = (13, 71, 161)
 #: Above this many links the tree is text (and the link list picks): a button each is too many.
 _MAX_TREE_BUTTONS = 400
 
@@ -127,6 +130,9 @@ class SetupPage(PartsTab, StatesTab, CheckTab):
     # ------------------------------------------------------------------ building
     def _build(self) -> None:
         gui = self.server.gui
+        # No logo (an image without text) nor share button (an unnamed icon, and a page for
+        # one's own eyes only); buttons in a blue that white text reads on (4.5:1, WCAG AA).
+        gui.configure_theme(show_logo=False, show_share_button=False, brand_color=BRAND)
         panel = gui.add_panel()
         with panel.add_tab("Kinematic tree"):
             self._tree = gui.add_html("")

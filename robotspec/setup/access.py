@@ -155,9 +155,9 @@ def _add_page_additions(response: Response) -> None:
     from robotspec.setup.page_a11y import add_to_page
 
     zipped = response.headers.get("Content-Encoding", "identity") == "gzip"
-    page = gzip.decompress(response.body) if zipped else response.body
+    page = gzip.decompress(response.body) if zipped else bytes(response.body)
     added = add_to_page(page)
-    if added is page:
+    if added == page:
         return
     response.body = gzip.compress(added, compresslevel=6) if zipped else added
     del response.headers["Content-Length"]  # websockets' Headers adds, never replaces

@@ -37,7 +37,7 @@ from robotspec.model.rotations import matrix_to_quat_wxyz, rpy_to_matrix
 from robotspec.semantic import AbstractRobot
 from robotspec.semantic.base import JointState
 
-__all__ = ["MjcfExport", "MjcfJoint", "SERVO_HZ", "mjcf_export"]
+__all__ = ["MjcfExport", "MjcfJoint", "SERVO_HZ", "mjcf_export", "named_states"]
 
 #: The natural frequency every position servo is tuned to (critically damped), in Hz.
 SERVO_HZ = 8.0
@@ -72,8 +72,11 @@ class MjcfExport:
         return np.asarray(out, dtype=np.float64)
 
 
-def _states(robot: AbstractRobot) -> dict[str, JointState]:
-    """Every named state by the robot's key for it (``left_arm.park``, ``torso.low``)."""
+def named_states(robot: AbstractRobot) -> dict[str, JointState]:
+    """Every named state by its keyframe name: the robot's own keys, then ``hand.open``.
+
+    ``annotate mjcf`` names its keyframes the same way (one function for both).
+    """
     found = dict(robot.joint_states)
     for m in robot.manipulators:
         for state_name, state in m.states.items():
@@ -169,7 +172,7 @@ def mjcf_export(
     out = MjcfExport("", tuple(b.assets.files()), tuple(order), (), ())
     keyframe = etree.SubElement(root_el, "keyframe")
     keys = [("default", q0)]
-    for key_name, state in _states(robot).items():
+    for key_name, state in named_states(robot).items():
         keys.append((key_name, world.configuration(state.as_dict())))
     index = {c.name: i for i, c in enumerate(servoed)}
     qpos_index: dict[str, int] = {}

@@ -25,7 +25,7 @@ from robotspec.model.rotations import matrix_to_quat_wxyz
 from robotspec.semantic import AbstractRobot
 from robotspec.semantic.sensors import Camera
 
-__all__ = ["BodyWriter", "MjcfJoint", "TINY_MASS", "num", "nums", "place"]
+__all__ = ["BodyWriter", "MjcfJoint", "TINY_MASS", "camera_frame", "num", "nums", "place"]
 
 #: Mass and inertia given to a moving body that, with what is welded to it, has none: MuJoCo
 #: refuses a massless moving body (URDF frames on a joint, links without ``<inertial>``).
@@ -227,20 +227,25 @@ class BodyWriter:
             geom.set("conaffinity", "0")
 
     def camera(self, el: etree._Element, camera: Camera) -> None:
-        """A ``<camera>`` looking along the camera's forward axis (MuJoCo's cameras look -z).
-
-        Up is the body's +z, or -y when the camera looks along z (an optical frame, whose y
-        points down), so an optical frame's image is the same picture in both.
-        """
-        forward = np.asarray(camera.forward_facing_axis, dtype=np.float64)
-        forward = forward / np.linalg.norm(forward)
-        z = -forward
-        up = np.array([0.0, -1.0, 0.0]) if abs(forward[2]) > 0.9 else np.array([0.0, 0.0, 1.0])
-        y = up - (up @ z) * z
-        y = y / np.linalg.norm(y)
-        x = np.cross(y, z)
-        pose = np.eye(4)
-        pose[:3, :3] = np.column_stack((x, y, z))
+        """A ``<camera>`` at :func:`camera_frame` in the camera's body, with its fovy."""
         cam = etree.SubElement(el, "camera", name=camera.name)
-        place(cam, pose)
+        place(cam, camera_frame(camera))
         cam.set("fovy", num(math.degrees(camera.field_of_view.vertical_angle)))
+
+
+def camera_frame(camera: Camera) -> F64:
+    """The MuJoCo camera's pose in its body: looking along the forward axis (MuJoCo looks -z).
+
+    Up is the body's +z, or -y when the camera looks along z (an optical frame, whose y
+    points down), so an optical frame's image is the same picture in both. One function for
+    the export and ``annotate mjcf``, so both put a spec's camera the same way.
+    """
+    forward = np.asarray(camera.forward_facing_axis, dtype=np.float64)
+    forward = forward / np.linalg.norm(forward)
+    z = -forward
+    up = np.array([0.0, -1.0, 0.0]) if abs(forward[2]) > 0.9 else np.array([0.0, 0.0, 1.0])
+    y = up - (up @ z) * z
+    y = y / np.linalg.norm(y)
+    pose = np.eye(4)
+    pose[:3, :3] = np.column_stack((np.cross(y, z), y, z))
+    return pose

@@ -23,8 +23,10 @@ import numpy as np
 
 from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError
+from robotspec.export.mjcf import named_states
+from robotspec.export.mjcf_bodies import camera_frame
 from robotspec.interop.mujoco_fit import TOLERANCE, fit_frames, inverse
-from robotspec.interop.mujoco_matcher import Matcher, camera_frame, named_states
+from robotspec.interop.mujoco_matcher import Matcher
 from robotspec.interop.mujoco_model import read_model
 from robotspec.interop.mujoco_names import NameMatch
 from robotspec.semantic import AbstractRobot

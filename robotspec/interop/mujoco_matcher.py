@@ -15,6 +15,7 @@ import numpy as np
 
 from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError, raise_collected
+from robotspec.export.mjcf import named_states
 from robotspec.interop.mujoco_fit import TOLERANCE, FrameFit, fit_frames, inverse
 from robotspec.interop.mujoco_model import TheirModel
 from robotspec.interop.mujoco_names import (
@@ -25,34 +26,10 @@ from robotspec.interop.mujoco_names import (
 )
 from robotspec.model.entities import ConnectionType
 from robotspec.semantic import AbstractRobot
-from robotspec.semantic.base import JointState
-from robotspec.semantic.sensors import Camera
 
-__all__ = ["Matcher", "camera_frame", "named_states"]
+__all__ = ["Matcher"]
 
 _MOVING = {ConnectionType.REVOLUTE, ConnectionType.CONTINUOUS, ConnectionType.PRISMATIC}
-
-
-def named_states(robot: AbstractRobot) -> dict[str, JointState]:
-    """Every named state by the key the MJCF export gives it (``ready``, ``hand.open``)."""
-    found = dict(robot.joint_states)
-    for m in robot.manipulators:
-        for state_name, state in m.states.items():
-            found.setdefault(f"{m.name}.{state_name}", state)
-    return found
-
-
-def camera_frame(camera: Camera) -> F64:
-    """The MuJoCo camera's pose in the camera body (looks along -z), as the export writes it."""
-    forward = np.asarray(camera.forward_facing_axis, dtype=np.float64)
-    forward = forward / np.linalg.norm(forward)
-    z = -forward
-    up = np.array([0.0, -1.0, 0.0]) if abs(forward[2]) > 0.9 else np.array([0.0, 0.0, 1.0])
-    y = up - (up @ z) * z
-    y = y / np.linalg.norm(y)
-    pose = np.eye(4)
-    pose[:3, :3] = np.column_stack((np.cross(y, z), y, z))
-    return pose
 
 
 class Matcher:

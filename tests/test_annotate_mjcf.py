@@ -326,3 +326,23 @@ def test_another_folder_and_an_include(tmp_path: Path, panda: AbstractRobot) -> 
         "body 'robot0_panda_link7' is not written in this file (it comes from an <include> or "
         "an attached model): annotate the file that defines it"
     )
+
+
+def test_mujocos_complaint_is_one_line_at_its_line(tmp_path: Path, panda: AbstractRobot) -> None:
+    """MuJoCo's two-line complaint (what, then where) reads as one line at the model's line."""
+
+    def unbalanced(tree: Any) -> None:  # a hand-edited inertia that breaks A + B >= C
+        body = next(b for b in tree.iter("body") if b.get("name") == "robot0_panda_link3")
+        inertial = body.find("inertial")
+        inertial.attrib.pop("fullinertia", None)
+        inertial.set("diaginertia", "1 0.1 0.1")
+        tree.find("compiler").attrib.pop("balanceinertia", None)
+
+    path = foreign(tmp_path, "panda", "robot0_", unbalanced)
+    with pytest.raises(RobotSpecError) as err:
+        annotate_mjcf(panda, path)
+    text = path.read_text().splitlines()
+    line = next(i for i, t in enumerate(text, 1) if 'name="robot0_panda_link3"' in t)
+    assert err.value.line == line and "\n" not in err.value.message
+    assert err.value.message.startswith("MuJoCo cannot load it: inertia must satisfy A + B >= C")
+    assert "element 'robot0_panda_link3'" in err.value.message

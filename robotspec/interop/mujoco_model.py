@@ -10,6 +10,7 @@ is replaced.
 from __future__ import annotations
 
 import importlib.util
+import re
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -50,10 +51,30 @@ def read_model(path: Path) -> TheirModel:
         spec = mujoco.MjSpec.from_file(str(path))
         model = spec.compile()
     except ValueError as exc:
-        raise RobotSpecError(
-            f"MuJoCo cannot load it: {str(exc).strip()}", file=str(path), kind="model"
-        ) from exc
+        raise _complaint(exc, path) from exc
     return TheirModel(Path(path), spec, model)
+
+
+def _complaint(exc: ValueError, path: Path) -> RobotSpecError:
+    """MuJoCo's complaint as one line at the line it names.
+
+    Why: MuJoCo says what is wrong, then on a second line where (``Element name 'x', id 3,
+    line 11``); printed as it is, the second line came out as an escaped line break.
+    """
+    lines = [t.strip() for t in str(exc).splitlines() if t.strip()]
+    what = (lines[0] if lines else "no reason given").removeprefix("Error: ")
+    where = re.search(r"Element name '([^']*)'", " ".join(lines[1:]))
+    line = re.search(r"\bline (\d+)", " ".join(lines[1:]))
+    if where is not None:
+        what += f" (element '{where.group(1)}')"
+    elif len(lines) > 1:
+        what += f" ({'; '.join(lines[1:])})"
+    return RobotSpecError(
+        f"MuJoCo cannot load it: {what}",
+        file=str(path),
+        line=int(line.group(1)) if line is not None else None,
+        kind="model",
+    )
 
 
 class TheirModel:

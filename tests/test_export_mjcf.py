@@ -179,7 +179,37 @@ def test_a_bad_inertial_names_the_link_and_line(tmp_path: Path, tiny: Path) -> N
         robot = check_spec(path).robot
         assert robot is not None
         mjcf_export(robot, joined_urdf(load_spec(path)), name="robot")
-    assert "link1" in str(caught.value)
+    assert "link1" in str(caught.value) and "tiny.urdf:" in str(caught.value)
+
+
+def test_an_infinite_inertia_names_the_link_and_its_line(tmp_path: Path, tiny: Path) -> None:
+    """The inertia tensor is read by the export alone: its error still says where."""
+    (tmp_path / "tiny.urdf").write_text(TINY_URDF.replace('ixy="0.0001"', 'ixy="inf"'))
+    line = next(i for i, t in enumerate(TINY_URDF.splitlines(), 1) if 'ixy="0.0001"' in t)
+    link = next(i for i, t in enumerate(TINY_URDF.splitlines(), 1) if 'name="link1"' in t)
+    path = resolve_spec(tiny)
+    robot = check_spec(path).robot
+    assert robot is not None
+    with pytest.raises(RobotSpecError) as caught:
+        mjcf_export(robot, joined_urdf(load_spec(path)), name="robot")
+    assert str(caught.value).endswith(
+        f"link 'link1' (URDF line {link}): ixy='inf' must be 1 finite number"
+    )
+    assert caught.value.line == line
+
+
+def test_an_impossible_inertia_is_said(tmp_path: Path, tiny: Path) -> None:
+    """A tensor with a negative principal moment is raised to MuJoCo's floor with a note."""
+    bad = TINY_URDF.replace('ixx="0.004" iyy="0.004"', 'ixx="-0.004" iyy="0.004"')
+    (tmp_path / "tiny.urdf").write_text(bad)
+    robot, out = _export(tiny)
+    assert any(
+        n.startswith("body 'link2': the URDF inertia has a negative principal moment (-0.004")
+        for n in out.notes  # type: ignore[attr-defined]
+    )
+    (tmp_path / "tiny.urdf").write_text(TINY_URDF)
+    _, fine = _export(tiny)
+    assert not any("negative principal" in n for n in fine.notes)  # type: ignore[attr-defined]
 
 
 def test_a_mesh_over_mujocos_face_cap_is_cut_in_pieces(tmp_path: Path) -> None:

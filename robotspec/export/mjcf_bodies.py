@@ -180,6 +180,12 @@ class BodyWriter:
         values, vectors = np.linalg.eigh(inertial.tensor)
         if np.linalg.det(vectors) < 0.0:
             vectors[:, 0] = -vectors[:, 0]
+        if values[0] < -1e-9 * max(float(values[-1]), TINY_INERTIA):
+            # Not rounding: a tensor no body can have (MuJoCo would refuse it). Said, not hidden.
+            self.notes.append(
+                f"body '{body.name}': the URDF inertia has a negative principal moment "
+                f"({values[0]:.3g} kg m^2): raised to {TINY_INERTIA} (check the URDF's inertia)"
+            )
         values = np.maximum(values, TINY_INERTIA)
         etree.SubElement(
             el,

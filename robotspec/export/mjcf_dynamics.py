@@ -52,6 +52,17 @@ def _line(el: etree._Element) -> int | None:
     return line if isinstance(line, int) else None
 
 
+def _at(el: etree._Element) -> str:
+    """`` (URDF line N)``: the joined tree has no file name, so the line goes in the message.
+
+    Why: an error with a line but no file prints without either; the line of the link or
+    joint is what the user needs to find the number in their URDF (a composed robot's line
+    is in the part that defines it).
+    """
+    line = _line(el)
+    return f" (URDF line {line})" if line is not None else ""
+
+
 def _numbers(el: etree._Element, attr: str, count: int, where: str, default: str) -> list[float]:
     text = el.get(attr, default)
     parts = text.split()
@@ -76,7 +87,7 @@ def urdf_inertials(tree: etree._Element) -> dict[str, Inertial]:
         el = link.find("inertial")
         if el is None:
             continue
-        where = f"link '{name}'"
+        where = f"link '{name}'{_at(link)}"
         mass_el = el.find("mass")
         mass = 0.0 if mass_el is None else _numbers(mass_el, "value", 1, where, "0")[0]
         if mass < 0.0:
@@ -109,7 +120,7 @@ def urdf_dynamics(tree: etree._Element) -> dict[str, JointDynamics]:
         el = joint.find("dynamics")
         if el is None:
             continue
-        where = f"joint '{joint.get('name', '')}'"
+        where = f"joint '{joint.get('name', '')}'{_at(joint)}"
         damping = _numbers(el, "damping", 1, where, "0")[0]
         friction = _numbers(el, "friction", 1, where, "0")[0]
         if damping < 0.0 or friction < 0.0:

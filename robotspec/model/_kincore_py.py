@@ -8,13 +8,12 @@ are the C core's (see ``_kincore.pyi``): each argument is read as the C core rea
 (:mod:`robotspec.model._core_args`), in the C core's order, so a mistake raises the same
 exception with the same message whichever core runs. :mod:`robotspec.model.kincore` chooses.
 
-One configuration and a batch run the same code (a batch of one): ``fk(q)`` and
-``fk_batch(Q)[i]`` agree bit for bit, as in the C core, where both run one loop per sample.
-
-How it stays vectorised: a tree program's rows are grouped by depth (a row's parent slot is
-written by a shallower row), so one numpy call per depth moves every body of that depth, for
-every sample of a batch at once; products are written out term by term in the C core's order,
-so the collision broad phase keeps exactly the C core's candidates.
+The tree program (every body pose: ``tree``, ``fk``, ``fk_batch``) is
+:mod:`robotspec.model._kintree_py`, laid out for numpy (one matrix product per depth for all
+samples); the chain programs, Jacobians and the collision broad phase are here. One configuration
+and a batch run the same code (a batch of one), so ``fk(q)`` and ``fk_batch(Q)[i]`` agree bit for
+bit, as in the C core. The broad phase writes its products term by term in the C core's order,
+so it keeps exactly the C core's candidates for the same body poses.
 """
 
 from __future__ import annotations
@@ -25,43 +24,43 @@ from typing import Any
 import numpy as np
 
 from robotspec.arrays import F64, I64
-from robotspec.model._core_args import from_any, index, real, table, truth
+from robotspec.model._core_args import from_any, index, real, table
+from robotspec.model._kintree_py import (
+    KIND_FIXED,
+    KIND_PRISMATIC,
+    KIND_REVOLUTE,
+    check_out,
+    fk,
+    fk_batch,
+    tree,
+    tree_size,
+)
+from robotspec.model._kintree_py import config as _config
+from robotspec.model._kintree_py import copy_f64 as _copy_f64
+from robotspec.model._kintree_py import copy_i64 as _copy_i64
 
-KIND_FIXED = 0
-KIND_REVOLUTE = 1
-KIND_PRISMATIC = 2
+__all__ = [
+    "KIND_FIXED",
+    "KIND_PRISMATIC",
+    "KIND_REVOLUTE",
+    "broad",
+    "chain",
+    "chain_fk",
+    "chain_fk_batch",
+    "chain_jacobian",
+    "check_out",
+    "fk",
+    "fk_batch",
+    "geoms",
+    "tree",
+    "tree_size",
+]
 
 #: Samples per step of a batch: bounds the per-row motion arrays (a few MB) on long batches.
 _CHUNK = 256
 
 
 # ----------------------------------------------------------------------------------- helpers
-def _copy_i64(obj: object, want: int, what: str) -> I64:
-    """The C core's ``copy_i64``: exactly one dimension, ``want`` int64 values."""
-    return _sized(from_any(obj, np.int64, 1, 1), want, what)
-
-
-def _copy_f64(obj: object, want: int, what: str) -> F64:
-    """The C core's ``copy_f64``: any shape holding ``want`` float64 values."""
-    return _sized(from_any(obj, np.float64), want, what)
-
-
-def _sized(a: np.ndarray[Any, Any], want: int, what: str) -> np.ndarray[Any, Any]:
-    if a.size != want:
-        raise ValueError(f"{what}: expected {want} values, got {a.size}")
-    return a.reshape(-1).copy()
-
-
-def _config(obj: object, ndim: int, width: int) -> F64:
-    """The C core's ``as_config``: a configuration (ndim 1) or batch (ndim 2) of finite values."""
-    a = from_any(obj, np.float64, ndim, ndim)
-    if a.shape[-1] != width:
-        raise ValueError("configuration has the wrong number of values")
-    if not np.isfinite(a).all():
-        raise ValueError("configuration contains NaN or infinite values")
-    return a
-
-
 def _motions(kind: I64, axis: F64, v: F64) -> F64:
     """Each row's motion (..., R, 3, 4) at values ``v`` (..., R): a rotation, translation or 1.
 
@@ -106,175 +105,6 @@ def _full(m: F64) -> F64:
     out[..., :3, :] = m
     out[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
     return out
-
-
-# -------------------------------------------------------------------------------- the tree
-@dataclass(frozen=True)
-class Tree:
-    """A tree program (see ``_kincore.c``), its rows sorted by depth.
-
-    Row k sets slot child[k] = slot parent[k] times origin[k] times the row's motion. The rows
-    of one depth, ``levels`` (first, end), only read slots that shallower rows wrote, so each
-    depth is one step over every sample.
-    """
-
-    n_slots: int
-    n_out: int
-    n_dof: int
-    parent: I64
-    child: I64
-    kind: I64
-    dof: I64  # the DOF each row reads; n_dof (a column of zeros) for a fixed row
-    origin: F64
-    axis: F64
-    mul: F64
-    off: F64
-    levels: tuple[tuple[int, int], ...]
-
-
-def tree(
-    parent: Any,
-    child: Any,
-    kind: Any,
-    origin: Any,
-    axis: Any,
-    dof: Any,
-    mul: Any,
-    off: Any,
-    n_slots: int,
-    n_out: int,
-    n_dof: int,
-) -> object:
-    # In the C core's order: the counts (parsed first), the rows' number, the arrays, each row.
-    n_slots, n_out, n_dof = index(n_slots), index(n_out), index(n_dof)
-    n = len(parent)  # TypeError as PyObject_Length raises
-    if not 1 <= n_out <= n_slots or n_slots > n_out + n or n_dof < 0:
-        raise ValueError("tree program: slot or DOF counts out of range")
-    p = _copy_i64(parent, n, "parent")
-    c = _copy_i64(child, n, "child")
-    k = _copy_i64(kind, n, "kind")
-    d = _copy_i64(dof, n, "dof")
-    o = _copy_f64(origin, 16 * n, "origin").reshape(n, 4, 4)
-    a = _copy_f64(axis, 3 * n, "axis").reshape(n, 3)
-    m = _copy_f64(mul, n, "mul")
-    f = _copy_f64(off, n, "off")
-    for r in range(n):
-        pr, ch = int(p[r]), int(c[r])
-        if (
-            not 0 <= pr < n_slots
-            or not 0 < ch < n_slots
-            or pr == ch
-            or (k[r] != KIND_FIXED and not 0 <= d[r] < n_dof)
-        ):
-            raise ValueError("tree program refers to a slot or DOF out of range")
-        if not KIND_FIXED <= k[r] <= KIND_PRISMATIC:
-            raise ValueError("tree program has a motion kind out of range")
-    depth = np.full(n_slots, -1, dtype=np.int64)
-    depth[0] = 0
-    row_depth = np.zeros(n, dtype=np.int64)
-    for r in range(n):
-        pr, ch = int(p[r]), int(c[r])
-        if depth[pr] < 0:
-            raise ValueError("tree program reads a slot before a row writes it")
-        depth[ch] = row_depth[r] = depth[pr] + 1
-    if (depth[1:n_out] < 0).any():
-        raise ValueError("tree program leaves a body's pose unset")
-    reads = np.where(k == KIND_FIXED, n_dof, d)  # a fixed row's DOF is never read, nor checked
-    order = np.argsort(row_depth, kind="stable")
-    ends = np.searchsorted(row_depth[order], np.arange(1, int(row_depth.max(initial=0)) + 2))
-    levels = tuple((int(lo), int(hi)) for lo, hi in zip(ends[:-1], ends[1:], strict=True))
-    return Tree(
-        n_slots,
-        n_out,
-        n_dof,
-        p[order],
-        c[order],
-        k[order],
-        reads[order],
-        o[order],
-        a[order],
-        m[order],
-        f[order],
-        levels,
-    )
-
-
-def _tree_of(obj: object) -> Tree:
-    return table(obj, Tree, "a tree program (from tree())")
-
-
-def tree_size(tree: object) -> tuple[int, int]:
-    """(bodies returned, degrees of freedom) of a tree program."""
-    t = _tree_of(tree)
-    return t.n_out, t.n_dof
-
-
-def _run_tree(t: Tree, q: F64, out: F64) -> None:
-    """Every output pose of the samples of ``q`` (N, D) into ``out`` (N, B, 4, 4)."""
-    n = q.shape[0]
-    slots = np.empty((n, t.n_slots, 3, 4))
-    slots[:, 0] = np.eye(4)[:3]
-    row = _compose(t.origin[:, :3], _motions(t.kind, t.axis, _values(t, q)))
-    for lo, hi in t.levels:
-        slots[:, t.child[lo:hi]] = _compose(slots[:, t.parent[lo:hi]], row[:, lo:hi])
-    out[..., :3, :] = slots[:, : t.n_out]
-    out[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
-
-
-def _values(t: Tree, q: F64) -> F64:
-    """Each row's motion value (N, R) for the samples of ``q`` (N, D); 0 for a fixed row."""
-    padded = np.zeros((q.shape[0], t.n_dof + 1))
-    padded[:, : t.n_dof] = q
-    v: F64 = padded[:, t.dof] * t.mul + t.off
-    return v
-
-
-def fk(tree: object, q: object) -> F64:
-    t = _tree_of(tree)
-    qa = _config(q, 1, t.n_dof)
-    # A batch of one, by the batch's own operations: np.matmul (BLAS, whose sums may fuse or
-    # reorder) would differ from fk_batch in the last bit.
-    poses: F64 = np.empty((1, t.n_out, 4, 4))
-    _run_tree(t, qa[None, :], poses)
-    pose: F64 = poses[0]
-    return pose
-
-
-def fk_batch(tree: object, q: object, out: Any = None, stream: bool = False) -> F64:
-    """Every pose of a batch; ``stream`` is the C core's choice of stores, meaningless here."""
-    truth(stream)  # read as the C core reads it (an array of several values is an error)
-    t = _tree_of(tree)
-    qa = _config(q, 2, t.n_dof)
-    n = qa.shape[0]
-    shape = (n, t.n_out, 4, 4)
-    if out is None:
-        out = np.empty(shape)
-    else:
-        check_out(out, shape)
-    for lo in range(0, n, _CHUNK):
-        _run_tree(t, qa[lo : lo + _CHUNK], out[lo : lo + _CHUNK])
-    result: F64 = out
-    return result
-
-
-def check_out(out: object, shape: tuple[int, ...]) -> None:
-    """Check a caller's array for poses of ``shape`` as the C core does.
-
-    TypeError for the wrong type, byte order or alignment (the core writes native float64 in
-    place), ValueError for the wrong shape.
-    """
-    what = "out must be a writeable, aligned, native-order C-contiguous float64 array (N, B, 4, 4)"
-    if not (
-        isinstance(out, np.ndarray)
-        and out.dtype.type is np.float64
-        and out.dtype.isnative
-        and out.flags.aligned
-        and out.flags.c_contiguous
-        and out.flags.writeable
-    ):
-        raise TypeError(what)
-    if out.shape != shape:
-        raise ValueError(what)
 
 
 # --------------------------------------------------------------------------------- a chain

@@ -151,6 +151,9 @@ class SetupPage(PartsTab, StatesTab, CheckTab):
         panel.set_width(300)
         self._status = gui.add_markdown("")
         self._message = gui.add_markdown("Pick a link in the robot or the tree.")
+        # Above the tabs, so Ctrl+Z and Ctrl+Shift+Z (the page's script) find them on any tab.
+        self._button(gui, "undo", lambda: self._stepped(back=True))
+        self._button(gui, "redo", lambda: self._stepped(back=False))
         self._link = gui.add_dropdown("link", self.links, initial_value=self.links[0])
         self._link.on_update(self._guarded(lambda _e: self.select(str(self._link.value))))
         tabs = gui.add_tab_group()

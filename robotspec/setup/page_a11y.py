@@ -105,6 +105,21 @@ _SCRIPT = r"""
       if (root) root.setAttribute("role", "main");
     }
   }
+  // Ctrl+Z / Ctrl+Shift+Z (and Ctrl+Y): the page's undo and redo buttons, except in a text
+  // box, where they undo the typing as everywhere.
+  addEventListener("keydown", (e) => {
+    if (!(e.ctrlKey || e.metaKey) || e.altKey) return;
+    const key = e.key.toLowerCase();
+    if (key !== "z" && key !== "y") return;
+    const t = e.target;
+    const typing = t && (t.tagName === "TEXTAREA" || t.isContentEditable
+      || (t.tagName === "INPUT" && !/^(button|checkbox|radio|range)$/i.test(t.type)));
+    if (typing) return;
+    const which = key === "y" || e.shiftKey ? "redo" : "undo";
+    const button = [...document.querySelectorAll("button")]
+      .find((b) => b.textContent.trim() === which);
+    if (button) { e.preventDefault(); button.click(); }
+  });
   let queued = false;
   const later = () => { if (!queued) { queued = true; requestAnimationFrame(() => {
     queued = false; fix(); }); } };

@@ -52,6 +52,7 @@ class PageBase:
             try:
                 fn(event)
             except RobotSpecError as exc:
+                self.session.failed(exc.message)  # the next undo says so, and undoes nothing
                 near = f" (did you mean {', '.join(exc.suggestions)}?)" if exc.suggestions else ""
                 self.say(f"**{exc.severity}:** {html.escape(exc.message)}{near}")
             except Exception as exc:  # noqa: BLE001 - the server outlives any bug in one action

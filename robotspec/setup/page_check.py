@@ -1,4 +1,4 @@
-"""The page's check & save tab: validate's problems, undo, the collision matrix, save."""
+"""The page's check & save tab: validate's problems, the collision matrix, save; undo, redo."""
 
 from __future__ import annotations
 
@@ -26,7 +26,6 @@ class CheckTab(PageBase):
 
     def _build_check(self, gui: Any) -> None:
         self._problems = gui.add_markdown("")
-        self._button(gui, "undo", lambda: self._after(self.session.undo(), "undone"))
         with gui.add_folder("self-collision matrix"):
             self._samples = gui.add_number("samples", 2000, min=100, max=1_000_000, step=100)
             self._button(gui, "generate collision matrix", lambda: self._collisions("generate"))
@@ -40,6 +39,14 @@ class CheckTab(PageBase):
         where = ", ".join(f"`{html.escape(str(f))}`" for f in self.session.fence.folders)
         gui.add_markdown(f"<small>save as writes inside {where} only</small>")
         self._button(gui, "save", self._save)
+
+    def _stepped(self, *, back: bool) -> None:
+        """Undo or redo one change (any tab's), saying which (Ctrl+Z, Ctrl+Shift+Z press these)."""
+        v, said = self.session.step(back=back)
+        if said.startswith(("undone", "redone")):
+            self._after(v, html.escape(said))
+        else:
+            self.say(html.escape(said))
 
     def _collisions(self, what: str) -> None:
         from robotspec.setup.collisions import audit_session, generate_matrix, plain_audit_report

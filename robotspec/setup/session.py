@@ -12,12 +12,14 @@ from __future__ import annotations
 import copy
 import threading
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
+from robotspec.errors import RobotSpecError
 from robotspec.files.writing import check_writable, write_file
 from robotspec.model.world import World
 from robotspec.setup.edits import PartEdits, SetupError, _chain, _manipulator
+from robotspec.setup.history import History, describe
 from robotspec.setup.questions import Question, questions_of
 from robotspec.setup.save import spec_text, write_spec
 from robotspec.setup.source import Source, open_source
@@ -28,8 +30,6 @@ from robotspec.setup.validation import Validation, validate_text
 from robotspec.spec.draft.model import Draft
 
 __all__ = ["SetupError", "SetupSession", "Snapshot"]
-
-_HISTORY = 50
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,8 @@ class SetupSession(PartEdits):
         self.fence = SaveFence(output, tuple(allow_save), dict(source.inputs))
         self._lock = threading.RLock()
         self._draft = copy.deepcopy(source.draft)
-        self._history: list[Draft] = []
+        #: Undo and redo, each step with what it changed (``setup/history.py``).
+        self._history: History[tuple[Draft, Snapshot]] = History()
         self._listeners: list[Callable[[Snapshot], None]] = []
         self._version = 0
         #: Ordered delivery (:meth:`_publish`): the last (version, saved) delivered, and
@@ -202,14 +203,25 @@ class SetupSession(PartEdits):
     def edit(self, change: Callable[[Draft], None]) -> Validation:
         """Apply ``change`` to a copy of the draft, validate it, make it the state."""
         with self._lock:
-            new = copy.deepcopy(self._draft)
-            change(new)
+            try:
+                new = copy.deepcopy(self._draft)
+                change(new)
+                snap = self._make_snapshot(new)
+            except RobotSpecError as exc:
+                self._history.fail(exc.message)
+                raise
             self._version += 1
-            snap = self._make_snapshot(new)
-            self._history = [*self._history[-_HISTORY + 1 :], self._draft]
+            snap = replace(snap, version=self._version)
+            before = (self._draft, self._snapshot)
+            self._history.record(before, (new, snap), describe(before[1].text, snap.text))
             self._draft, self._snapshot = new, snap
         self._publish()
         return snap.validation
+
+    def failed(self, what: str) -> None:
+        """An action of the page failed and changed nothing: the next undo says so."""
+        with self._lock:
+            self._history.fail(what)
 
     def _publish(self) -> None:
         """Tell the listeners of the newest state, states in the order they were made.
@@ -244,15 +256,31 @@ class SetupSession(PartEdits):
 
     def undo(self) -> Validation:
         """Go back one change (nothing happens when there is none)."""
+        return self.step(back=True)[0]
+
+    def redo(self) -> Validation:
+        """Make the change undone last again (nothing happens when there is none)."""
+        return self.step(back=False)[0]
+
+    def step(self, *, back: bool) -> tuple[Validation, str]:
+        """Undo (``back``) or redo one change; what it did in words ("undone: line 12: ...").
+
+        The first undo after a failed action undoes nothing and says so
+        (:class:`~robotspec.setup.history.History`).
+        """
         with self._lock:
-            if not self._history:
-                return self.validation
-            previous = self._history.pop()
+            step, said = self._history.undo() if back else self._history.redo()
+            if step is None:
+                return self.validation, said
+            draft, snap = step.before if back else step.after
             self._version += 1
-            snap = self._make_snapshot(previous)
-            self._draft, self._snapshot = previous, snap
+            # The text and its validation as they were; saved or not is judged now.
+            srdf = self._srdf_of(draft)
+            saved = (snap.text, srdf and srdf[1]) == self._saved
+            snap = replace(snap, version=self._version, saved=saved)
+            self._draft, self._snapshot = copy.deepcopy(draft), snap
         self._publish()
-        return snap.validation
+        return snap.validation, said
 
     # ------------------------------------------------------------------ states and the SRDF
     def set_srdf(self, ref: str | None) -> Validation:

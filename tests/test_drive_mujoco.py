@@ -277,3 +277,25 @@ def test_a_joint_pressed_past_its_soft_limit_is_reported_at_the_limit(
     robot.step()
     assert data.qpos[panda.plant.joint_qpos[i]] > robot.limits.upper[i]  # MuJoCo: still past
     assert robot.robot_state.joint_position[i] == robot.limits.upper[i]  # reported at the stop
+
+
+def test_a_joints_dry_friction_beyond_its_servo_is_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The tiny arm's j1 (URDF friction 0.1 N m) stops up to friction/kp short: said up front."""
+    from robotspec.driver.mujoco_model import friction_dead_bands
+    from tests.test_export_mjcf import TINY_SPEC, TINY_SRDF, TINY_URDF
+
+    (tmp_path / "tiny.urdf").write_text(TINY_URDF)
+    (tmp_path / "tiny.srdf").write_text(TINY_SRDF)
+    (tmp_path / "tiny.yaml").write_text(TINY_SPEC)
+    target = physics_target(tmp_path / "tiny.yaml", "arm")
+    bands = friction_dead_bands(target.plant, target.joint_names, 1e-4)
+    assert [b.joint for b in bands] == ["j1"]  # j2 has no friction
+    j1 = bands[0]
+    assert j1.friction == 0.1 and j1.unit == "N m"
+    assert j1.band == pytest.approx(0.1 / float(target.plant.kp[0]), rel=1e-12)
+    err = capsys.readouterr().err
+    assert "note: the URDF's dry friction holds 1 of the chain's joints short of a jog's " in err
+    assert f"{j1.band:.2g} rad on j1" in err
+    assert friction_dead_bands(target.plant, target.joint_names, 1.0) == []  # within a rad

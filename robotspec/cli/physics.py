@@ -58,7 +58,8 @@ def physics_target(
     Raises a RobotSpecError naming ``pip install 'robotspec[mujoco]'`` without MuJoCo, before
     anything is compiled.
     """
-    from robotspec.driver.mujoco_model import require_mujoco
+    from robotspec.driver.fill import JOG_ARRIVAL_TOLERANCE
+    from robotspec.driver.mujoco_model import friction_dead_bands, require_mujoco
     from robotspec.export.physics_model import plant_model
 
     require_mujoco()
@@ -78,6 +79,18 @@ def physics_target(
         sys.stderr.write(f"note: {note}\n")
     names = [j.joint_identifier.name for j in exported.info.joint_info]
     plant = plant_model(robot, export, names, gravity_compensation=gravity_compensation)
+    bands = friction_dead_bands(plant, names, JOG_ARRIVAL_TOLERANCE)
+    if bands:
+        worst = bands[0]
+        listed = ", ".join(
+            f"{b.band:.2g} {'m' if b.unit == 'N' else 'rad'} on {b.joint}" for b in bands
+        )
+        sys.stderr.write(
+            f"note: the URDF's dry friction holds {len(bands)} of the chain's joints short of a "
+            f"jog's {JOG_ARRIVAL_TOLERANCE:g} arrival (friction over servo stiffness, "
+            f"{worst.joint}: {worst.friction:g} {worst.unit} against {worst.stiffness:.3g}): "
+            f"{listed}\n"
+        )
     return PhysicsTarget(robot, exported, export, plant)
 
 

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from robotspec.collision import CollisionRules, SelfCollisionChecker
-from robotspec.collision.checker import _solid
+from robotspec.collision.distances import _solid
 from robotspec.description.urdf import load_urdf
 from robotspec.errors import CollisionError
 

@@ -1,0 +1,168 @@
+"""The narrow phase of a block of samples: which broad-phase candidates collide.
+
+A candidate is a (sample row, geometry pair) whose bounding boxes come within the margin. Two
+meshes are first proven apart or crossing by the C mesh core (tens of times cheaper than coal
+when they nearly touch); coal's ``ComputeCollision`` decides every candidate the proofs leave.
+
+Two ways through the candidates, with the same answers:
+
+- :func:`block_hits` walks them in order in Python (every colliding pair, or the first of each
+  sample), proving mesh pairs one by one as it reaches them unless they were proven in one call
+  beforehand (:func:`prove_apart`).
+- :func:`first_hits` answers "does the sample collide" in waves: the first candidate of every
+  sample, then the next one, two, four... of the samples not yet seen colliding, each wave's mesh
+  proofs in one C call. The C call releases the GIL, so threads sharing a checker run their
+  proofs at once; the waves keep the work near the one-by-one walk's, which stops each sample at
+  its first hit (proving every candidate of a block at once costs twice as much on the PR2).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from robotspec.arrays import F64, I64
+from robotspec.collision import meshcore
+from robotspec.collision.compiled import Compiled, Scratch
+
+__all__ = ["APART", "CROSS", "UNKNOWN", "UNTRIED", "block_hits", "first_hits", "prove_apart"]
+
+#: What the mesh core proved of a candidate (its codes), and "not asked".
+UNKNOWN, APART, CROSS, UNTRIED = 0, 1, 2, -1
+#: Candidate positions within a sample that make up each wave of :func:`first_hits`.
+_WAVES = ((0, 1), (1, 2), (2, 3), (3, 5), (5, 8), (8, 13), (13, 1 << 62))
+
+Hits = tuple[list[int], list[int]]
+
+
+def prove_apart(
+    c: Compiled, poses: F64, rows: list[int], ks: list[int], eps: float
+) -> tuple[list[int], list[int], list[int]]:
+    """The candidates left once the mesh pairs proven apart are dropped, and their proofs.
+
+    Each is ``UNKNOWN`` or ``CROSS`` (coal decides the first, the second is a collision), or
+    ``UNTRIED`` for a pair that is not two meshes.
+    """
+    r = np.asarray(rows, dtype=np.int64)
+    k = np.asarray(ks, dtype=np.int64)
+    at = np.flatnonzero(np.asarray(c.two_meshes, dtype=np.bool_)[k])
+    proofs = np.full(len(k), UNTRIED, dtype=np.int64)
+    if not len(at):
+        return rows, ks, proofs.tolist()
+    proofs[at] = meshcore.core().apart(
+        c.meshes, poses, r[at], k[at], c.pair_geom1, c.pair_geom2, eps
+    )
+    keep = proofs != APART
+    return r[keep].tolist(), k[keep].tolist(), proofs[keep].tolist()
+
+
+def block_hits(
+    c: Compiled,
+    scratch: Scratch,
+    req: Any,
+    poses: F64,
+    candidates: tuple[list[int], list[int], list[int]],
+    found: list[bool] | None,
+    eps: float,
+    *,
+    first_only: bool,
+    drop_found: bool,
+) -> Hits:
+    """The (row, body pair)s that collide among ``candidates`` (rows, geometry pairs, proofs).
+
+    ``first_only`` stops a row at its first colliding pair; ``drop_found`` skips a pair that has
+    collided before (``found``, per body pair, is updated when given).
+    """
+    res = scratch.result
+    clear, is_collision = res.clear, res.isCollision
+    tf = scratch.transforms
+    fns = c.collide
+    owner = c.pair_of_list
+    g1s, g2s = c.pair_geom1_list, c.pair_geom2_list
+    meshes, two_meshes = c.meshes, c.two_meshes
+    apart = meshcore.core().apart_one
+    hit_rows: list[int] = []
+    hit_pairs: list[int] = []
+    stamp = [-1] * len(tf)
+    last_row = -1
+    skip_row = False
+    row_hits: set[int] = set()
+    for r, k, proof in zip(*candidates, strict=True):
+        if r != last_row:
+            last_row, skip_row = r, False
+            row_hits = set()
+        elif skip_row:
+            continue
+        p = owner[k]
+        if p in row_hits or (drop_found and found is not None and found[p]):
+            continue
+        i, j = g1s[k], g2s[k]
+        if proof == UNTRIED and two_meshes[k]:
+            proof = apart(meshes, poses, r, i, j, eps)
+            if proof == APART:
+                continue
+        if proof != CROSS:
+            if stamp[i] != r:
+                stamp[i] = r
+                pose = poses[r, i]
+                tf[i].setRotation(pose[:3, :3])
+                tf[i].setTranslation(pose[:3, 3])
+            if stamp[j] != r:
+                stamp[j] = r
+                pose = poses[r, j]
+                tf[j].setRotation(pose[:3, :3])
+                tf[j].setTranslation(pose[:3, 3])
+            clear()
+            fns[k](tf[i], tf[j], req, res)
+            if not is_collision():
+                continue
+        row_hits.add(p)
+        hit_rows.append(r)
+        hit_pairs.append(p)
+        if found is not None:
+            found[p] = True
+        skip_row = first_only
+    return hit_rows, hit_pairs
+
+
+def first_hits(
+    c: Compiled, scratch: Scratch, req: Any, poses: F64, rows: I64, ks: I64, eps: float
+) -> Hits:
+    """One colliding (row, body pair) per row that collides, in waves (see the module's doc).
+
+    ``rows`` (sorted) and ``ks`` are the broad phase's candidates of the block.
+    """
+    n_cand = len(ks)
+    if not n_cand:
+        return [], []
+    starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
+    pos = np.arange(n_cand) - np.repeat(starts, np.diff(np.r_[starts, n_cand]))
+    two = np.asarray(c.two_meshes, dtype=np.bool_)[ks] if c.meshes is not None else None
+    done = np.zeros(poses.shape[0], dtype=np.bool_)
+    hit_rows: list[int] = []
+    hit_pairs: list[int] = []
+    most = int(pos.max())
+    for lo, hi in _WAVES:
+        if lo > most:
+            break
+        sel = np.flatnonzero((pos >= lo) & (pos < hi) & ~done[rows])
+        if not len(sel):
+            continue
+        r, k = rows[sel], ks[sel]
+        proofs = np.full(len(sel), UNTRIED, dtype=np.int64)
+        if two is not None:
+            at = np.flatnonzero(two[sel])
+            if len(at):
+                proofs[at] = meshcore.core().apart(
+                    c.meshes, poses, r[at], k[at], c.pair_geom1, c.pair_geom2, eps
+                )
+        keep = proofs != APART
+        wave = (r[keep].tolist(), k[keep].tolist(), proofs[keep].tolist())
+        rs, ps = block_hits(
+            c, scratch, req, poses, wave, None, eps, first_only=True, drop_found=False
+        )
+        done[rs] = True
+        hit_rows += rs
+        hit_pairs += ps
+    return hit_rows, hit_pairs

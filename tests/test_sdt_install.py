@@ -64,3 +64,18 @@ def test_with_sdt_but_no_giskardpy_giskardpy_is_named() -> None:
     assert "it imports giskardpy" in child.stderr
     assert GISKARDPY_INSTALL in child.stderr.replace("\n", " ")
     assert "robotspec[sdt]" not in child.stderr
+
+
+def test_an_installed_sdt_without_a_module_is_not_called_absent() -> None:
+    """A module of SDT's own that its version lacks: the version named, not 'not installed'."""
+    require_sdt()
+    import importlib
+
+    from robotspec.interop.sdt.install import import_error
+
+    with pytest.raises(ImportError) as raised:
+        importlib.import_module("semantic_digital_twin.robots.no_such_robot_module")
+    message = str(import_error(raised.value, tested="26.7"))
+    assert "not installed" not in message
+    assert "has no module 'semantic_digital_twin.robots.no_such_robot_module'" in message
+    assert "pip install 'semantic-digital-twin==26.7.*'" in message

@@ -36,12 +36,13 @@ def import_error(exc: ImportError, *, tested: str) -> RobotSpecError:
 
     Three cases, each with its own command: SDT itself absent (the ``sdt`` extra); a module
     SDT imports without declaring it (giskardpy: from its source; another: named as such);
-    an SDT of another version whose names the bridge does not find (the pinned version).
+    an SDT of another version whose names or modules the bridge does not find (the pinned
+    version; an installed SDT without one of its modules is not "not installed").
     """
     missing = (exc.name or "") if isinstance(exc, ModuleNotFoundError) else ""
     top = missing.partition(".")[0]
     version = _installed("semantic-digital-twin")
-    if version is None or top == "semantic_digital_twin":
+    if version is None or missing == "semantic_digital_twin":
         message = (
             f"the semantic digital twin is not installed ({exc}): pip install 'robotspec[sdt]' "
             f"(semantic-digital-twin {tested}.*; see docs/sdt.md, 'Installing SDT')"
@@ -51,6 +52,12 @@ def import_error(exc: ImportError, *, tested: str) -> RobotSpecError:
             f"semantic-digital-twin {version} is installed, but it imports giskardpy "
             "(giskardpy.utils.utils.create_path, while it loads its World), which is not "
             f"installed and not on PyPI: {GISKARDPY_INSTALL} (see docs/sdt.md, 'Installing SDT')"
+        )
+    elif top == "semantic_digital_twin":  # installed, without a module the bridge imports
+        message = (
+            f"semantic-digital-twin {version} is installed but has no module '{missing}' "
+            f"({exc}); robotspec's bridge is written for {tested}.*: pip install "
+            f"'semantic-digital-twin=={tested}.*'"
         )
     elif top and importlib.util.find_spec(top) is None:
         message = (

@@ -26,6 +26,8 @@ from robotspec.model.world import Body, Connection, ConnectionType, World
 
 __all__ = ["ChainKinematics", "Kinematics"]
 
+_NDARRAY = np.ndarray  # a module global: the queries' one test of their argument
+
 
 # Motion kinds, as the C core (_kincore.c) numbers them.
 _FIXED = 0
@@ -97,15 +99,19 @@ class Kinematics:
         self._nb = len(world.bodies)
         self._nd = len(world.degrees_of_freedom)
         self._tree = _tree_program(world)
+        # The core's entry point, bound once: the table above is that core's (a query never
+        # looks the core up again), and a bound call is the cheapest Python can make.
+        self._fk = kincore.core().fk
         self._chains: dict[tuple[int, int], ChainKinematics] = {}
+        self._from_root: dict[str, ChainKinematics] = {}  # pose()'s chains, by body name
 
     # -------------------------------------------------------------------------- queries
     def forward(self, q: object) -> F64:
         """``root_T_body`` for every body (B, 4, 4) at configuration ``q`` (D,)."""
+        if type(q) is not _NDARRAY:  # an array goes to the core as it is (see _numbers)
+            q = _numbers(q, self._nd, self.world.name, False)
         try:
-            poses: F64 = kincore.core().fk(
-                self._tree, _numbers(q, self._nd, self.world.name, False)
-            )
+            poses: F64 = self._fk(self._tree, q)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self.world.name, False) from None
         return poses
@@ -163,11 +169,15 @@ class Kinematics:
         Only the connections above ``body`` are composed (its chain from the root), so one
         frame costs less than every body.
         """
-        root = self.world.bodies[0]
-        pose = self.chain(root, body).fk(q)
+        chain = self._from_root.get(body) if type(body) is str else None
+        if chain is None:
+            chain = self.chain(self.world.bodies[0], body)
+            if type(body) is str:
+                self._from_root[body] = chain
+        pose = chain.fk(q)
         if relative_to is None:
             return pose
-        ref = self.chain(root, relative_to).fk(q)
+        ref = self.chain(self.world.bodies[0], relative_to).fk(q)
         relative: F64 = np.asarray(np.linalg.solve(ref, pose), dtype=np.float64)
         return relative
 
@@ -195,14 +205,17 @@ def _want(nd: int, world: str, batch: bool) -> str:
 
 
 def _numbers(q: object, nd: int, world: str, batch: bool) -> object:
-    """``q`` for the core: a float64 array as it is, anything else only if float64 holds it.
+    """``q`` for the core when it is not a numpy array: converted only if float64 holds it.
 
-    The core checks the shape and values; anything but a float64 array is converted here, and
-    refused by its dtype when float64 would change it (complex, longdouble, strings, objects).
-    Why here: the numpy fallback reads a list as float64 whatever it holds (strings included),
-    so the dtype is checked once for both cores; it costs nothing on a float64 array.
+    The core checks the shape, the values and an array's dtype: it casts an array only where no
+    value can change (numpy's safe rule), so a complex, longdouble or string array is its
+    TypeError. A list is another matter: both cores would read ``["1", "2"]`` as numbers, so
+    anything but an array is converted here, refused when float64 would change it. Why the
+    queries test ``type(q) is np.ndarray`` before calling this: that test is the whole cost an
+    array pays in front of the core (tens of nanoseconds; a call here and a dtype comparison
+    cost several hundred, a third of a small query, measured by benchmarks/bench_percall.py).
     """
-    if isinstance(q, np.ndarray) and q.dtype == np.float64:
+    if type(q) is _NDARRAY:
         return q
     return real_array(q, f"configuration of {_want(nd, world, batch)}", _error)
 
@@ -328,7 +341,10 @@ class ChainKinematics:
         self.dof_names: tuple[str, ...] = tuple(
             world.degrees_of_freedom[d].name for d in self.dof_indices
         )
-        self._program = kincore.core().chain(
+        core = kincore.core()
+        # Bound once, with the table they run (see Kinematics.__init__).
+        self._fk, self._jacobian = core.chain_fk, core.chain_jacobian
+        self._program = core.chain(
             np.array(pre, dtype=np.float64).reshape(-1, 4, 4),
             acc,
             np.array(kinds, dtype=np.int64),
@@ -343,10 +359,10 @@ class ChainKinematics:
 
     def fk(self, q: object) -> F64:
         """``root_T_tip`` (4, 4) for the world configuration ``q`` (D,)."""
+        if type(q) is not _NDARRAY:  # an array goes to the core as it is (see _numbers)
+            q = _numbers(q, self._nd, self._world_name, False)
         try:
-            pose: F64 = kincore.core().chain_fk(
-                self._program, _numbers(q, self._nd, self._world_name, False)
-            )
+            pose: F64 = self._fk(self._program, q)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self._world_name, False) from None
         return pose
@@ -367,10 +383,10 @@ class ChainKinematics:
         Linear velocity on top. A mimic joint adds its multiplier times its own column to its
         leader's column.
         """
+        if type(q) is not _NDARRAY:  # an array goes to the core as it is (see _numbers)
+            q = _numbers(q, self._nd, self._world_name, False)
         try:
-            jac: F64 = kincore.core().chain_jacobian(
-                self._program, _numbers(q, self._nd, self._world_name, False)
-            )
+            jac: F64 = self._jacobian(self._program, q)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self._world_name, False) from None
         return jac

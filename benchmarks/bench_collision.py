@@ -4,14 +4,25 @@ Run: ``python benchmarks/bench_collision.py`` (needs the dev extra: example-robo
 Both sides check the same pairs (the SRDF's active pairs) on the same random configurations with
 the same coal geometry; the answers are compared before anything is timed. Ratios are peer time /
 robotspec time: above 1 means robotspec is faster.
+
+The thread rows (``--threads``, default 2) run the batches on that many threads against
+pinocchio's ``computeCollisionsInParallel`` with a broad-phase pool on as many, and against
+robotspec's own batch on one thread (the ratio is then the speed-up). A control row runs work
+that holds no lock at all (sha256 of 32 MB per thread, which releases the GIL) on one thread
+and on ``--threads``: the speed-up the machine itself gives at that moment, so a loaded machine's
+figures can be read. All of them are interleaved rounds in one run (``--rounds``).
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
+import os
 import statistics
+import threading
 import time
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from rows import Row, add_json_flag, erd_share, print_rows
@@ -32,6 +43,9 @@ def main() -> None:
     parser.add_argument("--configs", type=int, default=2000, help="configurations per check run")
     parser.add_argument("--samples", type=int, default=10_000, help="matrix generation samples")
     parser.add_argument("--jobs", type=int, default=None, help="processes for the matrix")
+    parser.add_argument("--threads", type=int, default=2, help="threads of the parallel rows")
+    parser.add_argument("--rounds", type=int, default=9, help="interleaved rounds, thread rows")
+    parser.add_argument("--no-matrix", action="store_true", help="skip the matrix generation")
     add_json_flag(parser)
     args = parser.parse_args()
     say = (lambda *a, **k: None) if args.json else print
@@ -141,6 +155,10 @@ def main() -> None:
         f"({len(owner)} geometry pairs), {n} random configurations; answers identical\n"
     )
     table = [Row(name, a, f"pinocchio {peer}", b) for name, a, peer, b in rows]
+    table += thread_rows(checker, qs, pin, model, gmodel, pq, args.threads, args.rounds)
+    if args.no_matrix:
+        print_rows(table, args.json)
+        return
 
     t = time.perf_counter()
     matrix = generate_for_robot(robot, samples=args.samples, seed=0, processes=args.jobs)
@@ -167,6 +185,84 @@ def main() -> None:
         f"\n  against the shipped pr2.srdf ({len(reference)} pairs between bodies with geometry): "
         f"precision {precision:.3f}, recall {recall:.3f}"
     )
+
+
+def thread_rows(
+    checker: Any,
+    qs: np.ndarray,
+    pin: Any,
+    model: Any,
+    gmodel: Any,
+    pq: list[np.ndarray],
+    threads: int,
+    rounds: int,
+) -> list[Row]:
+    """The batches on ``threads`` threads: against pinocchio's parallel batch, against one thread.
+
+    Every timing of a row is taken in the same round as the others (interleaved), so machine
+    load hits all of them alike; each figure is the median over ``rounds``.
+    """
+    n = len(qs)
+    qmat = np.asfortranarray(np.array(pq).T)
+    pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(model, gmodel, threads)
+    any_one = checker.in_collision_batch(qs)
+    assert np.array_equal(checker.in_collision_batch(qs, threads=threads), any_one)
+    assert np.array_equal(
+        np.asarray(pin.computeCollisionsInParallel(threads, pool, qmat, True)), any_one
+    )
+    assert np.array_equal(
+        checker.collisions_batch(qs, threads=threads), checker.collisions_batch(qs)
+    )
+    blob = b"\x5a" * (32 << 20)
+
+    def control(k: int) -> None:
+        workers = [threading.Thread(target=hashlib.sha256, args=(blob,)) for _ in range(k)]
+        for w in workers:
+            w.start()
+        for w in workers:
+            w.join()
+
+    timed: dict[str, Callable[[], object]] = {
+        "any1": lambda: checker.in_collision_batch(qs, threads=1),
+        "anyN": lambda: checker.in_collision_batch(qs, threads=threads),
+        "pinN": lambda: pin.computeCollisionsInParallel(threads, pool, qmat, True),
+        "all1": lambda: checker.collisions_batch(qs, threads=1),
+        "allN": lambda: checker.collisions_batch(qs, threads=threads),
+        "ctl1": lambda: control(1),
+        "ctlN": lambda: control(threads),
+    }
+    t: dict[str, list[float]] = {k: [] for k in timed}
+    for _ in range(rounds):
+        for k, fn in timed.items():
+            t[k].append(median_time(fn, 1))
+    m = {k: _m(v) for k, v in t.items()}
+    load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
+    return [
+        Row(
+            f"any hit, batch, {threads} threads (per config)",
+            m["anyN"] / n,
+            f"pinocchio computeCollisionsInParallel, broad-phase pool, {threads} threads",
+            m["pinN"] / n,
+        ),
+        Row(
+            f"any hit, batch, {threads} threads (per config)",
+            m["anyN"] / n,
+            "robotspec on 1 thread (ratio = speed-up)",
+            m["any1"] / n,
+        ),
+        Row(
+            f"all colliding pairs, batch, {threads} threads (per config)",
+            m["allN"] / n,
+            "robotspec on 1 thread (ratio = speed-up)",
+            m["all1"] / n,
+        ),
+        Row(
+            f"control: {threads} x sha256(32 MB) on {threads} threads (load {load})",
+            m["ctlN"] / threads,
+            "1 x sha256 on 1 thread (ratio = the machine's speed-up)",
+            m["ctl1"],
+        ),
+    ]
 
 
 def _m(values: list[float]) -> float:

@@ -241,7 +241,12 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
 
         picked = _wait("a link picked by a click", click_robot)
         assert picked.startswith("link")
-        _wait("the pick shown", lambda: page._link.value == picked)
+        # Each tab its own pick (issue 33): the first tab's link list shows it, the other's not.
+        (mine,) = _wait(
+            "the tab that picked",
+            lambda: [c for c, link in page._picks.items() if c is not None and link == picked],
+        )
+        _wait("the pick shown", lambda: page.pick_list(mine).value == picked)
         # Software WebGL redraws the scene without end; hidden, it leaves the CPU to the page.
         d.execute_script(
             "document.querySelectorAll('canvas').forEach(c => c.style.display = 'none')"
@@ -262,14 +267,14 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         _tab(d, "Parts")
         _choose(d, page._part, "chains.arm")
         _click_tree(d, "link_eef")  # a pick in the tree: the link list and the robot follow
-        _wait("the tree's pick", lambda: page.selected == page._link.value == "link_eef")
+        _wait("the tree's pick", lambda: page.selected == page.pick_list(mine).value == "link_eef")
         t0 = time.perf_counter()
         _click_text(d, "root = picked link")  # the arm's root at its tip: an empty chain
         _wait("the error shown", lambda: "is empty" in body.text)
         change_to_shown = time.perf_counter() - t0
         assert "invalid" in body.text
         _shot(d, "setup-invalid.png")
-        _choose(d, page._link, "link_base")
+        _choose(d, page.pick_list(mine), "link_base")
         _click_text(d, "root = picked link")
         _wait("valid again", lambda: "✔ valid" in body.text and "is empty" not in body.text)
 
@@ -303,9 +308,12 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
             lambda: (
                 "0 open questions" in (t := d.find_element(By.TAG_NAME, "body").text)
                 and "saved" in t
+                and "tab 2 of 2" in t
             ),
             CATCH_UP,
         )
+        others = [c for c in page._lists if c != mine]
+        assert others and all(page.pick_list(c).value == page.links[0] for c in others)
     except Exception:
         d.save_screenshot(str(tmp_path / "failure.png"))  # kept by pytest, to look at
         raise

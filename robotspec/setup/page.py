@@ -26,6 +26,7 @@ from robotspec.setup.access import PageAccess, start_guarded
 from robotspec.setup.collisions import AuditReport
 from robotspec.setup.page_base import problem_line
 from robotspec.setup.page_check import CheckTab
+from robotspec.setup.page_clients import PICK_COLOUR, ClientsPart
 from robotspec.setup.page_parts import PartsTab
 from robotspec.setup.page_states import StatesTab
 from robotspec.setup.questions import Question
@@ -34,8 +35,8 @@ from robotspec.setup.tree import TreeRow, tree_rows
 
 __all__ = ["SELECTED_COLOUR", "SetupPage"]
 
-#: The picked link, drawn apart from every part colour.
-SELECTED_COLOUR = (230, 20, 20)
+#: The picked link, drawn apart from every part colour (in its own tab's scene).
+SELECTED_COLOUR = PICK_COLOUR
 #: The page's brand colour (#0d47a1): viser draws buttons in a lighter shade of it, which white
 #: text still reads on at 4.5:1 or more (viser's own blue gives 3.6:1, a lighter brand 3.4:1).
 BRAND = (13, 71, 161)
@@ -57,7 +58,7 @@ def _bare(session: SetupSession) -> Any:
     return v.robot
 
 
-class SetupPage(PartsTab, StatesTab, CheckTab):
+class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
     """The page of one session, served until :meth:`stop`."""
 
     def __init__(
@@ -91,7 +92,6 @@ class SetupPage(PartsTab, StatesTab, CheckTab):
         self._colours: dict[str, tuple[int, int, int]] = dict(self.viewer.scene.body_colours)
         self._groups: dict[str, str] = dict(self.viewer.scene.group_of_body)
         self._legend = ""
-        self.selected: str | None = None
         self._gui_lock = threading.RLock()
         self._questions_shown: tuple[Question, ...] | None = None
         self._q_handles: list[Any] = []
@@ -154,8 +154,7 @@ class SetupPage(PartsTab, StatesTab, CheckTab):
         # Above the tabs, so Ctrl+Z and Ctrl+Shift+Z (the page's script) find them on any tab.
         self._button(gui, "undo", lambda: self._stepped(back=True))
         self._button(gui, "redo", lambda: self._stepped(back=False))
-        self._link = gui.add_dropdown("link", self.links, initial_value=self.links[0])
-        self._link.on_update(self._guarded(lambda _e: self.select(str(self._link.value))))
+        self._build_clients(gui)  # this tab's own link list, and who else is here
         tabs = gui.add_tab_group()
         with tabs.add_tab("Questions"):
             self._q_intro = gui.add_markdown("")
@@ -167,24 +166,9 @@ class SetupPage(PartsTab, StatesTab, CheckTab):
         with tabs.add_tab("Check & save"):
             self._build_check(gui)
 
-    # ------------------------------------------------------------------ selection
-    def select(self, link: str) -> None:
-        """Pick a link: highlighted in 3D, marked in the tree, chosen in the dropdown."""
-        if link not in self.links:
-            raise RobotSpecError(f"no link '{link}' in the robot", kind="link", name=link)
-        with self._gui_lock:
-            previous, self.selected = self.selected, link
-            if self._link.value != link:
-                self._link.value = link
-            for body in (previous, link):
-                if body is not None:
-                    self._paint(body)
-            self._draw_tree()
-        part = self._groups.get(link)
-        self.say(f"picked **{link}**" + (f" (in {part})" if part else ""))
-
+    # ------------------------------------------------------------------ drawing
     def _paint(self, body: str) -> None:
-        colour = SELECTED_COLOUR if body == self.selected else self._colours.get(body, GREY)
+        colour = self._colours.get(body, GREY)
         for h in self.viewer.visual_meshes.get(body, ()):
             h.color = colour
 
@@ -193,7 +177,7 @@ class SetupPage(PartsTab, StatesTab, CheckTab):
         if self._tree_buttons:
             self._tree.content = self._legend
             for link, button in self._tree_buttons.items():
-                c = SELECTED_COLOUR if link == self.selected else self._colours.get(link, GREY)
+                c = self._colours.get(link, GREY)
                 if self._tree_colours.get(link) != c:
                     button.color = c
                     self._tree_colours[link] = c
@@ -201,7 +185,7 @@ class SetupPage(PartsTab, StatesTab, CheckTab):
         out = [self._legend, "<div style='font-family:monospace;font-size:0.8em;line-height:1.45'>"]
         for r in self.rows:
             c = self._colours.get(r.link, GREY)
-            style = "background:#fdd;font-weight:bold;" if r.link == self.selected else ""
+            style = ""
             out.append(
                 f"<div style='padding-left:{0.8 * r.depth:.1f}em;{style}'>"
                 f"<span style='display:inline-block;width:0.7em;height:0.7em;"

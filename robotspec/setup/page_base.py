@@ -37,7 +37,6 @@ class PageBase:
     session: SetupSession
     server: Any
     viewer: Any
-    selected: str | None
     _gui_lock: threading.RLock
     _message: Any
     _part: Any
@@ -49,6 +48,7 @@ class PageBase:
         def run(event: Any) -> None:
             if getattr(event, "client", True) is None:
                 return  # a value the server set itself
+            self._entered(event)  # which tab acts: its own pick (setup/page_clients.py)
             try:
                 fn(event)
             except RobotSpecError as exc:
@@ -58,6 +58,8 @@ class PageBase:
             except Exception as exc:  # noqa: BLE001 - the server outlives any bug in one action
                 traceback.print_exc(file=sys.stderr)
                 self.say(f"**internal error:** {type(exc).__name__}: {html.escape(str(exc))}")
+            finally:
+                self._exited()
 
         return run
 
@@ -79,9 +81,28 @@ class PageBase:
         return b
 
     def _pick(self) -> str:
-        if self.selected is None:
+        link = self.selected
+        if link is None:
             raise RobotSpecError("pick a link first (click the robot, or choose it above)")
-        return self.selected
+        return link
+
+    # ------------------------------------------------------------------ the tabs (clients)
+    @property
+    def selected(self) -> str | None:
+        """The picked link of the tab acting now (setup/page_clients.py)."""
+        raise NotImplementedError
+
+    def select(self, link: str) -> None:
+        """Pick a link for the tab acting now."""
+        raise NotImplementedError
+
+    def _entered(self, event: Any) -> None:
+        """A tab's callback starts on this thread."""
+        raise NotImplementedError
+
+    def _exited(self) -> None:
+        """That callback ended."""
+        raise NotImplementedError
 
     # ------------------------------------------------------------------ the tabs' own
     def _select_part(self, part: str) -> None:

@@ -20,14 +20,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from enum import StrEnum
 from pathlib import Path
-from typing import Annotated, Any, TypeVar
+from typing import Any
 from uuid import UUID
 
 from pydantic import (
     BaseModel,
-    BeforeValidator,
     ConfigDict,
     Field,
     ValidationError,
@@ -35,13 +33,33 @@ from pydantic import (
     model_validator,
 )
 
-from robotspec.driver.rr_names import rr_name_problem, rr_name_suggestion
-from robotspec.errors import RobotInfoError, RobotSpecErrors, closest_names
+from robotspec.driver.robot_info_checks import MAX_OFFSET_M, UNIT_TOL, semantic_checks
+from robotspec.driver.robot_info_enums import (
+    CAPABILITY_BITS,
+    CapabilityName,
+    EffortUnitName,
+    JointEffortUnits,
+    JointPositionUnits,
+    JointType,
+    JointTypeName,
+    PositionUnitName,
+    RobotCapability,
+    RobotTypeCode,
+    RobotTypeName,
+    ToolCapability,
+    ToolCapabilityName,
+    ToolTypeCode,
+    ToolTypeName,
+)
+from robotspec.errors import RobotInfoError, RobotSpecErrors
 from robotspec.files.validation import validation_errors
 from robotspec.files.yamlio import LocatedYaml, load_yaml, load_yaml_text
 
 __all__ = [
     "CAPABILITY_BITS",
+    "MAX_OFFSET_M",
+    "QUAT_TOL",
+    "UNIT_TOL",
     "DeviceInfo",
     "Identifier",
     "JointEffortUnits",
@@ -57,7 +75,9 @@ __all__ = [
     "RobotCapability",
     "RobotInfo",
     "RobotTypeCode",
+    "ToolCapability",
     "ToolInfo",
+    "ToolTypeCode",
     "Transform",
     "Vector3",
     "load_robot_info",
@@ -65,13 +85,8 @@ __all__ = [
     "read_robot_info_text",
 ]
 
-#: Axis vectors must be unit length to this tolerance (the toolbox asserts the same).
-UNIT_TOL = 1e-6
 #: Quaternions must be unit length to this tolerance (real files carry 6-digit rounding).
 QUAT_TOL = 1e-4
-#: Largest magnitude of a link offset or flange position, metres. Why a bound: finite but absurd
-#: values (1e200) make the pose and twist arithmetic overflow to infinity in the loop.
-MAX_OFFSET_M = 1e3
 #: Largest magnitude of a joint limit value (position, velocity, acceleration, ...), for the same
 #: reason: the braking arithmetic squares ``acceleration * period``.
 MAX_LIMIT = 1e9
@@ -85,153 +100,6 @@ class _Model(BaseModel):
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-class RobotTypeCode(StrEnum):
-    """``com.robotraconteur.robotics.robot.RobotTypeCode`` by name."""
-
-    unknown = "unknown"
-    serial = "serial"
-    dual_arm = "dual_arm"
-    differential_drive = "differential_drive"
-    planar = "planar"
-    floating = "floating"
-    freeform = "freeform"
-    other = "other"
-
-
-class RobotCapability(StrEnum):
-    """``RobotCapabilities`` flag names; the YAML lists names that are ORed into a bit set."""
-
-    unknown = "unknown"
-    jog_command = "jog_command"
-    trajectory_command = "trajectory_command"
-    position_command = "position_command"
-    velocity_command = "velocity_command"
-    homing_command = "homing_command"
-    software_reset_errors = "software_reset_errors"
-    software_enable = "software_enable"
-    interpolated_trajectory = "interpolated_trajectory"
-    raster_trajectory = "raster_trajectory"
-    trajectory_queueing = "trajectory_queueing"
-    speed_ratio = "speed_ratio"
-
-
-#: The robdef bit of each capability, for reporting the ``uint32`` the reference serves.
-CAPABILITY_BITS: dict[RobotCapability, int] = {
-    c: (0 if i == 0 else 1 << (i - 1)) for i, c in enumerate(RobotCapability)
-}
-
-
-class JointType(StrEnum):
-    """``com.robotraconteur.robotics.joints.JointType`` by name."""
-
-    unknown = "unknown"
-    revolute = "revolute"
-    continuous = "continuous"
-    prismatic = "prismatic"
-    wheel = "wheel"
-    screw = "screw"
-    other = "other"
-    revolute2 = "revolute2"
-    universal = "universal"
-    ball = "ball"
-    planar = "planar"
-    floating = "floating"
-    other_compound = "other_compound"
-    fixed = "fixed"
-
-
-#: Joint types an H/P chain can drive (the toolbox conversion accepts no others).
-DRIVABLE_JOINT_TYPES = frozenset({JointType.revolute, JointType.prismatic, JointType.continuous})
-
-
-class JointPositionUnits(StrEnum):
-    """``JointPositionUnits`` by name; informational, the driver works in radians and metres."""
-
-    implicit = "implicit"
-    meter = "meter"
-    radian = "radian"
-    degree = "degree"
-    ticks_lin = "ticks_lin"
-    ticks_rot = "ticks_rot"
-    nanoticks_lin = "nanoticks_lin"
-    nanoticks_rot = "nanoticks_rot"
-
-
-class JointEffortUnits(StrEnum):
-    """``JointEffortUnits`` by name; informational."""
-
-    implicit = "implicit"
-    newton = "newton"
-    newton_meter = "newton_meter"
-    ampere = "ampere"
-    volt = "volt"
-    pascal = "pascal"
-    coulomb = "coulomb"
-    tesla = "tesla"
-    weber = "weber"
-    meter_second2 = "meter_second2"
-    radian_second2 = "radian_second2"
-    degree_second2 = "degree_second2"
-
-
-class ToolTypeCode(StrEnum):
-    """``com.robotraconteur.robotics.tool.ToolTypeCode`` by name."""
-
-    unknown = "unknown"
-    basic_gripper = "basic_gripper"
-    basic_continuous_gripper = "basic_continuous_gripper"
-    pneumatic_gripper = "pneumatic_gripper"
-    electric_gripper = "electric_gripper"
-    vacuum_gripper = "vacuum_gripper"
-    soft_gripper = "soft_gripper"
-    welder = "welder"
-    hand = "hand"
-    palletizer = "palletizer"
-    other = "other"
-
-
-class ToolCapability(StrEnum):
-    """``ToolCapabilities`` flag names."""
-
-    unknown = "unknown"
-    open_close_command = "open_close_command"
-    continuous_command = "continuous_command"
-    homing_command = "homing_command"
-    software_reset_errors = "software_reset_errors"
-    software_enable = "software_enable"
-    sensor_feedback = "sensor_feedback"
-
-
-_E = TypeVar("_E", bound=StrEnum)
-
-
-def _enum_name(enum: type[_E], what: str) -> BeforeValidator:
-    """A validator that refuses an unknown enum name with the closest valid names.
-
-    Why: pydantic's own message lists every member; a user who wrote ``radians`` wants to read
-    "did you mean 'radian'?".
-    """
-    names = [m.value for m in enum]
-
-    def check(value: Any) -> Any:
-        if isinstance(value, str) and value not in names:
-            near = closest_names(value, names)
-            hint = f"; did you mean '{near[0]}'?" if near else f"; valid: {', '.join(names)}"
-            raise ValueError(f"unknown {what} '{value}'{hint}")
-        return value
-
-    return BeforeValidator(check)
-
-
-RobotTypeName = Annotated[RobotTypeCode, _enum_name(RobotTypeCode, "robot_type")]
-CapabilityName = Annotated[RobotCapability, _enum_name(RobotCapability, "robot capability")]
-JointTypeName = Annotated[JointType, _enum_name(JointType, "joint_type")]
-PositionUnitName = Annotated[JointPositionUnits, _enum_name(JointPositionUnits, "position unit")]
-EffortUnitName = Annotated[JointEffortUnits, _enum_name(JointEffortUnits, "effort unit")]
-ToolTypeName = Annotated[ToolTypeCode, _enum_name(ToolTypeCode, "tool_type")]
-ToolCapabilityName = Annotated[ToolCapability, _enum_name(ToolCapability, "tool capability")]
 
 
 class Identifier(_Model):
@@ -524,132 +392,6 @@ class LoadedRobotInfo:
     warnings: tuple[RobotInfoError, ...] = ()
 
 
-def _semantic_checks(
-    info: RobotInfo, doc: LocatedYaml
-) -> tuple[list[RobotInfoError], list[RobotInfoError]]:
-    """Cross-field checks pydantic cannot locate well: array lengths and joint references."""
-    errors: list[RobotInfoError] = []
-    warnings: list[RobotInfoError] = []
-    n_joints = len(info.joint_info)
-
-    def err(msg: str, loc: tuple[str | int, ...], *, warn: bool = False) -> None:
-        # Point at the key when the problem is the whole value (a list of the wrong length).
-        line, col = doc.key_position(loc) if isinstance(loc[-1], str) else doc.position(loc)
-        e = RobotInfoError(
-            msg,
-            file=doc.file,
-            line=line,
-            column=col,
-            location=loc,
-            severity="warning" if warn else "error",
-        )
-        (warnings if warn else errors).append(e)
-
-    device = info.device_info.device
-    name_problem = rr_name_problem(device.name) if device.name else None
-    if name_problem and device.uuid is None:
-        # Served, the device name becomes the node name and its identifier's lock file.
-        err(
-            f"device_info.device.name '{device.name}' {name_problem}: Robot Raconteur cannot "
-            "use it as a device name (letters, digits, '_', '.' and '-', starting with a "
-            f"letter); did you mean '{rr_name_suggestion(device.name)}'?",
-            ("device_info", "device", "name"),
-        )
-    if not info.joint_info:
-        err("joint_info must list at least one joint", ("joint_info",))
-    if not info.chains:
-        err("chains must list at least one kinematic chain", ("chains",))
-    seen_names: dict[str, int] = {}
-    for i, j in enumerate(info.joint_info):
-        name = j.joint_identifier.name
-        loc: tuple[str | int, ...] = ("joint_info", i, "joint_identifier")
-        if not name:
-            err(f"joint_info[{i}]: joint_identifier needs a name", loc)
-        elif name in seen_names:
-            err(f"joint_info[{i}]: joint name '{name}' repeats joint_info[{seen_names[name]}]", loc)
-        else:
-            seen_names[name] = i
-        if j.joint_type not in DRIVABLE_JOINT_TYPES:
-            err(
-                f"joint_info[{i}]: joint_type '{j.joint_type.value}' cannot be driven "
-                "(only revolute, prismatic or continuous)",
-                ("joint_info", i, "joint_type"),
-            )
-        elif j.joint_type is JointType.continuous:
-            err(
-                f"joint_info[{i}]: joint_type 'continuous' is driven as revolute within its limits "
-                "(the reference refuses it)",
-                ("joint_info", i, "joint_type"),
-                warn=True,
-            )
-    used: dict[int, int] = {}
-    for c, chain in enumerate(info.chains):
-        n = len(chain.joint_numbers)
-        where = f"chains[{c}]"
-        for i, h in enumerate(chain.H):
-            norm = math.hypot(h.x, h.y, h.z)  # no OverflowError for 1e200
-            if abs(norm - 1.0) > UNIT_TOL:
-                err(
-                    f"{where}.H[{i}] must be a unit vector (norm is {norm:.6g})",
-                    ("chains", c, "H", i),
-                )
-        offsets: list[tuple[str, tuple[str | int, ...], Vector3]] = [
-            (f"P[{i}]", ("chains", c, "P", i), p) for i, p in enumerate(chain.P)
-        ]
-        if chain.flange_pose is not None:
-            loc_f: tuple[str | int, ...] = ("chains", c, "flange_pose", "position")
-            offsets.append(("flange_pose.position", loc_f, chain.flange_pose.position))
-        for label, loc_p, p in offsets:
-            big = max(abs(p.x), abs(p.y), abs(p.z))
-            if big > MAX_OFFSET_M:
-                err(f"{where}.{label} is {big:g} m from its frame (max {MAX_OFFSET_M:g})", loc_p)
-        if len(chain.H) != n:
-            err(
-                f"{where}.H has {len(chain.H)} axes but the chain has {n} joints (joint_numbers)",
-                ("chains", c, "H"),
-            )
-        if len(chain.P) != n + 1:
-            err(
-                f"{where}.P has {len(chain.P)} vectors but needs {n + 1} (one more than joints)",
-                ("chains", c, "P"),
-            )
-        if chain.link_identifiers and len(chain.link_identifiers) != n + 1:
-            err(
-                f"{where}.link_identifiers has {len(chain.link_identifiers)} names "
-                f"but needs {n + 1}",
-                ("chains", c, "link_identifiers"),
-            )
-        if chain.link_inertias and len(chain.link_inertias) != n + 1:
-            err(
-                f"{where}.link_inertias has {len(chain.link_inertias)} entries but needs {n + 1}",
-                ("chains", c, "link_inertias"),
-            )
-        for k, jn in enumerate(chain.joint_numbers):
-            if jn >= n_joints:
-                err(
-                    f"{where}.joint_numbers[{k}] names joint {jn}, but joint_info has only "
-                    f"{n_joints} joints (0..{n_joints - 1})",
-                    ("chains", c, "joint_numbers", k),
-                )
-            elif jn in used:
-                err(
-                    f"{where}.joint_numbers[{k}]: joint {jn} already belongs to chains[{used[jn]}]",
-                    ("chains", c, "joint_numbers", k),
-                )
-            else:
-                used[jn] = c
-        if chain.flange_pose is None:
-            err(
-                f"{where} has no flange_pose; the identity is used (the reference does the same "
-                "silently)",
-                ("chains", c),
-                warn=True,
-            )
-        if chain.current_payload is not None and chain.current_tool is None:
-            err(f"{where}.current_payload needs a current_tool", ("chains", c, "current_payload"))
-    return errors, warnings
-
-
 def _read(doc: LocatedYaml) -> LoadedRobotInfo:
     if not isinstance(doc.data, dict):
         raise RobotInfoError("a RobotInfo file must be a YAML mapping", file=doc.file, line=1)
@@ -657,7 +399,7 @@ def _read(doc: LocatedYaml) -> LoadedRobotInfo:
         info = RobotInfo.model_validate(doc.data)
     except ValidationError as exc:
         raise validation_errors(exc, doc, RobotInfo, RobotInfoError) from None
-    errors, warnings = _semantic_checks(info, doc)
+    errors, warnings = semantic_checks(info, doc)
     if errors:
         if len(errors) == 1:
             raise errors[0]

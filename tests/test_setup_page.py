@@ -185,3 +185,17 @@ def test_each_tab_acts_on_its_own_pick(page: Any) -> None:
     page._guarded(lambda _e: page._set_chain(tip=page._pick()))(_Tab(3))  # a tab with no pick
     assert "pick a link first" in page.last_message
     assert "nothing undone: the last action (pick a link first" in page.session.step(back=True)[1]
+
+
+def test_a_camera_is_put_on_a_chain_from_the_parts_tab(page: Any) -> None:
+    s = page.session
+    s.add_camera("wrist", "link7")
+    page._part.value = "sensors.wrist"
+    page._select_part("sensors.wrist")
+    assert page._carrier.value == "(no chain)" and "chains.arm" in page._carrier.options
+    assert "on no chain" in page._part_info.content
+    page._carrier.value = "chains.arm"
+    page._guarded(lambda _e: page._set_carrier())(_Person())
+    assert s.sensor_carrier("sensors.wrist") == "chains.arm"
+    assert "carried by chains.arm" in page._part_info.content
+    assert "on no chain" not in page._part_info.content

@@ -59,6 +59,9 @@ class PartsTab(PageBase):
             self._button(gui, "set angles", lambda: self._set_camera(fov=True))
             self._optical = gui.add_dropdown("looks along", ("+z (optical)", "+x (body)"))
             self._optical.on_update(self._guarded(lambda _e: self._set_camera(optical=True)))
+            # The chain (or neck) it moves with: answers validate's "is on no chain".
+            self._carrier = gui.add_dropdown("carried by", s.carriers())
+            self._carrier.on_update(self._guarded(lambda _e: self._set_carrier()))
         self._f_drive = gui.add_folder("drive")
         with self._f_drive:
             self._drive = gui.add_dropdown("base", ("fixed", "omni", "differential", "floating"))
@@ -112,6 +115,11 @@ class PartsTab(PageBase):
             what = cam.preset or (cam.field_of_view and f"angles {cam.field_of_view}") or "?"
             lines.append(f"camera on **{cam.body}**, {what}")
             self._preset.value = cam.preset or _NO_PRESET
+            carriers, carrier = self.session.carriers(), self.session.sensor_carrier(part)
+            if tuple(self._carrier.options) != carriers:
+                self._carrier.options = carriers
+            self._carrier.value = carrier
+            lines.append(f"carried by {carrier}")
         elif kind == "drive" and d.drive is not None:
             facing = next((k for k, v in FORWARDS.items() if v == (d.forward or (1, 0, 0))), None)
             lines.append(f"base: **{d.drive.type}**; the robot {facing or d.forward}")
@@ -189,6 +197,12 @@ class PartsTab(PageBase):
         if optical:
             kw["optical"] = str(self._optical.value).startswith("+z")
         self._after(self.session.set_camera(part, **kw), f"{part} changed")
+
+    def _set_carrier(self) -> None:
+        part, carrier = self._part_name(), str(self._carrier.value)
+        if carrier == self.session.sensor_carrier(part):
+            return
+        self._after(self.session.set_sensor_carrier(part, carrier), f"{part} on {carrier}")
 
     def _set_forward(self) -> None:
         choice = str(self._forward.value)

@@ -19,6 +19,7 @@ from robotspec.errors import RobotSpecError
 from robotspec.files.writing import check_writable, write_file
 from robotspec.model.world import World
 from robotspec.setup.edits import PartEdits, SetupError, _chain, _manipulator
+from robotspec.setup.edits_sensors import SensorEdits
 from robotspec.setup.history import History, describe
 from robotspec.setup.questions import Question, questions_of
 from robotspec.setup.save import spec_text, write_spec
@@ -43,7 +44,7 @@ class Snapshot:
     saved: bool
 
 
-class SetupSession(PartEdits):
+class SetupSession(PartEdits, SensorEdits):
     """A draft being turned into a valid spec, and where it will be saved."""
 
     def __init__(

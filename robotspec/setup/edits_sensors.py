@@ -1,0 +1,71 @@
+"""Which chain carries a sensor: the assistant's answer to "sensor 'X' is on no chain".
+
+Why its own change: a camera on a wrist moves with the arm, and the spec says so by listing the
+sensor under that chain's ``sensors:`` (or the neck's); validate warns of a sensor no chain or
+neck carries. A sensor is carried by one part at most, so choosing a carrier takes it off any
+other; the torso carries none (the spec has no ``sensors:`` there).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from robotspec.setup.edits import SetupError, _camera, _chain
+from robotspec.setup.validation import Validation
+from robotspec.spec.draft.model import Draft, DraftChain
+
+__all__ = ["NO_CARRIER", "SensorEdits"]
+
+#: The carrier choice for a sensor no chain carries.
+NO_CARRIER = "(no chain)"
+
+
+def _holders(d: Draft) -> list[DraftChain]:
+    return [*d.chains, *([d.neck] if d.neck is not None else [])]
+
+
+def _part_of(d: Draft, holder: DraftChain) -> str:
+    return "neck" if holder is d.neck else f"chains.{holder.name}"
+
+
+class SensorEdits:
+    """Sensor carriers, for :class:`~robotspec.setup.session.SetupSession`."""
+
+    def edit(self, change: Callable[[Draft], None]) -> Validation:
+        """Apply ``change`` as the session's state (:meth:`SetupSession.edit`)."""
+        raise NotImplementedError
+
+    def draft(self) -> Draft:
+        """A copy of the current draft."""
+        raise NotImplementedError
+
+    def carriers(self) -> tuple[str, ...]:
+        """The parts that may carry a sensor: every chain, and the neck."""
+        d = self.draft()
+        return (NO_CARRIER, *(_part_of(d, h) for h in _holders(d)))
+
+    def sensor_carrier(self, part: str) -> str:
+        """The chain or neck that carries ``part`` (``sensors.NAME``), or :data:`NO_CARRIER`."""
+        d = self.draft()
+        name = _camera(d, part).name
+        return next((_part_of(d, h) for h in _holders(d) if name in h.sensors), NO_CARRIER)
+
+    def set_sensor_carrier(self, part: str, carrier: str) -> Validation:
+        """Put ``part`` on ``carrier`` (a chain or the neck), or on none (:data:`NO_CARRIER`)."""
+        if carrier == "torso":
+            raise SetupError(
+                "the torso carries no sensors in a spec; choose a chain or the neck",
+                kind="part",
+                name=carrier,
+            )
+
+        def change(d: Draft) -> None:
+            name = _camera(d, part).name
+            target = None if carrier == NO_CARRIER else _chain(d, carrier)
+            for holder in _holders(d):
+                if name in holder.sensors and holder is not target:
+                    holder.sensors.remove(name)
+            if target is not None and name not in target.sensors:
+                target.sensors.append(name)
+
+        return self.edit(change)

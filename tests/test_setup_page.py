@@ -199,3 +199,27 @@ def test_a_camera_is_put_on_a_chain_from_the_parts_tab(page: Any) -> None:
     assert s.sensor_carrier("sensors.wrist") == "chains.arm"
     assert "carried by chains.arm" in page._part_info.content
     assert "on no chain" not in page._part_info.content
+
+
+def test_one_jaw_of_a_gripper_says_why_nothing_is_written_yet(page: Any) -> None:
+    page._part.value = "manipulators.tool"
+    page._select_part("manipulators.tool")
+    page._guarded(lambda _e: page.select("link7"))(_Tab(1))
+    page._guarded(lambda _e: page._set_hand(finger=True))(_Tab(1))
+    assert "finger kept; nothing written until its thumb tip is picked too" in page.last_message
+    assert "type: generic" in page.last_message and "finger:" not in page.session.snapshot.text
+
+
+def test_refused_inputs_say_why_at_once(page: Any) -> None:
+    """A joint value past its limit is put back, an empty 'save as' named, each with why."""
+    page._state_part.value = "chains.arm"
+    page._show_sliders()
+    lo, hi = page.session.joint_range("joint1")
+    page._sliders["joint1"].value = hi + 5.0  # what a number typed in the slider's box sends
+    page._guarded(lambda _e: page._slid("joint1"))(_Person())
+    assert page._sliders["joint1"].value == hi
+    assert f"joint1: {hi + 5.0:g} is outside its limits [{lo:g}, {hi:g}]" in page.last_message
+    page._save_path.value = "  "
+    page._guarded(lambda _e: page._save())(_Person())
+    assert "'save as' is empty: give the file to write" in page.last_message.replace("&#x27;", "'")
+    assert not page.session.snapshot.saved

@@ -92,5 +92,12 @@ class CheckTab(PageBase):
         threading.Thread(target=work, name=f"setup-{what}", daemon=True).start()
 
     def _save(self) -> None:
-        path = self.session.save(Path(str(self._save_path.value)).expanduser())
+        typed = str(self._save_path.value).strip()
+        if not typed:
+            raise RobotSpecError(
+                f"'save as' is empty: give the file to write, a .yaml or .yml name "
+                f"(the output is {self.session.output})",
+                kind="file",
+            )
+        path = self.session.save(Path(typed).expanduser())
         self.say(f"saved **{html.escape(str(path))}**; `robotspec validate {path}` accepts it")

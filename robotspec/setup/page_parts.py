@@ -17,6 +17,13 @@ __all__ = ["PartsTab"]
 
 _NEW_KINDS = ("arm", "leg", "chain", "torso", "neck", "manipulator", "camera")
 _NO_PRESET = "(angles below)"
+#: Why a gripper with one jaw given is not written as one (yet, or ever: one moving jaw).
+_HALF_GRIPPER = (
+    "nothing written until its {lack} tip is picked too: a parallel_gripper has two moving "
+    "jaws, each a chain with a joint (the compiler refuses an empty one). A gripper with one "
+    "moving jaw against a fixed one (the SO-100's) stays type: generic (no fingers): its "
+    "tool frame and states say what it does"
+)
 
 
 class PartsTab(PageBase):
@@ -178,6 +185,11 @@ class PartsTab(PageBase):
         if named:
             kw["named"] = (str(self._finger_name.value), self._pick())
         v = self.session.set_manipulator(part, generic=generic, **kw)
+        m = next(m for m in self.session.draft().manipulators if m.name == name)
+        if (m.thumb is None) != (m.finger is None) and not m.fingers:
+            have, lack = ("thumb", "finger") if m.finger is None else ("finger", "thumb")
+            self._after(v, f"{part}: {have} kept; {_HALF_GRIPPER.format(lack=lack)}")
+            return
         self._after(v, f"{part} changed")
 
     def _set_camera(

@@ -51,12 +51,30 @@ class StatesTab(PageBase):
                     step = max((hi - lo) / 200.0, 1e-4)
                     now = float(np.clip(self._joint_value(j), lo, hi))
                     sl = gui.add_slider(j, min=lo, max=hi, step=step, initial_value=now)
-                    sl.on_update(self._guarded(lambda _e: self._preview()))
+                    sl.on_update(self._guarded(lambda _e, j=j: self._slid(j)))
                     self._sliders[j] = sl
             self._state_info.content = (
                 f"{len(joints)} joints of {part}" if joints else f"{part} moves no joint"
             )
             self._show_saved_states()
+        self._preview()
+
+    def _slid(self, joint: str) -> None:
+        """A slider moved or its box typed in: a value past the joint's limits is refused."""
+        slider = self._sliders.get(joint)
+        if slider is None:
+            return
+        lo, hi = self.session.joint_range(joint)
+        typed = float(slider.value)
+        if not np.isfinite(typed) or not lo <= typed <= hi:
+            slider.value = float(np.clip(np.nan_to_num(typed, nan=lo), lo, hi))
+            self._preview()
+            raise RobotSpecError(
+                f"{joint}: {typed:g} is outside its limits [{lo:g}, {hi:g}] (the URDF's); "
+                f"set to {float(slider.value):g}",
+                kind="joint",
+                name=joint,
+            )
         self._preview()
 
     def _joint_value(self, joint: str) -> float:

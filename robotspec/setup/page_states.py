@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -51,13 +52,19 @@ class StatesTab(PageBase):
                     step = max((hi - lo) / 200.0, 1e-4)
                     now = float(np.clip(self._joint_value(j), lo, hi))
                     sl = gui.add_slider(j, min=lo, max=hi, step=step, initial_value=now)
-                    sl.on_update(self._guarded(lambda _e, j=j: self._slid(j)))
+                    sl.on_update(self._guarded(self._slider_moved(j)))
                     self._sliders[j] = sl
             self._state_info.content = (
                 f"{len(joints)} joints of {part}" if joints else f"{part} moves no joint"
             )
             self._show_saved_states()
         self._preview()
+
+    def _slider_moved(self, joint: str) -> Callable[[Any], None]:
+        def moved(_event: Any) -> None:
+            self._slid(joint)
+
+        return moved
 
     def _slid(self, joint: str) -> None:
         """A slider moved or its box typed in: a value past the joint's limits is refused."""

@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "robotspec"
 #: The stack, bottom first. A room may import rooms of lower floors and its own room only.
 FLOORS: tuple[tuple[str, ...], ...] = (
     ("errors", "shipped", "arrays", "accel", "exact"),
-    ("diagnostics",),
+    ("diagnostics", "extras"),
     ("files",),
     ("model",),
     ("description", "spec"),

@@ -23,6 +23,7 @@ import numpy as np
 
 from robotspec.arrays import F64, I64
 from robotspec.errors import CollisionError, RobotSpecError
+from robotspec.extras import Extra, require
 from robotspec.files.meshes import read_triangles
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
 from robotspec.model.world import Body, World
@@ -46,22 +47,17 @@ MissingMeshPolicy = Literal["error", "skip"]
 :attr:`GeometryModel.skipped`, for the caller to report; never a silent skip."""
 
 
+#: coal, a dependency of robotspec, imported only by the collision queries.
+COAL = Extra("coal", "coal")
+
+
 def import_coal() -> Any:
     """The ``coal`` module, or a CollisionError saying how to install it.
 
     Why lazily: the rest of robotspec (validation, inspection, the driver) must work without the
     collision library installed.
     """
-    try:
-        import coal
-    except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise CollisionError(
-            f"collision checking needs the 'coal' package ({exc}); install it with "
-            "`pip install coal`",
-            kind="dependency",
-            name="coal",
-        ) from None
-    return coal
+    return require(COAL, "collision checking", CollisionError)
 
 
 @dataclass(frozen=True)

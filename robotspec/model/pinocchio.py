@@ -32,24 +32,21 @@ from typing import Any
 import numpy as np
 
 from robotspec.arrays import F64, finite_array, real_array
-from robotspec.errors import KinematicsError, RobotSpecError
+from robotspec.errors import KinematicsError
+from robotspec.extras import Extra, require
 from robotspec.model.entities import Connection, ConnectionType
 from robotspec.model.world import World
 
 __all__ = ["PinocchioRobot", "import_pinocchio", "set_limits", "to_se3", "world_to_pinocchio"]
 
 
+#: pinocchio: the module, its PyPI package and the extra that installs it.
+PINOCCHIO = Extra("pinocchio", "pin", "pinocchio", label="pinocchio (PyPI package 'pin')")
+
+
 def import_pinocchio() -> Any:
     """The pinocchio module, or a RobotSpecError saying how to install it."""
-    try:
-        import pinocchio
-    except ImportError:
-        raise RobotSpecError(
-            "pinocchio is not installed: pip install 'robotspec[pinocchio]' (PyPI package 'pin')",
-            kind="dependency",
-            name="pinocchio",
-        ) from None
-    return pinocchio
+    return require(PINOCCHIO, "robot.to_pinocchio()")
 
 
 @dataclass(frozen=True)

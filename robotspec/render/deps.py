@@ -7,19 +7,11 @@ after the robot compiled.
 
 from __future__ import annotations
 
-import importlib.util
-
-from robotspec.errors import RobotSpecError
+from robotspec.extras import Extra, require_present
 
 __all__ = ["require"]
 
 
 def require(module: str, package: str, feature: str) -> None:
-    """Raise a RobotSpecError naming the pip package when ``module`` cannot be imported."""
-    if importlib.util.find_spec(module) is None:
-        raise RobotSpecError(
-            f"{feature} needs the '{package}' package; install it with "
-            f"`pip install '{package}'` or `pip install 'robotspec[view]'`",
-            kind="dependency",
-            name=package,
-        )
+    """Raise a RobotSpecError naming the ``view`` extra when ``module`` cannot be imported."""
+    require_present(Extra(module, package, "view"), feature)

@@ -38,6 +38,7 @@ from robotspec.model._kintree_py import (
 from robotspec.model._kintree_py import config as _config
 from robotspec.model._kintree_py import copy_f64 as _copy_f64
 from robotspec.model._kintree_py import copy_i64 as _copy_i64
+from robotspec.model._kintree_py import motion_terms as _motion_terms
 
 __all__ = [
     "KIND_FIXED",
@@ -56,36 +57,11 @@ __all__ = [
     "tree_size",
 ]
 
-#: Samples per step of a batch: bounds the per-row motion arrays (a few MB) on long batches.
+#: Samples per step of a chain's batch: bounds its per-step arrays (a few MB) on long batches.
 _CHUNK = 256
 
 
 # ----------------------------------------------------------------------------------- helpers
-def _motions(kind: I64, axis: F64, v: F64) -> F64:
-    """Each row's motion (..., R, 3, 4) at values ``v`` (..., R): a rotation, translation or 1.
-
-    Every row is computed alike: a row that does not rotate gets angle 0 (the identity,
-    exactly), one that does not slide gets offset 0. Poses here drop the last row (0 0 0 1).
-    """
-    vr = np.where(kind == KIND_REVOLUTE, v, 0.0)
-    vp = np.where(kind == KIND_PRISMATIC, v, 0.0)
-    x, y, z = axis[:, 0], axis[:, 1], axis[:, 2]
-    s, c = np.sin(vr), np.cos(vr)
-    t = 1.0 - c
-    m = np.empty((*v.shape, 3, 4))
-    m[..., 0, 0] = c + x * x * t
-    m[..., 0, 1] = x * y * t - z * s
-    m[..., 0, 2] = x * z * t + y * s
-    m[..., 1, 0] = y * x * t + z * s
-    m[..., 1, 1] = c + y * y * t
-    m[..., 1, 2] = y * z * t - x * s
-    m[..., 2, 0] = z * x * t - y * s
-    m[..., 2, 1] = z * y * t + x * s
-    m[..., 2, 2] = c + z * z * t
-    m[..., 3] = axis * vp[..., None]
-    return m
-
-
 def _compose(a: F64, b: F64) -> F64:
     """``a @ b`` of stacked poses without their last row (..., 3, 4), term by term.
 
@@ -110,7 +86,12 @@ def _full(m: F64) -> F64:
 # --------------------------------------------------------------------------------- a chain
 @dataclass(frozen=True)
 class Chain:
-    """A chain program: T = pre[0] m_0(q) pre[1] m_1(q) ... m_{n-1}(q) post."""
+    """A chain program: T = pre[0] m_0(q) pre[1] m_1(q) ... m_{n-1}(q) post.
+
+    ``terms`` (n, 3, 4, 4) is each step ``pre[i] m_i`` as ``pre + a pre M1 + b pre M2`` (see
+    :func:`robotspec.model._kintree_py.motion_terms`); ``columns`` (n, n_cols) adds each step's
+    Jacobian column into its DOF's (a mimic joint's into its leader's), as one product.
+    """
 
     n_cols: int
     n_dof: int
@@ -122,6 +103,10 @@ class Chain:
     mul: F64
     off: F64
     col: I64
+    terms: F64
+    revolute: I64
+    prismatic: I64
+    columns: F64
 
 
 def chain(
@@ -140,42 +125,75 @@ def chain(
     n = len(kind)  # TypeError as PyObject_Length raises
     if n_cols < 0 or n_dof < 0:
         raise ValueError("chain program: column or DOF count out of range")
-    c = Chain(
-        n_cols,
-        n_dof,
-        _copy_f64(pre, 16 * n, "pre").reshape(n, 4, 4),
-        _copy_f64(post, 16, "post").reshape(4, 4),
-        _copy_i64(kind, n, "kind"),
-        _copy_f64(axis, 3 * n, "axis").reshape(n, 3),
-        _copy_i64(dof, n, "dof"),
-        _copy_f64(mul, n, "mul"),
-        _copy_f64(off, n, "off"),
-        _copy_i64(col, n, "col"),
-    )
+    p = _copy_f64(pre, 16 * n, "pre").reshape(n, 4, 4)
+    post_ = _copy_f64(post, 16, "post").reshape(4, 4)
+    k = _copy_i64(kind, n, "kind")
+    ax = _copy_f64(axis, 3 * n, "axis").reshape(n, 3)
+    d = _copy_i64(dof, n, "dof")
+    m = _copy_f64(mul, n, "mul")
+    f = _copy_f64(off, n, "off")
+    cols = _copy_i64(col, n, "col")
     bad = (
-        (c.dof < 0)
-        | (c.dof >= n_dof)
-        | (c.col < 0)
-        | (c.col >= n_cols)
-        | ((c.kind != KIND_REVOLUTE) & (c.kind != KIND_PRISMATIC))
+        (d < 0)
+        | (d >= n_dof)
+        | (cols < 0)
+        | (cols >= n_cols)
+        | ((k != KIND_REVOLUTE) & (k != KIND_PRISMATIC))
     )
     if bad.any():
         raise ValueError("chain program refers to a DOF out of range")
-    return c
+    m1, m2 = _motion_terms(k, ax)
+    columns = np.zeros((n, n_cols))
+    columns[np.arange(n), cols] = m
+    return Chain(
+        n_cols,
+        n_dof,
+        p,
+        post_,
+        k,
+        ax,
+        d,
+        m,
+        f,
+        cols,
+        np.stack([p, p @ m1, p @ m2], axis=1),
+        np.flatnonzero(k == KIND_REVOLUTE),
+        np.flatnonzero(k == KIND_PRISMATIC),
+        columns,
+    )
 
 
 def _chain_of(obj: object) -> Chain:
     return table(obj, Chain, "a chain program (from chain())")
 
 
+def _prefix(c: Chain, q: F64) -> F64:
+    """``pre[0] m_0 ... pre[i] m_i`` for every step i (N, n, 4, 4) of the samples of ``q``.
+
+    Every step's matrix at once, then the running products by doubling (step i takes the
+    product ending 2^k steps before it): log2(n) stacked products instead of n small ones.
+    """
+    v = q[:, c.dof] * c.mul + c.off  # (N, n)
+    a, b = np.zeros_like(v), np.zeros_like(v)
+    a[:, c.revolute] = np.sin(v[:, c.revolute])
+    b[:, c.revolute] = 1.0 - np.cos(v[:, c.revolute])
+    a[:, c.prismatic] = v[:, c.prismatic]
+    t = c.terms
+    run: F64 = t[:, 0] + a[..., None, None] * t[:, 1] + b[..., None, None] * t[:, 2]
+    d, n = 1, run.shape[1]
+    while d < n:
+        run[:, d:] = np.matmul(run[:, :-d], run[:, d:])
+        d *= 2
+    return run
+
+
 def _chain_run(c: Chain, q: F64) -> F64:
     """root_T_tip (N, 4, 4) of the samples of ``q`` (N, D)."""
-    v = q[:, c.dof] * c.mul + c.off
-    steps = _compose(c.pre[:, :3], _motions(c.kind, c.axis, v))
-    t = np.broadcast_to(np.eye(4)[:3], (q.shape[0], 3, 4))
-    for i in range(steps.shape[1]):
-        t = _compose(t, steps[:, i])
-    return _full(_compose(t, c.post[:3]))
+    if not len(c.kind):
+        return np.broadcast_to(c.post, (q.shape[0], 4, 4)).copy()
+    ends: F64 = np.matmul(_prefix(c, q)[:, -1], c.post)
+    ends[:, 3] = (0.0, 0.0, 0.0, 1.0)
+    return ends
 
 
 def chain_fk(chain: object, q: object) -> F64:
@@ -198,24 +216,19 @@ def chain_jacobian(chain: object, q: object) -> F64:
     c = _chain_of(chain)
     qa = _config(q, 1, c.n_dof)
     n = len(c.kind)
-    motion = _full(_motions(c.kind, c.axis, qa[c.dof] * c.mul + c.off))
-    z = np.empty((n, 3))
-    p = np.empty((n, 3))
-    t = np.eye(4)
-    for i in range(n):
-        u = t @ c.pre[i]
-        z[i] = u[:3, :3] @ c.axis[i]
-        p[i] = u[:3, 3]
-        t = u @ motion[i]
-    tip = (t @ c.post)[:3, 3]
-    m = c.mul[:, None]
+    if not n:
+        return np.zeros((6, c.n_cols))
+    run = _prefix(c, qa[None, :])[0]
+    before = np.empty_like(run)  # the frame each step starts from, its pre included
+    before[0] = c.pre[0]
+    np.matmul(run[:-1], c.pre[1:], out=before[1:])
+    z = np.matmul(before[:, :3, :3], c.axis[:, :, None])[:, :, 0]
+    d = (run[-1, :3, :3] @ c.post[:3, 3] + run[-1, :3, 3]) - before[:, :3, 3]
     rev = (c.kind == KIND_REVOLUTE)[:, None]
-    d = tip - p
     x, y = [1, 2, 0], [2, 0, 1]  # the cross product z x d, written out (np.cross costs more)
-    lin = np.where(rev, z[:, x] * d[:, y] - z[:, y] * d[:, x], z) * m
-    ang = np.where(rev, z, 0.0) * m
-    jac = np.zeros((6, c.n_cols))
-    np.add.at(jac.T, c.col, np.hstack([lin, ang]))
+    lin = np.where(rev, z[:, x] * d[:, y] - z[:, y] * d[:, x], z)
+    ang = np.where(rev, z, 0.0)
+    jac: F64 = np.concatenate([lin, ang], axis=1).T @ c.columns
     return jac
 
 

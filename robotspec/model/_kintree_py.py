@@ -105,6 +105,7 @@ class Tree:
     revolute: I64  # rows that turn
     prismatic: I64  # rows that slide
     levels: tuple[tuple[int, int], ...]
+    steps: tuple[tuple[slice, Any, F64], ...]  # per depth: its rows, their parents, weights
 
 
 def tree(
@@ -184,7 +185,8 @@ def _arranged(
         parent[r] = last[p[r]]
         last[c[r]] = r + 1
     m1, m2 = motion_terms(k, a)
-    weights = np.concatenate([o, o @ m1, o @ m2], axis=2).transpose(0, 2, 1)
+    weights = np.ascontiguousarray(np.concatenate([o, o @ m1, o @ m2], axis=2).transpose(0, 2, 1))
+    steps = tuple((slice(lo, hi), _reads(parent[lo:hi]), weights[lo:hi]) for lo, hi in levels)
     return Tree(
         n_slots,
         n_out,
@@ -194,11 +196,20 @@ def _arranged(
         np.where(k == KIND_FIXED, n_dof, d[order]),
         m,
         f,
-        np.ascontiguousarray(weights),
+        weights,
         np.flatnonzero(k == KIND_REVOLUTE),
         np.flatnonzero(k == KIND_PRISMATIC),
         levels,
+        steps,
     )
+
+
+def _reads(parents: I64) -> slice | I64:
+    """The slots one depth reads: a slice when they are consecutive (a view, not a copy)."""
+    lo = int(parents[0])
+    if (parents == np.arange(lo, lo + len(parents))).all():
+        return slice(lo, lo + len(parents))
+    return parents
 
 
 def _tree_of(obj: object) -> Tree:
@@ -225,15 +236,14 @@ def _run(t: Tree, q: F64, out: F64) -> None:
     a4, b4 = a[:, None, None, :], b[:, None, None, :]
     slots = np.empty((rows + 1, 4, 3, n))  # slot[column, row, sample]
     slots[0] = np.eye(4)[:, :3, None]
-    for lo, hi in t.levels:
-        k = hi - lo
-        x = np.matmul(t.weights[lo:hi], slots[t.parent[lo:hi]].reshape(k, 4, 3 * n))
-        x = x.reshape(k, 3, 4, 3, n)  # the W0, W1 and W2 terms
-        dst = slots[lo + 1 : hi + 1]
-        np.multiply(a4[lo:hi], x[:, 1], out=dst)
+    flat = slots.reshape(rows + 1, 4, 3 * n)
+    for rows_of, reads, weights in t.steps:
+        x = np.matmul(weights, flat[reads]).reshape(-1, 3, 4, 3, n)  # the W0, W1, W2 terms
+        dst = slots[1:][rows_of]
+        np.multiply(a4[rows_of], x[:, 1], out=dst)
         dst += x[:, 0]
         w2 = x[:, 2]
-        w2 *= b4[lo:hi]
+        w2 *= b4[rows_of]
         dst += w2
     out[:, :, :3, :] = slots[t.outputs].transpose(3, 0, 2, 1)
     out[:, :, 3, :] = (0.0, 0.0, 0.0, 1.0)

@@ -23,7 +23,7 @@ What MJCF cannot hold (velocity limits) is listed in a comment at the top of the
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,8 +31,8 @@ from lxml import etree
 
 from robotspec.arrays import F64
 from robotspec.export.mjcf_bodies import TINY_MASS, BodyWriter, MjcfJoint, num, nums
-from robotspec.export.mjcf_dynamics import joint_inertias
-from robotspec.model.entities import ConnectionType
+from robotspec.export.mjcf_dynamics import Inertial, joint_inertias
+from robotspec.model.entities import Connection, ConnectionType
 from robotspec.model.rotations import matrix_to_quat_wxyz, rpy_to_matrix
 from robotspec.semantic import AbstractRobot
 from robotspec.semantic.base import JointState
@@ -130,67 +130,103 @@ def mjcf_export(
     if not len(asset):
         root_el.remove(asset)
     order = [b.joints[el.get("name", "")] for el in worldbody.iter("joint", "freejoint")]
+    _couplings(root_el, robot)
+    servoed = _servos(root_el, robot, b.inertials, servo_hz)
+    out = MjcfExport("", tuple(b.assets.files()), tuple(order), (), ())
+    _keyframes(root_el, robot, out, servoed)
+    header = _header(robot, servo_hz, gravity_compensation) + [f" note: {n} " for n in b.notes]
+    for i, text in enumerate(header):
+        root_el.insert(i, etree.Comment(text.replace("--", "- -")))
+    etree.indent(root_el, space="  ")
+    xml = etree.tostring(root_el, encoding="unicode") + "\n"
+    actuated = tuple(c.name for c in servoed)
+    return MjcfExport(xml, out.meshes, out.joints, actuated, tuple(b.notes))
 
+
+def _couplings(root_el: etree._Element, robot: AbstractRobot) -> None:
+    """Disabled pairs as ``<exclude>``; mimic joints as ``<equality><joint>`` couplings.
+
+    MuJoCo's polycoef reads ``joint1 - ref1 = a0 + a1 (joint2 - ref2)``: the URDF's offset, then
+    its multiplier (no ``ref`` is written, so both references are zero).
+    """
+    world = robot.world
     pairs = sorted(tuple(sorted(p)) for p in robot.disabled_collision_pairs if len(p) == 2)
     if pairs:
         contact = etree.SubElement(root_el, "contact")
         for first, second in pairs:
             etree.SubElement(contact, "exclude", body1=first, body2=second)
-
-    mimics = [c for c in world.connections if c.mimic is not None]
+    mimics = [(c, c.mimic) for c in world.connections if c.mimic is not None]
     if mimics:
         equality = etree.SubElement(root_el, "equality")
-        for c in mimics:
-            assert c.mimic is not None
+        for c, mimic in mimics:
             leader = world.connections_of_dof(c.dofs[0])[0].name
-            coef = (c.mimic.offset, c.mimic.multiplier, 0.0, 0.0, 0.0)
+            coef = (mimic.offset, mimic.multiplier, 0.0, 0.0, 0.0)
             etree.SubElement(equality, "joint", joint1=c.name, joint2=leader, polycoef=nums(coef))
 
+
+def _servos(
+    root_el: etree._Element, robot: AbstractRobot, inertials: Mapping[str, Inertial], hz: float
+) -> list[Connection]:
+    """The servoed connections, each with a position servo (the commanded 1-DOF joints).
+
+    Each servo is critically damped at ``hz`` from its joint's inertia at the default
+    configuration; the drive's joint has none (a base is not position-controlled).
+    """
+    world = robot.world
     drive = robot.drive
     servoed = [
         c
         for c in world.connections
         if c.is_active and c.is_1dof and (drive is None or c.index != drive.index)
     ]
-    q0 = world.default_configuration()
-    poses = robot.kinematics.forward(q0)
-    inertia = joint_inertias(world, poses, b.inertials, servoed)
-    omega = 2.0 * math.pi * servo_hz
-    if servoed:
-        actuator = etree.SubElement(root_el, "actuator")
-        for c in servoed:
-            dof = world.degrees_of_freedom[c.dofs[0]]
-            m = max(inertia[c.name], TINY_MASS)
-            act = etree.SubElement(actuator, "position", name=c.name, joint=c.name)
-            act.set("kp", num(m * omega * omega))
-            act.set("kv", num(2.0 * m * omega))
-            if c.type is not ConnectionType.CONTINUOUS and dof.is_bounded:
-                act.set("ctrlrange", nums((dof.lower, dof.upper)))
-            if math.isfinite(dof.effort) and dof.effort > 0.0:
-                act.set("forcerange", nums((-dof.effort, dof.effort)))
+    if not servoed:
+        return servoed
+    poses = robot.kinematics.forward(world.default_configuration())
+    inertia = joint_inertias(world, poses, inertials, servoed)
+    omega = 2.0 * math.pi * hz
+    actuator = etree.SubElement(root_el, "actuator")
+    for c in servoed:
+        dof = world.degrees_of_freedom[c.dofs[0]]
+        m = max(inertia[c.name], TINY_MASS)
+        act = etree.SubElement(actuator, "position", name=c.name, joint=c.name)
+        act.set("kp", num(m * omega * omega))
+        act.set("kv", num(2.0 * m * omega))
+        if c.type is not ConnectionType.CONTINUOUS and dof.is_bounded:
+            act.set("ctrlrange", nums((dof.lower, dof.upper)))
+        if math.isfinite(dof.effort) and dof.effort > 0.0:
+            act.set("forcerange", nums((-dof.effort, dof.effort)))
+    return servoed
 
-    out = MjcfExport("", tuple(b.assets.files()), tuple(order), (), ())
-    keyframe = etree.SubElement(root_el, "keyframe")
-    keys = [("default", q0)]
+
+def _keyframes(
+    root_el: etree._Element, robot: AbstractRobot, out: MjcfExport, servoed: list[Connection]
+) -> None:
+    """The default configuration and every named state as a ``<key>`` (servo targets too)."""
+    world = robot.world
+    keys = [("default", world.default_configuration())]
     for key_name, state in named_states(robot).items():
         keys.append((key_name, world.configuration(state.as_dict())))
-    index = {c.name: i for i, c in enumerate(servoed)}
     qpos_index: dict[str, int] = {}
-    for j in order:  # a free joint takes 7 entries of qpos (position, quaternion)
-        qpos_index[j.name] = sum(7 if o.kind == "free" else 1 for o in order[: order.index(j)])
+    at = 0
+    for j in out.joints:  # a free joint takes 7 entries of qpos (position, quaternion)
+        qpos_index[j.name] = at
+        at += 7 if j.kind == "free" else 1
+    keyframe = etree.SubElement(root_el, "keyframe")
     for key_name, q in keys:
         qpos = out.qpos(robot, q)
-        ctrl = [qpos[qpos_index[c.name]] for c in servoed]
         key = etree.SubElement(keyframe, "key", name=key_name, qpos=nums(qpos))
-        if index:
-            key.set("ctrl", nums(ctrl))
+        if servoed:
+            key.set("ctrl", nums([qpos[qpos_index[c.name]] for c in servoed]))
 
+
+def _header(robot: AbstractRobot, servo_hz: float, gravity_compensation: bool) -> list[str]:
+    """The comments at the top: what MJCF cannot hold (velocity limits), servos, gravity."""
     limited = [
         f"{d.name}: {num(d.velocity)}"
-        for d in world.degrees_of_freedom
+        for d in robot.world.degrees_of_freedom
         if math.isfinite(d.velocity)
     ]
-    header = [
+    return [
         f" {robot.name}: exported by robotspec (robotspec export mjcf). ",
         " MJCF cannot hold velocity limits; the robot's, per degree of freedom (rad/s or m/s): "
         + ("; ".join(limited) if limited else "none")
@@ -201,10 +237,3 @@ def mjcf_export(
         if gravity_compensation
         else " Gravity acts in full: an effort limit that cannot hold a link lets it sag. ",
     ]
-    header += [f" note: {n} " for n in b.notes]
-    for i, text in enumerate(header):
-        root_el.insert(i, etree.Comment(text.replace("--", "- -")))
-    etree.indent(root_el, space="  ")
-    xml = etree.tostring(root_el, encoding="unicode") + "\n"
-    actuated = tuple(c.name for c in servoed)
-    return MjcfExport(xml, out.meshes, out.joints, actuated, tuple(b.notes))

@@ -50,16 +50,19 @@ def accelerated() -> bool:
     return CHOICE.accelerated()
 
 
-def fk_batch(tree: object, q: object, threads: int = 1, out: Any = None) -> F64:
+def fk_batch(
+    tree: object, q: object, threads: int = 1, out: Any = None, module: ModuleType | None = None
+) -> F64:
     """Every body pose (N, B, 4, 4) of the batch ``q`` (N, D), into ``out`` when given.
 
     With ``threads`` > 1 the samples are split into that many contiguous slices, one core call
     each on its own thread; the result does not depend on the split. ``q`` is checked whole
     before any slice runs, so an error leaves ``out`` untouched. A ``q`` that is not an array
     (a list of lists) is converted first, as the core converts it (same errors), so that it is
-    split over the threads too instead of running on one.
+    split over the threads too instead of running on one. ``module`` is the core that built
+    ``tree`` (default: the one in use).
     """
-    c = core()
+    c = core() if module is None else module
     if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= 64:
         raise ValueError(f"threads must be between 1 and 64, got {threads!r}")
     if not isinstance(q, np.ndarray):

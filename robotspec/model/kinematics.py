@@ -101,7 +101,8 @@ class Kinematics:
         self._tree = _tree_program(world)
         # The core's entry point, bound once: the table above is that core's (a query never
         # looks the core up again), and a bound call is the cheapest Python can make.
-        self._fk = kincore.core().fk
+        self._core = kincore.core()
+        self._fk = self._core.fk
         self._chains: dict[tuple[int, int], ChainKinematics] = {}
         self._from_root: dict[str, ChainKinematics] = {}  # pose()'s chains, by body name
 
@@ -149,7 +150,7 @@ class Kinematics:
                     "would overwrite configurations not yet read; pass a separate array"
                 )
         try:
-            poses: F64 = kincore.fk_batch(self._tree, arr, threads, out)
+            poses: F64 = kincore.fk_batch(self._tree, arr, threads, out, self._core)
         except (ValueError, TypeError):
             raise _bad_configuration(q, self._nd, self.world.name, True) from None
         return poses
@@ -344,6 +345,7 @@ class ChainKinematics:
         core = kincore.core()
         # Bound once, with the table they run (see Kinematics.__init__).
         self._fk, self._jacobian = core.chain_fk, core.chain_jacobian
+        self._fk_batch = core.chain_fk_batch
         self._program = core.chain(
             np.array(pre, dtype=np.float64).reshape(-1, 4, 4),
             acc,
@@ -370,7 +372,7 @@ class ChainKinematics:
     def fk_batch(self, q: object) -> F64:
         """``root_T_tip`` (N, 4, 4) for each configuration of ``q`` (N, D), in one C loop."""
         try:
-            poses: F64 = kincore.core().chain_fk_batch(
+            poses: F64 = self._fk_batch(
                 self._program, _numbers(q, self._nd, self._world_name, True)
             )
         except (ValueError, TypeError):

@@ -11,7 +11,7 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
-__all__ = ["portable_ref", "relative_path"]
+__all__ = ["package_candidates", "portable_ref", "relative_path"]
 
 
 def portable_ref(
@@ -34,6 +34,24 @@ def portable_ref(
     if best is not None:
         return best[1], best[2]
     return relative_path(real, spec_folder), None
+
+
+def package_candidates(path: Path, packages: Mapping[str, Path]) -> list[tuple[str, Path]]:
+    """Every ``package://`` URI naming ``path`` through a known package, innermost first.
+
+    Why all of them: the innermost package is the natural name, but it may be one the spec
+    cannot find where it is read (a sub-folder known only by its name beside the robot file);
+    the caller takes the first that resolves as the spec will resolve it.
+    """
+    real = path.resolve()
+    found: list[tuple[int, str, Path]] = []
+    for name, folder in packages.items():
+        root = folder.resolve()
+        if real.is_relative_to(root):
+            uri = f"package://{name}/{real.relative_to(root).as_posix()}"
+            found.append((len(root.parts), uri, root))
+    found.sort(key=lambda f: -f[0])  # stable: the index's order (declared names first)
+    return [(uri, root) for _, uri, root in found]
 
 
 def relative_path(path: Path, spec_folder: Path) -> str:

@@ -13,7 +13,7 @@ from robotspec.description.load import Description, load_description
 from robotspec.spec.draft.build import draft_spec
 from robotspec.spec.draft.facts import read_facts
 from robotspec.spec.draft.model import Draft
-from robotspec.spec.draft.paths import portable_ref, relative_path
+from robotspec.spec.draft.paths import package_candidates, relative_path
 
 __all__ = ["draft_from_files"]
 
@@ -32,8 +32,20 @@ def _named_packages(desc: Description) -> dict[str, Path]:
     return {
         name: folder
         for name, folder in resolver.packages().items()
-        if (folder / "package.xml").is_file() or folder.parent in listed
+        if (folder / "package.xml").is_file()
+        or (folder.parent in listed and not (folder == here and _layout_name(folder)))
     }
+
+
+def _layout_name(folder: Path) -> bool:
+    """A folder named for what it holds (``urdf/``), not for the robot: no package name to write.
+
+    Why: ``-P my_robot`` makes ``my_robot/urdf`` findable as ``package://urdf``, which resolves
+    but names nothing a person or another tool would look for; the relative path is clearer.
+    """
+    from robotspec.files.package_search import DESCRIPTION_SUBFOLDERS
+
+    return folder.name.lower() in DESCRIPTION_SUBFOLDERS
 
 
 def draft_from_files(
@@ -65,23 +77,36 @@ def draft_from_files(
         meshes="keep",
         base_folder=base,
     )
-    # What a spec finds without flags: the environment's packages and the installed data. The
-    # user's -P is not written anywhere else, so the folders it names go into package_paths.
-    findable = PackageResolver.create(None).packages()
-    findable_roots = {p.resolve() for p in findable.values()}
+    # What a spec finds: the user's -P (written into package_paths below), the environment and
+    # the installed data; a URI is written only when it resolves that way, to the very file.
+    given = [Path(p) if Path(p).is_absolute() else base / p for p in map(str, package_paths)]
     packages = _named_packages(desc)
     extra_paths: list[str] = []
 
-    def ref(given: str) -> str:
-        if "://" in given:
-            return given
-        path = Path(given) if Path(given).is_absolute() else base / given
-        text, pkg_root = portable_ref(path, folder, packages)
-        if pkg_root is not None and pkg_root not in findable_roots:
-            entry = relative_path(pkg_root.parent, folder)
-            if entry not in extra_paths:
-                extra_paths.append(entry)
-        return text
+    def resolves(uri: str, path: Path, extra: list[Path]) -> bool:
+        from robotspec.errors import RobotSpecError
+
+        resolver = PackageResolver.create(
+            None, extra_paths=[*given, *extra], share_crawls_with=desc.resolver
+        )
+        try:
+            return resolver.resolve(uri, relative_to=folder).resolve() == path.resolve()
+        except (RobotSpecError, OSError, ValueError):
+            return False
+
+    def ref(given_ref: str) -> str:
+        if "://" in given_ref:
+            return given_ref
+        path = Path(given_ref) if Path(given_ref).is_absolute() else base / given_ref
+        for uri, pkg_root in package_candidates(path, packages):
+            if resolves(uri, path, []):
+                return uri
+            if resolves(uri, path, [pkg_root.parent]):
+                entry = relative_path(pkg_root.parent, folder)
+                if entry not in extra_paths:
+                    extra_paths.append(entry)
+                return uri
+        return relative_path(path, folder)
 
     draft = draft_spec(
         desc.world,

@@ -223,3 +223,24 @@ def test_refused_inputs_say_why_at_once(page: Any) -> None:
     page._guarded(lambda _e: page._save())(_Person())
     assert "'save as' is empty: give the file to write" in page.last_message.replace("&#x27;", "'")
     assert not page.session.snapshot.saved
+
+
+def test_the_yaml_pane_and_the_proposed_tool_frame(page: Any) -> None:
+    """The text save writes, the lines errors cite marked; a facing answer drawn before applied."""
+    s = page.session
+    assert "chains:" in page._yaml.content and "#ffd9d9" not in page._yaml.content
+    page._part.value = "chains.arm"
+    page._select_part("chains.arm")
+    page._guarded(lambda _e: page.select("link_eef"))(_Tab(1))
+    page._guarded(lambda _e: page._set_chain(root=page._pick()))(_Tab(1))  # an empty chain
+    (err,) = [p for p in s.validation.errors if p.part == "chains.arm"]
+    marked = [r for r in page._yaml.content.split("<div") if "#ffd9d9" in r]
+    assert len(marked) == 1 and f"{err.line:>4} " in marked[0]
+    assert f"line {err.line}: " in page._yaml.content  # the message listed under the text
+    (q,) = [q for q in s.snapshot.questions if q.part == "manipulators.tool"]
+    (choice,) = [h for h in page._q_handles if getattr(h, "label", "") == f"answer {q.id}"]
+    assert page._proposed and page._proposed[-1].text == f"proposed: {choice.value} (red)"
+    choice.value = "tool faces +z"
+    page._proposer(q, choice)(_Person())
+    assert page._proposed[-1].text == "proposed: tool faces +z (red)"
+    assert page._proposed[0].name == "/robot/link_eef/proposed"

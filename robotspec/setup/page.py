@@ -24,12 +24,14 @@ from robotspec.render.scene import GREY, colour_parts
 from robotspec.render.viewer import RobotViewer
 from robotspec.setup.access import PageAccess, start_guarded
 from robotspec.setup.collisions import AuditReport
+from robotspec.setup.edits import _facing
 from robotspec.setup.page_base import problem_line
 from robotspec.setup.page_check import CheckTab
 from robotspec.setup.page_clients import PICK_COLOUR, ClientsPart
 from robotspec.setup.page_parts import PartsTab
 from robotspec.setup.page_states import StatesTab
-from robotspec.setup.questions import Question
+from robotspec.setup.page_yaml import yaml_html
+from robotspec.setup.questions import FACINGS, Question
 from robotspec.setup.session import SetupSession, Snapshot
 from robotspec.setup.tree import TreeRow, tree_rows
 
@@ -95,6 +97,7 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
         self._gui_lock = threading.RLock()
         self._questions_shown: tuple[Question, ...] | None = None
         self._q_handles: list[Any] = []
+        self._proposed: list[Any] = []
         self._sliders: dict[str, Any] = {}
         #: Whether a collision check runs; checked and set under its lock (two tabs may press).
         self._busy = False
@@ -147,6 +150,8 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
                     )
                     b.on_click(self._guarded(self._picker(r.link)))
                     self._tree_buttons[r.link] = b
+        with panel.add_tab("YAML"):  # what save writes, the lines errors cite marked
+            self._yaml = gui.add_html("")
         panel.dock_left()
         panel.set_width(300)
         self._status = gui.add_markdown("")
@@ -208,6 +213,7 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
                 f"{len(v.warnings)} warnings · {n_q} open questions · "
                 f"{'saved' if snap.saved else 'not saved'} · checked in {v.seconds:.2f} s"
             )
+            self._yaml.content = yaml_html(snap.text, v.problems)
             self._problems.content = (
                 "\n".join(problem_line(p) for p in v.problems) or "validate finds no problem"
             )
@@ -240,9 +246,9 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
         if questions == self._questions_shown:
             return
         self._questions_shown = questions
-        for h in self._q_handles:
+        for h in [*self._q_handles, *reversed(self._proposed)]:  # a frame's label first
             h.remove()
-        self._q_handles = []
+        self._q_handles, self._proposed = [], []
         gui = self.server.gui
         self._q_intro.content = (
             f"{len(questions)} guesses of the draft to check: keep each, or choose another answer."
@@ -256,6 +262,9 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
                     f"<small>why: {html.escape(q.reason)}</small>"
                 )
                 choice = gui.add_dropdown(f"answer {q.id}", q.choices, initial_value=q.choices[0])
+                if any(c in FACINGS for c in q.choices):  # the frame each answer proposes, drawn
+                    choice.on_update(self._guarded(self._proposer(q, choice)))
+                    self._propose(q, str(choice.value))
                 button = gui.add_button(f"apply to {q.id}")
 
                 def answer(_e: Any, q: Question = q, choice: Any = choice) -> None:
@@ -264,3 +273,31 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
 
                 button.on_click(self._guarded(answer))
                 self._q_handles += [text, choice, button]
+
+    def _proposer(self, q: Question, choice: Any) -> Callable[[Any], None]:
+        def propose(_event: Any) -> None:
+            self._propose(q, str(choice.value))
+
+        return propose
+
+    def _propose(self, q: Question, choice: str) -> None:
+        """Axes at the tool frame as ``choice`` would turn it (red: the way the tool faces)."""
+        with self._gui_lock:
+            for h in reversed(self._proposed):  # the label, then its frame
+                h.remove()
+            self._proposed = []
+            m = next(
+                (m for m in self.session.draft().manipulators if q.part.endswith(m.name)), None
+            )
+            if m is None or m.tool_frame not in self.links:
+                return
+            axis = FACINGS.get(choice)  # another answer turns the frame; keeping it, as it is
+            x, y, z, w = _facing(axis) if axis is not None else m.front_facing
+            size = float(self.viewer.scene.size)
+            at = f"/robot/{m.tool_frame}/proposed"
+            self._proposed = [
+                self.server.scene.add_frame(
+                    at, wxyz=(w, -x, -y, -z), axes_length=0.15 * size, axes_radius=0.006 * size
+                ),
+                self.server.scene.add_label(f"{at}/label", f"proposed: {choice} (red)"),
+            ]

@@ -30,8 +30,9 @@ __all__ = ["APART", "CROSS", "UNKNOWN", "UNTRIED", "block_hits", "first_hits", "
 
 #: What the mesh core proved of a candidate (its codes), and "not asked".
 UNKNOWN, APART, CROSS, UNTRIED = 0, 1, 2, -1
-#: Candidate positions within a sample that make up each wave of :func:`first_hits`.
-_WAVES = ((0, 1), (1, 2), (2, 3), (3, 5), (5, 8), (8, 13), (13, 1 << 62))
+#: Fewest candidates (counted before dropping the samples already seen colliding) a wave of
+#: :func:`first_hits` takes, several positions at once if need be.
+_WAVE_MIN = 64
 
 Hits = tuple[list[int], list[int]]
 
@@ -131,22 +132,31 @@ def first_hits(
 ) -> Hits:
     """One colliding (row, body pair) per row that collides, in waves (see the module's doc).
 
-    ``rows`` (sorted) and ``ks`` are the broad phase's candidates of the block.
+    ``rows`` (sorted) and ``ks`` are the broad phase's candidates of the block. Wave after wave
+    takes the next candidate of every row not yet seen colliding; once fewer than
+    ``_WAVE_MIN`` candidates are left per position, a wave takes several positions at once (a
+    C call and a few numpy steps cost more than the proofs they would spare).
     """
     n_cand = len(ks)
     if not n_cand:
         return [], []
     starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
     pos = np.arange(n_cand) - np.repeat(starts, np.diff(np.r_[starts, n_cand]))
+    order = np.argsort(pos, kind="stable")
+    most = int(pos[order[-1]])
+    bounds = np.searchsorted(pos[order], np.arange(most + 2))
     two = np.asarray(c.two_meshes, dtype=np.bool_)[ks] if c.meshes is not None else None
     done = np.zeros(poses.shape[0], dtype=np.bool_)
     hit_rows: list[int] = []
     hit_pairs: list[int] = []
-    most = int(pos.max())
-    for lo, hi in _WAVES:
-        if lo > most:
-            break
-        sel = np.flatnonzero((pos >= lo) & (pos < hi) & ~done[rows])
+    p = 0
+    while p <= most:
+        q = p + 1
+        while q <= most and bounds[q + 1] - bounds[p] < _WAVE_MIN:
+            q += 1
+        sel = np.sort(order[bounds[p] : bounds[q]])  # by row again, as block_hits walks them
+        p = q
+        sel = sel[~done[rows[sel]]]
         if not len(sel):
             continue
         r, k = rows[sel], ks[sel]

@@ -244,3 +244,53 @@ def test_the_yaml_pane_and_the_proposed_tool_frame(page: Any) -> None:
     page._proposer(q, choice)(_Person())
     assert page._proposed[-1].text == "proposed: tool faces +z (red)"
     assert page._proposed[0].name == "/robot/link_eef/proposed"
+
+
+def _generated(page: Any) -> None:
+    page._samples.value = 200
+    page._collisions("generate")
+    end = time.monotonic() + 300  # a hang bound: a few seconds at rest, more on a busy machine
+    while page._busy and time.monotonic() < end:
+        time.sleep(0.05)
+    assert "pairs disabled" in page._collision_text.content
+
+
+def test_the_collision_pairs_table_and_pairs_toggled_by_hand(page: Any) -> None:
+    from robotspec.setup.pairs import pair_rows
+
+    assert "generate the matrix" in page._pair_table.content
+    _generated(page)
+    rows = pair_rows(page.session)
+    assert rows and {r.reason for r in rows} <= {"Adjacent", "Never", "Always", "Default"}
+    assert "Adjacent" in page._pair_table.content and "pairs not checked, and why" in (
+        page._pair_table.content
+    )
+    adjacent = next(r for r in rows if r.reason == "Adjacent")
+    checked = next(
+        (a, b)
+        for a in page._pair_a.options
+        for b in page._pair_b.options
+        if a < b and not any({r.link1, r.link2} == {a, b} for r in rows)
+    )
+    # One pair disabled by hand, one adjacent pair checked again.
+    page._pair_a.value, page._pair_b.value = checked
+    page._guarded(lambda _e: page._toggle(disable=True))(_Person())
+    assert "not checked (User)" in page.last_message
+    page._pair_a.value, page._pair_b.value = adjacent.link1, adjacent.link2
+    page._guarded(lambda _e: page._toggle(disable=False))(_Person())
+    page._pair_filter.value = "User"
+    page._show_pairs()
+    assert page._pair_table.content.count("<tr><td>") == 1 and "✋" in page._pair_table.content
+
+    def by_hand() -> tuple[bool, bool]:
+        now = {frozenset((r.link1, r.link2)): r.reason for r in pair_rows(page.session)}
+        return now.get(frozenset(checked)) == "User", frozenset(
+            (adjacent.link1, adjacent.link2)
+        ) not in now
+
+    assert by_hand() == (True, True)
+    _generated(page)  # regenerated: the choices made by hand are kept
+    assert by_hand() == (True, True)
+    page._pair_a.value = page._pair_b.value = adjacent.link1
+    page._guarded(lambda _e: page._toggle(disable=True))(_Person())
+    assert "a pair is two links" in page.last_message

@@ -60,6 +60,10 @@ def generate_matrix(
         robot, samples=samples, seed=seed, processes=1, progress=progress, on_missing_mesh="skip"
     )
     srdf = matrix.to_srdf(robot.srdf, merge=False) if robot.srdf else matrix.to_srdf()
+    if session.pair_choices:  # a person's pairs outlive a rerun (setup/pairs.py)
+        from robotspec.setup.pairs import apply_choices
+
+        srdf = apply_choices(srdf, session.pair_choices)
     name, _ = session.keep_srdf(write_srdf(srdf))
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
     summary = (

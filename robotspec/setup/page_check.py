@@ -12,12 +12,12 @@ from typing import Any
 
 from robotspec.errors import RobotSpecError
 from robotspec.setup.collisions import AuditReport
-from robotspec.setup.page_base import PageBase
+from robotspec.setup.page_matrix import MatrixPart
 
 __all__ = ["CheckTab"]
 
 
-class CheckTab(PageBase):
+class CheckTab(MatrixPart):
     """The check & save tab of :class:`~robotspec.setup.page.SetupPage`."""
 
     _audit_report: AuditReport | None
@@ -35,6 +35,7 @@ class CheckTab(PageBase):
                 "The generated SRDF stays here until *save*, which writes it beside the spec "
                 "(never over the robot's own SRDF)."
             )
+            self._build_matrix(gui)
         self._save_path = gui.add_text("save as", str(self.session.output))
         where = ", ".join(f"`{html.escape(str(f))}`" for f in self.session.fence.folders)
         gui.add_markdown(f"<small>save as writes inside {where} only</small>")
@@ -72,6 +73,7 @@ class CheckTab(PageBase):
                 if what == "generate":
                     r = generate_matrix(self.session, samples=samples, progress=progress)
                     self._collision_text.content = r.summary
+                    self._show_pairs()
                 else:
                     report = self._audit_report or plain_audit_report
                     ok, text = audit_session(

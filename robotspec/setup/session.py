@@ -74,6 +74,8 @@ class SetupSession(PartEdits, SensorEdits):
         self._delivering = False
         #: A generated SRDF kept until save: (its name beside the spec, its text).
         self._pending_srdf: tuple[str, str] | None = None
+        #: Collision pairs a person disabled (True) or checks (False), by hand (setup/pairs.py).
+        self.pair_choices: dict[frozenset[str], bool] = {}
         self._saved: tuple[str, str | None] | None = None
         self._snapshot = self._make_snapshot(self._draft)
         robot = self._snapshot.validation.robot

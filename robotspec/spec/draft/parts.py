@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robotspec.model.entities import Body
+from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
 from robotspec.spec.draft.driven import stated_drive
 from robotspec.spec.draft.limbs import HEAD_WORDS, beside_branch
@@ -184,6 +184,11 @@ def add_torso(d: Drafter) -> None:
     if not world.is_ancestor(root, branch):
         return
     path = [c for c in world.compute_chain_of_connections(root, branch) if not c.is_fixed]
+    why = f"the joints between the root and where the arms branch ('{branch.name}')"
+    if not path:  # rooted where the arms branch (Booster T1's trunk): the waist below it
+        path, why = _waist(d, branch)
+        if not path:
+            return
     joints = frozenset(c.name for c in path if c.is_active)
     if not joints or any(
         c.name in ch.joints for c in path for ch in draft.chains if ch.joints != joints
@@ -197,7 +202,7 @@ def add_torso(d: Drafter) -> None:
         role="torso",
         joints=joints,
     )
-    t.decide.append(f"the joints between the root and where the arms branch ('{branch.name}')")
+    t.decide.append(why)
     kept = []
     for c in draft.chains:
         if c.joints == joints:
@@ -207,6 +212,28 @@ def add_torso(d: Drafter) -> None:
         kept.append(c)
     draft.chains = kept
     draft.torso = t
+
+
+def _waist(d: Drafter, branch: Body) -> tuple[list[Connection], str]:
+    """The moving joints from where the arms branch down to where the legs branch, if any.
+
+    Why: a humanoid rooted at its upper body has its torso's joints below the root, between
+    the arms and the legs (a waist); written from the root down, as the URDF's tree runs.
+    """
+    world = d.world
+    legs = [c for c in d.draft.chains if c.role == "leg"]
+    if len(legs) < 2:
+        return [], ""
+    hips = world.get_body_by_name(legs[0].root)
+    for c in legs[1:]:
+        hips = world.common_ancestor(hips, c.root)
+    if hips is branch or not world.is_ancestor(branch, hips):
+        return [], ""
+    path = [c for c in world.compute_chain_of_connections(branch, hips) if not c.is_fixed]
+    return (
+        path,
+        f"the joints between where the arms branch ('{branch.name}') and the legs ('{hips.name}')",
+    )
 
 
 # ------------------------------------------------------------------------------ drive

@@ -1,0 +1,62 @@
+"""Torso and drive of a draft (issue 30), each rule on a small layout of its shape."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robotspec.compiler import check_spec
+from robotspec.spec.draft import Draft, render_draft
+from robotspec.spec.draft.run import draft_from_files
+
+_BOX = '<collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision>'
+
+
+def _link(name: str) -> str:
+    return f'<link name="{name}">{_BOX}</link>'
+
+
+def _joint(name: str, parent: str, child: str, xyz: str, axis: str = "0 1 0") -> str:
+    return (
+        f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}"/><axis xyz="{axis}"/>'
+        '<limit lower="-2" upper="2" effort="1" velocity="1"/></joint>'
+    )
+
+
+def _limb(side: str, parent: str, names: list[str], start: str, step: str) -> list[str]:
+    parts, above = [], parent
+    for i, n in enumerate(names):
+        link = f"{side}_{n}_link"
+        axis = ("0 1 0", "1 0 0", "0 0 1")[i % 3]
+        parts += [_link(link), _joint(f"{side}_{n}", above, link, start if i == 0 else step, axis)]
+        above = link
+    return parts
+
+
+def _draft(tmp_path: Path, name: str, parts: list[str]) -> Draft:
+    urdf = tmp_path / f"{name}.urdf"
+    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
+    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
+    spec = tmp_path / f"{name}.yaml"
+    spec.write_text(render_draft(draft))
+    assert check_spec(spec).robot is not None  # valid as written
+    return draft
+
+
+def test_a_humanoid_rooted_at_its_trunk_has_its_waist_as_torso(tmp_path: Path) -> None:
+    # Booster T1's shape: arms branch at the root (the trunk), the legs below a waist joint.
+    parts = [
+        _link("trunk"),
+        _link("waist"),
+        _joint("waist_yaw", "trunk", "waist", "0 0 -0.2", "0 0 1"),
+    ]
+    arm = ["shoulder_pitch", "shoulder_roll", "elbow_pitch", "elbow_yaw"]
+    leg = ["hip_pitch", "hip_roll", "hip_yaw", "knee", "ankle_pitch", "ankle_roll"]
+    for side, y in (("left", "0.15"), ("right", "-0.15")):
+        parts += _limb(f"{side}_arm", "trunk", arm, f"0 {y} 0.1", "0 0 -0.15")
+        parts += _limb(f"{side}_leg", "waist", leg, f"0 {float(y) / 2} -0.1", "0 0 -0.15")
+    d = _draft(tmp_path, "trunk_rooted", parts)
+    assert sorted(c.role for c in d.chains) == ["arm", "arm", "leg", "leg"]
+    assert d.torso is not None
+    assert (d.torso.root, d.torso.tip, d.torso.joints) == ("trunk", "waist", {"waist_yaw"})
+    assert d.torso.decide  # a guess from the tree: the person checks it

@@ -105,7 +105,7 @@ class Tree:
     revolute: I64  # rows that turn
     prismatic: I64  # rows that slide
     levels: tuple[tuple[int, int], ...]
-    steps: tuple[tuple[slice, Any, F64], ...]  # per depth: its rows, their parents, weights
+    steps: tuple[tuple[slice, Any, F64, slice], ...]  # per depth: rows, reads, weights, writes
 
 
 def tree(
@@ -186,7 +186,10 @@ def _arranged(
         last[c[r]] = r + 1
     m1, m2 = motion_terms(k, a)
     weights = np.ascontiguousarray(np.concatenate([o, o @ m1, o @ m2], axis=2).transpose(0, 2, 1))
-    steps = tuple((slice(lo, hi), _reads(parent[lo:hi]), weights[lo:hi]) for lo, hi in levels)
+    steps = tuple(
+        (slice(lo, hi), _reads(parent[lo:hi]), weights[lo:hi], slice(lo + 1, hi + 1))
+        for lo, hi in levels
+    )
     return Tree(
         n_slots,
         n_out,
@@ -228,23 +231,22 @@ def _run(t: Tree, q: F64, out: F64) -> None:
     qt = np.zeros((t.n_dof + 1, n))
     qt[: t.n_dof] = q.T
     v = qt[t.dof] * t.mul[:, None] + t.off[:, None]  # (R, N): each row's motion value
-    a, b = np.zeros((rows, n)), np.zeros((rows, n))
+    ab = np.zeros((rows, 2, n))  # per row and sample: a (sin v, or v sliding), b (1 - cos v)
     turn = v[t.revolute]
-    a[t.revolute] = np.sin(turn)
-    b[t.revolute] = 1.0 - np.cos(turn)
-    a[t.prismatic] = v[t.prismatic]
-    a4, b4 = a[:, None, None, :], b[:, None, None, :]
+    ab[t.revolute, 0] = np.sin(turn)
+    ab[t.revolute, 1] = 1.0 - np.cos(turn)
+    ab[t.prismatic, 0] = v[t.prismatic]
+    ab5 = ab[:, :, None, None, :]
     slots = np.empty((rows + 1, 4, 3, n))  # slot[column, row, sample]
     slots[0] = np.eye(4)[:, :3, None]
     flat = slots.reshape(rows + 1, 4, 3 * n)
-    for rows_of, reads, weights in t.steps:
+    for rows_of, reads, weights, writes in t.steps:
         x = np.matmul(weights, flat[reads]).reshape(-1, 3, 4, 3, n)  # the W0, W1, W2 terms
-        dst = slots[1:][rows_of]
-        np.multiply(a4[rows_of], x[:, 1], out=dst)
-        dst += x[:, 0]
-        w2 = x[:, 2]
-        w2 *= b4[rows_of]
-        dst += w2
+        moved = x[:, 1:]
+        moved *= ab5[rows_of]  # a W1 and b W2 at once
+        dst = slots[writes]
+        np.add(x[:, 0], moved[:, 0], out=dst)
+        dst += moved[:, 1]
     out[:, :, :3, :] = slots[t.outputs].transpose(3, 0, 2, 1)
     out[:, :, 3, :] = (0.0, 0.0, 0.0, 1.0)
 

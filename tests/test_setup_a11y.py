@@ -87,7 +87,7 @@ def test_every_tab_has_no_serious_accessibility_violation(browser: Any, tmp_path
         _wait("the page's additions", lambda: d.find_elements(By.TAG_NAME, "h1"))
         page._state_part.value = "chains.arm"  # the arm's sliders on the states tab
         page._show_sliders()
-        for tab in ("Questions", "Parts", "States", "Check & save"):
+        for tab in ("Questions", "Parts", "States", "Check & save", "YAML"):
             _tab(d, tab)
             _wait(f"the {tab} tab shown", lambda tab=tab: _shown(d, tab))
             if tab == "States":
@@ -116,6 +116,15 @@ def test_every_tab_has_no_serious_accessibility_violation(browser: Any, tmp_path
         before = title.get_attribute("aria-expanded")
         title.send_keys(Keys.ENTER)
         _wait("the folder toggled", lambda: title.get_attribute("aria-expanded") != before)
+        # Ctrl+Z and Ctrl+Shift+Z press the page's undo and redo (nothing done yet: it says so).
+        from selenium.webdriver.common.action_chains import ActionChains
+
+        d.execute_script("document.activeElement && document.activeElement.blur()")
+        ActionChains(d).key_down(Keys.CONTROL).send_keys("z").key_up(Keys.CONTROL).perform()
+        _wait("Ctrl+Z", lambda: page.last_message == "nothing to undo")
+        keys = ActionChains(d).key_down(Keys.CONTROL).key_down(Keys.SHIFT).send_keys("z")
+        keys.key_up(Keys.SHIFT).key_up(Keys.CONTROL).perform()
+        _wait("Ctrl+Shift+Z", lambda: page.last_message == "nothing to redo")
     except Exception:
         d.save_screenshot(str(tmp_path / "failure.png"))
         raise

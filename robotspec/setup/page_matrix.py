@@ -70,7 +70,8 @@ class MatrixPart(PageBase):
             else ""
         )
         self._pair_table.content = (
-            "<div style='max-height:18em;overflow:auto'>"
+            "<div role='region' tabindex='0' aria-label='collision pairs not checked' "
+            "style='max-height:18em;overflow:auto'>"
             "<table style='font-size:0.75em;border-collapse:collapse;width:100%'>"
             f"<caption style='text-align:left'>{len(rows)} pairs not checked, and why</caption>"
             "<thead><tr><th scope='col'>link</th><th scope='col'>link</th>"

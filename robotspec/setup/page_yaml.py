@@ -47,7 +47,7 @@ def yaml_html(text: str, problems: Iterable[Problem]) -> str:
         for p in ps
     )
     return (
-        "<div role='region' aria-label='the spec as save would write it' "
+        "<div role='region' tabindex='0' aria-label='the spec as save would write it' "
         "style='font-family:monospace;font-size:0.75em;white-space:pre;overflow-x:auto;"
         "line-height:1.35'>"
         + "".join(rows)

@@ -126,6 +126,33 @@ def test_the_small_layout_agrees_with_mujoco_and_its_servos_hold(
     )
 
 
+def test_a_fixed_base_touching_its_first_link_is_no_contact(tiny: Path, tmp_path: Path) -> None:
+    """Adjacent links never collide in robotspec; MuJoCo filters a parent only when it moves.
+
+    The small layout on a fixed base, its first link's hull reaching into the base's box (as
+    Go2's hips reach into its trunk): the pair is excluded, so nothing touches at rest.
+    """
+    from tests.test_export_mjcf import TINY_SPEC, TINY_URDF
+
+    overlap = TINY_URDF.replace(
+        '<collision><origin xyz="0 0 0.15"/>', '<collision><origin xyz="0 0 0.0"/>', 1
+    )
+    assert overlap != TINY_URDF
+    (tmp_path / "tiny.urdf").write_text(overlap)
+    tiny.write_text(TINY_SPEC.replace("drive: {type: floating}", "drive: {type: fixed}"))
+    robot, ex = _export(tiny)
+    model = _load(ex, tmp_path / "out")
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    mujoco.mj_forward(model, data)
+    body = model.geom_bodyid
+    touching = {
+        tuple(sorted(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body[g]) for g in pair))
+        for pair in ((c.geom1, c.geom2) for c in data.contact[: data.ncon])
+    }
+    assert touching == set()
+
+
 def test_a_drafted_robot_nobody_specified_exports(tmp_path: Path) -> None:
     """example-robot-data's Solo-12 (floating base, four legs): drafted by init, then exported."""
     urdf = erd_robots() / "solo_description" / "robots" / "solo12.urdf"

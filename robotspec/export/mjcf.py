@@ -144,13 +144,24 @@ def mjcf_export(
 
 
 def _couplings(root_el: etree._Element, robot: AbstractRobot) -> None:
-    """Disabled pairs as ``<exclude>``; mimic joints as ``<equality><joint>`` couplings.
+    """Pairs robotspec never checks as ``<exclude>``; mimic joints as ``<equality><joint>``.
+
+    The pairs are the SRDF's and spec's disabled ones and the adjacent ones (MoveIt's
+    adjacency, which robotspec's own checker skips unless the SRDF re-enables them). Why the
+    adjacent ones too: MuJoCo filters a body and its parent only when the parent moves, so a
+    fixed base (or one the physics driver welds) collided with its first link where their
+    hulls overlap (Go2's hips inside its trunk pushed the hind leg 2 mrad off its target).
 
     MuJoCo's polycoef reads ``joint1 - ref1 = a0 + a1 (joint2 - ref2)``: the URDF's offset, then
     its multiplier (no ``ref`` is written, so both references are zero).
     """
+    from robotspec.collision.rules import CollisionRules, pair_key
+
     world = robot.world
-    pairs = sorted(tuple(sorted(p)) for p in robot.disabled_collision_pairs if len(p) == 2)
+    rules = CollisionRules.from_robot(robot)
+    stated = {pair_key(*sorted(p)) for p in robot.disabled_collision_pairs if len(p) == 2}
+    adjacent = {p for p in rules.adjacent if not rules.is_checked(*p)}
+    pairs = sorted(stated | adjacent)
     if pairs:
         contact = etree.SubElement(root_el, "contact")
         for first, second in pairs:

@@ -68,7 +68,8 @@ def test_panda_with_srdf_arm_group_and_parallel_gripper(tmp_path: Path) -> None:
     d, _ = _draft(
         "panda_description/urdf/panda.urdf", "panda_description/srdf/panda.srdf", tmp_path
     )
-    assert [(c.name, c.root, c.tip) for c in d.chains] == [("arm", "panda_link0", "panda_link7")]
+    # The group ends at panda_link7; the chain at the flange past it, where the files say.
+    assert [(c.name, c.root, c.tip) for c in d.chains] == [("arm", "panda_link0", "panda_link8")]
     (hand,) = d.manipulators
     assert d.chains[0].manipulator == hand.name == "end_effector"  # the SRDF's own name
     assert hand.is_gripper and hand.root == "panda_hand" and hand.tool_frame == "panda_hand_tcp"
@@ -344,7 +345,7 @@ def test_srdf_groups_of_links_and_subgroups(tmp_path: Path) -> None:
     out.write_text(render_draft(draft))
     check_spec(out)
     (chain,) = draft.chains
-    assert (chain.name, chain.root, chain.tip) == ("manipulator", "panda_link0", "panda_link7")
+    assert (chain.name, chain.root, chain.tip) == ("manipulator", "panda_link0", "panda_link8")
     assert chain.group is None  # not one <chain>: written as root and tip
     assert chain.states == {"home": {f"panda_joint{i}": v for i, v in HOME.items()}}
     # A state outside a joint's limits is left out, and the draft says why.

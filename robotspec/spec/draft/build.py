@@ -33,6 +33,7 @@ from robotspec.spec.draft.limbs import (
     Limb,
     eyes,
     find_limbs,
+    group_end,
     hand_span,
     is_named,
 )
@@ -200,13 +201,15 @@ class Drafter:
                 limb = limbs[limb_i] if limb_i is not None else None
                 if limb_i is not None:
                     used.add(limb_i)
+                end = group_end(self.world, gc.tip, limb, gc.joints)
                 c = DraftChain(
                     unique(gc.group.name, self.names),
                     gc.root.name,
-                    gc.tip.name,
+                    end,
                     f"the SRDF group '{gc.group.name}'",
                     role=limb.kind if limb is not None else role_by_name(gc.group.name),
-                    group=gc.group.name if gc.single_chain else None,
+                    # A group's <chain> ends at its tip: past it, root and tip are written.
+                    group=gc.group.name if gc.single_chain and end == gc.tip.name else None,
                     srdf_group=gc.group.name,
                     joints=gc.joints,
                 )

@@ -22,6 +22,7 @@ __all__ = [
     "Limb",
     "beside_branch",
     "chain_end",
+    "group_end",
     "eyes",
     "find_limbs",
     "hand_cut",
@@ -361,3 +362,18 @@ def beside_branch(world: World, body: Body, tip: Body | str) -> bool:
         if any(not c.is_fixed for b in world.subtree(k) if (c := world.parent_connection(b))):
             return True
     return False
+
+
+def group_end(world: World, tip: Body, limb: Limb | None, joints: frozenset[str]) -> str:
+    """Where a chain drafted from an SRDF group ends: past the group's tip where the files say.
+
+    Why: a group lists what a planner moves, often ending at the last moving link (Panda's
+    ``panda_link7``); the chain ends at the flange beyond it (``panda_link8``) as the tree's
+    limb of the same joints does, found past fixed joints only (never another moving one).
+    """
+    if limb is None or limb.joints != joints or limb.tip is tip:
+        return tip.name
+    if not world.is_ancestor(tip, limb.tip):
+        return tip.name
+    path = world.compute_chain_of_connections(tip, limb.tip)
+    return limb.tip.name if all(c.is_fixed for c in path) else tip.name

@@ -79,7 +79,7 @@ def draft_from_files(
     )
     # What a spec finds: the user's -P (written into package_paths below), the environment and
     # the installed data; a URI is written only when it resolves that way, to the very file.
-    given = [Path(p) if Path(p).is_absolute() else base / p for p in map(str, package_paths)]
+    allowed = [Path(p) if Path(p).is_absolute() else base / p for p in map(str, package_paths)]
     packages = _named_packages(desc)
     extra_paths: list[str] = []
 
@@ -87,7 +87,7 @@ def draft_from_files(
         from robotspec.errors import RobotSpecError
 
         resolver = PackageResolver.create(
-            None, extra_paths=[*given, *extra], share_crawls_with=desc.resolver
+            None, extra_paths=[*allowed, *extra], share_crawls_with=desc.resolver
         )
         try:
             return resolver.resolve(uri, relative_to=folder).resolve() == path.resolve()

@@ -60,3 +60,51 @@ def test_a_humanoid_rooted_at_its_trunk_has_its_waist_as_torso(tmp_path: Path) -
     assert d.torso is not None
     assert (d.torso.root, d.torso.tip, d.torso.joints) == ("trunk", "waist", {"waist_yaw"})
     assert d.torso.decide  # a guess from the tree: the person checks it
+
+
+def _gripper_arm() -> list[str]:
+    """A 6-joint arm, a flange, a hand with two sliding fingers, and a bare frame on the hand."""
+    parts = [_link("base")]
+    parts += _limb("arm", "base", [f"j{i}" for i in range(1, 7)], "0 0 0.1", "0 0 0.15")
+    parts += [_link("flange"), _fixed("flange_joint", "arm_j6_link", "flange", "0 0 0.05")]
+    parts += [_link("hand"), _fixed("hand_mount", "flange", "hand", "0 0 0.01")]
+    for side, y in (("left", "0.03"), ("right", "-0.03")):
+        parts += [
+            _link(f"{side}_finger"),
+            f'<joint name="{side}_finger_joint" type="prismatic"><parent link="hand"/>'
+            f'<child link="{side}_finger"/><origin xyz="0 {y} 0.06"/><axis xyz="0 1 0"/>'
+            '<limit lower="0" upper="0.04" effort="1" velocity="1"/></joint>',
+        ]
+    parts += ['<link name="grip_point"/>', _fixed("grip", "hand", "grip_point", "0 0 0.07")]
+    return parts
+
+
+def _fixed(name: str, parent: str, child: str, xyz: str) -> str:
+    return (
+        f'<joint name="{name}" type="fixed"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}"/></joint>'
+    )
+
+
+def test_the_srdf_end_effector_parent_link_is_the_tool_frame(tmp_path: Path) -> None:
+    # MoveIt's <end_effector parent_link=...>: a bare frame on the hand is the TCP, a fact.
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text('<robot name="arm">' + "".join(_gripper_arm()) + "</robot>")
+    srdf = tmp_path / "arm.srdf"
+    srdf.write_text(
+        '<robot name="arm"><group name="manipulator"><chain base_link="base"'
+        ' tip_link="arm_j6_link"/></group>'
+        '<group name="gripper"><joint name="left_finger_joint"/>'
+        '<joint name="right_finger_joint"/></group>'
+        '<end_effector name="gripper" parent_link="grip_point" group="gripper"'
+        ' parent_group="manipulator"/></robot>'
+    )
+    draft, _ = draft_from_files(str(urdf), str(srdf), folder=tmp_path, base_folder=tmp_path)
+    spec = tmp_path / "arm.yaml"
+    spec.write_text(render_draft(draft))
+    assert check_spec(spec).robot is not None
+    (chain,) = draft.chains
+    assert chain.tip == "flange"  # past the group's tip, to the link the hand is met on
+    (m,) = draft.manipulators
+    assert (m.name, m.tool_frame) == ("gripper", "grip_point")
+    assert not any("tool frame" in q for q in m.decide)  # stated by the SRDF: no question

@@ -63,7 +63,7 @@ from robotspec.spec.draft.srdf_groups import (
     group_notes,
 )
 from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset
-from robotspec.spec.draft.tool_frames import fixed_jaw, frame_at_tips
+from robotspec.spec.draft.tool_frames import fixed_jaw, frame_at_tips, is_bare_frame
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = ["Drafter", "draft_spec"]
@@ -251,9 +251,18 @@ class Drafter:
 
     # ----------------------------------------------------------------------- manipulators
     def manipulator(
-        self, chain: DraftChain, limb: Limb | None, name: str, start: Body | None = None
+        self,
+        chain: DraftChain,
+        limb: Limb | None,
+        name: str,
+        start: Body | None = None,
+        stated: Body | None = None,
     ) -> DraftManipulator | None:
-        """The hand at a chain's end (``start``: where an SRDF end effector says it begins)."""
+        """The hand at a chain's end (``start``: where an SRDF end effector says it begins).
+
+        ``stated``: the SRDF end effector's parent link; a bare frame on the hand, it is the
+        tool frame the files state (no question asked).
+        """
         tree, world = self.tree, self.world
         tip = world.get_body_by_name(chain.tip)
         hand = start if start is not None else (limb.hand if limb is not None else None)
@@ -299,12 +308,14 @@ class Drafter:
                 top = tip
         if gripper is not None and not world.is_ancestor(top, gripper.root):
             gripper = None
+        if stated is not None and world.is_ancestor(top, stated) and is_bare_frame(world, stated):
+            tool, decide = stated, []  # the SRDF end effector's parent link: a fact
         frame: DraftFrame | None = None
         if tool is not None:
             tool_name = tool.name
-            # A bare frame named as a TCP is the files' answer (no question); other names and
-            # links are guesses. (Above the hand: said already.)
-            if not decide and not is_named_tcp(world, tool):
+            # A bare frame named as a TCP, or the SRDF's, is the files' answer (no question);
+            # other names and links are guesses. (Above the hand: said already.)
+            if not decide and not is_named_tcp(world, tool) and tool is not stated:
                 jaw = tool is fixed_jaw(world, top)  # a one-jaw gripper's: by where it is
                 decide.append(
                     f"the tool frame '{tool.name}' "
@@ -523,7 +534,10 @@ class Drafter:
             name = ee.name
             if name in self.names:  # Talos' feet are named as their legs
                 name = f"{ee.name}_{'foot' if chain.role == 'leg' else 'hand'}"
-            m = self.manipulator(chain, limb, name, hand_start)
+            parent = (
+                world.get_body_by_name(ee.parent_link) if world.has_body(ee.parent_link) else None
+            )
+            m = self.manipulator(chain, limb, name, hand_start, parent)
             if m is not None:
                 m.source = f"the SRDF end effector '{ee.name}' ({m.source})"
 

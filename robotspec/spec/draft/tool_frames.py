@@ -24,6 +24,7 @@ __all__ = [
     "fixed_jaw",
     "frame_at_tips",
     "hand_center",
+    "is_bare_frame",
     "is_named_tcp",
     "own_geometry",
 ]
@@ -88,10 +89,15 @@ TCP_NAMES: tuple[str, ...] = (
 )
 
 
+def is_bare_frame(world: World, body: Body) -> bool:
+    """Whether ``body`` is a bare frame: a leaf without geometry on a fixed joint."""
+    c = world.parent_connection(body)
+    return c is not None and c.is_fixed and not world.child_bodies(body) and not own_geometry(body)
+
+
 def is_named_tcp(world: World, body: Body) -> bool:
     """Whether ``body`` is a bare frame (a leaf without geometry, on a fixed joint) named a TCP."""
-    c = world.parent_connection(body)
-    if c is None or not c.is_fixed or world.child_bodies(body) or own_geometry(body):
+    if not is_bare_frame(world, body):
         return False
     name = _named_as(body.name)
     return any(_matches(hint, name) for hint in TCP_NAMES)

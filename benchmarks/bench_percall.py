@@ -10,8 +10,10 @@ lookup). A change that adds a few hundred nanoseconds there is invisible in any 
 yet makes every query 20-40 % slower (issue 34 measured it). ``benchmarks/percall_baseline.json``
 holds the per-call times of the landing before those checks (c19da32) on the machine named in
 it; each row is that time against today's (ratio = baseline / now: below 1 means the calls got
-slower). Another machine gives other times: record its own baseline with ``--record FILE``,
-run on the baseline commit (see docs/performance.md).
+slower). Another machine gives other times: record its own baseline on the baseline commit,
+``git worktree add /tmp/base c19da32``, ``python setup.py build_ext --inplace`` there, then
+``PYTHONPATH=/tmp/base python benchmarks/bench_percall.py --record FILE`` (then
+``--baseline FILE``).
 
 How it times: ``calls`` calls of one query in a block, the queries in turn, ``rounds`` blocks
 each; the figure is the FASTEST block's time per call. On a shared machine other processes only

@@ -176,7 +176,8 @@ def _arranged(
     order = np.argsort(row_depth, kind="stable")
     ends = np.searchsorted(row_depth[order], np.arange(1, int(row_depth.max(initial=0)) + 2))
     levels = tuple((int(lo), int(hi)) for lo, hi in zip(ends[:-1], ends[1:], strict=True))
-    p, c, k, o, a, m, f = (x[order] for x in (p, c, k, o, a, m, f))
+    p, c, k = p[order], c[order], k[order]
+    o, a, m, f = o[order], a[order], m[order], f[order]
     # Rows in depth order: a row's parent slot is final when the row runs (C's row order
     # within a depth is kept, so a slot written twice ends as in C).
     last = np.zeros(n_slots, dtype=np.int64)

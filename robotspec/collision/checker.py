@@ -258,7 +258,8 @@ class SelfCollisionChecker:
         """
         margin = real_number(margin, "margin", _config_error, minimum=0.0)
         pair_mask = None if pair_mask is None else self._pair_mask(pair_mask)
-        threads = checked_threads(threads)
+        if threads != 1 or type(threads) is not int:  # one thread: the single queries' path
+            threads = checked_threads(threads)
         c = self._build()
         n = qs.shape[0]
         hits = np.zeros((n, len(self._pairs)), dtype=np.bool_)
@@ -268,6 +269,10 @@ class SelfCollisionChecker:
         # With several threads, an any-hit query proves its mesh pairs in one C call per block
         # too: the one-by-one proofs hold the GIL, the batch call does not (see _scan_rows).
         batch_proofs = not first_only or threads > 1
+
+        if threads == 1:
+            self._scan_rows(c, qs, hits, margin, geom_mask, first_only, drop_found, batch_proofs)
+            return hits
 
         def scan(lo: int, hi: int) -> None:
             mask = None if geom_mask is None else geom_mask.copy()  # drop_found narrows it
@@ -328,7 +333,7 @@ class SelfCollisionChecker:
                     first_only=first_only,
                     drop_found=drop_found,
                 )
-            hit_rows += [start + r for r in rs]
+            hit_rows += [start + r for r in rs] if start else rs
             hit_pairs += ps
         hits[hit_rows, hit_pairs] = True
 

@@ -108,3 +108,48 @@ def test_the_srdf_end_effector_parent_link_is_the_tool_frame(tmp_path: Path) -> 
     (m,) = draft.manipulators
     assert (m.name, m.tool_frame) == ("gripper", "grip_point")
     assert not any("tool frame" in q for q in m.decide)  # stated by the SRDF: no question
+
+
+def _wheel(name: str, parent: str, xyz: str) -> list[str]:
+    cylinder = (
+        '<collision><origin rpy="1.5708 0 0"/><geometry><cylinder radius="0.06" length="0.03"/>'
+        "</geometry></collision>"
+    )
+    return [f'<link name="{name}">{cylinder}</link>', _fixed(f"{name}_joint", parent, name, xyz)]
+
+
+def test_a_quadrotor_with_propellers_on_fixed_joints_floats(tmp_path: Path) -> None:
+    # Crazyflie's shape in a simulator's URDF: four propeller links, nothing moves.
+    parts = [_link("base_link")]
+    for i, xyz in enumerate(("0.03 -0.03 0", "-0.03 -0.03 0", "-0.03 0.03 0", "0.03 0.03 0")):
+        parts += [
+            _link(f"prop{i}_link"),
+            _fixed(f"prop{i}_joint", "base_link", f"prop{i}_link", xyz),
+        ]
+    d = _draft(tmp_path, "quadrotor", parts)
+    assert d.drive is not None and d.drive.type == "floating" and d.drive.decide
+
+
+def test_base_joints_over_two_wheels_on_fixed_joints_are_differential(tmp_path: Path) -> None:
+    # ManiSkill's Fetch: x, y, theta joints move the base; its two wheels are on fixed joints.
+    parts = ['<link name="root"/><link name="x_link"/><link name="y_link"/>', _link("base_link")]
+    for name, parent, child, kind, axis in (
+        ("root_x_axis_joint", "root", "x_link", "prismatic", "1 0 0"),
+        ("root_y_axis_joint", "x_link", "y_link", "prismatic", "0 1 0"),
+        ("root_z_rotation_joint", "y_link", "base_link", "continuous", "0 0 1"),
+    ):
+        parts.append(
+            f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<axis xyz="{axis}"/><limit lower="-10" upper="10" effort="1" velocity="1"/></joint>'
+        )
+    parts += _wheel("l_wheel_link", "base_link", "0 0.19 0.05")
+    parts += _wheel("r_wheel_link", "base_link", "0 -0.19 0.05")
+    d = _draft(tmp_path, "planar_base", parts)
+    assert d.drive is not None and d.drive.type == "differential"
+    assert "2 wheels on fixed joints" in d.drive.decide
+    # Four wheels on fixed joints and no moving base: the files state no drive, so it is asked.
+    still = [_link("base_link")]
+    for i, xyz in enumerate(("0.2 0.2 0", "0.2 -0.2 0", "-0.2 0.2 0", "-0.2 -0.2 0")):
+        still += _wheel(f"wheel_{i}_link", "base_link", xyz)
+    d = _draft(tmp_path, "wheels_held", still)
+    assert d.drive is not None and d.drive.type == "fixed" and "4 wheels" in d.drive.decide

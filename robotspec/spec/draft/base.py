@@ -21,7 +21,7 @@ from robotspec.model.world import World
 from robotspec.spec.draft.model import DraftDrive
 from robotspec.spec.draft.tree import words
 
-__all__ = ["OwnBase", "own_base", "own_drive", "wheel_joints"]
+__all__ = ["OwnBase", "fixed_wheels", "own_base", "own_drive", "wheel_joints"]
 
 #: Words that name a spinning part that is no wheel.
 _NOT_WHEELS = frozenset({"rotor", "propeller", "prop", "fan"})
@@ -156,14 +156,35 @@ def wheel_joints(world: World, poses: np.ndarray | None = None) -> list[Connecti
     return out
 
 
+def fixed_wheels(world: World) -> list[Connection]:
+    """Fixed joints carrying a link named a wheel (a simulator's base moved by other joints).
+
+    Why: Fetch in ManiSkill moves its base by x/y/theta joints and models its two wheels on
+    fixed joints; they still tell a two-wheeled (differential) base from an omni one. Casters
+    (named so) are no wheels that drive.
+    """
+    out = []
+    for c in world.connections:
+        if not c.is_fixed:
+            continue
+        named = words(c.name) | words(world.bodies[c.child].name)
+        if "wheel" in named and not named & (_NOT_WHEELS | {"caster", "castor"}):
+            out.append(c)
+    return out
+
+
 def own_drive(world: World, base: OwnBase, wheels: list[Connection]) -> DraftDrive:
     """The drafted drive of the URDF's own base: omni, or differential on exactly two wheels.
 
     Why a DECIDE mark: the joints say the base moves in the plane, not whether it can move
     sideways; two driven wheels say it cannot, anything else is drafted omni for a person to check.
     """
+    rolled = ""
+    if not wheels:  # wheels modelled on fixed joints still say what carries the base
+        wheels = fixed_wheels(world)
+        rolled = " on fixed joints" if wheels else ""
     kind = "differential" if len(wheels) == 2 else "omni"
-    why = f"{len(wheels)} wheels: {kind}?" if wheels else f"{kind}?"
+    why = f"{len(wheels)} wheels{rolled}: {kind}?" if wheels else f"{kind}?"
     if base.joints is not None:
         return DraftDrive(
             kind,

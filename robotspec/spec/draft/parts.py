@@ -14,6 +14,7 @@ import numpy as np
 
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
+from robotspec.spec.draft.base import fixed_wheels
 from robotspec.spec.draft.driven import stated_drive
 from robotspec.spec.draft.limbs import HEAD_WORDS, beside_branch
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
@@ -237,6 +238,14 @@ def _waist(d: Drafter, branch: Body) -> tuple[list[Connection], str]:
 
 
 # ------------------------------------------------------------------------------ drive
+_ROTOR_WORDS = frozenset({"rotor", "propeller", "prop"})
+
+
+def _rotor(world: World, c: Connection) -> bool:
+    """Whether a joint or the link it carries is named as a rotor (Crazyflie's 'prop0_link')."""
+    return bool((words(c.name) | words(world.bodies[c.child].name)) & _ROTOR_WORDS)
+
+
 def add_drive(d: Drafter) -> None:
     """From the SRDF's virtual joint, else guessed from wheels, legs or rotors."""
     draft, world = d.draft, d.world
@@ -246,7 +255,10 @@ def add_drive(d: Drafter) -> None:
     wheels = d.wheels
     casters = [c for c in joints if "caster" in words(c.name) and "wheel" not in words(c.name)]
     legs = [c for c in draft.chains if c.role == "leg"]
-    rotors = [c for c in joints if words(c.name) & {"rotor", "propeller", "prop"}]
+    rotors = [c for c in joints if words(c.name) & _ROTOR_WORDS]
+    if not rotors:  # propellers modelled on fixed joints (a simulator's multirotor): 3 or more
+        fixed = [c for c in world.connections if c.is_fixed and _rotor(world, c)]
+        rotors = fixed if len(fixed) >= 3 else []
     movable = d.tree.root is world.root
     stated = stated_drive(d.tree, d.facts, wheels) if wheels and movable else None
     if stated is not None:  # what the transmissions or a Gazebo drive plugin say
@@ -258,6 +270,9 @@ def add_drive(d: Drafter) -> None:
     elif (len(legs) >= 2 or rotors) and movable:
         why = f"{len(legs)} legs" if len(legs) >= 2 else f"{len(rotors)} rotors"
         draft.drive = DraftDrive("floating", None, None, "the URDF tree", f"{why}: floating")
+    elif movable and (held := fixed_wheels(world)):  # MPO-500: no joint of the base moves
+        why = f"{len(held)} wheels on fixed joints (none turns) and no drive stated: fixed?"
+        draft.drive = DraftDrive("fixed", None, None, "the URDF tree", why)
     else:
         draft.drive = DraftDrive(
             "fixed", None, None, "the URDF tree", "no wheels, legs or rotors: a fixed base"

@@ -1,0 +1,80 @@
+"""The Kinova session of issue 33 through the page in headless Chromium: a bare URDF and SRDF
+become a spec with a wrist camera carried by the arm, saved, that validate accepts with no
+warning of the spec's own (the robot's SRDF keeps its one: a group_state without a group).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from robotspec.compiler import check_spec
+from tests.conftest import erd_robots
+from tests.test_setup_browser import _choose, _click, _click_text, _click_tree, _tab, _wait, driver
+
+__all__ = ["driver"]  # the browser, from the xArm7's browser test
+
+
+def test_a_wrist_camera_on_the_kinova_arm_through_the_page(driver: Any, tmp_path: Path) -> None:
+    from selenium.webdriver.common.by import By
+
+    from robotspec.setup import SetupSession
+    from robotspec.setup.page import SetupPage
+
+    kinova = erd_robots() / "kinova_description"
+    if not kinova.is_dir():
+        pytest.skip("example-robot-data without kinova_description")
+    d = driver
+    out = tmp_path / "kinova.yaml"
+    session = SetupSession.open(
+        str(kinova / "robots" / "kinova.urdf"),
+        srdf=str(kinova / "srdf" / "kinova.srdf"),
+        output=out,
+    )
+    page = SetupPage(session, port=0)
+    try:
+        d.get(page.url)
+        body = d.find_element(By.TAG_NAME, "body")
+        _wait("the page drawn", lambda: "open questions" in body.text)
+        d.execute_script("document.querySelectorAll('canvas').forEach(c => c.remove())")
+        for q in session.snapshot.questions:  # keep every guess of the draft
+            left = len(session.snapshot.questions)
+            _click_text(d, f"apply to {q.id}")
+            _wait(f"{q.id} answered", lambda n=left: len(session.snapshot.questions) < n)
+        _click_tree(d, "j2s6s200_link_6")
+        _wait("the wrist picked", lambda: page.selected == "j2s6s200_link_6")
+        _tab(d, "Parts")
+        _click(
+            d,
+            "add a part",
+            lambda: d.find_element(By.XPATH, "//*[@data-robotspec-folder and .='add a part']"),
+        )
+        # viser's label names no input (its 'for' is not the input's id); the page's script
+        # ties them (aria-labelledby), as a screen reader finds the box, so does the test.
+        boxes = "//input[@aria-labelledby=//label[normalize-space()='name']/@id]"
+        name = _wait("the name box", lambda: d.find_element(By.XPATH, boxes))
+        name.clear()
+        name.send_keys("wrist_camera")
+        _wait("the name typed", lambda: page._new_name.value == "wrist_camera")
+        _choose(d, page._new_kind, "camera")
+        _click_text(d, "add at the picked link")
+        _wait("the camera added", lambda: "sensors.wrist_camera" in session.parts())
+        _wait("its part shown", lambda: page._part.value == "sensors.wrist_camera")
+        _wait("its warning", lambda: "on no chain" in body.text)
+        _choose(d, page._preset, "realsense_d435")
+        _wait("its preset", lambda: "preset: realsense_d435" in session.snapshot.text)
+        _choose(d, page._carrier, "chains.end_effector")
+        _wait("carried by the arm", lambda: "sensors: [wrist_camera]" in session.snapshot.text)
+        _wait("no warning of its own", lambda: not session.validation.at("sensors.wrist_camera"))
+        _tab(d, "Check & save")
+        _click_text(d, "save")
+        _wait("saved", lambda: out.exists() and session.snapshot.saved)
+    except Exception:
+        d.save_screenshot(str(tmp_path / "failure.png"))
+        raise
+    finally:
+        page.stop()
+    warnings = [w.message for w in check_spec(out).warnings]
+    assert warnings == ["group_state 'arm_up' has no group attribute"], warnings

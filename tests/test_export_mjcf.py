@@ -213,6 +213,30 @@ def test_an_impossible_inertia_is_said(tmp_path: Path, tiny: Path) -> None:
     assert not any("negative principal" in n for n in fine.notes)  # type: ignore[attr-defined]
 
 
+def test_servos_are_tuned_at_the_largest_inertia_not_the_default(tiny: Path) -> None:
+    """j1 turns link2 about z: upright at the default it sees less than tilted at 'arm.ready'.
+
+    A servo tuned at the default alone would be too soft (Kinova's base joint: 400 times).
+    """
+    from robotspec.export.mjcf_bodies import BodyWriter
+    from robotspec.export.mjcf_dynamics import joint_inertias
+
+    robot, ex = _export(tiny)
+    world = robot.world
+    j1 = world.get_connection_by_name("j1")
+    inertials = BodyWriter(robot, joined_urdf(load_spec(resolve_spec(tiny))), "m").inertials
+
+    def inertia(state: dict[str, float]) -> float:
+        poses = robot.kinematics.forward(world.configuration(state))
+        return joint_inertias(world, poses, inertials, [j1])["j1"]
+
+    at_default, at_ready = inertia({}), inertia({"j1": 0.5, "j2": -0.75})
+    assert at_ready > 1.05 * at_default
+    act = etree.fromstring(ex.xml.encode()).find(".//position[@name='j1']")  # type: ignore[attr-defined]
+    omega = 2.0 * math.pi * 8.0
+    assert float(act.get("kp")) >= at_ready * omega**2 * (1.0 - 1e-12)
+
+
 def test_a_mesh_over_mujocos_face_cap_is_cut_in_pieces(tmp_path: Path) -> None:
     n = MAX_FACES + 10
     vertices = np.random.default_rng(1).random((n + 2, 3))

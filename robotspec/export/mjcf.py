@@ -14,7 +14,8 @@ resolved, disabled pairs read), so the export writes MJCF from the world model:
 * disabled collision pairs as ``<exclude>``, disabled bodies' geoms colliding with nothing,
   mimic joints as ``<equality><joint>`` couplings;
 * one position servo per commanded 1-DOF joint, range and effort from its limits, gains from
-  its inertia (:func:`robotspec.export.mjcf_dynamics.joint_inertias`);
+  its largest inertia over a few configurations
+  (:func:`robotspec.export.mjcf_dynamics.joint_inertias`);
 * the default configuration and every named state as a ``<key>``.
 
 What MJCF cannot hold (velocity limits) is listed in a comment at the top of the file.
@@ -180,8 +181,9 @@ def _servos(
 ) -> list[Connection]:
     """The servoed connections, each with a position servo (the commanded 1-DOF joints).
 
-    Each servo is critically damped at ``hz`` from its joint's inertia at the default
-    configuration; the drive's joint has none (a base is not position-controlled).
+    Each servo is critically damped at ``hz`` from its joint's largest inertia over
+    :func:`_tuning_configurations`; the drive's joint has none (a base is not
+    position-controlled).
     """
     world = robot.world
     drive = robot.drive
@@ -192,8 +194,11 @@ def _servos(
     ]
     if not servoed:
         return servoed
-    poses = robot.kinematics.forward(world.default_configuration())
-    inertia = joint_inertias(world, poses, inertials, servoed)
+    inertia: dict[str, float] = {}
+    for q in _tuning_configurations(robot):
+        found = joint_inertias(world, robot.kinematics.forward(q), inertials, servoed)
+        for name, value in found.items():
+            inertia[name] = max(inertia.get(name, 0.0), value)
     omega = 2.0 * math.pi * hz
     actuator = etree.SubElement(root_el, "actuator")
     for c in servoed:
@@ -207,6 +212,29 @@ def _servos(
         if math.isfinite(dof.effort) and dof.effort > 0.0:
             act.set("forcerange", nums((-dof.effort, dof.effort)))
     return servoed
+
+
+def _tuning_configurations(robot: AbstractRobot, samples: int = 8) -> list[F64]:
+    """The default configuration, the named states and ``samples`` seeded ones within limits.
+
+    Why not the default alone: a joint's inertia depends on the rest of the arm. At a default
+    that folds the arm onto an axis (Kinova's: its base joint sees 1/400 of what it sees with
+    the arm stretched out) a servo tuned there is a hundred times too soft and rings for
+    seconds. Tuned at the largest inertia seen, it is critically damped or stiffer everywhere.
+    """
+    world = robot.world
+    q0 = world.default_configuration()
+    found = [q0] + [world.configuration(s.as_dict()) for s in named_states(robot).values()]
+    rng = np.random.default_rng(0)  # the same gains every export
+    for _ in range(samples):
+        q = q0.copy()
+        for dof in world.degrees_of_freedom:
+            if dof.is_bounded:
+                q[dof.index] = rng.uniform(dof.lower, dof.upper)
+            else:
+                q[dof.index] = rng.uniform(-math.pi, math.pi)
+        found.append(q)
+    return found
 
 
 def _keyframes(
@@ -242,8 +270,8 @@ def _header(robot: AbstractRobot, servo_hz: float, gravity_compensation: bool) -
         " MJCF cannot hold velocity limits; the robot's, per degree of freedom (rad/s or m/s): "
         + ("; ".join(limited) if limited else "none")
         + " ",
-        f" Position servos: critically damped at {servo_hz:g} Hz from each joint's inertia at the "
-        "default configuration; forcerange is the URDF effort. ",
+        f" Position servos: critically damped at {servo_hz:g} Hz from each joint's largest "
+        "inertia (default, named states, 8 seeded configurations); forcerange is the URDF effort. ",
         " Gravity compensated on every body (gravcomp). "
         if gravity_compensation
         else " Gravity acts in full: an effort limit that cannot hold a link lets it sag. ",

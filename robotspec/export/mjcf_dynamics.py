@@ -9,7 +9,8 @@ with the link and the URDF line.
 
 The servo gains come from the same numbers: a position servo tuned to one natural frequency on
 every joint needs each joint's own inertia about its axis (a finger and a shoulder differ by
-six orders of magnitude), computed here at the default configuration.
+six orders of magnitude), computed here at one configuration (the export takes the largest
+over several).
 """
 
 from __future__ import annotations

@@ -73,17 +73,17 @@ def to_sdt(
     from robotspec.interop.sdt.classes import remember, robot_class
     from robotspec.interop.sdt.identity import build, checked_class, fit, named_class
     from robotspec.interop.sdt.recipe import robot_recipe
+    from robotspec.interop.sdt.serial import run
     from robotspec.interop.sdt.world import sdt_world
 
+    api = sdt_api()  # before anything is stored: without SDT, only the error
     recipe = robot_recipe(robot)
     own: type | None = None
     if sdt_class is not None or robot.sdt_class is not None:
-        api = sdt_api()
         own = checked_class(api, sdt_class or named_class(robot.sdt_class or ""))
         recipe = fit(recipe, own)
     for note in recipe.left_out:
         warnings.warn(f"{robot.name}: {note}", SdtBridgeWarning, stacklevel=2)
-    cls = robot_class(recipe) if own is None else None
     try:
         remember(recipe, class_store)
     except OSError as exc:  # this process works without it; a fresh one cannot rebuild
@@ -94,13 +94,19 @@ def to_sdt(
             SdtBridgeWarning,
             stacklevel=2,
         )
-    world = sdt_world(robot.world, drive=robot.drive_type)
-    if own is not None:
-        sdt_robot = build(sdt_api(), own, recipe, world)
-    else:
-        sdt_robot = cls.from_world(world)  # type: ignore[union-attr]
-    if recipe.extra_hardware_joints:
-        with world.modify_world():
-            for name in recipe.extra_hardware_joints:
-                world.get_connection_by_name(name).has_hardware_interface = True
-    return sdt_robot
+
+    def build_in_sdt() -> Any:
+        cls = robot_class(recipe) if own is None else None
+        world = sdt_world(robot.world, drive=robot.drive_type)
+        if own is not None:
+            sdt_robot = build(api, own, recipe, world)
+        else:
+            sdt_robot = cls.from_world(world)  # type: ignore[union-attr]
+        if recipe.extra_hardware_joints:
+            with world.modify_world():
+                for name in recipe.extra_hardware_joints:
+                    world.get_connection_by_name(name).has_hardware_interface = True
+        return sdt_robot
+
+    # One build at a time, and never on a thread that will exit (.serial says why).
+    return run(build_in_sdt)

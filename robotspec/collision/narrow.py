@@ -167,8 +167,18 @@ def first_hits(
                 proofs[at] = meshcore.core().apart(
                     c.meshes, poses, r[at], k[at], c.pair_geom1, c.pair_geom2, eps
                 )
-        keep = proofs != APART
-        wave = (r[keep].tolist(), k[keep].tolist(), proofs[keep].tolist())
+        # Proven crossing: a hit, no coal (numpy, no Python per candidate; rows are sorted, so
+        # np.unique's first index is each row's first crossing pair).
+        cross = proofs == CROSS
+        if cross.any():
+            cr, first = np.unique(r[cross], return_index=True)
+            done[cr] = True
+            hit_rows += cr.tolist()
+            hit_pairs += c.pair_of[k[cross][first]].tolist()
+        ask = (proofs != APART) & ~cross & ~done[r]  # coal decides these, one by one
+        if not ask.any():
+            continue
+        wave = (r[ask].tolist(), k[ask].tolist(), proofs[ask].tolist())
         rs, ps = block_hits(
             c, scratch, req, poses, wave, None, eps, first_only=True, drop_found=False
         )

@@ -55,6 +55,8 @@ Point = tuple[float, float, float]
 
 #: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).
 _BLOCK = 512
+#: Samples from which an any-hit batch proves its mesh pairs in waves of C calls.
+_WAVES_FROM = 64
 #: Candidates of a block from which mesh proofs run in one C call rather than one by one.
 _BATCH_PROOFS = 64
 #: Room (m) beyond the margin by which a mesh pair must be proven apart before coal is skipped:
@@ -266,9 +268,11 @@ class SelfCollisionChecker:
         if not len(c.pair_of):
             return hits
         geom_mask = None if pair_mask is None else pair_mask[c.pair_of].astype(np.uint8)
-        # With several threads, an any-hit query proves its mesh pairs in one C call per block
-        # too: the one-by-one proofs hold the GIL, the batch call does not (see _scan_rows).
-        batch_proofs = not first_only or threads > 1
+        # An any-hit batch proves its mesh pairs in waves of C calls too (.narrow.first_hits):
+        # the one-by-one proofs hold the GIL, the C calls do not, so other threads (the batch's
+        # own, or a planner's) run meanwhile; on one thread the waves cost what the walk does.
+        # A few configurations keep the walk (numpy's fixed cost per wave would show).
+        batch_proofs = not first_only or threads > 1 or n >= _WAVES_FROM
 
         if threads == 1:
             self._scan_rows(c, qs, hits, margin, geom_mask, first_only, drop_found, batch_proofs)

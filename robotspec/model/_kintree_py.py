@@ -11,7 +11,9 @@ How it stays fast: a row sets ``child = parent @ origin @ motion(v)``. Its motio
 row, made once when the program is built. The rows are grouped by depth; for one depth, the
 parents of every sample are multiplied by the rows' stacked ``[W0 W1 W2]`` in ONE matrix product
 (samples and pose rows side by side in the columns, so BLAS sees wide matrices), then combined
-with the samples' ``s`` and ``t`` in three whole-array operations. A pose is stored transposed,
+with the samples' ``s`` and ``t`` in three whole-array operations. A fixed row (most of a
+humanoid's or the PR2's: sensor frames, links welded on) needs ``W0`` only: a depth's fixed rows
+are one product written straight into their slots. A pose is stored transposed,
 (column, row, sample), so every elementwise operation runs along the samples. Slots are
 renumbered at build time so that each depth writes one contiguous block: no scatter.
 
@@ -84,6 +86,11 @@ def motion_terms(kind: I64, axis: F64) -> tuple[F64, F64]:
     return m1, m2
 
 
+#: One depth of a tree program: its moving rows (rows, slots read, weights (k, 12, 4), slots
+#: written) and its fixed rows (slots read, W0^T (k, 4, 4), slots written), either None.
+Step = tuple[tuple[slice, Any, F64, slice] | None, tuple[Any, F64, slice] | None]
+
+
 @dataclass(frozen=True)
 class Tree:
     """A tree program (see ``_kincore.c``), rearranged for numpy.
@@ -105,7 +112,7 @@ class Tree:
     revolute: I64  # rows that turn
     prismatic: I64  # rows that slide
     levels: tuple[tuple[int, int], ...]
-    steps: tuple[tuple[slice, Any, F64, slice], ...]  # per depth: rows, reads, weights, writes
+    steps: tuple[Step, ...]  # per depth: (rows, reads, weights, writes) moving, fixed
 
 
 def tree(
@@ -173,7 +180,11 @@ def _arranged(
     row_depth: I64,
 ) -> Tree:
     """The checked rows sorted by depth, slots renumbered, each row's weights made."""
-    order = np.argsort(row_depth, kind="stable")
+    # Within a depth, the moving rows first: the fixed ones need one product and no motion
+    # (unless a slot is written twice, where C's row order decides which write stays).
+    fixed = k == KIND_FIXED
+    unique = len(np.unique(c)) == len(c)
+    order = np.lexsort((fixed, row_depth)) if unique else np.argsort(row_depth, kind="stable")
     ends = np.searchsorted(row_depth[order], np.arange(1, int(row_depth.max(initial=0)) + 2))
     levels = tuple((int(lo), int(hi)) for lo, hi in zip(ends[:-1], ends[1:], strict=True))
     p, c, k = p[order], c[order], k[order]
@@ -187,10 +198,7 @@ def _arranged(
         last[c[r]] = r + 1
     m1, m2 = motion_terms(k, a)
     weights = np.ascontiguousarray(np.concatenate([o, o @ m1, o @ m2], axis=2).transpose(0, 2, 1))
-    steps = tuple(
-        (slice(lo, hi), _reads(parent[lo:hi]), weights[lo:hi], slice(lo + 1, hi + 1))
-        for lo, hi in levels
-    )
+    steps = tuple(_step(lo, hi, parent, weights, k[lo:hi] == KIND_FIXED) for lo, hi in levels)
     return Tree(
         n_slots,
         n_out,
@@ -206,6 +214,22 @@ def _arranged(
         levels,
         steps,
     )
+
+
+def _step(lo: int, hi: int, parent: I64, weights: F64, fixed: Any) -> Step:
+    """One depth's work: its moving rows (all three terms) and its fixed ones (W0 only)."""
+    n_move = int((~fixed).sum())
+    if not fixed[n_move:].all():  # not sorted moving-first (see _arranged): all run as moving
+        n_move = hi - lo
+    mid = lo + n_move
+    move = None
+    if mid > lo:
+        move = (slice(lo, mid), _reads(parent[lo:mid]), weights[lo:mid], slice(lo + 1, mid + 1))
+    fix = None
+    if hi > mid:
+        w0 = np.ascontiguousarray(weights[mid:hi, :4])
+        fix = (_reads(parent[mid:hi]), w0, slice(mid + 1, hi + 1))
+    return move, fix
 
 
 def _reads(parents: I64) -> slice | I64:
@@ -241,13 +265,18 @@ def _run(t: Tree, q: F64, out: F64) -> None:
     slots = np.empty((rows + 1, 4, 3, n))  # slot[column, row, sample]
     slots[0] = np.eye(4)[:, :3, None]
     flat = slots.reshape(rows + 1, 4, 3 * n)
-    for rows_of, reads, weights, writes in t.steps:
-        x = np.matmul(weights, flat[reads]).reshape(-1, 3, 4, 3, n)  # the W0, W1, W2 terms
-        moved = x[:, 1:]
-        moved *= ab5[rows_of]  # a W1 and b W2 at once
-        dst = slots[writes]
-        np.add(x[:, 0], moved[:, 0], out=dst)
-        dst += moved[:, 1]
+    for move, fix in t.steps:
+        if move is not None:
+            rows_of, reads, weights, writes = move
+            x = np.matmul(weights, flat[reads]).reshape(-1, 3, 4, 3, n)  # W0, W1, W2 terms
+            moved = x[:, 1:]
+            moved *= ab5[rows_of]  # a W1 and b W2 at once
+            dst = slots[writes]
+            np.add(x[:, 0], moved[:, 0], out=dst)
+            dst += moved[:, 1]
+        if fix is not None:
+            reads, w0, writes = fix
+            np.matmul(w0, flat[reads], out=flat[writes])
     out[:, :, :3, :] = slots[t.outputs].transpose(3, 0, 2, 1)
     out[:, :, 3, :] = (0.0, 0.0, 0.0, 1.0)
 

@@ -119,6 +119,14 @@ def test_every_tab_has_no_serious_accessibility_violation(browser: Any, tmp_path
         # Ctrl+Z and Ctrl+Shift+Z press the page's undo and redo (nothing done yet: it says so).
         from selenium.webdriver.common.action_chains import ActionChains
 
+        # The first Tab stop (first in the page's order) skips the tree's buttons to the panel.
+        first = d.execute_script(
+            "return document.querySelector('a[href], button, input, [tabindex=\"0\"]')"
+        )
+        assert first.get_attribute("id") == "robotspec-skip", first.get_attribute("outerHTML")
+        d.execute_script("arguments[0].focus()", first)  # as Tab from the page's top does
+        ActionChains(d).send_keys(Keys.ENTER).perform()
+        _wait("the panel reached", lambda: d.switch_to.active_element.text.strip() == "undo")
         d.execute_script("document.activeElement && document.activeElement.blur()")
         ActionChains(d).key_down(Keys.CONTROL).send_keys("z").key_up(Keys.CONTROL).perform()
         _wait("Ctrl+Z", lambda: page.last_message == "nothing to undo")

@@ -22,6 +22,9 @@ label, .mantine-InputWrapper-label, .mantine-Input-label { color: #495057 !impor
 .mantine-Notification-description { color: #495057 !important; }
 html, body { overflow-x: hidden; }
 [data-robotspec-folder]:focus-visible { outline: 2px solid #1971c2; outline-offset: 2px; }
+#robotspec-skip { position: absolute; left: -9999px; z-index: 1000; }
+#robotspec-skip:focus { left: 0.5em; top: 0.5em; background: #fff; color: #0d47a1;
+  padding: 0.4em 0.8em; border: 2px solid #0d47a1; }
 </style>
 """
 
@@ -98,6 +101,18 @@ _SCRIPT = r"""
         + "clip:rect(0 0 0 0);white-space:nowrap");
       const header = document.createElement("header");  // a landmark: nothing outside one
       header.appendChild(h1);
+      // The first Tab stop: past the tree's buttons (one per link) to the panel's undo.
+      const skip = document.createElement("a");
+      skip.href = "#";
+      skip.id = "robotspec-skip";
+      skip.textContent = "skip to the setup panel";
+      skip.addEventListener("click", (e) => {
+        e.preventDefault();
+        const undo = [...document.querySelectorAll("button")]
+          .find((b) => b.textContent.trim() === "undo");
+        if (undo) undo.focus();
+      });
+      header.appendChild(skip);
       document.body.prepend(header);
     }
     if (!document.querySelector("main")) {

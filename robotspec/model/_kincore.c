@@ -568,6 +568,9 @@ static PyObject *py_broad(PyObject *self, PyObject *args) {
     double *hi = malloc(sizeof(double) * 3 * (size_t)(g->n_geom > 0 ? g->n_geom : 1));
     int failed = gp == NULL || rows == NULL || ks == NULL || lo == NULL || hi == NULL;
     if (!failed) {
+        /* Plain C over arrays this call holds: other threads run meanwhile (batched checks on
+           several threads, issue 34). */
+        Py_BEGIN_ALLOW_THREADS
         const double *bp = PyArray_DATA(poses);
         double *gv = PyArray_DATA(gp);
         const uint8_t *mv = mask == NULL ? NULL : PyArray_DATA(mask);
@@ -594,6 +597,7 @@ static PyObject *py_broad(PyObject *self, PyObject *args) {
                 nk++;
             }
         }
+        Py_END_ALLOW_THREADS
     }
     free(lo);
     free(hi);

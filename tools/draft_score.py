@@ -26,7 +26,8 @@ the draft has it:
 
 Whether a wrong item carried a ``DECIDE`` mark (``RobotScore.unmarked`` lists those that did
 not): an extra drafted chain, camera, gripper, torso, neck, drive or facing by its own mark; a
-missed chain when a drafted chain over some of its joints is marked; a missed tool frame or
+missed chain, torso or neck when a drafted chain over some of its joints is marked (the
+question the user is asked is then the one that finds it); a missed tool frame or
 gripper when some drafted manipulator is marked; a missed camera never (nothing asks to look).
 """
 
@@ -209,12 +210,11 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
             continue
         want_j = None if want_part is None else joints(want_part["root"], want_part["tip"])
         have_j = None if have_part is None else have_part.joints
-        s.add(
-            "torso/neck/drive",
-            want_j == have_j,
-            f"{key}: {sorted(have_j or [])}",
-            marked=have_part is not None and bool(have_part.decide),
-        )
+        if have_part is not None:
+            marked = bool(have_part.decide)
+        else:  # a missed torso or neck, as a missed chain: a marked chain over its joints asks
+            marked = any(d.decide for d in draft.chains if d.joints & (want_j or frozenset()))
+        s.add("torso/neck/drive", want_j == have_j, f"{key}: {sorted(have_j or [])}", marked=marked)
     want_fwd = tuple(float(v) for v in t.get("forward") or (1.0, 0.0, 0.0))
     have_fwd = draft.forward or (1.0, 0.0, 0.0)
     if want_fwd != (1.0, 0.0, 0.0) or have_fwd != (1.0, 0.0, 0.0):

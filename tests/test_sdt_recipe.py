@@ -157,6 +157,11 @@ def test_without_sdt_the_bridge_says_how_to_install_it(monkeypatch: pytest.Monke
     monkeypatch.delitem(sys.modules, "robotspec.interop.sdt._api", raising=False)
     # Where SDT is installed an earlier test imported the module: the package holds it too.
     monkeypatch.delattr(sdt, "_api", raising=False)
+    # ... and its distribution as if not installed (the message tells a missing SDT from an
+    # installed one that lacks a module by the installed distributions).
+    from robotspec.interop.sdt import install
+
+    monkeypatch.setattr(install, "_installed", lambda distribution: None)
     with pytest.raises(RobotSpecError, match=r"pip install 'robotspec\[sdt\]'"):
         sdt.sdt_api()
 

@@ -134,8 +134,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     for arg in argv if argv is not None else sys.argv[1:]:
         cls, _, files = arg.partition("=")
         if files:
-            urdf, _, srdf = files.partition(",")
-            found[cls] = (Path(urdf), Path(srdf) if srdf else None, [Path(urdf).parent])
+            urdf_text, _, srdf_text = files.partition(",")
+            urdf_file = Path(urdf_text)
+            found[cls] = (urdf_file, Path(srdf_text) if srdf_text else None, [urdf_file.parent])
         wanted.append(cls)
     _out("| class | migrated | validate errors | each, whose fault |")
     _out("| --- | --- | --- | --- |")

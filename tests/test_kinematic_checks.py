@@ -167,7 +167,7 @@ def test_tiago_torso_states_in_the_wrong_order(tmp_path: Path) -> None:
         "broken.yaml:3:55: error: torso.states.high: state 'high' of the torso gives the height "
         "of 'torso_lift_link' 0.888 m, state 'mid' 1.063 m: 'high' must give more than 'mid' "
         "(swapped?)",
-        "tiago.yaml:16:10: error: torso.states.mid: state 'mid' of the torso gives the height "
+        "tiago.yaml:17:10: error: torso.states.mid: state 'mid' of the torso gives the height "
         "of 'torso_lift_link' 1.063 m, state 'low' 1.238 m: 'mid' must give more than 'low' "
         "(swapped?)",
     ]
@@ -219,7 +219,7 @@ def test_hsrb_two_default_cameras(tmp_path: Path) -> None:
     text = "robotspec: 1\nextends: hsrb\nsensors: {head_rgbd_camera: {default: true}}\n"
     assert _problems(tmp_path, text, hsrb) == [
         "broken.yaml:3:39: error: sensors.head_rgbd_camera.default: cameras "
-        "'head_center_camera' (hsrb.yaml:90) and 'head_rgbd_camera' are both the default "
+        "'head_center_camera' (hsrb.yaml:91) and 'head_rgbd_camera' are both the default "
         "camera; the first would win silently: mark one"
     ]
 

@@ -9,12 +9,12 @@ how many threads ran.
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Callable
 
 import numpy as np
 
 from robotspec.errors import CollisionError
+from robotspec.model.slices import run_slices
 
 __all__ = ["MAX_THREADS", "MIN_SLICE", "checked_threads", "run_in_slices"]
 
@@ -44,27 +44,4 @@ def run_in_slices(n: int, threads: int, work: Callable[[int, int], None]) -> Non
     The first slice runs on the caller's thread. The first error of any slice is raised here,
     after every slice has ended (no thread is left writing into the caller's arrays).
     """
-    threads = max(1, min(threads, n // MIN_SLICE))
-    if threads == 1:
-        work(0, n)
-        return
-    errors: list[BaseException] = []
-
-    def run(lo: int, hi: int) -> None:
-        try:
-            work(lo, hi)
-        except BaseException as exc:  # noqa: BLE001 - re-raised on the caller's thread
-            errors.append(exc)
-
-    cuts = [n * k // threads for k in range(threads + 1)]
-    workers = [
-        threading.Thread(target=run, args=(cuts[k], cuts[k + 1]), daemon=True)
-        for k in range(1, threads)
-    ]
-    for w in workers:
-        w.start()
-    run(cuts[0], cuts[1])
-    for w in workers:
-        w.join()
-    if errors:
-        raise errors[0]
+    run_slices(n, max(1, min(threads, n // MIN_SLICE)), work)

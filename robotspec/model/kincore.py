@@ -14,7 +14,6 @@ Python thread (the C core releases the GIL while it runs, so the slices run in p
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Callable
 from types import ModuleType
 from typing import Any
@@ -23,6 +22,7 @@ import numpy as np
 
 from robotspec.accel import NO_ACCEL_ENV, CoreChoice, accelerators_disabled
 from robotspec.arrays import F64
+from robotspec.model.slices import run_slices
 
 __all__ = [
     "CHOICE",
@@ -89,24 +89,9 @@ def fk_batch(
     if stream:  # the core's checks of the caller's array, once (each slice is a view of it)
         check_out(out, (n, n_out, 4, 4))
     result: F64 = np.empty((n, n_out, 4, 4)) if out is None else out
-    errors: list[BaseException] = []
 
     def run(lo: int, hi: int) -> None:
-        try:
-            c.fk_batch(tree, arr[lo:hi], result[lo:hi], stream)
-        except BaseException as exc:  # noqa: BLE001 - re-raised on the caller's thread
-            errors.append(exc)
+        c.fk_batch(tree, arr[lo:hi], result[lo:hi], stream)
 
-    cuts = [n * k // threads for k in range(threads + 1)]
-    workers = [
-        threading.Thread(target=run, args=(cuts[k], cuts[k + 1]), daemon=True)
-        for k in range(1, threads)
-    ]
-    for w in workers:
-        w.start()
-    run(cuts[0], cuts[1])
-    for w in workers:
-        w.join()
-    if errors:
-        raise errors[0]
+    run_slices(n, threads, run)
     return result

@@ -216,10 +216,23 @@ def _check_srdf(
             continue  # its error already says what to change
         # An SRDF often outlives its URDF (HSRB's names odom_x/y/t); like MoveIt, warn and
         # ignore the element. A spec that *uses* a stale name still fails on its own line.
-        diag.add(err.with_severity("warning"))
+        diag.add(_at_srdf(err.with_severity("warning"), own_file=own_file))
     for err in [*srdf.warnings, *self_pair_warnings(srdf)]:
-        diag.add(err)
+        diag.add(_at_srdf(err, own_file=own_file))
     return srdf
+
+
+def _at_srdf(err: RobotSpecError, *, own_file: bool) -> RobotSpecError:
+    """An SRDF warning also placed at the spec's ``description.srdf`` (file and line kept).
+
+    Why: ``accept_warnings`` accepts a warning by its spec path; one from the robot's own SRDF
+    (a group_state without a group) had none, so no spec naming that SRDF could be warning-free.
+    """
+    if not own_file or err.severity != "warning" or err.detail.location:
+        return err
+    return err.located(
+        file=err.file, line=err.line, column=err.column, location=("description", "srdf")
+    )
 
 
 def compile_loaded(

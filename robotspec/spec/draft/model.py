@@ -158,6 +158,9 @@ class Draft:
     forward: tuple[float, float, float] | None = None
     #: Why ``forward`` was drafted (a guess: written as a DECIDE mark); "" once a person decided.
     forward_decide: str | None = None
+    #: Warnings a person accepted in ``robotspec setup``: (at, says, because), written as new
+    #: ``accept_warnings`` entries by the assistant (``setup/accept.py``), not by the drafter.
+    accepted: list[tuple[str, str, str]] = field(default_factory=list)
 
     @property
     def arms(self) -> list[DraftChain]:

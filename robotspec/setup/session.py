@@ -18,6 +18,7 @@ from pathlib import Path
 from robotspec.errors import RobotSpecError
 from robotspec.files.writing import check_writable, write_file
 from robotspec.model.world import World
+from robotspec.setup.accept import AcceptEdits, with_accepted
 from robotspec.setup.edits import PartEdits, SetupError, _chain, _manipulator
 from robotspec.setup.edits_sensors import SensorEdits
 from robotspec.setup.history import History, describe
@@ -44,7 +45,7 @@ class Snapshot:
     saved: bool
 
 
-class SetupSession(PartEdits, SensorEdits):
+class SetupSession(PartEdits, SensorEdits, AcceptEdits):
     """A draft being turned into a valid spec, and where it will be saved."""
 
     def __init__(
@@ -185,10 +186,12 @@ class SetupSession(PartEdits, SensorEdits):
     def _text(self, draft: Draft) -> str:
         """The text saving writes: a spec's own text with the changes made, or the draft's."""
         written = self.source.written
-        if written is None:
-            return spec_text(draft, self.source.kept, self.source.presets)
         try:
-            return written.text_of(draft, self.source.presets)
+            if written is None:
+                text = spec_text(draft, self.source.kept, self.source.presets)
+            else:
+                text = written.text_of(draft, self.source.presets)
+            return with_accepted(text, draft.accepted)  # new accept_warnings lines, if any
         except TextEditError as exc:
             raise SetupError(exc.message, kind=exc.detail.kind, name=exc.detail.name) from None
 

@@ -1,6 +1,6 @@
 """The Kinova session of issue 33 through the page in headless Chromium: a bare URDF and SRDF
 become a spec with a wrist camera carried by the arm, saved, that validate accepts with no
-warning of the spec's own (the robot's SRDF keeps its one: a group_state without a group).
+warning (the robot's SRDF's one, a group_state without a group, accepted with a reason).
 """
 
 from __future__ import annotations
@@ -15,6 +15,8 @@ from tests.conftest import erd_robots
 from tests.test_setup_browser import _choose, _click, _click_text, _click_tree, _tab, _wait, driver
 
 __all__ = ["driver"]  # the browser, from the xArm7's browser test
+
+SRDF_WARNING = "description.srdf: group_state 'arm_up' has no group attribute"
 
 
 def test_a_wrist_camera_on_the_kinova_arm_through_the_page(driver: Any, tmp_path: Path) -> None:
@@ -69,6 +71,19 @@ def test_a_wrist_camera_on_the_kinova_arm_through_the_page(driver: Any, tmp_path
         _wait("carried by the arm", lambda: "sensors: [wrist_camera]" in session.snapshot.text)
         _wait("no warning of its own", lambda: not session.validation.at("sensors.wrist_camera"))
         _tab(d, "Check & save")
+        # The robot's own SRDF's warning, accepted with a reason (an empty one is refused).
+        _wait("the SRDF's warning offered", lambda: page._accept_pick.value == SRDF_WARNING)
+        _click_text(d, "accept with reason")
+        _wait("an empty reason refused at its box", lambda: "give the reason" in body.text)
+        assert "accept_warnings" not in session.snapshot.text
+        boxes = "//input[@aria-labelledby=//label[normalize-space()='because']/@id]"
+        because = _wait("the reason box", lambda: d.find_element(By.XPATH, boxes))
+        because.send_keys("arm_up is a pose of the whole robot")
+        _wait("the reason typed", lambda: page._because.value.endswith("whole robot"))
+        _click_text(d, "accept with reason")
+        _wait("accepted", lambda: "accept_warnings:" in session.snapshot.text)
+        _wait("no warning left", lambda: not session.validation.warnings)
+        _wait("the YAML tab shows it", lambda: "accept_warnings" in page._yaml.content)
         _click_text(d, "save")
         _wait("saved", lambda: out.exists() and session.snapshot.saved)
     except Exception:
@@ -76,5 +91,4 @@ def test_a_wrist_camera_on_the_kinova_arm_through_the_page(driver: Any, tmp_path
         raise
     finally:
         page.stop()
-    warnings = [w.message for w in check_spec(out).warnings]
-    assert warnings == ["group_state 'arm_up' has no group attribute"], warnings
+    assert check_spec(out).warnings == ()

@@ -241,6 +241,7 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
             self._show_part_info()
             self._show_saved_states()
             self._show_pairs()
+            self._show_acceptable(v)
             self.shown_version = snap.version
 
     def _show_questions(self, questions: tuple[Question, ...]) -> None:

@@ -11,10 +11,15 @@ from pathlib import Path
 from typing import Any
 
 from robotspec.errors import RobotSpecError
+from robotspec.setup.accept import acceptances
 from robotspec.setup.collisions import AuditReport
 from robotspec.setup.page_matrix import MatrixPart
+from robotspec.setup.validation import Validation
 
-__all__ = ["CheckTab"]
+__all__ = ["NO_WARNING", "CheckTab"]
+
+#: The warning list's one entry when no warning can be accepted.
+NO_WARNING = "(no warning to accept)"
 
 
 class CheckTab(MatrixPart):
@@ -26,6 +31,16 @@ class CheckTab(MatrixPart):
 
     def _build_check(self, gui: Any) -> None:
         self._problems = gui.add_markdown("")
+        with gui.add_folder("accept a warning"):
+            gui.add_markdown(
+                "<small>A warning that is right for this robot, accepted with your reason: "
+                "an `accept_warnings` entry (new lines at the end of the spec; undo takes it "
+                "back).</small>"
+            )
+            self._accept_pick = gui.add_dropdown("warning", (NO_WARNING,))
+            self._because = gui.add_text("because", "")
+            self._because_note = gui.add_markdown("")
+            self._button(gui, "accept with reason", self._accept)
         with gui.add_folder("self-collision matrix"):
             self._samples = gui.add_number("samples", 2000, min=100, max=1_000_000, step=100)
             self._button(gui, "generate collision matrix", lambda: self._collisions("generate"))
@@ -40,6 +55,26 @@ class CheckTab(MatrixPart):
         where = ", ".join(f"`{html.escape(str(f))}`" for f in self.session.fence.folders)
         gui.add_markdown(f"<small>save as writes inside {where} only</small>")
         self._button(gui, "save", self._save)
+
+    def _show_acceptable(self, v: Validation) -> None:
+        """List the warnings an entry can accept now (an accepted one is gone from validate)."""
+        labels = tuple(a.label for a in acceptances(v)) or (NO_WARNING,)
+        if tuple(self._accept_pick.options) != labels:
+            self._accept_pick.options = labels
+
+    def _accept(self) -> None:
+        """Accept the chosen warning; an empty reason is refused at its box, saying why."""
+        warning = str(self._accept_pick.value)
+        if warning == NO_WARNING:
+            raise RobotSpecError("validate prints no warning an entry can accept now")
+        try:
+            v = self.session.accept_warning(warning, str(self._because.value))
+        except RobotSpecError as exc:
+            self._because_note.content = f"<small>**refused:** {html.escape(exc.message)}</small>"
+            raise
+        self._because_note.content = ""
+        self._because.value = ""
+        self._after(v, f"accepted {html.escape(warning)}")
 
     def _stepped(self, *, back: bool) -> None:
         """Undo or redo one change (any tab's), saying which (Ctrl+Z, Ctrl+Shift+Z press these)."""

@@ -294,7 +294,8 @@ class AcceptedWarning(SpecModel):
 
     at: str = Field(
         description="the spec path the warning is about, exactly as the warning prints it "
-        "(a parent path accepts nothing below it)",
+        "(a parent path accepts nothing below it); a warning about the spec's own SRDF is at "
+        "description.srdf",
         examples=["chains.left_leg"],
         min_length=1,
     )

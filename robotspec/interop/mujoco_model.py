@@ -20,6 +20,7 @@ import numpy as np
 from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError, missing_file
 from robotspec.export.mjcf_bodies import nums
+from robotspec.interop.mujoco_files import check_model_files
 from robotspec.interop.mujoco_fit import FrameFit, inverse, pose_error
 from robotspec.interop.mujoco_xml import Edit, site_edit, write_edits
 from robotspec.model.rotations import matrix_to_quat_wxyz
@@ -47,6 +48,7 @@ def read_model(path: Path) -> TheirModel:
 
     if not Path(path).is_file():
         raise missing_file(path)
+    check_model_files(Path(path))  # before MuJoCo opens what the model names
     try:
         spec = mujoco.MjSpec.from_file(str(path))
         model = spec.compile()

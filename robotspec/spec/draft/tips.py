@@ -9,8 +9,6 @@ geometry when they have none), measured along the way the hand reaches.
 
 from __future__ import annotations
 
-import re
-import struct
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -18,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robotspec.errors import RobotSpecError
+from robotspec.files.meshes import read_vertices as mesh_vertices
 from robotspec.model.entities import Body
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
 from robotspec.spec.draft.tree import Tree
@@ -80,48 +79,6 @@ def shape_points(shape: Shape, find: Callable[[str], str | None] | None = None) 
     homo = np.hstack([local, np.ones((len(local), 1))])
     out: F64 = (np.asarray(shape.origin, dtype=np.float64) @ homo.T).T[:, :3]
     return out
-
-
-_STL_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
-
-
-def mesh_vertices(path: str) -> F64:
-    """A mesh file's vertices (unscaled); an STL read here, other formats by ``read_triangles``.
-
-    Why a reader of its own for STL: only the vertices are needed, and trimesh's import alone
-    costs ``init`` about 0.7 s of CPU; STL, the usual collision format, is read with numpy
-    under the same caps (file size, triangles) and refusals (non-finite vertices).
-    """
-    from robotspec.files.limits import limits
-    from robotspec.files.meshes import read_mesh_bytes, read_triangles
-
-    if not path.lower().endswith(".stl"):
-        return read_triangles(path)[0]
-    data = read_mesh_bytes(path)
-    cap = limits().max_mesh_triangles
-    if len(data) >= 84:
-        (count,) = struct.unpack_from("<I", data, 80)
-        if len(data) == 84 + 50 * count:  # binary: 12 floats and 2 bytes a triangle
-            if count > cap:
-                raise RobotSpecError("mesh has too many triangles", file=path, kind="mesh")
-            rows = np.frombuffer(data, dtype=np.uint8, offset=84).reshape(count, 50)
-            floats = rows[:, :48].copy().view("<f4").reshape(count, 12)
-            vertices = floats[:, 3:].reshape(-1, 3).astype(np.float64)
-            return _finite(vertices, path)
-    found = _STL_VERTEX.findall(data)
-    if len(found) > 3 * cap:
-        raise RobotSpecError("mesh has too many triangles", file=path, kind="mesh")
-    try:
-        vertices = np.array(found, dtype=np.float64).reshape(-1, 3)
-    except ValueError:
-        raise RobotSpecError("cannot read mesh: a vertex is no number", file=path) from None
-    return _finite(vertices, path)
-
-
-def _finite(vertices: F64, path: str) -> F64:
-    if not len(vertices) or not np.all(np.isfinite(vertices)):
-        raise RobotSpecError("mesh has no finite vertices", file=path, kind="mesh")
-    return vertices
 
 
 def _finder(tree: Tree) -> Callable[[str], str | None]:

@@ -43,10 +43,9 @@ from robotspec.errors import CollisionError, KinematicsError, RobotSpecError
 from robotspec.model import kincore
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
-from robotspec.semantic.states import state_configuration
 
 if TYPE_CHECKING:
-    from robotspec.semantic.robot import AbstractRobot
+    from robotspec.collision.robot_view import CollisionRobot
 
 __all__ = ["PairDistance", "SelfCollisionChecker"]
 
@@ -106,7 +105,7 @@ class SelfCollisionChecker:
         self._compiled: Compiled | None = None
         self._distance_fns: tuple[Any, ...] | None = None
         self._hull_fns: tuple[Any, ...] | None = None
-        self._robot: AbstractRobot | None = None
+        self._robot: CollisionRobot | None = None
         # Built-once state is built under the lock; what queries write is per thread.
         self._lock = threading.RLock()
         self._local = threading.local()
@@ -115,7 +114,7 @@ class SelfCollisionChecker:
     @classmethod
     def from_robot(
         cls,
-        robot: AbstractRobot,
+        robot: CollisionRobot,
         *,
         adjacency: bool = True,
         meshes: MeshLibrary | None = None,
@@ -164,7 +163,7 @@ class SelfCollisionChecker:
             raise CollisionError(
                 "named states need a robot: build the checker with SelfCollisionChecker.from_robot"
             )
-        return state_configuration(self._robot, states, values)
+        return self._robot.state_configuration(states, values)
 
     def _build(self) -> Compiled:
         compiled = self._compiled

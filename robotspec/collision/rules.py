@@ -24,8 +24,8 @@ from robotspec.errors import CollisionError, closest_names
 from robotspec.model.world import World
 
 if TYPE_CHECKING:
+    from robotspec.collision.robot_view import CollisionRobot
     from robotspec.description.srdf import Srdf
-    from robotspec.semantic.robot import AbstractRobot
 
 __all__ = [
     "ADJACENT",
@@ -151,7 +151,7 @@ class CollisionRules:
         )
 
     @classmethod
-    def from_robot(cls, robot: AbstractRobot, *, adjacency: bool = True) -> CollisionRules:
+    def from_robot(cls, robot: CollisionRobot, *, adjacency: bool = True) -> CollisionRules:
         """The rules a compiled robot carries: SRDF, disabled bodies, buffer distance.
 
         The SRDF counts when the spec applies it; the buffer distance is the robot's

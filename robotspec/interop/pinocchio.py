@@ -7,12 +7,14 @@ ids of every chain tip, tool frame and camera.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from types import MappingProxyType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 from robotspec.collision.checker import SelfCollisionChecker
+from robotspec.collision.robot_view import CollisionRobot
 from robotspec.collision.rules import pair_key
 from robotspec.model.pinocchio import (
     PinocchioRobot,
@@ -24,13 +26,57 @@ from robotspec.model.pinocchio import (
 
 if TYPE_CHECKING:
     from robotspec.collision.shapes import MeshLibrary, MissingMeshPolicy
-    from robotspec.semantic.robot import AbstractRobot
+    from robotspec.model.world import Body
 
-__all__ = ["robot_to_pinocchio"]
+__all__ = ["PinocchioSubject", "robot_to_pinocchio"]
+
+
+class _Chain(Protocol):
+    @property
+    def name(self) -> str: ...
+    @property
+    def tip(self) -> Body: ...
+
+
+class _Tool(Protocol):
+    @property
+    def name(self) -> str: ...
+    @property
+    def tool_frame(self) -> Body: ...
+
+
+class _Mounted(Protocol):
+    @property
+    def name(self) -> str: ...
+    @property
+    def root(self) -> Body: ...
+
+
+class PinocchioSubject(CollisionRobot, Protocol):
+    """A robot as the hand-off reads it: collision's view, plus its semantic frames.
+
+    Why a protocol: this room builds on collision, and the semantic robot's ``to_pinocchio()``
+    calls it; naming the semantic class here would close an import cycle.
+    """
+
+    @property
+    def all_chains(self) -> Sequence[_Chain]:
+        """Every kinematic chain (each tip gets a frame id)."""
+        ...
+
+    @property
+    def manipulators(self) -> Sequence[_Tool]:
+        """Every manipulator (each tool frame gets a frame id)."""
+        ...
+
+    @property
+    def cameras(self) -> Sequence[_Mounted]:
+        """Every camera (each root gets a frame id)."""
+        ...
 
 
 def robot_to_pinocchio(
-    robot: AbstractRobot,
+    robot: PinocchioSubject,
     *,
     meshes: MeshLibrary | None = None,
     on_missing_mesh: MissingMeshPolicy = "error",

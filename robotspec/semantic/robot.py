@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,8 +20,10 @@ from robotspec.semantic.base import AssignmentError, JointState, SemanticRobotAn
 from robotspec.semantic.chains import KinematicChain, Neck, Torso
 from robotspec.semantic.manipulators import Manipulator
 from robotspec.semantic.sensors import Camera, Sensor
+from robotspec.semantic.states import state_configuration
 
 if TYPE_CHECKING:
+    from robotspec.arrays import F64
     from robotspec.description.srdf import Srdf
     from robotspec.model.kinematics import ChainKinematics, Kinematics
     from robotspec.model.pinocchio import PinocchioRobot
@@ -336,6 +338,20 @@ class AbstractRobot:
         """The tip pose (``.fk(q)``) and Jacobian (``.jacobian(q)``) of a chain, by chain name."""
         chain = self.get_chain(name)
         return self.kinematics.chain(chain.root, chain.tip)
+
+    def state_configuration(
+        self,
+        states: Sequence[str] | str = (),
+        values: Mapping[str, float] | None = None,
+        *,
+        base: F64 | None = None,
+    ) -> F64:
+        """A configuration from named states and joint values: see :func:`state_configuration`.
+
+        Why a method too: the collision room reads a robot through a protocol
+        (:class:`robotspec.collision.robot_view.CollisionRobot`) and asks it for its states.
+        """
+        return state_configuration(self, states, values, base=base)
 
     def to_pinocchio(self) -> PinocchioRobot:
         """The robot as a pinocchio model and collision model, with its semantic frames' ids.

@@ -13,7 +13,12 @@ fetch each repository of the manifest first, then::
     python -m tools.corpus.extract_github --list       # where each robot's files are
 
 Files go to ``$ROBOTSPEC_CORPUS/github/OWNER+REPO@COMMIT/`` (default
-``~/.cache/robotspec-corpus``), one tree per commit; a tree already extracted is kept. Blobs the
+``~/.cache/robotspec-corpus``), one tree per commit; a tree already extracted is kept. A ROS 2
+package whose xacro names files where its build installs them (``$(find PKG)/ros2_control/...``
+for the source's ``description/ros2_control/``) is read from an install space, as a ROS 2 user's
+robot is: a manifest entry's ``share: {PKG: [PATH, ...]}`` copies each PATH of the repository
+into ``_share/PKG/`` of the tree (what ``colcon build`` installs into ``install/PKG/share/PKG``),
+and its ``urdf`` and ``package_paths`` may name ``_share``. Blobs the
 mirror lacks (snapshots leave out files of 4 MiB and more: large meshes) are skipped and
 counted; the URDF, SRDF and xacro files are small and always there.
 """
@@ -22,16 +27,26 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import subprocess
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from tools.corpus.fetch import cache_root
 
-__all__ = ["MANIFEST", "GithubRobot", "cache_root", "extract", "load_manifest", "main", "mirror_of"]
+__all__ = [
+    "MANIFEST",
+    "GithubRobot",
+    "cache_root",
+    "extract",
+    "install_shares",
+    "load_manifest",
+    "main",
+    "mirror_of",
+]
 
 #: The manifest: one entry per robot, with the commit its truth was written from.
 MANIFEST = Path(__file__).resolve().parents[2] / "tests" / "data" / "blind_corpus" / "github.yaml"
@@ -52,6 +67,9 @@ class GithubRobot:
     package_paths: tuple[str, ...]  # folders inside the repository
     half: str
     what: str
+    #: ROS 2 packages installed from the repository: package name -> paths copied into
+    #: ``_share/<package>/`` of the tree (see the module docstring).
+    share: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
     @property
     def folder(self) -> Path:
@@ -81,6 +99,7 @@ def load_manifest(path: Path = MANIFEST) -> list[GithubRobot]:
                 package_paths=tuple(str(p) for p in e.get("package_paths") or ()),
                 half=str(e["half"]),
                 what=str(e.get("what", "")),
+                share={str(k): tuple(str(p) for p in v) for k, v in (e.get("share") or {}).items()},
             )
         )
     return out
@@ -144,6 +163,28 @@ def extract(repo: str, commit: str, dest: Path, mirrors: Path = MIRRORS) -> tupl
     return written, missing
 
 
+def install_shares(robot: GithubRobot) -> None:
+    """Copy ``robot``'s ``share`` paths into ``_share/<package>/`` of its extracted tree.
+
+    Why: a ROS 2 xacro names its own files where ``colcon build`` installs them, which is not
+    where they are in the repository; the copy is that install step, done once per tree.
+    """
+    for package, paths in robot.share.items():
+        dest = robot.folder / "_share" / package
+        if dest.is_dir():
+            continue
+        tmp = dest.with_name(package + ".partial")
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir(parents=True)
+        for rel in paths:
+            src = robot.folder / rel
+            if src.is_dir():
+                shutil.copytree(src, tmp / src.name, symlinks=True)
+            else:
+                shutil.copy2(src, tmp / src.name)
+        tmp.rename(dest)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Extract every commit the manifest lists (or, with ``--list``, print where each robot is)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -169,6 +210,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             continue
         gone = f", {missing} large files missing from the mirror" if missing else ""
         sys.stdout.write(f"{repo}@{commit[:12]}: {written} files at {dest}{gone}\n")
+    for r in robots:
+        if r.share and r.folder.is_dir():
+            install_shares(r)
     return 1 if failed else 0
 
 

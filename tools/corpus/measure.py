@@ -105,6 +105,7 @@ def corpus_robots(quiet: bool = True) -> tuple[list[CorpusRobot], list[str]]:
             except (subprocess.CalledProcessError, OSError) as exc:
                 skipped.append(f"{g.id}: not extracted ({type(exc).__name__})")
                 continue
+        extract_github.install_shares(g)  # a ROS 2 package's install step (its 'share')
         robots.append(
             CorpusRobot(
                 g.id,

@@ -21,6 +21,7 @@ from robotspec.diagnostics import loc_text
 from robotspec.errors import closest_names
 from robotspec.setup.edits import SetupError
 from robotspec.setup.text_edit import TextEditError, _last_line
+from robotspec.setup.text_render import style_of
 from robotspec.setup.validation import Problem, Validation
 from robotspec.spec.draft.model import Draft
 from robotspec.spec.draft.render import scalar
@@ -83,8 +84,8 @@ def with_accepted(text: str, entries: Sequence[tuple[str, str, str]]) -> str:
     node = None
     if isinstance(root, yaml.MappingNode):
         node = next((v for k, v in root.value if k.value == "accept_warnings"), None)
-    if node is None:  # a new list at the end of the file
-        new = ["accept_warnings:", *_lines(entries, 2)]
+    if node is None:  # a new list at the end of the file, its dashes where the file has them
+        new = ["accept_warnings:", *_lines(entries, style_of(root).dash)]
         return "".join(lines) + "".join(line + newline for line in new)
     if isinstance(node, yaml.SequenceNode) and not node.flow_style and node.value:
         at = _last_line(node) + 1

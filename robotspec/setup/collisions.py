@@ -64,7 +64,12 @@ def generate_matrix(
         from robotspec.setup.pairs import apply_choices
 
         srdf = apply_choices(srdf, session.pair_choices)
-    name, _ = session.keep_srdf(write_srdf(srdf))
+    if session.extras.passive:  # and their passive joints (setup/passive.py)
+        from robotspec.setup.passive import apply_passive
+
+        srdf = apply_passive(srdf, dict(session.extras.passive))
+    said = f"collision matrix generated ({len(matrix.disabled)} pairs not checked)"
+    name, _ = session.keep_srdf(write_srdf(srdf), what=said)
     counts = ", ".join(f"{k} {v}" for k, v in matrix.reasons().items())
     summary = (
         f"{len(matrix.disabled)} pairs disabled ({counts}); {len(matrix.checked)} stay checked; "

@@ -9,6 +9,7 @@ other; the torso carries none (the spec has no ``sensors:`` there).
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 from robotspec.setup.edits import SetupError, _camera, _chain
 from robotspec.setup.validation import Validation
@@ -44,10 +45,19 @@ class SensorEdits:
         d = self.draft()
         return (NO_CARRIER, *(_part_of(d, h) for h in _holders(d)))
 
+    def generic_sensors(self) -> dict[str, dict[str, Any]]:
+        """The spec's sensors that are not cameras (``setup/edits_more.py``)."""
+        raise NotImplementedError
+
+    def _sensor(self, d: Draft, part: str) -> str:
+        """The name of sensor ``part`` (``sensors.NAME``): a camera, or a generic sensor."""
+        name = part.removeprefix("sensors.")
+        return name if name in self.generic_sensors() else _camera(d, part).name
+
     def sensor_carrier(self, part: str) -> str:
         """The chain or neck that carries ``part`` (``sensors.NAME``), or :data:`NO_CARRIER`."""
         d = self.draft()
-        name = _camera(d, part).name
+        name = self._sensor(d, part)
         return next((_part_of(d, h) for h in _holders(d) if name in h.sensors), NO_CARRIER)
 
     def set_sensor_carrier(self, part: str, carrier: str) -> Validation:
@@ -60,7 +70,7 @@ class SensorEdits:
             )
 
         def change(d: Draft) -> None:
-            name = _camera(d, part).name
+            name = self._sensor(d, part)
             target = None if carrier == NO_CARRIER else _chain(d, carrier)
             for holder in _holders(d):
                 if name in holder.sensors and holder is not target:

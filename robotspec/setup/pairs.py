@@ -5,7 +5,8 @@ reason: Adjacent, Never, Always, Default) and lets a person tick a pair by hand.
 are the ``disable_collisions`` of the SRDF the spec names (a generated one is kept in the
 session until save); a pair toggled by hand is written with reason ``User`` (or dropped, to be
 checked again), and remembered in the session's ``pair_choices`` so "generate" applies it again
-after regenerating: a person's choice outlives a rerun, as in MoveIt's assistant.
+after regenerating: a person's choice outlives a rerun, as in MoveIt's assistant. Each toggle is
+one change of the session's history: undo takes it back (the SRDF kept before it, the choice).
 """
 
 from __future__ import annotations
@@ -90,8 +91,12 @@ def toggle_pair(session: SetupSession, link1: str, link2: str, *, disable: bool)
             )
     if link1 == link2:
         raise SetupError(f"a pair is two links; both are '{link1}'", kind="link", name=link1)
-    session.pair_choices[_key(link1, link2)] = disable
-    srdf = apply_choices(robot.srdf, {_key(link1, link2): disable})
-    name, _ = session.keep_srdf(write_srdf(srdf))
+    pair = _key(link1, link2)
+    srdf = apply_choices(robot.srdf, {pair: disable})
     what = "not checked (User)" if disable else "checked again"
+    name, _ = session.keep_srdf(
+        write_srdf(srdf),
+        extras=lambda e: e.with_pair(pair, disable),
+        what=f"collision pair {link1} - {link2}: {what}",
+    )
     return f"{link1} - {link2}: {what}; kept in {name} until save, and on regenerate"

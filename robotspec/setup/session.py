@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import copy
 import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -19,15 +19,17 @@ from robotspec.errors import RobotSpecError
 from robotspec.files.writing import check_writable, write_file
 from robotspec.model.world import World
 from robotspec.setup.accept import AcceptEdits, with_accepted
-from robotspec.setup.edits import PartEdits, SetupError, _chain, _manipulator
+from robotspec.setup.edits import PartEdits, SetupError
+from robotspec.setup.edits_more import MoreEdits
 from robotspec.setup.edits_sensors import SensorEdits
+from robotspec.setup.edits_states import StateEdits
+from robotspec.setup.extras import Extras, apply_edits
 from robotspec.setup.history import History, describe
 from robotspec.setup.questions import Question, questions_of
 from robotspec.setup.save import spec_text, write_spec
 from robotspec.setup.source import Source, open_source
 from robotspec.setup.targets import SaveFence
 from robotspec.setup.text_edit import TextEditError
-from robotspec.setup.tree import chain_joints, joint_range, subtree_joints
 from robotspec.setup.validation import Validation, validate_text
 from robotspec.spec.draft.model import Draft
 
@@ -45,7 +47,7 @@ class Snapshot:
     saved: bool
 
 
-class SetupSession(PartEdits, SensorEdits, AcceptEdits):
+class SetupSession(PartEdits, MoreEdits, SensorEdits, StateEdits, AcceptEdits):
     """A draft being turned into a valid spec, and where it will be saved."""
 
     def __init__(
@@ -64,8 +66,10 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
         self.fence = SaveFence(output, tuple(allow_save), dict(source.inputs))
         self._lock = threading.RLock()
         self._draft = copy.deepcopy(source.draft)
+        #: What the session holds beside the draft (``setup/extras.py``), undone with it.
+        self._extras = Extras()
         #: Undo and redo, each step with what it changed (``setup/history.py``).
-        self._history: History[tuple[Draft, Snapshot]] = History()
+        self._history: History[tuple[Draft, Extras, Snapshot]] = History()
         self._listeners: list[Callable[[Snapshot], None]] = []
         self._version = 0
         #: Ordered delivery (:meth:`_publish`): the last (version, saved) delivered, and
@@ -73,12 +77,8 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
         self._publish_lock = threading.Lock()
         self._delivered: tuple[int, bool] = (-1, False)
         self._delivering = False
-        #: A generated SRDF kept until save: (its name beside the spec, its text).
-        self._pending_srdf: tuple[str, str] | None = None
-        #: Collision pairs a person disabled (True) or checks (False), by hand (setup/pairs.py).
-        self.pair_choices: dict[frozenset[str], bool] = {}
         self._saved: tuple[str, str | None] | None = None
-        self._snapshot = self._make_snapshot(self._draft)
+        self._snapshot = self._make_snapshot(self._draft, self._extras)
         robot = self._snapshot.validation.robot
         if robot is not None and robot.srdf is not None and robot.srdf.file:
             self.fence.inputs.setdefault(Path(robot.srdf.file), "its SRDF")
@@ -135,29 +135,15 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
         written = self.source.written
         return None if written is None else written.defined_in(part)
 
-    def part_joints(self, part: str) -> tuple[str, ...]:
-        """The joints a part's states name: a chain's from root to tip, a hand's below its root."""
-        with self._lock:
-            d = self._draft
-            if part == "robot":
-                return tuple(
-                    c.name for c in self.world.connections if c.is_active and not c.is_mimic
-                )
-            if part.startswith("manipulators."):
-                return subtree_joints(self.world, _manipulator(d, part).root)
-            c = _chain(d, part)
-            if c.group is not None and not c.root:
-                return ()
-            return chain_joints(self.world, c.root, c.tip)
+    @property
+    def extras(self) -> Extras:
+        """What the session holds beside the draft now (a value)."""
+        return self._extras
 
-    def part_states(self, part: str) -> dict[str, dict[str, float]]:
-        """A part's named states (``robot``: the spec's top-level ``states``)."""
-        with self._lock:
-            return copy.deepcopy(self._states_of(self._draft, part))
-
-    def joint_range(self, joint: str) -> tuple[float, float]:
-        """The range a state's slider spans (the joint's limits)."""
-        return joint_range(self.world, joint)
+    @property
+    def pair_choices(self) -> dict[frozenset[str], bool]:
+        """Collision pairs a person disabled (True) or checks (False), by hand (setup/pairs.py)."""
+        return dict(self._extras.pairs)
 
     def subscribe(self, listener: Callable[[Snapshot], None]) -> None:
         """Call ``listener`` with every new state (from the thread that made it)."""
@@ -165,25 +151,26 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
             self._listeners.append(listener)
 
     # ------------------------------------------------------------------ the one way to change
-    def _srdf_of(self, draft: Draft) -> tuple[str, str] | None:
+    @staticmethod
+    def _srdf_of(draft: Draft, extras: Extras) -> tuple[str, str] | None:
         """The generated SRDF ``draft`` names, while it is kept in the session (not saved)."""
-        pending = self._pending_srdf
+        pending = extras.srdf
         return pending if pending is not None and draft.srdf == pending[0] else None
 
-    def _validate(self, draft: Draft, text: str, at: Path) -> Validation:
+    def _validate(self, draft: Draft, extras: Extras, text: str, at: Path) -> Validation:
         """What validate says of ``text`` saved as ``at`` (a kept SRDF staged beside it)."""
-        srdf = self._srdf_of(draft)
+        srdf = self._srdf_of(draft, extras)
         if srdf is None:
             return validate_text(text, at, package_paths=self.package_paths)
 
         def naming(staged: str) -> str:
             d = copy.copy(draft)
             d.srdf = staged
-            return self._text(d)
+            return self._text(d, extras)
 
         return validate_text(naming, at, package_paths=self.package_paths, srdf=srdf)
 
-    def _text(self, draft: Draft) -> str:
+    def _text(self, draft: Draft, extras: Extras) -> str:
         """The text saving writes: a spec's own text with the changes made, or the draft's."""
         written = self.source.written
         try:
@@ -191,36 +178,52 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
                 text = spec_text(draft, self.source.kept, self.source.presets)
             else:
                 text = written.text_of(draft, self.source.presets)
+            if extras.edits:  # what the draft cannot state; before the entries accepted now
+                elsewhere = written.elsewhere if written is not None else (lambda path: None)
+                fixed = ("description",) if written is not None and written.composed else ()
+                text = apply_edits(text, extras.edits, elsewhere=elsewhere, fixed=fixed)
             return with_accepted(text, draft.accepted)  # new accept_warnings lines, if any
         except TextEditError as exc:
             raise SetupError(exc.message, kind=exc.detail.kind, name=exc.detail.name) from None
 
-    def _make_snapshot(self, draft: Draft) -> Snapshot:
-        text = self._text(draft)
-        srdf = self._srdf_of(draft)
+    def _make_snapshot(self, draft: Draft, extras: Extras) -> Snapshot:
+        text = self._text(draft, extras)
+        srdf = self._srdf_of(draft, extras)
         return Snapshot(
             self._version,
             text,
-            self._validate(draft, text, self.output),
+            self._validate(draft, extras, text, self.output),
             questions_of(draft, self.source.presets),
             saved=(text, srdf and srdf[1]) == self._saved,
         )
 
-    def edit(self, change: Callable[[Draft], None]) -> Validation:
-        """Apply ``change`` to a copy of the draft, validate it, make it the state."""
+    def edit(
+        self,
+        change: Callable[[Draft], None],
+        *,
+        extras: Callable[[Extras], Extras] | None = None,
+        what: str | None = None,
+    ) -> Validation:
+        """Apply ``change`` to a copy of the draft, validate it, make it the state.
+
+        ``extras`` changes what the session holds beside the draft in the same step; ``what``
+        is how undo names the step (default: the lines it changed).
+        """
         with self._lock:
             try:
                 new = copy.deepcopy(self._draft)
                 change(new)
-                snap = self._make_snapshot(new)
+                ext = self._extras if extras is None else extras(self._extras)
+                snap = self._make_snapshot(new, ext)
             except RobotSpecError as exc:
                 self._history.fail(exc.message)
                 raise
             self._version += 1
             snap = replace(snap, version=self._version)
-            before = (self._draft, self._snapshot)
-            self._history.record(before, (new, snap), describe(before[1].text, snap.text))
-            self._draft, self._snapshot = new, snap
+            before = (self._draft, self._extras, self._snapshot)
+            said = what or describe(before[2].text, snap.text)
+            self._history.record(before, (new, ext, snap), said)
+            self._draft, self._extras, self._snapshot = new, ext, snap
         self._publish()
         return snap.validation
 
@@ -278,13 +281,13 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
             step, said = self._history.undo() if back else self._history.redo()
             if step is None:
                 return self.validation, said
-            draft, snap = step.before if back else step.after
+            draft, extras, snap = step.before if back else step.after
             self._version += 1
             # The text and its validation as they were; saved or not is judged now.
-            srdf = self._srdf_of(draft)
+            srdf = self._srdf_of(draft, extras)
             saved = (snap.text, srdf and srdf[1]) == self._saved
             snap = replace(snap, version=self._version, saved=saved)
-            self._draft, self._snapshot = copy.deepcopy(draft), snap
+            self._draft, self._extras, self._snapshot = copy.deepcopy(draft), extras, snap
         self._publish()
         return snap.validation, said
 
@@ -293,8 +296,17 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
         """The SRDF the spec names (a path relative to the spec, or a ``package://`` URI)."""
         return self.edit(lambda d: setattr(d, "srdf", ref))
 
-    def keep_srdf(self, text: str) -> tuple[str, Validation]:
+    def keep_srdf(
+        self,
+        text: str,
+        *,
+        extras: Callable[[Extras], Extras] | None = None,
+        what: str | None = None,
+    ) -> tuple[str, Validation]:
         """A generated SRDF, kept in the session and named by the spec; save writes it.
+
+        One change undo takes back whole: the SRDF kept before, the spec's ``srdf:`` line, and
+        ``extras`` (a pair or a passive joint chosen by hand, said as ``what``).
 
         Why not written now: a generated file is an output like the spec, written by "save" (or
         never); and its name, beside the spec, is never the robot's own SRDF
@@ -302,41 +314,12 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
         """
         with self._lock:
             name = self.fence.srdf_name(self.output)
-            self._pending_srdf = (name, text)
-            return name, self.set_srdf(name)
 
-    def _states_of(self, d: Draft, part: str) -> dict[str, dict[str, float]]:
-        if part == "robot":
-            return d.states
-        if part.startswith("manipulators."):
-            return _manipulator(d, part).states
-        return _chain(d, part).states
+            def kept(e: Extras) -> Extras:
+                return replace(e if extras is None else extras(e), srdf=(name, text))
 
-    def set_state(self, part: str, name: str, values: Mapping[str, float]) -> Validation:
-        """A named state of a part (``robot`` for the spec's own ``states``), joint by joint."""
-        if not name.strip():
-            raise SetupError("a state needs a name", kind="state")
-        clean: dict[str, float] = {}
-        for joint, value in values.items():
-            if not self.world.has_connection(joint):
-                raise SetupError(f"no joint '{joint}' in the robot", kind="joint", name=joint)
-            clean[joint] = round(float(value), 6)
-
-        def change(d: Draft) -> None:
-            self._states_of(d, part)[name] = clean
-
-        return self.edit(change)
-
-    def remove_state(self, part: str, name: str) -> Validation:
-        """Drop a named state."""
-
-        def change(d: Draft) -> None:
-            states = self._states_of(d, part)
-            if name not in states:
-                raise SetupError(f"no state '{name}' on {part}", kind="state", name=name)
-            del states[name]
-
-        return self.edit(change)
+            said = what or f"the SRDF {name} kept until save"
+            return name, self.edit(lambda d: setattr(d, "srdf", name), extras=kept, what=said)
 
     # ------------------------------------------------------------------ saving
     def save(self, path: Path | None = None) -> Path:
@@ -359,14 +342,14 @@ class SetupSession(PartEdits, SensorEdits, AcceptEdits):
                 )
             fence = self.fence
             dest, under, replace = fence.place(target)
-            srdf = self._srdf_of(self._draft)
+            srdf = self._srdf_of(self._draft, self._extras)
             srdf_at = None if srdf is None else fence.place(dest.parent / srdf[0], what="the SRDF")
             inputs = fence.input_map()
             for where, folder, force in filter(None, ((dest, under, replace), srdf_at)):
                 # A link on the way is refused before the check stages anything there.
                 check_writable(where, under=folder, force=force, inputs=inputs)
             if dest.resolve().parent != self.output.resolve().parent:
-                check = self._validate(self._draft, snap.text, dest)
+                check = self._validate(self._draft, self._extras, snap.text, dest)
                 if not check.valid:
                     raise SetupError(
                         "not saved: the spec's relative paths do not resolve from that folder",

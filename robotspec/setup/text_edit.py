@@ -21,17 +21,23 @@ part of a composed robot, the spec it ``extends``) defines it: :class:`Elsewhere
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import yaml
 
-from robotspec.errors import RobotSpecError
-from robotspec.spec.draft.render import scalar
+from robotspec.setup.text_render import (
+    TextEditError,
+    as_part,
+    block_lines,
+    flow,
+    nested,
+    restep,
+    style_of,
+)
 
-__all__ = ["Elsewhere", "TextEditError", "diff_ops", "edit_text", "remove_mark"]
+__all__ = ["Elsewhere", "Op", "TextEditError", "diff_ops", "edit_paths", "edit_text", "remove_mark"]
 
 Path_ = tuple[str | int, ...]
 #: Where another file defines the longest prefix of a path it defines: (file, line, prefix
@@ -41,10 +47,6 @@ Elsewhere = Callable[[Path_], "tuple[str, int | None, int] | None"]
 _SECTIONS = ("chains", "manipulators", "sensors", "states")
 
 _MARK = "  # DECIDE:"
-
-
-class TextEditError(RobotSpecError):
-    """A change the text of the spec cannot take (shared, defined in another file)."""
 
 
 @dataclass(frozen=True)
@@ -66,58 +68,6 @@ def diff_ops(old: Any, new: Any, path: Path_ = ()) -> list[Op]:
             ops += diff_ops(old[k], v, (*path, k)) if k in old else [Op("set", (*path, k), v)]
         return ops
     return [Op("set", path, new)]
-
-
-# ---------------------------------------------------------------------------- rendering values
-def _number(v: float) -> str:
-    if not math.isfinite(v):
-        raise TextEditError(f"not a finite number: {v}", kind="value")
-    return str(v) if isinstance(v, int) else repr(float(v))  # as YAML reads it back
-
-
-def _flow(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if v is None:
-        return "null"
-    if isinstance(v, int | float):
-        return _number(v)
-    if isinstance(v, str):
-        return scalar(v)
-    if isinstance(v, Mapping):
-        return "{" + ", ".join(f"{_flow(str(k))}: {_flow(x)}" for k, x in v.items()) + "}"
-    if isinstance(v, list | tuple):
-        return "[" + ", ".join(_flow(x) for x in v) + "]"
-    raise TextEditError(f"cannot write a {type(v).__name__} in a spec", kind="value")
-
-
-def _nested(v: Any) -> bool:
-    """Whether a mapping holds mappings of mappings (written as a block, not one flow line)."""
-    return isinstance(v, Mapping) and any(
-        isinstance(x, Mapping) and any(isinstance(y, Mapping) for y in x.values())
-        for x in v.values()
-    )
-
-
-def _as_part(path: Path_) -> bool:
-    """Whether the drafter writes the mapping at ``path`` as a block (a part, a section)."""
-    if len(path) == 1:
-        return path[0] != "drive"
-    if path[-1] in ("states", "fingers", "frames"):
-        return True  # one line per entry
-    return len(path) == 2 and path[0] in ("chains", "manipulators", "sensors")
-
-
-def _block(key: Any, v: Any, indent: int, path: Path_ = ()) -> list[str]:
-    """``key: value`` at ``indent``: parts and nested mappings as blocks, leaves as one line."""
-    pad = " " * indent
-    here = (*path, key)
-    if isinstance(v, Mapping) and v and (_nested(v) or _as_part(here) or len(_flow(v)) > 90):
-        out = [f"{pad}{_flow(str(key))}:"]
-        for k, x in v.items():
-            out += _block(k, x, indent + 2, here)
-        return out
-    return [f"{pad}{_flow(str(key))}: {_flow(v)}"]
 
 
 # ---------------------------------------------------------------------------- the file's nodes
@@ -192,6 +142,8 @@ class _Text:
     def __init__(self, text: str, model: _Index | None = None, model_text: str | None = None):
         self.text = text
         self.index = _Index(text)
+        #: How the file nests (measured once: new lines follow the file as it was opened).
+        self.style = style_of(self.index.root)
         #: The new data as the drafter writes it: a new part's lines come from there.
         self._model, self._model_text = model, model_text
 
@@ -201,7 +153,7 @@ class _Text:
         Only when they state exactly ``value`` (a section the drafter writes whole may hold
         entries this file does not gain).
         """
-        if self._model is None or self._model_text is None or not _as_part(path):
+        if self._model is None or self._model_text is None or not as_part(path):
             return None
         entry = self._model.entries.get(path)
         if entry is None or entry.key is None:
@@ -214,6 +166,7 @@ class _Text:
         lines = [line[shift:] for line in lines]
         if yaml.safe_load("\n".join(lines)) != {path[-1]: value}:
             return None
+        lines = restep(lines, self.style.step)
         return [" " * indent + line if line.strip() else "" for line in lines]
 
     def _replace(self, start: int, end: int, new: str) -> None:
@@ -254,13 +207,13 @@ class _Text:
             self._add(have, node, path[cut], value)
             return
         if isinstance(value, Mapping) and isinstance(entry.parent, yaml.MappingNode):
-            if entry.key is not None and not entry.parent.flow_style and (value and _nested(value)):
+            if entry.key is not None and not entry.parent.flow_style and (value and nested(value)):
                 self._as_block(path, entry, value)
                 return
         if isinstance(node, yaml.MappingNode | yaml.SequenceNode) and not node.flow_style:
             self._as_block(path, entry, value)
             return
-        self._replace(node.start_mark.index, node.end_mark.index, _flow(value))
+        self._replace(node.start_mark.index, node.end_mark.index, flow(value))
 
     def _as_block(self, path: Path_, entry: _Entry, value: Any) -> None:
         """A value written as the lines below its key (its key's line and comment kept)."""
@@ -273,19 +226,20 @@ class _Text:
         if (
             isinstance(value, Mapping)
             and value
-            and len(_block(path[-1], value, indent, path[:-1])) > 1
+            and len(block_lines(path[-1], value, indent, path[:-1])) > 1
         ):
+            step = self.style.step
             for k, v in value.items():  # each entry as the drafter writes it, if it is a part
-                lines += self._model_lines((*path, k), v, indent + 2) or _block(
-                    k, v, indent + 2, path
+                lines += self._model_lines((*path, k), v, indent + step) or block_lines(
+                    k, v, indent + step, path, step
                 )
         if not lines:  # one flow line after all
             if block:  # the block's lines go; the value follows its key
                 colon = self.text.find(":", key.end_mark.index)
                 end = _eol(self.text, self._line_start(_last_line(node)))
-                self._replace(colon + 1, end, " " + _flow(value))
+                self._replace(colon + 1, end, " " + flow(value))
             else:
-                self._replace(node.start_mark.index, node.end_mark.index, _flow(value))
+                self._replace(node.start_mark.index, node.end_mark.index, flow(value))
             return
         last = _last_line(node)
         if block:
@@ -303,7 +257,7 @@ class _Text:
         if isinstance(node, yaml.MappingNode) and not node.flow_style and node.value:
             indent = _indent_of(node)
             lines = self._model_lines((*have, key), value, indent)
-            lines = lines or _block(key, value, indent, have)
+            lines = lines or block_lines(key, value, indent, have, self.style.step)
             self._lines(_last_line(node) + 1, _last_line(node), lines)
             return
         if isinstance(node, yaml.MappingNode) or (
@@ -320,13 +274,21 @@ class _Text:
 
     def delete(self, path: Path_) -> None:
         entry = self.index.entries.get(path)
-        if entry is None or entry.key is None:
+        if entry is None or entry.parent is None:
             return
         parent = entry.parent
-        if not isinstance(parent, yaml.MappingNode):  # pragma: no cover - keys live in mappings
+        start, end = parent.start_mark.index, parent.end_mark.index
+        if isinstance(parent, yaml.SequenceNode):  # a list item: its lines, or the list anew
+            if parent.flow_style or len(parent.value) == 1:
+                items = list(yaml.safe_load(self.text[start:end]) or [])
+                del items[int(path[-1])]
+                self.set(path[:-1], items)
+            else:
+                self._lines(entry.node.start_mark.line, _last_line(entry.node), [])
+            return
+        if not isinstance(parent, yaml.MappingNode) or entry.key is None:  # pragma: no cover
             raise TextEditError(f"cannot delete {path[-1]!r}: not a key", kind="value")
         if parent.flow_style or len(parent.value) == 1:
-            start, end = parent.start_mark.index, parent.end_mark.index
             current = dict(yaml.safe_load(self.text[start:end]) or {})
             current.pop(path[-1], None)
             self.set(path[:-1], current)
@@ -363,7 +325,42 @@ def edit_text(
     comments: ``# from``, ``# DECIDE:``) a new part takes. No change returns ``text`` itself.
     """
     t = _Text(text, None if written is None else _Index(written), written)
-    for op in diff_ops(old, new):
+    return apply_ops(t, _kept_entries(t, old, diff_ops(old, new)), elsewhere, fixed)
+
+
+def _kept_entries(t: _Text, old: Any, ops: list[Op]) -> list[Op]:
+    """A section the data lost, dropped entry by entry when the text holds others there.
+
+    Why: the draft states a section's cameras, not a generic sensor the text also holds there;
+    its last camera removed must not take the lidar with it.
+    """
+    data = yaml.safe_load(t.text)
+    out: list[Op] = []
+    for op in ops:
+        key = op.path[0] if op.kind == "delete" and len(op.path) == 1 else None
+        here = data.get(key) if isinstance(data, dict) and key in _SECTIONS else None
+        gone = old.get(key) if isinstance(old, Mapping) and key is not None else None
+        if isinstance(here, Mapping) and isinstance(gone, Mapping) and set(here) - set(gone):
+            out += [Op("delete", (op.path[0], k)) for k in gone]
+        else:
+            out.append(op)
+    return out
+
+
+def edit_paths(
+    text: str,
+    ops: list[Op],
+    *,
+    elsewhere: Elsewhere = lambda path: None,
+    fixed: tuple[str, ...] = (),
+) -> str:
+    """``text`` with ``ops`` made, each at its spec path (a list item by its index)."""
+    return apply_ops(_Text(text), ops, elsewhere, fixed)
+
+
+def apply_ops(t: _Text, ops: list[Op], elsewhere: Elsewhere, fixed: tuple[str, ...]) -> str:
+    """Make ``ops`` in ``t``; refused where the value is shared or defined in another file."""
+    for op in ops:
         where = ".".join(map(str, op.path))
         if op.path and op.path[0] in fixed:
             raise TextEditError(

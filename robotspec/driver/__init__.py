@@ -21,7 +21,9 @@ Modules, one job each:
 * :mod:`~robotspec.driver.cartesian_jog` -- Cartesian jogs in the loop, and when they stop;
 * :mod:`~robotspec.driver.state_fill` -- flags, TCP poses and the published snapshot;
 * :mod:`~robotspec.driver.loop` -- the loop, its timing and the timestep pipeline;
-* :mod:`~robotspec.driver.robot_driver` -- the driver base class: the seed's client API;
+* :mod:`~robotspec.driver.robot_driver` -- the driver base class: the seed's client API (command
+  modes, status, enable, homing), with :mod:`~robotspec.driver.robot_driver_motion` (jogs,
+  trajectories, streams) and :mod:`~robotspec.driver.robot_driver_tools` (tools, payloads);
 * :mod:`~robotspec.driver.sim` -- the simulated robot with injectable faults;
 * :mod:`~robotspec.driver.mujoco_plant` -- the simulated robot on MuJoCo physics (the
   ``mujoco`` extra), :mod:`~robotspec.driver.mujoco_model` the model it steps;

@@ -22,6 +22,7 @@ from robotspec.errors import DriverError
 
 if TYPE_CHECKING:
     from robotspec.driver.robot_driver import RobotDriver
+    from robotspec.driver.robot_driver_motion import MotionCommands
 
 __all__ = [
     "Completion",
@@ -107,7 +108,7 @@ class TrajectoryGenerator:
     Also a Python iterator: ``for status in gen: ...``.
     """
 
-    def __init__(self, driver: RobotDriver, task: TrajectoryTask) -> None:
+    def __init__(self, driver: MotionCommands, task: TrajectoryTask) -> None:
         self._driver = driver
         self._task = task
 

@@ -36,7 +36,7 @@
  * INTERFACE): bump both whenever an entry point's arguments or results change. The module exports
  * it as INTERFACE, and robotspec/accel.py refuses a module whose number differs (a stale build).
  */
-#define MESHCORE_INTERFACE 1
+#define MESHCORE_INTERFACE 2
 
 /* A tree from vertices (V, 3) and triangles (T, 3); NULL with an exception set on bad input. */
 static Tree *tree_new(PyObject *vobj, PyObject *fobj) {
@@ -106,6 +106,11 @@ static void set_free(PyObject *capsule) {
     for (Py_ssize_t i = 0; i < s->n; i++) tree_free(s->trees[i]);
     if (s->one != NULL) scratch_free(s->one);
     free(s->one);
+    for (ptrdiff_t k = 0; k < s->n_spare; k++) {
+        scratch_free(s->spare[k]);
+        free(s->spare[k]);
+    }
+    free(s->spare);
     free(s->trees);
     free(s);
 }
@@ -175,12 +180,46 @@ static PyObject *py_mesh_set(PyObject *self, PyObject *args) {
 
 /* The set in a capsule made by mesh_set, else NULL with a TypeError naming it (as the numpy
  * fallback raises for anything but its own sets; PyCapsule_GetPointer's is a ValueError). */
-static const MeshSet *set_of(PyObject *cap) {
+static MeshSet *set_of(PyObject *cap) {
     if (!PyCapsule_IsValid(cap, "robotspec.meshset")) {
         PyErr_SetString(PyExc_TypeError, "expected a mesh set (from mesh_set())");
         return NULL;
     }
     return PyCapsule_GetPointer(cap, "robotspec.meshset");
+}
+
+/*
+ * A scratch for one call that releases the GIL: a spare one of the set's, else a new one; NULL
+ * with MemoryError set. Taken and given back with the GIL held (the GIL is the pool's lock: this
+ * module declares no free-threading support, so a free-threaded CPython enables the GIL for it).
+ * Why a pool: a scratch is sized for the set's largest mesh and its stamps must start cleared,
+ * which cost a single query more than its proofs when made per call.
+ */
+static Scratch *scratch_take(MeshSet *s) {
+    if (s->n_spare > 0) return s->spare[--s->n_spare];
+    Scratch *st = calloc(1, sizeof(Scratch));
+    if (st == NULL || scratch_init(st, s->most_tri) != 0) {
+        free(st);
+        PyErr_NoMemory();
+        return NULL;
+    }
+    return st;
+}
+
+/* st back to the set's spares (GIL held); freed when there is no room to keep it. */
+static void scratch_give(MeshSet *s, Scratch *st) {
+    if (s->n_spare == s->cap_spare) {
+        ptrdiff_t cap = s->cap_spare > 0 ? 2 * s->cap_spare : 4;
+        Scratch **grown = realloc(s->spare, sizeof(Scratch *) * (size_t)cap);
+        if (grown == NULL) {
+            scratch_free(st);
+            free(st);
+            return;
+        }
+        s->spare = grown;
+        s->cap_spare = cap;
+    }
+    s->spare[s->n_spare++] = st;
 }
 
 /*
@@ -194,7 +233,7 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
     double eps;
     if (!PyArg_ParseTuple(args, "OOOOOOd", &cap, &pobj, &robj, &kobj, &g1obj, &g2obj, &eps))
         return NULL;
-    const MeshSet *s = set_of(cap);
+    MeshSet *s = set_of(cap);
     if (s == NULL) return NULL;
     if (!(eps >= 1e-9) || !isfinite(eps)) {
         /* At least a nanometre: the squared comparisons leave rounding no room below that. */
@@ -214,8 +253,7 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
     if (g1 != NULL)
         g2 = (PyArrayObject *)PyArray_FROMANY(g2obj, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
     PyArrayObject *out = NULL;
-    Scratch st;
-    memset(&st, 0, sizeof(Scratch));
+    Scratch *st = NULL;
     if (poses == NULL || rows == NULL || ks == NULL || g1 == NULL || g2 == NULL) goto done;
     npy_intp n = PyArray_DIM(poses, 0), ng = PyArray_DIM(poses, 1), nc = PyArray_DIM(rows, 0);
     npy_intp nq = PyArray_DIM(g1, 0);
@@ -236,9 +274,8 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
     npy_intp od[1] = {nc};
     out = (PyArrayObject *)PyArray_ZEROS(1, od, NPY_UINT8, 0);
     if (out == NULL) goto done;
-    if (scratch_init(&st, s->most_tri) != 0) {
+    if ((st = scratch_take(s)) == NULL) {
         Py_CLEAR(out);
-        PyErr_NoMemory();
         goto done;
     }
     const double *pv = PyArray_DATA(poses);
@@ -248,7 +285,7 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
     for (npy_intp c = 0; c < nc && !oom; c++) {
         const int64_t i = g1v[kv[c]], j = g2v[kv[c]];
         int res = candidate_apart(s, i, j, pv + (rv[c] * ng + i) * 16, pv + (rv[c] * ng + j) * 16,
-                                  eps, &st);
+                                  eps, st);
         if (res < 0) oom = 1;
         ov[c] = res > 0 ? (uint8_t)res : 0;
     }
@@ -258,7 +295,7 @@ static PyObject *py_apart(PyObject *self, PyObject *args) {
         PyErr_NoMemory();
     }
 done:
-    scratch_free(&st);
+    if (st != NULL) scratch_give(s, st);
     Py_XDECREF((PyObject *)poses);
     Py_XDECREF((PyObject *)rows);
     Py_XDECREF((PyObject *)ks);
@@ -309,7 +346,7 @@ static PyObject *py_apart_one(PyObject *self, PyObject *args) {
     Py_ssize_t row, i, j;
     double eps;
     if (!PyArg_ParseTuple(args, "OOnnnd", &cap, &pobj, &row, &i, &j, &eps)) return NULL;
-    const MeshSet *s = set_of(cap);
+    MeshSet *s = set_of(cap);
     if (s == NULL) return NULL;
     PyArrayObject *poses = geometry_poses(pobj, s, "apart_one");
     if (poses == NULL) return NULL;
@@ -328,6 +365,135 @@ static PyObject *py_apart_one(PyObject *self, PyObject *args) {
     return PyLong_FromLong(res);
 }
 
+/* ------------------------------------------------------------------------ the narrow walk */
+
+/* 1 when obj is a 1-D array the core reads in place as int64 (or uint8 when `byte`): its data in
+ * *data and length in *len; else 0 with a TypeError naming it. */
+static int flat_array(PyObject *obj, int byte, const char *what, void **data, npy_intp *len) {
+    PyArrayObject *a = (PyArrayObject *)obj;
+    if (!PyArray_Check(obj) || PyArray_TYPE(a) != (byte ? NPY_UINT8 : NPY_INT64) ||
+        PyArray_NDIM(a) != 1 || !PyArray_ISNOTSWAPPED(a) || !PyArray_ISALIGNED(a) ||
+        !PyArray_IS_C_CONTIGUOUS(a)) {
+        PyErr_Format(PyExc_TypeError, "walk: %s must be a C-contiguous 1-D %s numpy array", what,
+                     byte ? "uint8" : "int64");
+        return 0;
+    }
+    *data = PyArray_DATA(a);
+    *len = PyArray_DIM(a, 0);
+    return 1;
+}
+
+/* A new int64 array (n,) holding v[0 .. n). */
+static PyObject *int64_array(const int64_t *v, npy_intp n) {
+    PyArrayObject *a = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INT64);
+    if (a != NULL && n > 0) memcpy(PyArray_DATA(a), v, sizeof(int64_t) * (size_t)n);
+    return (PyObject *)a;
+}
+
+/*
+ * walk(set, poses (N, G, 4, 4), rows (K,), pairs (K,), g1 (Q,), g2 (Q,), owner (Q,), found (P,),
+ *      eps, mode) -> (hit rows (H,), hit body pairs (H,), open candidates (M,))
+ * The narrow phase of a block of broad-phase candidates (rows non-decreasing), in one call with
+ * the GIL released (see walk_rows): which (row, body pair)s are proven to collide, and which
+ * candidates (indices into rows/pairs, in order) coal must decide. mode 0: every colliding body
+ * pair; 1: a row ends at its first; 2: body pairs set in found (uint8, written) are skipped and
+ * set when proven. Arrays are numpy's, read in place (no conversion: the checker made them).
+ * Why: the narrow phase once ran in Python between C calls, holding the GIL, so two threads
+ * checking a batch took turns (issue 34).
+ */
+static PyObject *py_walk(PyObject *self, PyObject *args) {
+    PyObject *cap, *pobj, *robj, *kobj, *g1obj, *g2obj, *oobj, *fobj;
+    double eps;
+    int mode;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOdi", &cap, &pobj, &robj, &kobj, &g1obj, &g2obj, &oobj,
+                          &fobj, &eps, &mode))
+        return NULL;
+    MeshSet *s = set_of(cap);
+    if (s == NULL) return NULL;
+    PyArrayObject *poses = geometry_poses(pobj, s, "walk");
+    if (poses == NULL) return NULL;
+    npy_intp nc, nk, nq, nq2, nq3, np_;
+    void *rv, *kv, *g1v, *g2v, *ov, *fv;
+    if (!flat_array(robj, 0, "rows", &rv, &nc) || !flat_array(kobj, 0, "pairs", &kv, &nk) ||
+        !flat_array(g1obj, 0, "g1", &g1v, &nq) || !flat_array(g2obj, 0, "g2", &g2v, &nq2) ||
+        !flat_array(oobj, 0, "owner", &ov, &nq3) || !flat_array(fobj, 1, "found", &fv, &np_))
+        return NULL;
+    const int64_t *rows = rv, *ks = kv, *g1 = g1v, *g2 = g2v, *owner = ov;
+    uint8_t *found = fv;
+    if (!PyArray_ISWRITEABLE((PyArrayObject *)fobj)) {
+        PyErr_SetString(PyExc_ValueError, "walk: found must be writeable");
+        return NULL;
+    }
+    if (!(eps >= 1e-9) || !isfinite(eps)) {
+        PyErr_SetString(PyExc_ValueError, "eps must be finite and >= 1e-9");
+        return NULL;
+    }
+    if (mode < WALK_ALL || mode > WALK_DROP_FOUND) {
+        PyErr_SetString(PyExc_ValueError, "walk: mode must be 0, 1 or 2");
+        return NULL;
+    }
+    if (nk != nc || nq2 != nq || nq3 != nq) {
+        PyErr_SetString(PyExc_ValueError, "walk: arrays of the wrong shape");
+        return NULL;
+    }
+    const npy_intp n = PyArray_DIM(poses, 0), ng = s->n;
+    for (npy_intp q = 0; q < nq; q++) {
+        if (g1[q] < 0 || g1[q] >= ng || g2[q] < 0 || g2[q] >= ng || owner[q] < 0 ||
+            owner[q] >= np_) {
+            PyErr_SetString(PyExc_ValueError, "walk: a geometry pair is out of range");
+            return NULL;
+        }
+    }
+    for (npy_intp c = 0; c < nc; c++) {
+        if (rows[c] < 0 || rows[c] >= n || ks[c] < 0 || ks[c] >= nq ||
+            (c > 0 && rows[c] < rows[c - 1])) {
+            PyErr_SetString(PyExc_ValueError,
+                            "walk: a candidate is out of range or out of row order");
+            return NULL;
+        }
+    }
+    size_t room = (size_t)(nc > 0 ? nc : 1);
+    WalkIn in = {PyArray_DATA(poses), ng, rows, ks, nc, g1, g2, owner};
+    WalkOut out;
+    memset(&out, 0, sizeof(WalkOut));
+    out.hit_row = malloc(sizeof(int64_t) * room);
+    out.hit_pair = malloc(sizeof(int64_t) * room);
+    out.open = malloc(sizeof(int64_t) * room);
+    out.stamp = malloc(sizeof(int64_t) * (size_t)(np_ > 0 ? np_ : 1));
+    out.code = malloc(room);
+    PyObject *result = NULL;
+    Scratch *st = NULL;
+    if (!out.hit_row || !out.hit_pair || !out.open || !out.stamp || !out.code) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    if ((st = scratch_take(s)) == NULL) goto done;
+    for (npy_intp p = 0; p < np_; p++) out.stamp[p] = -1;
+    int failed;
+    Py_BEGIN_ALLOW_THREADS
+    failed = walk_rows(s, &in, found, eps, mode, st, &out);
+    Py_END_ALLOW_THREADS
+    scratch_give(s, st);
+    if (failed) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    PyObject *hr = int64_array(out.hit_row, out.n_hit);
+    PyObject *hp = hr == NULL ? NULL : int64_array(out.hit_pair, out.n_hit);
+    PyObject *op = hp == NULL ? NULL : int64_array(out.open, out.n_open);
+    if (op != NULL) result = PyTuple_Pack(3, hr, hp, op);
+    Py_XDECREF(hr);
+    Py_XDECREF(hp);
+    Py_XDECREF(op);
+done:
+    free(out.hit_row);
+    free(out.hit_pair);
+    free(out.open);
+    free(out.stamp);
+    free(out.code);
+    return result;
+}
+
 /* ------------------------------------------------------------------------ points on a mesh */
 
 /*
@@ -341,7 +507,7 @@ static PyObject *py_on_surface(PyObject *self, PyObject *args) {
     Py_ssize_t row, g;
     double tol;
     if (!PyArg_ParseTuple(args, "OOnnOd", &cap, &pobj, &row, &g, &xobj, &tol)) return NULL;
-    const MeshSet *s = set_of(cap);
+    MeshSet *s = set_of(cap);
     if (s == NULL) return NULL;
     PyArrayObject *poses = geometry_poses(pobj, s, "on_surface");
     if (poses == NULL) return NULL;
@@ -373,6 +539,7 @@ static PyMethodDef methods[] = {
     {"mesh_set", py_mesh_set, METH_VARARGS, "Box trees of the meshes of a checker."},
     {"apart", py_apart, METH_VARARGS, "Per candidate: 1 when its two meshes are proven apart."},
     {"apart_one", py_apart_one, METH_VARARGS, "Whether one candidate's meshes are proven apart."},
+    {"walk", py_walk, METH_VARARGS, "The narrow phase's proofs of a block: hits and what coal decides."},
     {"on_surface", py_on_surface, METH_VARARGS, "Whether a point lies on a geometry's mesh."},
     {NULL, NULL, 0, NULL},
 };

@@ -58,6 +58,11 @@ typedef struct {
     Tree **trees; /* one per geometry; NULL where the geometry is not a mesh */
     int32_t most_tri;
     Scratch *one; /* apart_one's scratch: used only with the GIL held, so never shared */
+    /* Scratches of finished calls, kept for the next (taken and given back by the glue with the
+     * GIL held, used without it): a call that releases the GIL owns its scratch while it runs,
+     * so threads never share one, and none pays for allocating and stamping it afresh. */
+    Scratch **spare;
+    ptrdiff_t n_spare, cap_spare;
 } MeshSet;
 
 /* ------------------------------------------------------------------------------ building */
@@ -516,6 +521,82 @@ static int candidate_apart(const MeshSet *s, int64_t i, int64_t j, const double 
         p[x] = pa[x] * d[0] + pa[4 + x] * d[1] + pa[8 + x] * d[2];
     }
     return meshes_apart(ta, tb, r, p, eps, st);
+}
+
+/* ------------------------------------------------------------------ the narrow phase's walk */
+
+/* What walk_rows does with a row's candidates: every colliding body pair, the first one only, or
+ * every body pair not yet found colliding in any row (found is read and written). */
+enum { WALK_ALL = 0, WALK_FIRST = 1, WALK_DROP_FOUND = 2 };
+
+/* The arrays of one walk: candidates (rows[c], ks[c]) grouped by row (rows non-decreasing), the
+ * geometry pairs (g1, g2) and their body pair (owner), geometry poses (ng per row, 4x4). */
+typedef struct {
+    const double *poses;
+    ptrdiff_t ng;
+    const int64_t *rows, *ks;
+    ptrdiff_t nc;
+    const int64_t *g1, *g2, *owner;
+} WalkIn;
+
+/* What a walk found: proven collisions (row, body pair) and the candidates left to coal
+ * (indices into the candidates, in order); stamp (per body pair, -1 at first) and code (per
+ * candidate) are working room. */
+typedef struct {
+    int64_t *hit_row, *hit_pair, *open, *stamp;
+    uint8_t *code;
+    ptrdiff_t n_hit, n_open;
+} WalkOut;
+
+/*
+ * Every row's candidates proven in order, without a Python step between them (so the caller can
+ * release the GIL for the whole block): a pair of meshes proven crossing is a collision of its
+ * body pair, one proven apart is dropped, and what is neither (no proof, or not two meshes) is
+ * left to coal, unless its body pair already collides in that row. WALK_FIRST ends a row at its
+ * first proven collision and leaves nothing of that row to coal (it collides whatever coal
+ * says). 0, or -1 when out of memory.
+ */
+static int walk_rows(const MeshSet *s, const WalkIn *in, uint8_t *found, double eps, int mode,
+                     Scratch *st, WalkOut *out) {
+    ptrdiff_t a = 0;
+    while (a < in->nc) {
+        const int64_t r = in->rows[a];
+        ptrdiff_t b = a;
+        while (b < in->nc && in->rows[b] == r) b++;
+        int row_done = 0;
+        for (ptrdiff_t c = a; c < b; c++) {
+            const int64_t k = in->ks[c], p = in->owner[k], i = in->g1[k], j = in->g2[k];
+            out->code[c] = 1; /* skipped, as if apart */
+            if (out->stamp[p] == r || (mode == WALK_DROP_FOUND && found[p])) continue;
+            int res = 0;
+            if (s->trees[i] != NULL && s->trees[j] != NULL) {
+                const double *pr = in->poses + r * in->ng * 16;
+                res = candidate_apart(s, i, j, pr + i * 16, pr + j * 16, eps, st);
+                if (res < 0) return -1;
+            }
+            out->code[c] = (uint8_t)res;
+            if (res != 2) continue;
+            out->stamp[p] = r;
+            out->hit_row[out->n_hit] = r;
+            out->hit_pair[out->n_hit] = p;
+            out->n_hit++;
+            if (mode == WALK_DROP_FOUND) found[p] = 1;
+            if (mode == WALK_FIRST) {
+                row_done = 1;
+                break;
+            }
+        }
+        if (!row_done) {
+            for (ptrdiff_t c = a; c < b; c++) {
+                if (out->code[c] != 0) continue;
+                const int64_t p = in->owner[in->ks[c]];
+                if (out->stamp[p] == r || (mode == WALK_DROP_FOUND && found[p])) continue;
+                out->open[out->n_open++] = c;
+            }
+        }
+        a = b;
+    }
+    return 0;
 }
 
 /* The point of triangle abc closest to p (Ericson, Real-Time Collision Detection, 5.1.5). */

@@ -35,7 +35,13 @@ from robotspec.collision.distances import (
     distance_rows,
     hull_functors,
 )
-from robotspec.collision.narrow import UNTRIED, block_hits, first_hits, prove_apart
+from robotspec.collision.narrow import (
+    WALK_ALL,
+    WALK_DROP_FOUND,
+    WALK_FIRST,
+    batch_proofs_for,
+    narrow_block,
+)
 from robotspec.collision.rules import CollisionRules, pair_key
 from robotspec.collision.shapes import GeometryModel, MeshLibrary, MissingMeshPolicy, import_coal
 from robotspec.collision.slices import checked_threads, run_in_slices
@@ -54,10 +60,6 @@ Point = tuple[float, float, float]
 
 #: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).
 _BLOCK = 512
-#: Samples from which an any-hit batch proves its mesh pairs in waves of C calls.
-_WAVES_FROM = 64
-#: Candidates of a block from which mesh proofs run in one C call rather than one by one.
-_BATCH_PROOFS = 64
 #: Room (m) beyond the margin by which a mesh pair must be proven apart before coal is skipped:
 #: coal's own collision test between triangles stops within about 1e-6 m, so a pair proven this far
 #: apart is one coal calls apart too, and the answers stay coal's.
@@ -267,21 +269,16 @@ class SelfCollisionChecker:
         if not len(c.pair_of):
             return hits
         geom_mask = None if pair_mask is None else pair_mask[c.pair_of].astype(np.uint8)
-        # An any-hit batch proves its mesh pairs in waves of C calls too (.narrow.first_hits):
-        # the one-by-one proofs hold the GIL, the C calls do not, so other threads (the batch's
-        # own, or a planner's) run meanwhile; on one thread the waves cost what the walk does.
-        # A few configurations keep the walk (numpy's fixed cost per wave would show).
-        batch_proofs = not first_only or threads > 1 or n >= _WAVES_FROM
+        mode = WALK_FIRST if first_only else WALK_DROP_FOUND if drop_found else WALK_ALL
+        batch_proofs = batch_proofs_for(n, mode, threads)
 
         if threads == 1:
-            self._scan_rows(c, qs, hits, margin, geom_mask, first_only, drop_found, batch_proofs)
+            self._scan_rows(c, qs, hits, margin, geom_mask, mode, batch_proofs)
             return hits
 
         def scan(lo: int, hi: int) -> None:
             mask = None if geom_mask is None else geom_mask.copy()  # drop_found narrows it
-            self._scan_rows(
-                c, qs[lo:hi], hits[lo:hi], margin, mask, first_only, drop_found, batch_proofs
-            )
+            self._scan_rows(c, qs[lo:hi], hits[lo:hi], margin, mask, mode, batch_proofs)
 
         run_in_slices(n, threads, scan)
         return hits
@@ -293,58 +290,58 @@ class SelfCollisionChecker:
         hits: Bools,
         margin: float,
         geom_mask: NDArray[np.uint8] | None,
-        first_only: bool,
-        drop_found: bool,
+        mode: int,
         batch_proofs: bool,
     ) -> None:
         """Set ``hits`` (n, P) for the samples ``qs`` (n, D) on this thread (see :meth:`_scan`).
 
-        ``batch_proofs``: the mesh proofs run in C calls over many candidates, without the GIL
-        (an any-hit query then goes in waves, :func:`.narrow.first_hits`), rather than one by
-        one as the loop reaches them.
+        Block by block: kinematics, broad phase and the narrow phase's proofs are one C call
+        each with the GIL released (:func:`.narrow.walk`); Python only joins them and asks coal
+        about what the proofs leave. ``batch_proofs``: see :func:`.narrow.narrow_block`.
         """
         scratch = self._scratch(c)
         req, _ = scratch.collision(margin)
-        found = [False] * len(self._pairs)
+        found = np.zeros(len(self._pairs), dtype=np.uint8)
         eps = margin + _APART_SLACK
         hit_rows: list[int] = []
         hit_pairs: list[int] = []
         for start in range(0, qs.shape[0], _BLOCK):
             block = qs[start : start + _BLOCK]
-            if drop_found and geom_mask is not None and start:
-                geom_mask &= ~np.asarray(found, dtype=np.bool_)[c.pair_of]
-            elif drop_found and start:
-                geom_mask = (~np.asarray(found, dtype=np.bool_)[c.pair_of]).astype(np.uint8)
+            if mode == WALK_DROP_FOUND and start:
+                left = (found == 0)[c.pair_of]
+                geom_mask = left.astype(np.uint8) if geom_mask is None else geom_mask & left
             rows, ks, poses = self._broad(c, block, margin, geom_mask)
-            if first_only and batch_proofs:
-                rs, ps = first_hits(c, scratch, req, poses, rows, ks, eps)
-            else:
-                cand = (rows.tolist(), ks.tolist(), [UNTRIED] * len(ks))
-                if c.meshes is not None and batch_proofs and len(ks) >= _BATCH_PROOFS:
-                    # Every candidate is tested, so the mesh proofs run in one C call (no Python
-                    # per candidate); a few candidates are proven one by one (numpy's fixed cost
-                    # would exceed the calls saved).
-                    cand = prove_apart(c, poses, cand[0], cand[1], eps)
-                rs, ps = block_hits(
-                    c,
-                    scratch,
-                    req,
-                    poses,
-                    cand,
-                    found,
-                    eps,
-                    first_only=first_only,
-                    drop_found=drop_found,
-                )
+            rs, ps = narrow_block(c, scratch, req, poses, rows, ks, found, eps, mode, batch_proofs)
             hit_rows += [start + r for r in rs] if start else rs
             hit_pairs += ps
         hits[hit_rows, hit_pairs] = True
 
     def in_collision(self, q: object, *, margin: float = 0.0) -> bool:
-        """Whether any checked pair collides (or comes closer than ``margin``) at ``q``."""
-        return bool(
-            self._scan(self._one(q, "in_collision_batch"), margin=margin, first_only=True).any()
-        )
+        """Whether any checked pair collides (or comes closer than ``margin``) at ``q``.
+
+        The single query's own path (issue 34: it is called thousands of times a second): the
+        configuration and margin are checked as every query checks them, then forward
+        kinematics, the broad phase and (only when boxes meet) the narrow phase's walk, with no
+        batch bookkeeping in between.
+        """
+        if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (self._n_dof,):
+            one: F64 = q  # values are checked by the kinematics core (NaN and inf refused)
+        else:
+            one = self._one(q, "in_collision_batch")[0]
+        if type(margin) is not float or not 0.0 <= margin < math.inf:
+            margin = real_number(margin, "margin", _config_error, minimum=0.0)
+        c = self._compiled
+        if c is None:
+            c = self._build()
+        rows, ks, poses = kincore.core().broad(c.broad, self.kinematics.forward(one), margin, None)
+        if not len(ks):
+            return False
+        scratch = self._scratch(c)
+        req, _ = scratch.collision(margin)
+        found = np.zeros(len(self._pairs), dtype=np.uint8)
+        eps = margin + _APART_SLACK
+        rs, _ = narrow_block(c, scratch, req, poses, rows, ks, found, eps, WALK_FIRST, False)
+        return bool(rs)
 
     def colliding_pairs(self, q: object, *, margin: float = 0.0) -> tuple[tuple[str, str], ...]:
         """The checked pairs that collide (or are closer than ``margin``) at ``q``."""

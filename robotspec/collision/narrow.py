@@ -4,7 +4,14 @@ A candidate is a (sample row, geometry pair) whose bounding boxes come within th
 meshes are first proven apart or crossing by the C mesh core (tens of times cheaper than coal
 when they nearly touch); coal's ``ComputeCollision`` decides every candidate the proofs leave.
 
-Two ways through the candidates, with the same answers:
+With the C mesh core, :func:`walk` proves a whole block in one C call without the GIL (every
+row's candidates in order, each row stopped at its first proven crossing when only "does it
+collide" is asked) and leaves coal the few candidates it cannot prove. Why: on the PR2 coal is
+asked about one candidate in a thousand, so the GIL is held only for a few Python steps per
+block, and threads checking a batch run side by side instead of taking turns (issue 34).
+
+Without it (the fallback core proves nothing) two ways walk the candidates, with the same
+answers (:func:`narrow_block` picks one):
 
 - :func:`block_hits` walks them in order in Python (every colliding pair, or the first of each
   sample), proving mesh pairs one by one as it reaches them unless they were proven in one call
@@ -21,15 +28,37 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from robotspec.arrays import F64, I64
 from robotspec.collision import meshcore
 from robotspec.collision.compiled import Compiled, Scratch
 
-__all__ = ["APART", "CROSS", "UNKNOWN", "UNTRIED", "block_hits", "first_hits", "prove_apart"]
+__all__ = [
+    "APART",
+    "CROSS",
+    "UNKNOWN",
+    "UNTRIED",
+    "WALK_ALL",
+    "WALK_DROP_FOUND",
+    "WALK_FIRST",
+    "batch_proofs_for",
+    "block_hits",
+    "first_hits",
+    "narrow_block",
+    "prove_apart",
+    "walk",
+]
 
 #: What the mesh core proved of a candidate (its codes), and "not asked".
 UNKNOWN, APART, CROSS, UNTRIED = 0, 1, 2, -1
+#: What a walk reports per row (the mesh core's modes): every colliding body pair; the first one
+#: only; every body pair not found colliding before (in any row: ``found`` is read and written).
+WALK_ALL, WALK_FIRST, WALK_DROP_FOUND = 0, 1, 2
+#: Fewest samples of an any-hit block whose fallback proofs go in waves (see narrow_block).
+_WAVES_FROM = 64
+#: Candidates of a block from which the fallback's mesh proofs run in one call, not one by one.
+_BATCH_PROOFS = 64
 #: Fewest candidates (counted before dropping the samples already seen colliding) a wave of
 #: :func:`first_hits` takes, several positions at once if need be.
 _WAVE_MIN = 64
@@ -186,3 +215,91 @@ def first_hits(
         hit_rows += rs
         hit_pairs += ps
     return hit_rows, hit_pairs
+
+
+def walk(
+    c: Compiled,
+    scratch: Scratch,
+    req: Any,
+    poses: F64,
+    rows: I64,
+    ks: I64,
+    found: NDArray[np.uint8],
+    eps: float,
+    mode: int,
+) -> Hits | None:
+    """The (row, body pair)s that collide among a block's candidates, proofs in one C call.
+
+    ``rows`` (non-decreasing) and ``ks`` are the broad phase's candidates, ``found`` (P,) the
+    body pairs found colliding so far (updated under ``WALK_DROP_FOUND``). Coal decides what the
+    proofs leave, row by row in order. None when the mesh core has no walk (the fallback) or the
+    checker no mesh: :func:`narrow_block` answers then.
+    """
+    fn = getattr(meshcore.core(), "walk", None)
+    if fn is None or c.meshes is None:
+        return None
+    hr, hp, left = fn(
+        c.meshes, poses, rows, ks, c.pair_geom1, c.pair_geom2, c.pair_of, found, eps, mode
+    )
+    hit_rows: list[int] = hr.tolist()
+    hit_pairs: list[int] = hp.tolist()
+    if len(left):
+        drop = mode == WALK_DROP_FOUND
+        seen = found.astype(np.bool_).tolist() if drop else None
+        cand = (rows[left].tolist(), ks[left].tolist(), [UNKNOWN] * len(left))
+        rs, ps = block_hits(
+            c, scratch, req, poses, cand, seen, eps, first_only=mode == WALK_FIRST, drop_found=drop
+        )
+        if drop:
+            found[ps] = 1
+        hit_rows += rs
+        hit_pairs += ps
+    return hit_rows, hit_pairs
+
+
+def narrow_block(
+    c: Compiled,
+    scratch: Scratch,
+    req: Any,
+    poses: F64,
+    rows: I64,
+    ks: I64,
+    found: NDArray[np.uint8],
+    eps: float,
+    mode: int,
+    batch_proofs: bool,
+) -> Hits:
+    """As :func:`walk`, for any mesh core: the walk where there is one, else Python's ways.
+
+    ``batch_proofs`` (Python's ways only): the mesh proofs run in calls over many candidates
+    (an any-hit query then goes in waves, :func:`first_hits`) rather than one by one.
+    """
+    walked = walk(c, scratch, req, poses, rows, ks, found, eps, mode)
+    if walked is not None:
+        return walked
+    if mode == WALK_FIRST and batch_proofs:
+        return first_hits(c, scratch, req, poses, rows, ks, eps)
+    drop = mode == WALK_DROP_FOUND
+    seen = found.astype(np.bool_).tolist()
+    cand = (rows.tolist(), ks.tolist(), [UNTRIED] * len(ks))
+    if c.meshes is not None and batch_proofs and len(ks) >= _BATCH_PROOFS:
+        # Every candidate is tested, so the mesh proofs run in one call (no Python per
+        # candidate); a few candidates are proven one by one (numpy's fixed cost would exceed
+        # the calls saved).
+        cand = prove_apart(c, poses, cand[0], cand[1], eps)
+    rs, ps = block_hits(
+        c, scratch, req, poses, cand, seen, eps, first_only=mode == WALK_FIRST, drop_found=drop
+    )
+    if drop:
+        found[ps] = 1
+    return rs, ps
+
+
+def batch_proofs_for(n: int, mode: int, threads: int) -> bool:
+    """Whether the fallback's proofs of ``n`` samples run in calls over many candidates.
+
+    An any-hit batch proves in waves of calls too (:func:`first_hits`): their numpy steps cost
+    what the one-by-one walk does on one thread, and let other threads run between them; a few
+    configurations keep the walk (numpy's fixed cost per wave would show).
+    """
+    return mode != WALK_FIRST or threads > 1 or n >= _WAVES_FROM

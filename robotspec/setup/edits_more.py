@@ -254,5 +254,6 @@ class MoreEdits:
                 del d.accepted[mine[0]]
 
             return self.edit(change)
-        edit = Edit(DELETE, ("accept_warnings", Entry(at, says)))
+        last = len(self.accepted_entries()) == 1  # the list goes with its last entry
+        edit = Edit(DELETE, ("accept_warnings",) if last else ("accept_warnings", Entry(at, says)))
         return self.edit(lambda d: None, extras=lambda e: e.with_edit(edit))

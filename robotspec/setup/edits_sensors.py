@@ -3,11 +3,13 @@
 Why its own change: a camera on a wrist moves with the arm, and the spec says so by listing the
 sensor under that chain's ``sensors:`` (or the neck's); validate warns of a sensor no chain or
 neck carries. A sensor is carried by one part at most, so choosing a carrier takes it off any
-other; the torso carries none (the spec has no ``sensors:`` there).
+other; the torso carries none (the spec has no ``sensors:`` there). A camera's viewing axis is
+here too: where it looks is what its chain carries it for.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -77,5 +79,26 @@ class SensorEdits:
                     holder.sensors.remove(name)
             if target is not None and name not in target.sensors:
                 target.sensors.append(name)
+
+        return self.edit(change)
+
+    def set_camera_axis(self, part: str, axis: tuple[float, float, float]) -> Validation:
+        """The axis a camera looks along in its body's frame (its ``forward_facing_axis``).
+
+        +z is an optical frame's (REP 103, written as no axis), +x a body frame's; any other
+        unit vector is written as it is (a camera mounted looking sideways, or down).
+        """
+        if len(axis) != 3 or not all(math.isfinite(v) for v in axis):
+            raise SetupError(f"an axis is three finite numbers, not {list(axis)}", kind="value")
+        if abs(math.sqrt(sum(v * v for v in axis)) - 1.0) > 1e-6:
+            raise SetupError(f"the axis is a unit vector, not {list(axis)}", kind="value")
+        a = (float(axis[0]), float(axis[1]), float(axis[2]))
+
+        def change(d: Draft) -> None:
+            c = _camera(d, part)
+            c.optical, c.axis, c.looks_along_z = a == (0.0, 0.0, 1.0), None, False
+            if a not in ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0)):
+                c.axis = a
+            c.decide.clear()
 
         return self.edit(change)

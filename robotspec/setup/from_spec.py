@@ -29,8 +29,7 @@ from robotspec.spec.load import LoadedSpec
 __all__ = ["ReadSpec", "draft_of_spec"]
 
 _MARK = "# DECIDE:"
-#: The camera axes a draft holds (optical +z, body +x); a camera facing another way is kept as
-#: written, like a generic sensor.
+#: The camera axes a draft writes without ``axis`` (optical +z, body +x); another is its axis.
 _AXES = (None, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
 _FROM = "# from "
 
@@ -107,8 +106,8 @@ def draft_of_spec(
 ) -> ReadSpec:
     """The draft a spec amounts to, with the robot's tree and what else it was read with.
 
-    What a draft cannot hold (a generic sensor, a camera facing another axis, a frame's
-    rotation, ``parts:``, ``extends:``) is left out of the draft: the saved text keeps it as
+    What a draft cannot hold (a generic sensor, a frame's rotation, ``parts:``, ``extends:``)
+    is left out of the draft: the saved text keeps it as
     written (:mod:`robotspec.setup.round_trip`). A composed robot's parts are its tree and its
     parts' chains, hands and sensors, each still written in its own file.
     """
@@ -232,8 +231,9 @@ def draft_of_spec(
             dm.fingers = {k: DraftFinger(f.root, f.tip) for k, f in m.fingers.items()}
         draft.manipulators.append(dm)
     for name, s in spec.sensors.items():
-        if s.type != "camera" or s.forward_facing_axis not in _AXES:
-            continue  # kept as written: the page does not edit it (the text keeps it)
+        if s.type != "camera":
+            continue  # a generic sensor: edited as text (setup/edits_more.py), kept as written
+        axis = s.forward_facing_axis
         fov = s.field_of_view
         angles = None if fov is None else (fov.horizontal, fov.vertical)
         placeholder = angles == PLACEHOLDER_FOV and marks.decide(("sensors", name, "field_of_view"))
@@ -241,7 +241,8 @@ def draft_of_spec(
             DraftCamera(
                 name=name,
                 body=s.body,
-                optical=s.forward_facing_axis != (1.0, 0.0, 0.0),
+                optical=axis in (None, (0.0, 0.0, 1.0)),
+                axis=None if axis in _AXES else axis,
                 decide=marks.decide(("sensors", name)),
                 preset=s.preset,
                 field_of_view=None if placeholder else angles,

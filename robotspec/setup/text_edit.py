@@ -279,10 +279,12 @@ class _Text:
         parent = entry.parent
         start, end = parent.start_mark.index, parent.end_mark.index
         if isinstance(parent, yaml.SequenceNode):  # a list item: its lines, or the list anew
-            if parent.flow_style or len(parent.value) == 1:
+            if parent.flow_style:
                 items = list(yaml.safe_load(self.text[start:end]) or [])
                 del items[int(path[-1])]
                 self.set(path[:-1], items)
+            elif len(parent.value) == 1:
+                self.set(path[:-1], [])
             else:
                 self._lines(entry.node.start_mark.line, _last_line(entry.node), [])
             return

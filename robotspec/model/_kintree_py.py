@@ -5,21 +5,25 @@ the collision checker's poses without the C core), laid out for numpy rather tha
 :mod:`robotspec.model._kincore_py` re-exports its entry points (``tree``, ``tree_size``, ``fk``,
 ``fk_batch``), whose arguments and errors are the C core's (see ``_kincore.pyi``).
 
-How it stays fast: a row sets ``child = parent @ origin @ motion(v)``. Its motion is Rodrigues'
-``I + s K + t (u u^T - I)`` (revolute: s = sin v, t = 1 - cos v) or ``I + v [0 | u]``
-(prismatic), so ``origin @ motion`` is ``W0 + s W1 + t W2`` with three constant 4x4 matrices per
-row, made once when the program is built. The rows are grouped by depth; for one depth, the
-parents of every sample are multiplied by the rows' stacked ``[W0 W1 W2]`` in ONE matrix product
-(samples and pose rows side by side in the columns, so BLAS sees wide matrices), then combined
-with the samples' ``s`` and ``t`` in three whole-array operations. A fixed row (most of a
-humanoid's or the PR2's: sensor frames, links welded on) needs ``W0`` only: a depth's fixed rows
-are one product written straight into their slots. A pose is stored transposed,
-(column, row, sample), so every elementwise operation runs along the samples. Slots are
-renumbered at build time so that each depth writes one contiguous block: no scatter.
+How it stays fast: only moving rows cost per sample. The program is evaluated symbolically once,
+in the C core's row order: a slot's pose is some *node*'s pose times a constant, so a fixed row
+(51 of the PR2's 84: sensor frames, links welded on) only multiplies constants, and a chain of
+fixed rows and a moving row's origin fold into that moving row's weights. Each moving row is a
+node: ``node = parent node @ W @ motion(v)``. A motion about or along a frame axis (almost
+every joint) is stored with its columns permuted so that the axis is the stored z (the
+permutation, exact, goes into the constants after it): then a turn mixes stored columns 0 and 1,
+which numpy sees as ONE complex multiplication by ``exp(-iv)`` over the whole group, and a slide
+adds ``v`` times column 2 to column 3. Any other axis keeps the Rodrigues terms
+``W0 + sin(v) W1 + (1 - cos v) W2``. Nodes are grouped by depth and kind; one group is one
+stacked matrix product (``(k, 4n, 4) @ (k, 4, 4)``, samples and rows as the long side, so BLAS
+sees tall matrices) written in place and one motion operation. The bodies are then one gather
+and one stacked product by their constants, and one copy into the result's layout.
 
+Poses are stored sample-major per node, (node, sample, 4, 4), so the last copy moves whole
+128-byte poses; a batch runs in steps of ``_CHUNK`` samples whose buffers stay in the caches.
 One configuration is a batch of one (the same operations), so ``fk(q)`` and ``fk_batch(Q)[i]``
-agree bit for bit; against the C core they agree to rounding (about 1e-15 on the PR2 and
-Talos, see tests/test_fallback_batch.py), the products being summed in another order.
+agree bit for bit; against the C core they agree to rounding (about 1e-15 on the PR2 and Talos,
+see tests/test_fallback_batch.py), the products being summed in another order.
 """
 
 from __future__ import annotations
@@ -36,9 +40,12 @@ KIND_FIXED = 0
 KIND_REVOLUTE = 1
 KIND_PRISMATIC = 2
 
-#: Samples per step of a batch: the per-depth products of a step stay in the CPU's caches
-#: (measured on the PR2: 512 to 2,000 samples are equally fast, 128 is a third slower).
-_CHUNK = 1024
+#: How a node moves: about its stored z axis (a frame axis), along it, or by Rodrigues' terms.
+TURN, SLIDE, GENERAL = 0, 1, 2
+
+#: Samples per step of a batch: the step's buffers (node poses, gathered and final body poses:
+#: about 3 MB on the PR2) stay in the caches.
+_CHUNK = 256
 
 
 def copy_i64(obj: object, want: int, what: str) -> I64:
@@ -86,33 +93,39 @@ def motion_terms(kind: I64, axis: F64) -> tuple[F64, F64]:
     return m1, m2
 
 
-#: One depth of a tree program: its moving rows (rows, slots read, weights (k, 12, 4), slots
-#: written) and its fixed rows (slots read, W0^T (k, 4, 4), slots written), either None.
-Step = tuple[tuple[slice, Any, F64, slice] | None, tuple[Any, F64, slice] | None]
+@dataclass(frozen=True)
+class Group:
+    """The nodes of one depth that move one way: one matrix product and one motion for all."""
+
+    how: int  # TURN, SLIDE or GENERAL
+    nodes: slice  # the node slots written
+    reads: slice | I64  # their parents' node slots (a slice when consecutive: a view)
+    weights: F64  # (k, 4, 4); GENERAL: (k, 4, 12), [W0 W1 W2]
+    motion: slice  # their rows of the motion values (Tree.dof)
+    turning: Any  # GENERAL only: (k, 1, 1, 1) whether each turns (else it slides)
 
 
 @dataclass(frozen=True)
 class Tree:
-    """A tree program (see ``_kincore.c``), rearranged for numpy.
+    """A tree program (see ``_kincore.c``), rearranged for numpy (module docstring).
 
-    Rows are sorted by depth (``levels``: (first, end) per depth); row k writes slot k + 1 (slot
-    0 is the root), ``parent`` is the renumbered slot it reads, ``outputs`` the slot of each
-    returned body. ``weights`` (R, 12, 4) is ``[W0 W1 W2]^T`` per row (module docstring).
+    Node 0 is the root (the identity); ``groups`` compute the others, in depth order. Motion
+    rows (``dof``, ``mul``, ``off``: value ``q[dof] * mul + off``) are the turns first (their
+    value is minus the C core's angle), then the slides, then the general motions. Body ``b`` is
+    node ``out_node[b]`` times ``out_pose[b]``.
     """
 
     n_slots: int
     n_out: int
     n_dof: int
-    parent: I64
-    outputs: I64
-    dof: I64  # the DOF each row reads; n_dof (a row of zeros) for a fixed row
+    n_nodes: int
+    dof: I64
     mul: F64
     off: F64
-    weights: F64
-    revolute: I64  # rows that turn
-    prismatic: I64  # rows that slide
-    levels: tuple[tuple[int, int], ...]
-    steps: tuple[Step, ...]  # per depth: (rows, reads, weights, writes) moving, fixed
+    n_turn: int
+    groups: tuple[Group, ...]
+    out_node: I64
+    out_pose: F64
 
 
 def tree(
@@ -162,78 +175,94 @@ def tree(
         depth[ch] = row_depth[r] = depth[pr] + 1
     if (depth[1:n_out] < 0).any():
         raise ValueError("tree program leaves a body's pose unset")
-    return _arranged(n_slots, n_out, n_dof, p, c, k, d, o, a, m, f, row_depth)
+    return _program(n_slots, n_out, n_dof, (p, c, k, d, o, a, m, f), row_depth)
 
 
-def _arranged(
-    n_slots: int,
-    n_out: int,
-    n_dof: int,
-    p: I64,
-    c: I64,
-    k: I64,
-    d: I64,
-    o: F64,
-    a: F64,
-    m: F64,
-    f: F64,
-    row_depth: I64,
-) -> Tree:
-    """The checked rows sorted by depth, slots renumbered, each row's weights made."""
-    # Within a depth, the moving rows first: the fixed ones need one product and no motion
-    # (unless a slot is written twice, where C's row order decides which write stays).
-    fixed = k == KIND_FIXED
-    unique = len(np.unique(c)) == len(c)
-    order = np.lexsort((fixed, row_depth)) if unique else np.argsort(row_depth, kind="stable")
-    ends = np.searchsorted(row_depth[order], np.arange(1, int(row_depth.max(initial=0)) + 2))
-    levels = tuple((int(lo), int(hi)) for lo, hi in zip(ends[:-1], ends[1:], strict=True))
-    p, c, k = p[order], c[order], k[order]
-    o, a, m, f = o[order], a[order], m[order], f[order]
-    # Rows in depth order: a row's parent slot is final when the row runs (C's row order
-    # within a depth is kept, so a slot written twice ends as in C).
-    last = np.zeros(n_slots, dtype=np.int64)
-    parent = np.empty(len(c), dtype=np.int64)
-    for r in range(len(c)):
-        parent[r] = last[p[r]]
-        last[c[r]] = r + 1
-    m1, m2 = motion_terms(k, a)
-    weights = np.ascontiguousarray(np.concatenate([o, o @ m1, o @ m2], axis=2).transpose(0, 2, 1))
-    steps = tuple(_step(lo, hi, parent, weights, k[lo:hi] == KIND_FIXED) for lo, hi in levels)
+def _frame_axis(u: F64) -> tuple[int, float] | None:
+    """(k, sign) when ``u`` is +-e_k exactly (the C core's ``motion_code`` test), else None."""
+    for k in range(3):
+        if u[k] in (1.0, -1.0) and u[(k + 1) % 3] == 0.0 and u[(k + 2) % 3] == 0.0:
+            return k, float(u[k])
+    return None
+
+
+def _program(n_slots: int, n_out: int, n_dof: int, rows: tuple[Any, ...], row_depth: I64) -> Tree:
+    """The checked rows, evaluated symbolically in the C core's order, as groups of nodes."""
+    p, c, k, d, o, a, m, f = rows
+    o = o.copy()
+    o[:, 3] = (0.0, 0.0, 0.0, 1.0)  # the C core reads an origin's three first rows only
+    on_node = np.zeros(n_slots, dtype=np.int64)  # slot = node pose @ times[slot]
+    times = np.tile(np.eye(4), (n_slots, 1, 1))
+    # per node: parent, depth, how, weights, dof, mul, off, turns
+    nodes: list[tuple[int, int, int, F64, int, float, float, bool]] = []
+    depth = [0]
+    for r in range(len(p)):
+        parent, lead = int(on_node[p[r]]), times[p[r]] @ o[r]
+        if k[r] == KIND_FIXED:
+            on_node[c[r]], times[c[r]] = parent, lead
+            continue
+        frame = _frame_axis(a[r])
+        if frame is None:
+            m1, m2 = motion_terms(k[r : r + 1], a[r : r + 1])
+            w = np.concatenate([lead, lead @ m1[0], lead @ m2[0]], axis=1)
+            how, mul, off, back = GENERAL, m[r], f[r], np.eye(4)
+        else:
+            ax, sign = frame
+            perm = np.eye(4)[:, [(ax + 1) % 3, (ax + 2) % 3, ax, 3]]  # stored = body @ perm
+            w, back = lead @ perm, perm.T
+            turn = k[r] == KIND_REVOLUTE
+            s = -sign if turn else sign  # a turn's value is minus its angle: exp(-i angle)
+            how, mul, off = (TURN if turn else SLIDE), s * m[r], s * f[r]
+        nodes.append(
+            (parent, depth[parent] + 1, how, w, int(d[r]), mul, off, k[r] == KIND_REVOLUTE)
+        )
+        depth.append(depth[parent] + 1)
+        on_node[c[r]], times[c[r]] = len(nodes), back
+    # Nodes sorted by (depth, how): each group one block of node slots and of motion rows.
+    order = sorted(range(len(nodes)), key=lambda i: (nodes[i][1], nodes[i][2]))
+    new_id = np.zeros(len(nodes) + 1, dtype=np.int64)
+    new_id[np.asarray(order, dtype=np.int64) + 1] = np.arange(1, len(nodes) + 1)
+    by_how = [[i for i in order if nodes[i][2] == h] for h in (TURN, SLIDE, GENERAL)]
+    motion_rows = by_how[0] + by_how[1] + by_how[2]
+    row_of = {i: r for r, i in enumerate(motion_rows)}
+    groups: list[Group] = []
+    lo = 0
+    while lo < len(order):
+        hi = lo
+        key = nodes[order[lo]][1:3]
+        while hi < len(order) and nodes[order[hi]][1:3] == key:
+            hi += 1
+        members = order[lo:hi]
+        how = key[1]
+        turning = np.array([nodes[i][7] for i in members])[:, None, None, None]
+        groups.append(
+            Group(
+                how,
+                slice(lo + 1, hi + 1),
+                _reads(new_id[[nodes[i][0] for i in members]]),
+                np.ascontiguousarray(np.stack([nodes[i][3] for i in members])),
+                slice(row_of[members[0]], row_of[members[0]] + len(members)),
+                turning if how == GENERAL else None,
+            )
+        )
+        lo = hi
     return Tree(
         n_slots,
         n_out,
         n_dof,
-        parent,
-        last[:n_out].copy(),
-        np.where(k == KIND_FIXED, n_dof, d[order]),
-        m,
-        f,
-        weights,
-        np.flatnonzero(k == KIND_REVOLUTE),
-        np.flatnonzero(k == KIND_PRISMATIC),
-        levels,
-        steps,
+        len(nodes) + 1,
+        np.array([nodes[i][4] for i in motion_rows], dtype=np.int64),
+        np.array([nodes[i][5] for i in motion_rows], dtype=np.float64),
+        np.array([nodes[i][6] for i in motion_rows], dtype=np.float64),
+        len(by_how[0]),
+        tuple(groups),
+        new_id[on_node[:n_out]],
+        np.ascontiguousarray(times[:n_out]),
     )
 
 
-def _step(lo: int, hi: int, parent: I64, weights: F64, fixed: Any) -> Step:
-    """One depth's work: its moving rows (all three terms) and its fixed ones (W0 only)."""
-    n_move = int((~fixed).sum())
-    if not fixed[n_move:].all():  # not sorted moving-first (see _arranged): all run as moving
-        n_move = hi - lo
-    mid = lo + n_move
-    move = None
-    if mid > lo:
-        move = (slice(lo, mid), _reads(parent[lo:mid]), weights[lo:mid], slice(lo + 1, mid + 1))
-    fix = None
-    if hi > mid:
-        w0 = np.ascontiguousarray(weights[mid:hi, :4])
-        fix = (_reads(parent[mid:hi]), w0, slice(mid + 1, hi + 1))
-    return move, fix
-
-
 def _reads(parents: I64) -> slice | I64:
-    """The slots one depth reads: a slice when they are consecutive (a view, not a copy)."""
+    """The node slots a group reads: a slice when they are consecutive (a view, not a copy)."""
     lo = int(parents[0])
     if (parents == np.arange(lo, lo + len(parents))).all():
         return slice(lo, lo + len(parents))
@@ -250,42 +279,53 @@ def tree_size(tree: object) -> tuple[int, int]:
     return t.n_out, t.n_dof
 
 
-def _run(t: Tree, q: F64, out: F64) -> None:
-    """Every output pose of the samples of ``q`` (N, D) into ``out`` (N, B, 4, 4)."""
-    n, rows = q.shape[0], len(t.mul)
-    qt = np.zeros((t.n_dof + 1, n))
-    qt[: t.n_dof] = q.T
-    v = qt[t.dof] * t.mul[:, None] + t.off[:, None]  # (R, N): each row's motion value
-    ab = np.zeros((rows, 2, n))  # per row and sample: a (sin v, or v sliding), b (1 - cos v)
-    turn = v[t.revolute]
-    ab[t.revolute, 0] = np.sin(turn)
-    ab[t.revolute, 1] = 1.0 - np.cos(turn)
-    ab[t.prismatic, 0] = v[t.prismatic]
-    ab5 = ab[:, :, None, None, :]
-    slots = np.empty((rows + 1, 4, 3, n))  # slot[column, row, sample]
-    slots[0] = np.eye(4)[:, :3, None]
-    flat = slots.reshape(rows + 1, 4, 3 * n)
-    for move, fix in t.steps:
-        if move is not None:
-            rows_of, reads, weights, writes = move
-            x = np.matmul(weights, flat[reads]).reshape(-1, 3, 4, 3, n)  # W0, W1, W2 terms
-            moved = x[:, 1:]
-            moved *= ab5[rows_of]  # a W1 and b W2 at once
-            dst = slots[writes]
-            np.add(x[:, 0], moved[:, 0], out=dst)
-            dst += moved[:, 1]
-        if fix is not None:
-            reads, w0, writes = fix
-            np.matmul(w0, flat[reads], out=flat[writes])
-    out[:, :, :3, :] = slots[t.outputs].transpose(3, 0, 2, 1)
-    out[:, :, 3, :] = (0.0, 0.0, 0.0, 1.0)
+def _buffers(t: Tree, n: int) -> tuple[F64, F64, F64]:
+    """A step's node poses (root set to the identity), gathered and final body poses."""
+    nodes = np.empty((t.n_nodes, n, 4, 4))
+    nodes[0] = np.eye(4)
+    return nodes, np.empty((t.n_out, n, 4, 4)), np.empty((t.n_out, n, 4, 4))
+
+
+def _run(t: Tree, q: F64, out: F64, bufs: tuple[F64, F64, F64]) -> None:
+    """Every output pose of the samples of ``q`` (n, D) into ``out`` (n, B, 4, 4)."""
+    n = q.shape[0]
+    nodes, gathered, bodies = bufs
+    v = np.take(q.T, t.dof, axis=0)  # (motion rows, n)
+    v *= t.mul[:, None]
+    v += t.off[:, None]
+    turns = np.empty((t.n_turn, n), dtype=np.complex128)  # exp(-i angle) of every turn
+    np.cos(v[: t.n_turn], out=turns.real)
+    np.sin(v[: t.n_turn], out=turns.imag)
+    for g in t.groups:
+        k = g.nodes.stop - g.nodes.start
+        src = nodes[g.reads] if isinstance(g.reads, slice) else np.take(nodes, g.reads, axis=0)
+        dst = nodes[g.nodes]
+        if g.how == GENERAL:
+            x = np.matmul(src.reshape(k, 4 * n, 4), g.weights).reshape(k, n, 4, 3, 4)
+            val = v[g.motion][:, :, None, None]
+            first = np.where(g.turning, np.sin(val), val)
+            second = np.where(g.turning, 1.0 - np.cos(val), 0.0)
+            np.add(x[..., 0, :], x[..., 1, :] * first, out=dst)
+            dst += x[..., 2, :] * second
+            continue
+        np.matmul(src.reshape(k, 4 * n, 4), g.weights, out=dst.reshape(k, 4 * n, 4))
+        if g.how == TURN:  # stored columns 0 and 1 as one complex number, turned at once
+            cols = dst.view(np.complex128)[..., 0]
+            cols *= turns[g.motion][:, :, None]
+        else:  # a slide along stored z: column 3 += v column 2
+            dst[..., 3] += dst[..., 2] * v[g.motion][:, :, None]
+    np.take(nodes, t.out_node, axis=0, out=gathered, mode="clip")
+    np.matmul(
+        gathered.reshape(t.n_out, 4 * n, 4), t.out_pose, out=bodies.reshape(t.n_out, 4 * n, 4)
+    )
+    out[...] = bodies.transpose(1, 0, 2, 3)
 
 
 def fk(tree: object, q: object) -> F64:
     t = _tree_of(tree)
     qa = config(q, 1, t.n_dof)
     poses: F64 = np.empty((1, t.n_out, 4, 4))
-    _run(t, qa[None, :], poses)  # a batch of one: fk_batch's operations, so its bits
+    _run(t, qa[None, :], poses, _buffers(t, 1))  # a batch of one: fk_batch's operations
     pose: F64 = poses[0]
     return pose
 
@@ -301,8 +341,11 @@ def fk_batch(tree: object, q: object, out: Any = None, stream: bool = False) -> 
         out = np.empty(shape)
     else:
         check_out(out, shape)
+    bufs = _buffers(t, min(n, _CHUNK))  # one set for every full step, reused
     for lo in range(0, n, _CHUNK):
-        _run(t, qa[lo : lo + _CHUNK], out[lo : lo + _CHUNK])
+        step = qa[lo : lo + _CHUNK]
+        fits = len(step) == bufs[0].shape[1]
+        _run(t, step, out[lo : lo + _CHUNK], bufs if fits else _buffers(t, len(step)))
     result: F64 = out
     return result
 

@@ -294,3 +294,77 @@ def test_the_collision_pairs_table_and_pairs_toggled_by_hand(page: Any) -> None:
     page._pair_a.value = page._pair_b.value = adjacent.link1
     page._guarded(lambda _e: page._toggle(disable=True))(_Person())
     assert "a pair is two links" in page.last_message
+
+
+def _press(page: Any, action: Any) -> None:
+    """A button of the page pressed by a person (through the guard every control has)."""
+    page._guarded(lambda _e: action())(_Person())
+
+
+def test_frames_other_sensors_and_passive_joints_from_their_tab(page: Any) -> None:
+    """Each refused input says why under its own inputs; each change is undone with its words."""
+    from robotspec.setup.page_more import at_input
+
+    s = page.session
+    page.select("link7")
+    page._frame_name.value, page._frame_xyz.value = "tcp", "0, 0, zero"
+    _press(page, at_input(page._frame_note, page._add_frame))
+    assert "&#x27;zero&#x27; is not a number" in page._frame_note.content
+    page._frame_xyz.value = "0, 0, 0.1"
+    _press(page, at_input(page._frame_note, page._add_frame))
+    assert page._frame_note.content == "" and "tcp: {parent: link7, xyz: [0, 0, 0.1]}" in (
+        s.snapshot.text
+    )
+    assert page._frame_pick.value == "tcp" and "no rotation" in page._frame_info.content
+    page._rot_kind.value, page._rot_values.value = "quaternion", "0, 0, 1, 1"
+    _press(page, at_input(page._frame_note, page._rotate))
+    assert "is a unit one" in page._frame_note.content and "is a unit one" in page.last_message
+    page._rot_kind.value, page._rot_values.value = "rpy", "[0, 0, 1.5708]"
+    _press(page, at_input(page._frame_note, page._rotate))
+    assert "rpy: [0, 0, 1.5708]" in s.snapshot.text and "rpy [0, 0, 1.5708]" in (
+        page._frame_info.content
+    )
+
+    page._gs_name.value = " "
+    _press(page, at_input(page._gs_note, page._add_sensor))
+    assert "a sensor needs a name" in page._gs_note.content
+    page._gs_name.value, page._gs_kind.value = "wrist_ft", "ft"
+    _press(page, at_input(page._gs_note, page._add_sensor))
+    assert "wrist_ft:\n    type: generic\n    body: link7\n    kind: ft" in s.snapshot.text
+    assert page._gs_pick.value == "wrist_ft" and "on link7, ft" in page._gs_info.content
+    page._gs_carrier.value = "chains.arm"
+    _press(page, page._carry_sensor)
+    assert s.sensor_carrier("sensors.wrist_ft") == "chains.arm"
+
+    page._pj_pick.value = "joint7"
+    _press(page, at_input(page._pj_note, lambda: page._passive(True)))
+    assert "joint7: passive" in page.last_message and "joint7 ✋" in page._pj_list.content
+    _press(page, lambda: page._stepped(back=True))
+    assert "undone: joint joint7: passive" in page.last_message
+    assert "no joint is passive" in page._pj_list.content
+    _press(page, lambda: page._stepped(back=True))
+    assert "undone: line" in page.last_message and "sensors: [wrist_ft]" not in s.snapshot.text
+
+
+def test_an_accepted_warning_is_edited_and_removed_from_the_check_tab(page: Any) -> None:
+    from robotspec.setup.accept import acceptances
+    from robotspec.setup.page_more import at_input
+
+    s = page.session
+    page.select("link7")
+    s.add_generic_sensor("wrist_ft", "link7", "ft")  # on no chain: a warning to accept
+    warning = next(a for a in acceptances(s.validation) if a.at == "sensors.wrist_ft")
+    s.accept_warning(warning.label, "wired to the controller box")
+    assert page._acc_pick.value == warning.label
+    assert "wired to the controller box" in page._acc_info.content
+    page._acc_reason.value = ""
+    _press(page, at_input(page._acc_note, page._reason))
+    assert "give the reason" in page._acc_note.content
+    page._acc_reason.value = "read by the wrist's own board"
+    _press(page, at_input(page._acc_note, page._reason))
+    assert page._acc_note.content == "" and "read by the wrist" in s.snapshot.text
+    _press(page, at_input(page._acc_note, page._unaccept))
+    assert (
+        "accept_warnings" not in s.snapshot.text and page._acc_pick.value == "(no accepted warning)"
+    )
+    assert any(p.location[:2] == ("sensors", "wrist_ft") for p in s.validation.warnings)

@@ -17,10 +17,11 @@ from typing import TYPE_CHECKING, Any
 import yaml
 
 from robotspec.errors import closest_names
+from robotspec.model.world import World
 from robotspec.setup.edits import SetupError
 from robotspec.setup.extras import DELETE, Edit, Entry, Extras
 from robotspec.setup.validation import Validation
-from robotspec.spec.draft.model import Draft
+from robotspec.spec.draft.model import Draft, DraftFrame
 
 if TYPE_CHECKING:
     from robotspec.setup.session import Snapshot
@@ -61,6 +62,7 @@ class MoreEdits:
 
     _lock: threading.RLock
     _snapshot: Snapshot
+    world: World
 
     def edit(
         self,
@@ -90,6 +92,34 @@ class MoreEdits:
         desc = self._data().get("description") or {}
         frames = desc.get("frames") if isinstance(desc, dict) else None
         return {str(k): v for k, v in (frames or {}).items() if isinstance(v, dict)}
+
+    def add_frame(self, name: str, parent: str, xyz: Sequence[float] = (0, 0, 0)) -> Validation:
+        """A frame the URDF lacks (a tool frame), fixed to link ``parent`` at ``xyz`` (m)."""
+        name = name.strip()
+        if not name:
+            raise SetupError("a frame needs a name", kind="frame")
+        if name in self.frames() or self.world.has_body(name):
+            raise SetupError(f"'{name}' is a link or frame already", kind="frame", name=name)
+        self._link(parent, "frame parent")
+        x, y, z = _numbers(xyz, 3, "a position [x, y, z]")
+        return self.edit(lambda d: d.frames.append(DraftFrame(name, parent, (x, y, z), "")))
+
+    def set_frame_position(self, frame: str, xyz: Sequence[float]) -> Validation:
+        """Move an extra frame in its parent link (``xyz``, m)."""
+        x, y, z = _numbers(xyz, 3, "a position [x, y, z]")
+
+        def change(d: Draft) -> None:
+            f = next((f for f in d.frames if f.name == frame), None)
+            if f is None:
+                raise SetupError(
+                    f"no frame '{frame}' of this spec",
+                    kind="frame",
+                    name=frame,
+                    suggestions=closest_names(frame, [f.name for f in d.frames]),
+                )
+            f.xyz = (x, y, z)
+
+        return self.edit(change)
 
     def set_frame_rotation(self, frame: str, kind: str, values: Sequence[float] = ()) -> Validation:
         """Turn an extra frame: ``rpy`` (rad, fixed axes), ``quaternion`` [x, y, z, w], ``none``.

@@ -6,7 +6,8 @@ the ``view`` extra is needed. Every control is server-side state shared by all t
 see one assistant; every callback goes through :meth:`SetupPage._guarded`, so whatever a page
 sends, the server answers with a message, never a crash. The page is this module (the robot,
 the tree, the questions, the state drawn) and one module per tab over a shared base:
-``page_parts``, ``page_states``, ``page_check``, ``page_base``.
+``page_parts``, ``page_states``, ``page_more``, ``page_check`` (with ``page_matrix`` and
+``page_accepted``), ``page_base``.
 
 viser is used as ``Any`` (as in the viewer): its API is large and its stubs must not decide the
 package's strict typing.
@@ -25,9 +26,11 @@ from robotspec.render.viewer import RobotViewer
 from robotspec.setup.access import PageAccess, start_guarded
 from robotspec.setup.collisions import AuditReport
 from robotspec.setup.edits import _facing
+from robotspec.setup.page_accepted import AcceptedPart
 from robotspec.setup.page_base import problem_line
 from robotspec.setup.page_check import CheckTab
 from robotspec.setup.page_clients import PICK_COLOUR, ClientsPart
+from robotspec.setup.page_more import MoreTab
 from robotspec.setup.page_parts import PartsTab
 from robotspec.setup.page_states import StatesTab
 from robotspec.setup.page_yaml import yaml_html
@@ -60,7 +63,7 @@ def _bare(session: SetupSession) -> Any:
     return v.robot
 
 
-class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
+class SetupPage(ClientsPart, PartsTab, StatesTab, MoreTab, AcceptedPart, CheckTab):
     """The page of one session, served until :meth:`stop`."""
 
     def __init__(
@@ -168,6 +171,8 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
             self._build_parts(gui)
         with tabs.add_tab("States"):
             self._build_states(gui)
+        with tabs.add_tab("Frames & more"):
+            self._build_more(gui)
         with tabs.add_tab("Check & save"):
             self._build_check(gui)
 
@@ -242,6 +247,8 @@ class SetupPage(ClientsPart, PartsTab, StatesTab, CheckTab):
             self._show_saved_states()
             self._show_pairs()
             self._show_acceptable(v)
+            self._show_accepted()
+            self._show_more()
             self.shown_version = snap.version
 
     def _show_questions(self, questions: tuple[Question, ...]) -> None:

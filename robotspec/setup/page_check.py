@@ -29,6 +29,10 @@ class CheckTab(MatrixPart):
     _busy: bool
     _busy_lock: threading.Lock
 
+    def _build_accepted(self, gui: Any) -> None:
+        """The accepted warnings' folder (``page_accepted``)."""
+        raise NotImplementedError
+
     def _build_check(self, gui: Any) -> None:
         self._problems = gui.add_markdown("")
         with gui.add_folder("accept a warning"):
@@ -41,6 +45,7 @@ class CheckTab(MatrixPart):
             self._because = gui.add_text("because", "")
             self._because_note = gui.add_markdown("")
             self._button(gui, "accept with reason", self._accept)
+        self._build_accepted(gui)
         with gui.add_folder("self-collision matrix"):
             self._samples = gui.add_number("samples", 2000, min=100, max=1_000_000, step=100)
             self._button(gui, "generate collision matrix", lambda: self._collisions("generate"))

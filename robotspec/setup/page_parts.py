@@ -16,6 +16,15 @@ from robotspec.setup.questions import FACINGS, FORWARDS
 __all__ = ["PartsTab"]
 
 _NEW_KINDS = ("arm", "leg", "chain", "torso", "neck", "manipulator", "camera")
+#: The axes a camera may look along in its body's frame (its ``forward_facing_axis``).
+LOOKS = {
+    "+z (optical)": (0.0, 0.0, 1.0),
+    "+x (body)": (1.0, 0.0, 0.0),
+    "-x": (-1.0, 0.0, 0.0),
+    "+y": (0.0, 1.0, 0.0),
+    "-y": (0.0, -1.0, 0.0),
+    "-z": (0.0, 0.0, -1.0),
+}
 _NO_PRESET = "(angles below)"
 #: Why a gripper with one jaw given is not written as one (yet, or ever: one moving jaw).
 _HALF_GRIPPER = (
@@ -64,7 +73,7 @@ class PartsTab(PageBase):
                 "angles (rad)", (1.0, 0.75), min=(0.01, 0.01), max=(3.1, 3.1), step=0.01
             )
             self._button(gui, "set angles", lambda: self._set_camera(fov=True))
-            self._optical = gui.add_dropdown("looks along", ("+z (optical)", "+x (body)"))
+            self._optical = gui.add_dropdown("looks along", tuple(LOOKS))
             self._optical.on_update(self._guarded(lambda _e: self._set_camera(optical=True)))
             # The chain (or neck) it moves with: answers validate's "is on no chain".
             self._carrier = gui.add_dropdown("carried by", s.carriers())
@@ -120,7 +129,11 @@ class PartsTab(PageBase):
         elif kind == "sensors":
             cam = next(c for c in d.cameras if c.name == name)
             what = cam.preset or (cam.field_of_view and f"angles {cam.field_of_view}") or "?"
-            lines.append(f"camera on **{cam.body}**, {what}")
+            axis = (0.0, 0.0, 1.0) if cam.optical else cam.axis or (1.0, 0.0, 0.0)
+            looks = next((k for k, v in LOOKS.items() if v == axis), str(list(axis)))
+            lines.append(f"camera on **{cam.body}**, {what}, looking along {looks}")
+            if looks in LOOKS:
+                self._optical.value = looks
             self._preset.value = cam.preset or _NO_PRESET
             carriers, carrier = self.session.carriers(), self.session.sensor_carrier(part)
             if tuple(self._carrier.options) != carriers:
@@ -207,7 +220,10 @@ class PartsTab(PageBase):
             h, w = self._fov.value
             kw["field_of_view"] = (float(h), float(w))
         if optical:
-            kw["optical"] = str(self._optical.value).startswith("+z")
+            looks = str(self._optical.value)
+            v = self.session.set_camera_axis(part, LOOKS[looks])
+            self._after(v, f"{part} looks along {looks}")
+            return
         self._after(self.session.set_camera(part, **kw), f"{part} changed")
 
     def _set_carrier(self) -> None:

@@ -32,8 +32,9 @@ FLOORS: tuple[tuple[str, ...], ...] = (
 )
 #: Rooms beside the stack, with the only rooms they may use.
 BESIDE: dict[str, frozenset[str]] = {
-    "driver": frozenset({"errors", "arrays", "exact", "files", "model"}),
-    "service": frozenset({"errors", "arrays", "driver"}),
+    # extras: the one fence of optional packages (MuJoCo for the plant, Robot Raconteur to serve).
+    "driver": frozenset({"errors", "arrays", "exact", "extras", "files", "model"}),
+    "service": frozenset({"errors", "arrays", "driver", "extras"}),
 }
 #: Which rooms of the stack may use a room beside it (the outputs and the CLI).
 USED_BY: dict[str, frozenset[str]] = {

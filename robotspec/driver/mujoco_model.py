@@ -8,13 +8,12 @@ imports MuJoCo at module level: ``import robotspec`` and the kinematic driver ne
 
 from __future__ import annotations
 
-import importlib.util
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from robotspec.arrays import F64
-from robotspec.errors import RobotSpecError
+from robotspec.extras import MUJOCO, require_present
 
 __all__ = [
     "MUJOCO_INSTALL",
@@ -27,7 +26,7 @@ __all__ = [
 ]
 
 #: What a user without MuJoCo is told to run.
-MUJOCO_INSTALL = "pip install 'robotspec[mujoco]'"
+MUJOCO_INSTALL = MUJOCO.command
 
 
 def require_mujoco(feature: str = "--physics mujoco") -> None:
@@ -36,12 +35,7 @@ def require_mujoco(feature: str = "--physics mujoco") -> None:
     Why up front: a user asking for physics without the extra gets one line saying what to
     install, before any robot is compiled, not a traceback.
     """
-    if importlib.util.find_spec("mujoco") is None:
-        raise RobotSpecError(
-            f"{feature} needs MuJoCo; install it with `{MUJOCO_INSTALL}`",
-            kind="dependency",
-            name="mujoco",
-        )
+    require_present(MUJOCO, feature)
 
 
 @dataclass(frozen=True)

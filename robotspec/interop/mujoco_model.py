@@ -9,7 +9,6 @@ is replaced.
 
 from __future__ import annotations
 
-import importlib.util
 import re
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -20,6 +19,7 @@ import numpy as np
 from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError, missing_file
 from robotspec.export.mjcf_bodies import nums
+from robotspec.extras import MUJOCO, require_present
 from robotspec.interop.mujoco_files import check_model_files
 from robotspec.interop.mujoco_fit import FrameFit, inverse, pose_error
 from robotspec.interop.mujoco_xml import Edit, site_edit, write_edits
@@ -31,19 +31,14 @@ if TYPE_CHECKING:
 __all__ = ["MUJOCO_INSTALL", "TheirModel", "read_model"]
 
 #: What a user without MuJoCo is told to run (the same words as the physics driver's).
-MUJOCO_INSTALL = "pip install 'robotspec[mujoco]'"
+MUJOCO_INSTALL = MUJOCO.command
 
 _SUFFIX = "_robotspec"
 
 
 def read_model(path: Path) -> TheirModel:
     """Read and compile ``path`` with MuJoCo; its complaint becomes a RobotSpecError."""
-    if importlib.util.find_spec("mujoco") is None:  # the driver's require_mujoco, one room up
-        raise RobotSpecError(
-            f"robotspec annotate mjcf needs MuJoCo; install it with `{MUJOCO_INSTALL}`",
-            kind="dependency",
-            name="mujoco",
-        )
+    require_present(MUJOCO, "robotspec annotate mjcf")
     import mujoco  # type: ignore[import-untyped, unused-ignore]
 
     if not Path(path).is_file():

@@ -33,15 +33,11 @@ import numpy as np
 
 from robotspec.arrays import F64, finite_array, real_array
 from robotspec.errors import KinematicsError
-from robotspec.extras import Extra, require
+from robotspec.extras import PINOCCHIO, require
 from robotspec.model.entities import Connection, ConnectionType
 from robotspec.model.world import World
 
 __all__ = ["PinocchioRobot", "import_pinocchio", "set_limits", "to_se3", "world_to_pinocchio"]
-
-
-#: pinocchio: the module, its PyPI package and the extra that installs it.
-PINOCCHIO = Extra("pinocchio", "pin", "pinocchio", label="pinocchio (PyPI package 'pin')")
 
 
 def import_pinocchio() -> Any:

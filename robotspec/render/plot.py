@@ -21,7 +21,7 @@ import numpy as np
 
 from robotspec.arrays import F64
 from robotspec.driver.state import RobotState
-from robotspec.extras import Extra, require
+from robotspec.extras import MATPLOTLIB, require
 
 __all__ = ["JointTrace", "PlotSummary", "plot_joint_trace"]
 
@@ -81,7 +81,7 @@ def plot_joint_trace(trace: JointTrace, path: Path, *, title: str = "") -> PlotS
     A joint's command line is left out when no position command was ever sent to it (the robot
     was only jogged or halted), so the line count tells what the run commanded.
     """
-    matplotlib: Any = require(Extra("matplotlib", "matplotlib", "view"), "--plot")
+    matplotlib: Any = require(MATPLOTLIB, "--plot")
     matplotlib.use("Agg", force=True)
     figure_mod: Any = importlib.import_module("matplotlib.figure")
     backend: Any = importlib.import_module("matplotlib.backends.backend_agg")

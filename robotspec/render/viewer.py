@@ -13,7 +13,6 @@ releases, and the package's strict typing must not depend on its stubs.
 from __future__ import annotations
 
 import contextlib
-import importlib
 import io
 import math
 import threading
@@ -25,6 +24,7 @@ import numpy as np
 
 from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError, ServiceError
+from robotspec.extras import VISER, require
 from robotspec.model.world import ConnectionType
 from robotspec.render.meshes import MissingMeshPolicy, TriangleLibrary
 from robotspec.render.scene import (
@@ -108,7 +108,7 @@ class RobotViewer:
         self._lock = threading.Lock()
         self._checker: Any = None
         self._checker_error: str | None = None
-        viser: Any = importlib.import_module("viser")
+        viser: Any = require(VISER, "robotspec view")
         try:
             # viser prints a banner of its own; the command prints the one URL that matters.
             with contextlib.redirect_stdout(io.StringIO()):

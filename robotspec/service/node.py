@@ -32,6 +32,7 @@ from typing import Any
 
 from robotspec.driver.rr_names import valid_rr_name
 from robotspec.errors import ServiceError
+from robotspec.extras import ROBOTRACONTEUR, ROBOTRACONTEUR_COMPANION, missing_extras, require_all
 
 __all__ = [
     "NODE_DIRECTORY_FIELDS",
@@ -63,17 +64,16 @@ NODE_DIRECTORY_FIELDS = (
 MAX_STATE_DIR_CHARS = 107 - len("/run/socket/0123456789abcdef.sock")
 
 
+#: What serving imports: Robot Raconteur and its companion (the ``robotraconteur`` extra).
+_RR_EXTRAS = (ROBOTRACONTEUR, ROBOTRACONTEUR_COMPANION)
+
 #: Set once the structure-class cache is installed (:func:`rr`).
 _types_cached: list[bool] = []
 
 
 def missing_packages() -> list[str]:
     """The optional packages the service needs that are not installed (empty when ready)."""
-    need = {
-        "RobotRaconteur": "robotraconteur",
-        "RobotRaconteurCompanion": "robotraconteurcompanion",
-    }
-    return [pip for mod, pip in need.items() if importlib.util.find_spec(mod) is None]
+    return [e.package for e in missing_extras(_RR_EXTRAS)]
 
 
 def rr() -> Any:
@@ -82,12 +82,7 @@ def rr() -> Any:
     Raises:
         ServiceError: the optional extra is not installed.
     """
-    missing = missing_packages()
-    if missing:
-        raise ServiceError(
-            f"serving needs {' and '.join(missing)}; install them with "
-            "pip install 'robotspec[robotraconteur]'"
-        )
+    require_all(_RR_EXTRAS, "serving", ServiceError)
     module = importlib.import_module("RobotRaconteur")
     if not _types_cached:
         # One class per structure type, not one per decoded value (see rr_types).

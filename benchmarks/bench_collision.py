@@ -11,6 +11,12 @@ robotspec's own batch on one thread (the ratio is then the speed-up). A control 
 that holds no lock at all (sha256 of 32 MB per thread, which releases the GIL) on one thread
 and on ``--threads``: the speed-up the machine itself gives at that moment, so a loaded machine's
 figures can be read. All of them are interleaved rounds in one run (``--rounds``).
+
+Below the table, the CPU time of the thread rows: the process's CPU time (every thread) against
+the wall time of each batch, and the CPU time of each thread of a batch split by hand as the
+checker splits it. Why: on a loaded machine the speed-up measures the other processes, while CPU
+time does not; work that is serialised (one thread doing it, or threads taking turns on a lock)
+shows as one thread's CPU holding most of the total, or as a total that grows with the threads.
 """
 
 from __future__ import annotations
@@ -155,9 +161,11 @@ def main() -> None:
         f"({len(owner)} geometry pairs), {n} random configurations; answers identical\n"
     )
     table = [Row(name, a, f"pinocchio {peer}", b) for name, a, peer, b in rows]
-    table += thread_rows(checker, qs, pin, model, gmodel, pq, args.threads, args.rounds)
+    cpu_notes: list[str] = []
+    table += thread_rows(checker, qs, pin, model, gmodel, pq, args.threads, args.rounds, cpu_notes)
     if args.no_matrix:
         print_rows(table, args.json)
+        say("\n" + "\n".join(cpu_notes))
         return
 
     t = time.perf_counter()
@@ -180,6 +188,7 @@ def main() -> None:
         )
     )
     print_rows(table, args.json)
+    say("\n" + "\n".join(cpu_notes))
     say(
         f"\ncollision matrix: {counts}; {len(matrix.checked)} pairs stay checked"
         f"\n  against the shipped pr2.srdf ({len(reference)} pairs between bodies with geometry): "
@@ -196,11 +205,13 @@ def thread_rows(
     pq: list[np.ndarray],
     threads: int,
     rounds: int,
+    cpu_notes: list[str],
 ) -> list[Row]:
     """The batches on ``threads`` threads: against pinocchio's parallel batch, against one thread.
 
     Every timing of a row is taken in the same round as the others (interleaved), so machine
-    load hits all of them alike; each figure is the median over ``rounds``.
+    load hits all of them alike; each figure is the median over ``rounds``. ``cpu_notes``
+    receives the CPU-time lines (see the module's doc).
     """
     n = len(qs)
     qmat = np.asfortranarray(np.array(pq).T)
@@ -232,11 +243,27 @@ def thread_rows(
         "ctlN": lambda: control(threads),
     }
     t: dict[str, list[float]] = {k: [] for k in timed}
+    cpu: dict[str, list[float]] = {k: [] for k in timed}
+    split: dict[str, list[list[float]]] = {"any": [], "all": []}
     for _ in range(rounds):
         for k, fn in timed.items():
+            c0 = time.process_time()
             t[k].append(median_time(fn, 1))
+            cpu[k].append(time.process_time() - c0)
+        split["any"].append(split_cpu(checker.in_collision_batch, qs, threads))
+        split["all"].append(split_cpu(checker.collisions_batch, qs, threads))
     m = {k: _m(v) for k, v in t.items()}
     load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
+    cpu_notes.append(f"CPU time, median of {rounds} rounds (load {load}):")
+    for kind, one, many in (("any hit", "any1", "anyN"), ("all pairs", "all1", "allN")):
+        each = [_m([r[i] for r in split[one[:3]]]) for i in range(threads)]
+        cpu_notes.append(
+            f"  {kind}: 1 thread {_m(cpu[one]) * 1e3:.1f} ms CPU in {m[one] * 1e3:.1f} ms wall; "
+            f"{threads} threads {_m(cpu[many]) * 1e3:.1f} ms CPU in {m[many] * 1e3:.1f} ms wall "
+            f"(CPU/wall {_m(cpu[many]) / m[many]:.2f}); split by hand, per thread: "
+            + " + ".join(f"{x * 1e3:.1f}" for x in each)
+            + " ms"
+        )
     return [
         Row(
             f"any hit, batch, {threads} threads (per config)",
@@ -263,6 +290,28 @@ def thread_rows(
             m["ctl1"],
         ),
     ]
+
+
+def split_cpu(query: Callable[..., object], qs: np.ndarray, threads: int) -> list[float]:
+    """CPU seconds of each of ``threads`` threads running ``query`` on its contiguous slice.
+
+    The slices are the checker's own (``threads=N`` cuts the batch the same way), each thread
+    reads its own CPU clock (``time.thread_time``), so the figures do not depend on the load.
+    """
+    bounds = np.linspace(0, len(qs), threads + 1).astype(int)
+    spent = [0.0] * threads
+
+    def work(i: int) -> None:
+        c0 = time.thread_time()
+        query(qs[bounds[i] : bounds[i + 1]], threads=1)
+        spent[i] = time.thread_time() - c0
+
+    workers = [threading.Thread(target=work, args=(i,)) for i in range(threads)]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join()
+    return spent
 
 
 def _m(values: list[float]) -> float:

@@ -7,11 +7,15 @@ calls thousands of times a second, which only the C cores make short).
 Why a baseline file: ``forward``, ``pose``, a chain's ``jacobian`` and ``in_collision`` cost one
 to a few microseconds, most of it Python in front of the C call (argument checks, the core's
 lookup). A change that adds a few hundred nanoseconds there is invisible in any other benchmark,
-yet makes every query 20-40 % slower (issue 34 measured it). ``benchmarks/percall_baseline.json``
-holds the per-call times of the landing before those checks (c19da32) on the machine named in
-it; each row is that time against today's (ratio = baseline / now: below 1 means the calls got
-slower). Another machine gives other times: record its own baseline on the baseline commit,
-``git worktree add /tmp/base c19da32``, ``python setup.py build_ext --inplace`` there, then
+yet makes every query 20-40 % slower (issue 34 measured it). ``in_collision`` is timed on a
+free configuration whose boxes all stay apart (kinematics and broad phase only) and on one near
+contact (a pair within 2 cm: the narrow phase's mesh proofs run too); the second row's baseline
+was recorded later than the others, on the same commit and machine (the file says when).
+``benchmarks/percall_baseline.json`` holds the per-call times of the landing before those checks
+(c19da32) on the machine named in it; each row is that time against today's (ratio = baseline /
+now: below 1 means the calls got slower). Another machine gives other times: record its own
+baseline on the baseline commit, ``git worktree add /tmp/base c19da32``, ``python setup.py
+build_ext --inplace`` there, then
 ``PYTHONPATH=/tmp/base python benchmarks/bench_percall.py --record FILE`` (then
 ``--baseline FILE``).
 
@@ -51,11 +55,18 @@ def queries(robot_name: str) -> dict[str, Callable[[], object]]:
     root, tip = chain.root.name, chain.tip.name
     arm = kin.chain(root, tip)
     q, free = qs[0], next(q for q in qs if not checker.in_collision(q))
+    # Free, but a pair within 2 cm: boxes meet, so the narrow phase runs (mesh proofs) too, as
+    # near contact in a planner's queries. Public calls only, so the baseline commit finds it.
+    more = np.asarray(random_configurations(robot.world, 64, seed=0), dtype=np.float64)
+    near = next(
+        q for q in more if not checker.in_collision(q) and checker.in_collision(q, margin=0.02)
+    )
     return {
         "forward": lambda: kin.forward(q),
         "pose": lambda: kin.pose(q, tip),
         "chain jacobian": lambda: arm.jacobian(q),
         "in_collision": lambda: checker.in_collision(free),
+        "in_collision, near contact": lambda: checker.in_collision(near),
     }
 
 
@@ -128,7 +139,7 @@ def main() -> None:
         for name, t in times.items()
         if base.get("robot") == args.robot
     ]
-    print_rows(rows, args.json, width=34, peer_width=24)
+    print_rows(rows, args.json, width=42, peer_width=24)
 
 
 if __name__ == "__main__":

@@ -34,10 +34,10 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 import yaml
 
 from robotspec.arrays import F64
+from robotspec.driver.hp_form import HPForm, clean, hp_form, refuse
 from robotspec.driver.robot_info import (
     DeviceClass,
     DeviceInfo,
@@ -80,8 +80,6 @@ DEFAULT_CAPABILITIES: tuple[RobotCapability, ...] = (
 )
 #: The Robot Raconteur standard UUID of the ``robot`` device class (as in the real files).
 _ROBOT_CLASS_UUID = "39b513e7-21b9-4b49-8654-7537473030eb"
-#: H vectors and the flange rotation are cleaned of round-off below this (exact zeros read well).
-_CLEAN_TOL = 1e-15
 
 
 @dataclass(frozen=True)
@@ -96,27 +94,12 @@ class ExportedRobotInfo:
     notes: tuple[str, ...] = ()
 
 
-def _clean(v: F64) -> F64:
-    out = np.where(np.abs(v) < _CLEAN_TOL, 0.0, v)
-    return np.asarray(out + 0.0, dtype=np.float64)  # + 0.0 turns -0.0 into 0.0
-
-
 def _body(world: World, body: Body | str) -> Body:
     return world.get_body_by_name(body) if isinstance(body, str) else body
 
 
 def _vec(v: F64) -> Vector3:
     return Vector3(x=float(v[0]), y=float(v[1]), z=float(v[2]))
-
-
-def _refuse(world: World, c: Connection, why: str) -> RobotInfoError:
-    return RobotInfoError(
-        f"joint '{c.name}' ({c.type.value}{', mimic' if c.is_mimic else ''}) {why}",
-        file=world.source,
-        line=c.line,
-        kind="joint",
-        name=c.name,
-    )
 
 
 def _positive(value: float, what: str) -> float:
@@ -191,155 +174,131 @@ def export_chain(
     flange_b = tip_b if flange is None else _body(world, flange)
     _positive(default_velocity, "default_velocity")
     _positive(continuous_limit, "continuous_limit")
-    to_tip = world.compute_chain_of_connections(root_b, tip_b)
-    after_tip = world.compute_chain_of_connections(tip_b, flange_b)
-    for c in after_tip:
-        if not c.is_fixed:
-            raise _refuse(
-                world, c, f"moves the flange '{flange_b.name}' beyond the tip '{tip_b.name}'"
-            )
-
-    r_acc = np.eye(3)
-    p_list: list[F64] = [np.zeros(3)]
-    h_list: list[F64] = []
-    movable: list[Connection] = []
-    for c in [*to_tip, *after_tip]:
-        if c.is_mimic:
-            assert c.mimic is not None
-            raise _refuse(
-                world,
-                c,
-                f"mimics '{c.mimic.leader}' inside the chain '{root_b.name}' -> '{tip_b.name}'; "
-                "a RobotInfo chain has no mimic joints (end the chain before it)",
-            )
-        if c.type in (ConnectionType.FLOATING, ConnectionType.PLANAR):
-            raise _refuse(world, c, "has no single axis; a RobotInfo chain is serial 1-DOF joints")
-        origin = np.asarray(c.origin, dtype=np.float64)
-        p_list[-1] = p_list[-1] + r_acc @ origin[:3, 3]
-        r_acc = r_acc @ origin[:3, :3]
-        if c.is_fixed:
-            continue
-        axis = r_acc @ np.asarray(c.axis, dtype=np.float64)
-        norm = float(np.linalg.norm(axis))
-        if not norm > 0.0:
-            raise _refuse(world, c, "has a zero axis")
-        h_list.append(_clean(axis / norm))
-        p_list.append(np.zeros(3))
-        movable.append(c)
-    if not movable:
-        raise RobotInfoError(
-            f"the chain '{root_b.name}' -> '{tip_b.name}' has no movable joint",
-            file=world.source,
-            kind="chain",
-            name=tip_b.name,
-        )
-
-    names = [world.degrees_of_freedom[c.dofs[0]].name for c in movable]
+    form = hp_form(world, root_b, tip_b, flange_b)
+    names = [world.degrees_of_freedom[c.dofs[0]].name for c in form.movable]
     accel = _per_joint(acceleration, names, "acceleration")
     notes: list[str] = []
-    joints: list[JointInfo] = []
-    defaulted_accel: list[str] = []
-    for c, name in zip(movable, names, strict=True):
-        dof = world.degrees_of_freedom[c.dofs[0]]
-        prismatic = c.type is ConnectionType.PRISMATIC
-        lower, upper = float(dof.lower), float(dof.upper)
-        jtype = JointType.prismatic if prismatic else JointType.revolute
-        if c.type is ConnectionType.CONTINUOUS or not (
-            math.isfinite(lower) and math.isfinite(upper)
-        ):
-            if prismatic:
-                raise _refuse(world, c, "has no position limits; a RobotInfo joint needs them")
-            if c.type is ConnectionType.CONTINUOUS and keep_continuous:
-                jtype = JointType.continuous
-            lower = max(lower, -continuous_limit)
-            upper = min(upper, continuous_limit)
-            notes.append(
-                f"joint '{name}' ({c.type.value}) has no position limits: "
-                f"[{lower:.6g}, {upper:.6g}] used"
-            )
-        velocity = float(dof.velocity)
-        if not (math.isfinite(velocity) and velocity > 0.0):
-            notes.append(
-                f"joint '{name}' has no velocity limit: {default_velocity:g} "
-                f"{'m/s' if prismatic else 'rad/s'} used"
-            )
-            velocity = default_velocity
-        if name in accel:
-            acc = accel[name]
-        else:
-            acc = float(f"{DEFAULT_ACCELERATION_FACTOR * velocity:.12g}")
-            defaulted_accel.append(name)
-        effort = float(dof.effort) if math.isfinite(dof.effort) and dof.effort > 0 else 0.0
-        try:
-            limits = JointLimits(
-                lower=lower,
-                upper=upper,
-                home=min(max(0.0, lower), upper),
-                velocity=velocity,
-                acceleration=acc,
-                effort=effort,
-            )
-        except ValueError as exc:  # pydantic's ValidationError is a ValueError
-            raise _refuse(world, c, f"has unusable limits: {exc}") from None
-        joints.append(
-            JointInfo(
-                joint_identifier=Identifier(name=name),
-                joint_type=jtype,
-                joint_limits=limits,
-                default_units=JointPositionUnits.meter if prismatic else JointPositionUnits.radian,
-                default_effort_units=JointEffortUnits.newton
-                if prismatic
-                else JointEffortUnits.newton_meter,
-            )
+    joints = [
+        _joint_info(
+            world, c, accel.get(name), default_velocity, continuous_limit, keep_continuous, notes
         )
+        for c, name in zip(form.movable, names, strict=True)
+    ]
+    defaulted_accel = [name for name in names if name not in accel]
     if defaulted_accel:
         notes.append(
             f"the description gives no acceleration limits: {DEFAULT_ACCELERATION_FACTOR:g} x "
             f"the velocity limit used for {', '.join(defaulted_accel)}"
         )
-
-    q = matrix_to_quat_wxyz(_clean(r_acc))
-    flange_pose = Pose(
-        orientation=Quaternion(w=float(q[0]), x=float(q[1]), y=float(q[2]), z=float(q[3])),
-        position=Vector3(x=0.0, y=0.0, z=0.0),
-    )
-    link_ids = (
-        Identifier(name=root_b.name),
-        *(Identifier(name=world.bodies[c.child].name) for c in movable),
-    )
-    chain = KinChainInfo(
-        kin_chain_identifier=Identifier(name=chain_name or device_name),
-        H=tuple(_vec(h) for h in h_list),
-        P=tuple(_vec(_clean(p)) for p in p_list),
-        link_identifiers=link_ids,
-        joint_numbers=tuple(range(len(movable))),
-        flange_pose=flange_pose,
-        flange_identifier=Identifier(name=flange_b.name),
-        description=description,
-    )
+    chain = _chain_info(world, form, root_b, flange_b, chain_name or device_name, description)
     info = RobotInfo(
-        device_info=DeviceInfo(
-            device=Identifier(name=device_name),
-            model=Identifier(name=world.name),
-            user_description=(
-                f"{world.name}: chain {root_b.name} -> {flange_b.name}, exported by robotspec"
-            ),
-            device_classes=(
-                DeviceClass(
-                    class_identifier=Identifier.model_validate(
-                        {"name": "robot", "uuid": _ROBOT_CLASS_UUID}
-                    ),
-                    subclasses=("serial",),
-                ),
-            ),
-            implemented_types=("com.robotraconteur.robotics.robot.Robot",),
-        ),
+        device_info=_device_info(world, device_name, root_b, flange_b),
         robot_type=RobotTypeCode.serial,
         robot_capabilities=tuple(RobotCapability(x) for x in capabilities),
         joint_info=tuple(joints),
         chains=(chain,),
     )
     return ExportedRobotInfo(info=info, notes=tuple(notes))
+
+
+def _joint_info(
+    world: World,
+    c: Connection,
+    acceleration: float | None,
+    default_velocity: float,
+    continuous_limit: float,
+    keep_continuous: bool,
+    notes: list[str],
+) -> JointInfo:
+    """One movable joint as a RobotInfo joint; each default that stands in adds to ``notes``."""
+    dof = world.degrees_of_freedom[c.dofs[0]]
+    name = dof.name
+    prismatic = c.type is ConnectionType.PRISMATIC
+    lower, upper = float(dof.lower), float(dof.upper)
+    jtype = JointType.prismatic if prismatic else JointType.revolute
+    if c.type is ConnectionType.CONTINUOUS or not (math.isfinite(lower) and math.isfinite(upper)):
+        if prismatic:
+            raise refuse(world, c, "has no position limits; a RobotInfo joint needs them")
+        if c.type is ConnectionType.CONTINUOUS and keep_continuous:
+            jtype = JointType.continuous
+        lower = max(lower, -continuous_limit)
+        upper = min(upper, continuous_limit)
+        notes.append(
+            f"joint '{name}' ({c.type.value}) has no position limits: "
+            f"[{lower:.6g}, {upper:.6g}] used"
+        )
+    velocity = float(dof.velocity)
+    if not (math.isfinite(velocity) and velocity > 0.0):
+        notes.append(
+            f"joint '{name}' has no velocity limit: {default_velocity:g} "
+            f"{'m/s' if prismatic else 'rad/s'} used"
+        )
+        velocity = default_velocity
+    if acceleration is None:
+        acceleration = float(f"{DEFAULT_ACCELERATION_FACTOR * velocity:.12g}")
+    effort = float(dof.effort) if math.isfinite(dof.effort) and dof.effort > 0 else 0.0
+    try:
+        limits = JointLimits(
+            lower=lower,
+            upper=upper,
+            home=min(max(0.0, lower), upper),
+            velocity=velocity,
+            acceleration=acceleration,
+            effort=effort,
+        )
+    except ValueError as exc:  # pydantic's ValidationError is a ValueError
+        raise refuse(world, c, f"has unusable limits: {exc}") from None
+    return JointInfo(
+        joint_identifier=Identifier(name=name),
+        joint_type=jtype,
+        joint_limits=limits,
+        default_units=JointPositionUnits.meter if prismatic else JointPositionUnits.radian,
+        default_effort_units=JointEffortUnits.newton
+        if prismatic
+        else JointEffortUnits.newton_meter,
+    )
+
+
+def _chain_info(
+    world: World, form: HPForm, root: Body, flange: Body, name: str, description: str
+) -> KinChainInfo:
+    """The chain's H/P record, with its flange pose (rotation only: the offset is ``P[n]``)."""
+    q = matrix_to_quat_wxyz(form.flange_rotation)
+    flange_pose = Pose(
+        orientation=Quaternion(w=float(q[0]), x=float(q[1]), y=float(q[2]), z=float(q[3])),
+        position=Vector3(x=0.0, y=0.0, z=0.0),
+    )
+    link_ids = (
+        Identifier(name=root.name),
+        *(Identifier(name=world.bodies[c.child].name) for c in form.movable),
+    )
+    return KinChainInfo(
+        kin_chain_identifier=Identifier(name=name),
+        H=tuple(_vec(h) for h in form.h),
+        P=tuple(_vec(clean(p)) for p in form.p),
+        link_identifiers=link_ids,
+        joint_numbers=tuple(range(len(form.movable))),
+        flange_pose=flange_pose,
+        flange_identifier=Identifier(name=flange.name),
+        description=description,
+    )
+
+
+def _device_info(world: World, device_name: str, root: Body, flange: Body) -> DeviceInfo:
+    return DeviceInfo(
+        device=Identifier(name=device_name),
+        model=Identifier(name=world.name),
+        user_description=f"{world.name}: chain {root.name} -> {flange.name}, exported by robotspec",
+        device_classes=(
+            DeviceClass(
+                class_identifier=Identifier.model_validate(
+                    {"name": "robot", "uuid": _ROBOT_CLASS_UUID}
+                ),
+                subclasses=("serial",),
+            ),
+        ),
+        implemented_types=("com.robotraconteur.robotics.robot.Robot",),
+    )
 
 
 def robot_info_from_chain(

@@ -12,8 +12,12 @@ Everything is built on the first query (meshes read once), so constructing a che
 
 Threads: one checker may be shared by threads. What is built once (geometries, coal functors,
 trees) is built under a lock and only read afterwards; what a query writes (each geometry's coal
-transform, coal's request and result) is per thread (:class:`Scratch`). Coal's own calls hold the
-GIL, so the functors' internal solver state is used by one call at a time.
+transform, coal's request and result) is per thread (:class:`Scratch`); the C mesh core gives
+each of its calls a scratch of its own. Coal's own calls hold the GIL, so the functors' internal
+solver state is used by one call at a time. A batch spends its time in three C calls per block
+of samples that release the GIL (kinematics, broad phase, the narrow phase's proofs,
+:func:`.narrow.walk`); coal is asked only about what the proofs leave (on the PR2, about one
+candidate in a thousand), so threads checking batches run side by side.
 """
 
 from __future__ import annotations
@@ -74,9 +78,11 @@ class SelfCollisionChecker:
 
     A checker may be shared by threads: every query answers as if it ran alone. The first query
     builds the geometry (under a lock, once); each thread then writes only its own coal
-    transforms and results. Coal holds the GIL, so threads do not check faster than one thread,
-    except in the kinematics and the mesh proofs of batches (C loops without the GIL); for
-    throughput on many configurations use worker processes (``collisions generate --jobs``).
+    transforms and results. Kinematics, broad phase and the mesh proofs run in C without the
+    GIL, so threads check faster than one thread where those hold the work (meshes: the PR2);
+    pairs the proofs leave, and every pair with a primitive shape, go to coal, which holds the
+    GIL. ``threads=`` splits a batch over threads; worker processes (``collisions generate
+    --jobs``) scale whatever the geometry.
     """
 
     def __init__(

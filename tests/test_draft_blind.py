@@ -300,12 +300,18 @@ def test_srdf_groups_are_evidence_not_the_answer(tmp_path: Path) -> None:
     assert [c.srdf_group for c in d.chains] == ["arm"]
     assert any("'gripper' moves one joint" in n for n in d.notes)
     assert any("'base' moves the base" in n for n in d.notes)
-    # The group the tree confirms is stated, and the gripper beside the base is the arm's, a
-    # parallel gripper (not a generic tool).
+    # The group the tree confirms is an arm, and the gripper beside the base is the arm's, a
+    # parallel gripper (not a generic tool). Nothing in the SRDF hangs on the group: a question.
     (arm,) = d.chains
-    assert arm.role == "arm" and not arm.decide
+    assert arm.role == "arm" and arm.decide == [
+        "the SRDF groups these joints ('arm'), but no end effector hangs on the group"
+    ]
     (m,) = d.manipulators
     assert m.is_gripper and arm.manipulator == m.name
+    # An end effector on the group states it: no question (confidence's rule).
+    ee = '<end_effector name="hand" parent_link="wrist" group="gripper" parent_group="arm"/>'
+    stated = _draft_srdf(tmp_path, "mobile_ee", parts, groups + ee)
+    assert [(c.srdf_group, c.decide) for c in stated.chains] == [("arm", [])]
     # A group the tree does not confirm (two of the arm's four joints) is a question.
     sweep = '<group name="sweep"><joint name="j2"/><joint name="j3"/></group>'
     (part,) = _draft_srdf(tmp_path, "sweep", parts, sweep).chains

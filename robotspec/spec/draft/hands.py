@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robotspec.model.entities import Body
+from robotspec.spec.draft.confidence import gripper_question
 from robotspec.spec.draft.limbs import FINGER_WORDS, HAND_WORDS, is_named
 from robotspec.spec.draft.model import DraftFinger
 from robotspec.spec.draft.tool_frames import (
@@ -115,7 +116,11 @@ def _jaws(tree: Tree, hand: Body) -> Gripper | None:
     if j1.type.value != "prismatic" and not named:
         return None  # two revolute links in series are a pendulum, not jaws
     root = world.bodies[j1.parent]
-    decide = None if j2.is_mimic else "both jaws are driven; the upper one is taken for the thumb"
+    decide = (
+        gripper_question(bool(set(j1.dofs) & set(j2.dofs)), True)
+        if j2.is_mimic
+        else "both jaws are driven; the upper one is taken for the thumb"
+    )
     return Gripper(
         root=root,
         thumb=DraftFinger(root.name, jaw1.name),
@@ -223,7 +228,9 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
                 for c in world.compute_chain_of_connections(body, _finger_tip(tree, k))
             )
         )
-    decide = None
+    # Stated only when a mimic tag couples the two sides, one driving the other (confidence).
+    moved = [set().union(*(_dofs(tree, k) for k in side)) for side in sides]
+    decide = gripper_question(bool(moved[0] & moved[1]), leaders[0] != leaders[1])
     if leaders[0] != leaders[1]:
         thumb_i = 0 if leaders[0] else 1
     else:
@@ -231,7 +238,6 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
         rot = np.linalg.inv(tree.poses[body.index])
         ys = [(rot @ tree.poses[t.index])[1, 3] for t in tips]
         thumb_i = 0 if ys[0] >= ys[1] else 1
-        decide = "both fingers are driven; the thumb is the one on the hand's +y side"
     finger_i = 1 - thumb_i
     gripper = Gripper(
         root=body,

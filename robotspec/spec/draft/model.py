@@ -49,6 +49,8 @@ class DraftManipulator:
     joints: frozenset[str] = frozenset()
     #: A hand's fingers besides its thumb, by name (written as ``type: hand``).
     fingers: dict[str, DraftFinger] = field(default_factory=dict)
+    #: How ``front_facing`` was derived (a plain comment: it follows the tool frame and tips).
+    facing: str | None = None
 
     @property
     def is_gripper(self) -> bool:

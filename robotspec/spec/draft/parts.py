@@ -15,6 +15,7 @@ import numpy as np
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
 from robotspec.spec.draft.base import fixed_wheels
+from robotspec.spec.draft.confidence import camera_question, drive_question
 from robotspec.spec.draft.driven import stated_drive
 from robotspec.spec.draft.limbs import HEAD_WORDS, beside_branch
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
@@ -31,6 +32,10 @@ __all__ = ["add_drive", "add_sensors", "add_states", "add_torso"]
 
 
 # ------------------------------------------------------------------ sensors, torso, neck
+#: Why a camera found by its frame's rotation alone is a question.
+_BY_ROTATION = "an optical frame by its rotation; no Gazebo sensor states it"
+
+
 def add_sensors(d: Drafter) -> None:
     """Cameras, the neck that carries the head's cameras, and the arms that carry the rest."""
     tree, world, draft = d.tree, d.world, d.draft
@@ -54,6 +59,8 @@ def add_sensors(d: Drafter) -> None:
                 )
             else:
                 cam.decide.append("named as a camera, but not rotated as an optical frame")
+        elif not cam.decide and (q := camera_question(False, _BY_ROTATION)):
+            cam.decide.append(q)  # REP 103's rotation alone: which channel, is it a camera?
         model = _model_preset(seen.body.name)
         if model is not None:
             cam.preset = model
@@ -84,8 +91,7 @@ def add_sensors(d: Drafter) -> None:
         for chain in draft.chains:
             if chain.joints == n.joints:
                 n.source = f"{chain.source} (a neck: it carries cameras)"
-                n.srdf_group = chain.srdf_group
-                n.decide.clear()
+                n.srdf_group = chain.srdf_group  # still a question: a group is no neck
                 continue
             kept.append(chain)
         draft.chains = kept
@@ -207,8 +213,7 @@ def add_torso(d: Drafter) -> None:
     kept = []
     for c in draft.chains:
         if c.joints == joints:
-            t.source, t.srdf_group = c.source, c.srdf_group
-            t.decide.clear()
+            t.source, t.srdf_group = c.source, c.srdf_group  # still a question (confidence)
             continue
         kept.append(c)
     draft.chains = kept
@@ -249,8 +254,8 @@ def _rotor(world: World, c: Connection) -> bool:
 def add_drive(d: Drafter) -> None:
     """From the SRDF's virtual joint, else guessed from wheels, legs or rotors."""
     draft, world = d.draft, d.world
-    if draft.drive is not None:
-        return
+    if draft.drive is not None and d.own_base is not None:
+        return  # the URDF's own base joints: own_drive said what to check
     joints = [c for c in world.connections if not c.is_fixed]
     wheels = d.wheels
     casters = [c for c in joints if "caster" in words(c.name) and "wheel" not in words(c.name)]
@@ -260,6 +265,10 @@ def add_drive(d: Drafter) -> None:
         fixed = [c for c in world.connections if c.is_fixed and _rotor(world, c)]
         rotors = fixed if len(fixed) >= 3 else []
     movable = d.tree.root is world.root
+    if draft.drive is not None:  # the SRDF's virtual joint: stated, or a question (confidence)
+        virtual = {"omni": "planar"}.get(draft.drive.type, draft.drive.type)
+        draft.drive.decide = drive_question(virtual, bool(wheels or len(legs) >= 2 or rotors))
+        return
     stated = stated_drive(d.tree, d.facts, wheels) if wheels and movable else None
     if stated is not None:  # what the transmissions or a Gazebo drive plugin say
         draft.drive = stated

@@ -128,7 +128,8 @@ def _manipulator(out: list[str], m: DraftManipulator) -> None:
     out.append(f"    root: {scalar(m.root)}")
     out.append(f"    tool_frame: {scalar(m.tool_frame)}")
     q = ", ".join(_num(v) for v in m.front_facing)
-    out.append(f"    front_facing_orientation: [{q}]")
+    why = f"  # {comment(m.facing)}" if m.facing else ""
+    out.append(f"    front_facing_orientation: [{q}]{why}")
     for role, f in (("thumb", m.thumb), ("finger", m.finger)):
         if f is not None and (m.is_gripper or m.is_hand):
             out.append(f"    {role}: {{root: {scalar(f.root)}, tip: {scalar(f.tip)}}}")

@@ -1,0 +1,139 @@
+"""When a drafted item carries a ``DECIDE`` mark: the one rule, in one place (issue 30, item 3).
+
+Why one module: a mark is a question to the person finishing the spec, and it only means
+something when it is dropped for one reason, everywhere: **a file states the answer**. Every
+decision resting on names, geometry heuristics or defaults keeps its mark, saying what to check.
+The detectors find; this module says whether what they found is stated. What states an answer:
+
+=================  ===========================================================================
+item               unmarked only when
+=================  ===========================================================================
+chain              an SRDF group states its joints, the tree finds an arm or a leg of exactly
+                   those joints, and an SRDF end effector hangs on it (names the group as its
+                   group or parent group, or its tip as parent link): the SRDF says it carries
+                   a hand or a foot
+tool frame         the SRDF end effector's parent link is a bare frame on the hand; or a bare
+                   frame named as a TCP (``tool0``, ``*_tcp``, ``ee_link``, ``grasp_frame``,
+                   ``tool_frame``, ``end_effector_link``...) at the manipulator's end: on the
+                   part that carries the fingers (or below it), or, without a hand, below the
+                   chain's tip with no moving joint below it
+parallel gripper   its two fingers are coupled by a ``mimic`` tag (one driven, one mimicking it)
+hand (3+ fingers)  never: which branch is the thumb rests on names and geometry
+camera             a Gazebo camera sensor names its frame (and nothing about its axis is odd)
+torso, neck        never: both are found by where arms branch and what carries cameras
+drive              a Gazebo drive plugin names it, or an SRDF virtual joint states ``floating``
+                   (or ``fixed`` on a robot with no wheels, legs or rotors); a planar virtual
+                   joint says the base moves in the plane, not whether sideways: a question
+forward            never
+=================  ===========================================================================
+
+A manipulator's ``front_facing_orientation`` follows from its tool frame and fingers (the way
+from the hand's root to its tips, in the tool frame): it is written with that reason as a plain
+comment, and marked only when the hand gives no way to face (a default).
+"""
+
+from __future__ import annotations
+
+from robotspec.description.srdf import Srdf
+from robotspec.model.entities import Body
+from robotspec.model.world import World
+from robotspec.spec.draft.tool_frames import is_bare_frame, is_named_tcp
+from robotspec.spec.draft.tree import Tree
+
+__all__ = [
+    "camera_question",
+    "chain_question",
+    "drive_question",
+    "gripper_question",
+    "srdf_carries",
+    "tool_frame_question",
+]
+
+
+def srdf_carries(srdf: Srdf | None, group: str, tip: str) -> str | None:
+    """The SRDF end effector that hangs on ``group`` (ending at ``tip``), if one does."""
+    if srdf is None:
+        return None
+    for ee in srdf.end_effectors:
+        if group in (ee.parent_group, ee.group) or ee.parent_link == tip:
+            return ee.name
+    return None
+
+
+def chain_question(srdf: Srdf | None, group: str | None, tip: str, tree_agrees: bool) -> str | None:
+    """Why a drafted chain is a question, or ``None`` when the files state it (see the table)."""
+    if group is None:
+        return "by the tree's shape"
+    if not tree_agrees:
+        return None  # the caller says how the tree disagrees
+    if srdf_carries(srdf, group, tip) is None:
+        return f"the SRDF groups these joints ('{group}'), but no end effector hangs on the group"
+    return None
+
+
+def tool_frame_question(
+    world: World,
+    tool: Body,
+    *,
+    hand: Body | None,
+    tip: Body,
+    srdf_parent: Body | None,
+    tree: Tree,
+) -> str | None:
+    """Why a tool frame the URDF has is a question, or ``None`` when the files state it.
+
+    ``hand``: where the hand's fingers hang (the gripper's root, or the hand the tree found);
+    ``tip``: the chain's tip; ``srdf_parent``: the SRDF end effector's parent link.
+    """
+    if srdf_parent is not None and tool is srdf_parent and is_bare_frame(world, tool):
+        return None
+    if not is_named_tcp(world, tool):
+        return f"the tool frame '{tool.name}' by its name"
+    if hand is not None:
+        if world.is_ancestor(hand, tool) or _rigid_with(world, tool, hand):
+            return None
+        return f"the tool frame '{tool.name}' is named as a TCP but hangs beside the hand"
+    if world.is_ancestor(tip, tool) and not tree.moves_below(tip):
+        return None
+    return f"the tool frame '{tool.name}' is named as a TCP but is not at the chain's end"
+
+
+def _rigid_with(world: World, a: Body, b: Body) -> bool:
+    """Whether ``a`` hangs on fixed joints from a body that ``b`` is fixed to (one rigid part)."""
+
+    def carrier(x: Body) -> Body:
+        while (c := world.parent_connection(x)) is not None and c.is_fixed:
+            x = world.bodies[c.parent]
+        return x
+
+    return carrier(a) is carrier(b)
+
+
+def gripper_question(coupled: bool, one_driven: bool) -> str | None:
+    """Why a parallel gripper's fingers are a question, or ``None`` when a mimic tag pairs them."""
+    if coupled and one_driven:
+        return None
+    if not coupled:
+        return "the two finger branches move on joints no mimic tag couples: a gripper?"
+    return "both fingers are driven; the thumb is the one on the hand's +y side"
+
+
+def camera_question(stated: bool, found_by: str) -> str | None:
+    """Why a camera is a question (``found_by``: how the tree found it), ``None`` when stated."""
+    return None if stated else found_by
+
+
+def drive_question(virtual: str, moves: bool) -> str | None:
+    """Why a drive taken from an SRDF virtual joint of type ``virtual`` is a question.
+
+    ``moves``: whether the tree has wheels, legs or rotors (a base that may move).
+    """
+    if virtual == "floating":
+        return None
+    if virtual == "fixed":
+        return (
+            "the SRDF's virtual joint is fixed, but the robot has wheels, legs or rotors"
+            if moves
+            else None
+        )
+    return f"the SRDF's {virtual} virtual joint moves the base in the plane: omni, or differential?"

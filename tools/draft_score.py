@@ -28,7 +28,9 @@ Whether a wrong item carried a ``DECIDE`` mark (``RobotScore.unmarked`` lists th
 not): an extra drafted chain, camera, gripper, torso, neck, drive or facing by its own mark; a
 missed chain, torso or neck when a drafted chain over some of its joints is marked (the
 question the user is asked is then the one that finds it); a missed tool frame or
-gripper when some drafted manipulator is marked; a missed camera never (nothing asks to look).
+gripper when some drafted manipulator is marked; a missed camera when a drafted camera rigidly
+fixed to the same link (another frame of the same device: its depth channel, its mount) is
+marked (the question asked about that camera is the one that finds it), else never.
 """
 
 from __future__ import annotations
@@ -193,7 +195,8 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
     want_cams = list(t.get("cameras") or [])
     have_cams = [c.body for c in draft.cameras]
     for body in want_cams:
-        s.add("cameras", body in have_cams, f"{body} not a camera", marked=False)
+        near = [c for c in draft.cameras if c.decide and _same_device(world, c.body, body)]
+        s.add("cameras", body in have_cams, f"{body} not a camera", marked=bool(near))
     for cam in draft.cameras:
         if cam.body not in want_cams:
             s.add(
@@ -236,6 +239,23 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         marked=d is not None and bool(d.decide),
     )
     return s
+
+
+def _same_device(world: object, a: str, b: str) -> bool:
+    """Whether links ``a`` and ``b`` are rigidly fixed to one link (fixed joints up to it)."""
+    from robotspec.model.world import World
+
+    assert isinstance(world, World)
+    if not (world.has_body(a) and world.has_body(b)):
+        return False
+
+    def carrier(name: str) -> object:
+        body = world.get_body_by_name(name)
+        while (c := world.parent_connection(body)) is not None and c.is_fixed:
+            body = world.bodies[c.parent]
+        return body
+
+    return carrier(a) is carrier(b)
 
 
 def score_missing(truth: Truth) -> RobotScore:

@@ -82,6 +82,14 @@ class LoopState:
         self._has_jog_command = robot_info.has(RobotCapability.jog_command)
         self._has_trajectory_command = robot_info.has(RobotCapability.trajectory_command)
         self._limits = JointLimitArrays.from_info(robot_info)
+        self._set_up_chains(robot_info)
+        self._set_up_seed_fields(update_period)
+        self._lock = threading.RLock()
+        self._clock: Clock = clock if clock is not None else RealClock()
+        self._set_up_internals(update_period)
+
+    def _set_up_chains(self, robot_info: RobotInfo) -> None:
+        """Each chain's H/P kinematics, reach, tool and payload, from the RobotInfo."""
         n = self._joint_count
         chains = robot_info.chains
         self._chain_joints = [np.array(c.joint_numbers, dtype=np.intp) for c in chains]
@@ -110,6 +118,9 @@ class LoopState:
         self._chain_is_all = [idx == list(range(n)) for idx in self._chain_idx_list]
         self._endpoint_key: tuple[bytes, bytes, int] | None = None
         self._endpoint_cache: tuple[list[TcpPose], list[F64]] | None = None
+
+    def _set_up_seed_fields(self, update_period: float) -> None:
+        """The reference driver's own fields: modes, measured state, flags, timeouts."""
         self._keep_going = False
         self._update_period = update_period
         self._speed_ratio = 1.0
@@ -140,9 +151,9 @@ class LoopState:
         self._config_seqno = 1
         self._base_set_operational_mode = True
         self._base_set_controller_state = True
-        self._lock = threading.RLock()
-        self._clock: Clock = clock if clock is not None else RealClock()
-        # --- internals beyond the seed ---
+
+    def _set_up_internals(self, update_period: float) -> None:
+        """Fields beyond the seed: the guard, jogs, streams, trajectories, timing, listeners."""
         self._guard = CommandGuard(self._limits, update_period)
         self._fault_message = ""
         self._flags = StateFlags.none

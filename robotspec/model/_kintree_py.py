@@ -43,6 +43,9 @@ KIND_PRISMATIC = 2
 #: How a node moves: about its stored z axis (a frame axis), along it, or by Rodrigues' terms.
 TURN, SLIDE, GENERAL = 0, 1, 2
 
+#: Fewer samples than this: a step's constant products gather their nodes (two numpy calls),
+#: not one product per node (fewer copies, more calls).
+_GATHER_BELOW = 32
 #: Samples per step of a batch: the step's buffers (node poses, gathered and final body poses:
 #: about 3 MB on the PR2) stay in the caches.
 _CHUNK = 256
@@ -99,9 +102,12 @@ class Group:
 
     how: int  # TURN, SLIDE or GENERAL
     nodes: slice  # the node slots written
-    reads: slice | I64  # their parents' node slots (a slice when consecutive: a view)
+    reads: tuple[tuple[slice, Any], ...]  # (its nodes, their parents): parents' slots as a
+    # slice (consecutive: a view), an int (one parent for all: broadcast) or an index array
+    parents: I64  # their parents' node slots
     weights: F64  # (k, 4, 4); GENERAL: (k, 4, 12), [W0 W1 W2]
     motion: slice  # their rows of the motion values (Tree.dof)
+    column: int  # TURN: the first of the two columns turned; SLIDE: the column slid along
     turning: Any  # GENERAL only: (k, 1, 1, 1) whether each turns (else it slides)
 
 
@@ -111,8 +117,9 @@ class Tree:
 
     Node 0 is the root (the identity); ``groups`` compute the others, in depth order. Motion
     rows (``dof``, ``mul``, ``off``: value ``q[dof] * mul + off``) are the turns first (their
-    value is minus the C core's angle), then the slides, then the general motions. Body ``b`` is
-    node ``out_node[b]`` times ``out_pose[b]``.
+    value is minus the C core's angle), then the slides, then the general motions. A body is
+    a node's pose as it is (``at``: its slot), or a node's pose times a constant (``extra_node``
+    times ``extra_pose``, stored after the nodes, at ``n_nodes + i``).
     """
 
     n_slots: int
@@ -124,8 +131,10 @@ class Tree:
     off: F64
     n_turn: int
     groups: tuple[Group, ...]
-    out_node: I64
-    out_pose: F64
+    at: I64  # per body: its slot in the step's store (nodes, then extra poses)
+    extra_node: I64
+    extra_pose: F64
+    extra_runs: tuple[tuple[int, slice], ...]  # (node, its extra poses): sorted by node
 
 
 def tree(
@@ -193,80 +202,140 @@ def _program(n_slots: int, n_out: int, n_dof: int, rows: tuple[Any, ...], row_de
     o[:, 3] = (0.0, 0.0, 0.0, 1.0)  # the C core reads an origin's three first rows only
     on_node = np.zeros(n_slots, dtype=np.int64)  # slot = node pose @ times[slot]
     times = np.tile(np.eye(4), (n_slots, 1, 1))
-    # per node: parent, depth, how, weights, dof, mul, off, turns
-    nodes: list[tuple[int, int, int, F64, int, float, float, bool]] = []
+    nodes: list[_Node] = []
     depth = [0]
     for r in range(len(p)):
         parent, lead = int(on_node[p[r]]), times[p[r]] @ o[r]
         if k[r] == KIND_FIXED:
             on_node[c[r]], times[c[r]] = parent, lead
             continue
-        frame = _frame_axis(a[r])
-        if frame is None:
-            m1, m2 = motion_terms(k[r : r + 1], a[r : r + 1])
-            w = np.concatenate([lead, lead @ m1[0], lead @ m2[0]], axis=1)
-            how, mul, off, back = GENERAL, m[r], f[r], np.eye(4)
-        else:
-            ax, sign = frame
-            perm = np.eye(4)[:, [(ax + 1) % 3, (ax + 2) % 3, ax, 3]]  # stored = body @ perm
-            w, back = lead @ perm, perm.T
-            turn = k[r] == KIND_REVOLUTE
-            s = -sign if turn else sign  # a turn's value is minus its angle: exp(-i angle)
-            how, mul, off = (TURN if turn else SLIDE), s * m[r], s * f[r]
-        nodes.append(
-            (parent, depth[parent] + 1, how, w, int(d[r]), mul, off, k[r] == KIND_REVOLUTE)
-        )
-        depth.append(depth[parent] + 1)
+        node, back = _node(parent, depth[parent] + 1, lead, k[r], a[r], int(d[r]), m[r], f[r])
+        nodes.append(node)
+        depth.append(node.depth)
         on_node[c[r]], times[c[r]] = len(nodes), back
-    # Nodes sorted by (depth, how): each group one block of node slots and of motion rows.
-    order = sorted(range(len(nodes)), key=lambda i: (nodes[i][1], nodes[i][2]))
+    # Nodes sorted by (depth, how, column): each group one block of node slots, of motion rows.
+    order = sorted(range(len(nodes)), key=lambda i: nodes[i].key)
     new_id = np.zeros(len(nodes) + 1, dtype=np.int64)
     new_id[np.asarray(order, dtype=np.int64) + 1] = np.arange(1, len(nodes) + 1)
-    by_how = [[i for i in order if nodes[i][2] == h] for h in (TURN, SLIDE, GENERAL)]
-    motion_rows = by_how[0] + by_how[1] + by_how[2]
+    motion_rows = sorted(order, key=lambda i: nodes[i].how)  # turns, slides, general (stable)
     row_of = {i: r for r, i in enumerate(motion_rows)}
     groups: list[Group] = []
     lo = 0
     while lo < len(order):
         hi = lo
-        key = nodes[order[lo]][1:3]
-        while hi < len(order) and nodes[order[hi]][1:3] == key:
+        while hi < len(order) and nodes[order[hi]].key == nodes[order[lo]].key:
             hi += 1
-        members = order[lo:hi]
-        how = key[1]
-        turning = np.array([nodes[i][7] for i in members])[:, None, None, None]
+        members = [nodes[i] for i in order[lo:hi]]
+        first = row_of[order[lo]]
+        how = members[0].how
+        turning = np.array([n.revolute for n in members])[:, None, None, None]
         groups.append(
             Group(
                 how,
                 slice(lo + 1, hi + 1),
-                _reads(new_id[[nodes[i][0] for i in members]]),
-                np.ascontiguousarray(np.stack([nodes[i][3] for i in members])),
-                slice(row_of[members[0]], row_of[members[0]] + len(members)),
+                _parts(new_id[[n.parent for n in members]]),
+                new_id[[n.parent for n in members]],
+                np.ascontiguousarray(np.stack([n.weights for n in members])),
+                slice(first, first + len(members)),
+                members[0].column,
                 turning if how == GENERAL else None,
             )
         )
         lo = hi
+    # A body whose constant is the identity is its node's pose; the others are computed after.
+    plain = (times[:n_out] == np.eye(4)).all(axis=(1, 2))
+    at = new_id[on_node[:n_out]]
+    extra = np.flatnonzero(~plain)
+    extra = extra[np.argsort(at[extra], kind="stable")]  # by node: one product per node
+    at[extra] = len(nodes) + 1 + np.arange(len(extra))
+    extra_node = new_id[on_node[extra]]
+    starts = np.flatnonzero(np.diff(extra_node, prepend=-1))
+    ends = np.append(starts[1:], len(extra))[: len(starts)]
     return Tree(
         n_slots,
         n_out,
         n_dof,
         len(nodes) + 1,
-        np.array([nodes[i][4] for i in motion_rows], dtype=np.int64),
-        np.array([nodes[i][5] for i in motion_rows], dtype=np.float64),
-        np.array([nodes[i][6] for i in motion_rows], dtype=np.float64),
-        len(by_how[0]),
+        np.array([nodes[i].dof for i in motion_rows], dtype=np.int64),
+        np.array([nodes[i].mul for i in motion_rows], dtype=np.float64),
+        np.array([nodes[i].off for i in motion_rows], dtype=np.float64),
+        sum(n.how == TURN for n in nodes),
         tuple(groups),
-        new_id[on_node[:n_out]],
-        np.ascontiguousarray(times[:n_out]),
+        at,
+        extra_node,
+        np.ascontiguousarray(times[extra]),
+        tuple(
+            (int(extra_node[i]), slice(int(i), int(j))) for i, j in zip(starts, ends, strict=True)
+        ),
     )
 
 
-def _reads(parents: I64) -> slice | I64:
-    """The node slots a group reads: a slice when they are consecutive (a view, not a copy)."""
-    lo = int(parents[0])
-    if (parents == np.arange(lo, lo + len(parents))).all():
-        return slice(lo, lo + len(parents))
-    return parents
+@dataclass(frozen=True)
+class _Node:
+    """A moving row at build time: ``node = parent @ weights @ motion(q[dof] * mul + off)``."""
+
+    parent: int
+    depth: int
+    how: int
+    column: int
+    weights: F64
+    dof: int
+    mul: float
+    off: float
+    revolute: bool
+
+    @property
+    def key(self) -> tuple[int, int, int]:
+        return self.depth, self.how, self.column
+
+
+def _node(
+    parent: int, depth: int, lead: F64, kind: Any, u: F64, dof: int, mul: float, off: float
+) -> tuple[_Node, F64]:
+    """A moving row as a node, and the constant its child slot's pose is the node's pose times.
+
+    A turn about frame axis k mixes columns i = k+1, j = k+2 (mod 3), as one complex number
+    ``col_i + i col_j`` when they are neighbours (x: 1 and 2, z: 0 and 1); about y the columns
+    are stored as (2, 0, 1), an exact permutation undone by the constant. A slide along frame
+    axis k adds ``v`` times column k to column 3. Any other axis: Rodrigues' terms.
+    """
+    revolute = bool(kind == KIND_REVOLUTE)
+    frame = _frame_axis(u)
+    if frame is None:
+        m1, m2 = motion_terms(np.array([kind]), u[None, :])
+        w = np.concatenate([lead, lead @ m1[0], lead @ m2[0]], axis=1)
+        return _Node(parent, depth, GENERAL, 0, w, dof, mul, off, revolute), np.eye(4)
+    ax, sign = frame
+    if not revolute:
+        return _Node(parent, depth, SLIDE, ax, lead, dof, sign * mul, sign * off, False), np.eye(4)
+    # a turn's value is minus its angle: its complex factor is exp(-i angle)
+    if ax == 1:
+        perm = np.eye(4)[:, [2, 0, 1, 3]]  # stored = body @ perm
+        return _Node(
+            parent, depth, TURN, 0, lead @ perm, dof, -sign * mul, -sign * off, True
+        ), perm.T
+    col = (ax + 1) % 3
+    return _Node(parent, depth, TURN, col, lead, dof, -sign * mul, -sign * off, True), np.eye(4)
+
+
+def _parts(parents: I64) -> tuple[tuple[slice, Any], ...]:
+    """A group's reads as few products as possible, none of them a gathered copy if it can be.
+
+    Runs of consecutive parents are a slice (a view), runs of one parent an int (broadcast
+    against the run's weights); more than two runs are one gather of every parent.
+    """
+    parts: list[tuple[slice, Any]] = []
+    lo = 0
+    while lo < len(parents):
+        hi, first = lo + 1, int(parents[lo])
+        same = hi < len(parents) and parents[hi] == first
+        while hi < len(parents) and parents[hi] == (first if same else first + hi - lo):
+            hi += 1
+        parts.append((slice(lo, hi), first if same else slice(first, first + hi - lo)))
+        lo = hi
+    if len(parts) > 2:
+        return ((slice(0, len(parents)), parents),)
+    return tuple(parts)
 
 
 def _tree_of(obj: object) -> Tree:
@@ -279,28 +348,45 @@ def tree_size(tree: object) -> tuple[int, int]:
     return t.n_out, t.n_dof
 
 
-def _buffers(t: Tree, n: int) -> tuple[F64, F64, F64]:
-    """A step's node poses (root set to the identity), gathered and final body poses."""
-    nodes = np.empty((t.n_nodes, n, 4, 4))
-    nodes[0] = np.eye(4)
-    return nodes, np.empty((t.n_out, n, 4, 4)), np.empty((t.n_out, n, 4, 4))
+def _buffers(t: Tree, n: int) -> tuple[F64, F64]:
+    """A step's store (node poses, root set to the identity, then extra poses) and gather."""
+    store = np.empty((t.n_nodes + len(t.extra_node), n, 4, 4))
+    store[0] = np.eye(4)
+    return store, np.empty((len(t.extra_node), n, 4, 4))
 
 
-def _run(t: Tree, q: F64, out: F64, bufs: tuple[F64, F64, F64]) -> None:
+def _cos_sin(v: F64, cos: F64, sin: F64) -> None:
+    """The cosine and sine of v from t = tan(v / 2): (1 - t^2) / (1 + t^2), 2 t / (1 + t^2).
+
+    Why: numpy vectorises ``tan`` (SIMD, about 2 ns a value here) but not ``sin`` and ``cos``
+    (about 15 ns each), and this is the one transcendental per turn. Near v = pi, t is large
+    and both quotients stay accurate (sin v is about 2 / t); the results agree with the C
+    core's ``sincos`` to a few units in the last place.
+    """
+    t = np.multiply(v, 0.5)
+    np.tan(t, out=t)
+    t2 = np.multiply(t, t)
+    np.subtract(1.0, t2, out=cos)
+    t2 += 1.0
+    cos /= t2
+    np.multiply(t, 2.0, out=sin)
+    sin /= t2
+
+
+def _run(t: Tree, q: F64, out: F64, bufs: tuple[F64, F64]) -> None:
     """Every output pose of the samples of ``q`` (n, D) into ``out`` (n, B, 4, 4)."""
     n = q.shape[0]
-    nodes, gathered, bodies = bufs
+    store, gathered = bufs
     v = np.take(q.T, t.dof, axis=0)  # (motion rows, n)
     v *= t.mul[:, None]
     v += t.off[:, None]
     turns = np.empty((t.n_turn, n), dtype=np.complex128)  # exp(-i angle) of every turn
-    np.cos(v[: t.n_turn], out=turns.real)
-    np.sin(v[: t.n_turn], out=turns.imag)
+    _cos_sin(v[: t.n_turn], turns.real, turns.imag)
     for g in t.groups:
         k = g.nodes.stop - g.nodes.start
-        src = nodes[g.reads] if isinstance(g.reads, slice) else np.take(nodes, g.reads, axis=0)
-        dst = nodes[g.nodes]
+        dst = store[g.nodes]
         if g.how == GENERAL:
+            src = np.take(store, g.parents, axis=0)
             x = np.matmul(src.reshape(k, 4 * n, 4), g.weights).reshape(k, n, 4, 3, 4)
             val = v[g.motion][:, :, None, None]
             first = np.where(g.turning, np.sin(val), val)
@@ -308,17 +394,29 @@ def _run(t: Tree, q: F64, out: F64, bufs: tuple[F64, F64, F64]) -> None:
             np.add(x[..., 0, :], x[..., 1, :] * first, out=dst)
             dst += x[..., 2, :] * second
             continue
-        np.matmul(src.reshape(k, 4 * n, 4), g.weights, out=dst.reshape(k, 4 * n, 4))
-        if g.how == TURN:  # stored columns 0 and 1 as one complex number, turned at once
-            cols = dst.view(np.complex128)[..., 0]
+        for part, src in g.reads:
+            width = part.stop - part.start
+            if isinstance(src, slice | int):
+                lhs = store[src].reshape(-1, 4 * n, 4)
+            else:
+                lhs = np.take(store, src, axis=0).reshape(width, 4 * n, 4)
+            np.matmul(lhs, g.weights[part], out=dst[part].reshape(width, 4 * n, 4))
+        if g.how == TURN:  # the two columns as one complex number, turned at once
+            cols = dst[..., g.column : g.column + 2].view(np.complex128)[..., 0]
             cols *= turns[g.motion][:, :, None]
-        else:  # a slide along stored z: column 3 += v column 2
-            dst[..., 3] += dst[..., 2] * v[g.motion][:, :, None]
-    np.take(nodes, t.out_node, axis=0, out=gathered, mode="clip")
-    np.matmul(
-        gathered.reshape(t.n_out, 4 * n, 4), t.out_pose, out=bodies.reshape(t.n_out, 4 * n, 4)
-    )
-    out[...] = bodies.transpose(1, 0, 2, 3)
+        else:  # a slide: column 3 += v column k
+            dst[..., 3] += dst[..., g.column] * v[g.motion][:, :, None]
+    n_extra = len(t.extra_node)
+    extra = store[t.n_nodes :].reshape(n_extra, 4 * n, 4)
+    if n < _GATHER_BELOW:  # a few samples: one gather and one product for all
+        np.take(store, t.extra_node, axis=0, out=gathered, mode="clip")
+        np.matmul(gathered.reshape(n_extra, 4 * n, 4), t.extra_pose, out=extra)
+    else:  # a product per node, its poses broadcast: no copy of them
+        for node, run in t.extra_runs:
+            np.matmul(store[node].reshape(4 * n, 4), t.extra_pose[run], out=extra[run])
+    # Whole poses (128 bytes) moved at once into the result's layout.
+    poses = store.reshape(len(store), n, 16).view("V128")[..., 0]
+    out.reshape(n, t.n_out, 16).view("V128")[..., 0][...] = np.take(poses, t.at, axis=0).T
 
 
 def fk(tree: object, q: object) -> F64:

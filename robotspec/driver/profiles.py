@@ -166,71 +166,11 @@ class JogMotion:
         tgt_l = tgt.tolist() if tgt is not None else None
         tv = self.target_velocity
         tv_l = tv.tolist() if tv is not None and self.t < self.velocity_until else None
-        n = len(q_l)
-        # 1. The velocity each joint wants.
-        want = [0.0] * n
-        for i in range(n):
-            if tgt_l is not None:
-                dist = tgt_l[i] - q_l[i]
-                b = braking_speed(abs(dist), amax_l[i] * BRAKING_MARGIN, dt)
-                vm = vmax_l[i]
-                b = vm if b > vm else b
-                want[i] = b if dist > 0.0 else (-b if dist < 0.0 else dist * 0.0)
-            elif tv_l is not None:
-                want[i] = tv_l[i]
-        # 2. Within the acceleration limits: joint by joint, or all joints scaled together.
-        if self.coordinated:
-            k = 1.0
-            for i in range(n):
-                dv = abs(want[i] - v_l[i])
-                adt = amax_l[i] * dt
-                if dv > adt:
-                    k = min(k, adt / dv)
-            v_new = [v_l[i] + k * (want[i] - v_l[i]) for i in range(n)]
-        else:
-            v_new = [0.0] * n
-            for i in range(n):
-                adt = amax_l[i] * dt
-                v = v_l[i]
-                x = want[i]
-                x = v - adt if x < v - adt else x
-                v_new[i] = v + adt if x > v + adt else x
-        # 3. Never faster than the speed from which the joint can stop at its limit.
-        q_out = [0.0] * n
-        all_landed = tgt_l is not None
-        moving = False
-        braking = False
-        for i in range(n):
-            q, a = q_l[i], amax_l[i]
-            lo, hi = lower_l[i], upper_l[i]
-            x = v_new[i]
-            cap_hi = braking_speed(hi - q, a, dt)
-            if x > cap_hi:
-                x = cap_hi
-                braking = True
-            cap_lo = -braking_speed(q - lo, a, dt)
-            if x < cap_lo:
-                x = cap_lo
-                braking = True
-            q_new = q + x * dt
-            if tgt_l is not None:
-                t_i = tgt_l[i]
-                # Snap onto the target when it is that close and the snap keeps the joint
-                # able to stop at its limits (a target on a limit is approached, not snapped).
-                if abs(t_i - q_new) <= SNAP_FRACTION * a * dt * dt and (
-                    cap_lo <= (t_i - q) / dt <= cap_hi
-                ):
-                    q_new = t_i
-                if q_new != t_i:
-                    all_landed = False
-            q_new = lo if q_new < lo else q_new
-            q_new = hi if q_new > hi else q_new
-            # The velocity actually realised (a snap or a clamp changes it by a hair).
-            x = (q_new - q) / dt
-            if x != 0.0:
-                moving = True
-            q_out[i] = q_new
-            v_new[i] = x
+        want = _wanted_velocity(q_l, tgt_l, tv_l, amax_l, vmax_l, dt)
+        v_new = _accelerate(want, v_l, amax_l, dt, coordinated=self.coordinated)
+        q_out, all_landed, moving, braking = _brake_and_move(
+            q_l, v_new, tgt_l, amax_l, lower_l, upper_l, dt
+        )
         self.limit_braking = braking
         if tgt_l is not None:
             self.done = all_landed and not moving
@@ -241,6 +181,109 @@ class JogMotion:
         self.v = np.array(v_new)
         self.t += dt
         return q_arr
+
+
+def _wanted_velocity(
+    q: list[float],
+    target: list[float] | None,
+    target_velocity: list[float] | None,
+    amax: list[float],
+    vmax: list[float],
+    dt: float,
+) -> list[float]:
+    """Step 1 of a jog: the velocity each joint wants (toward its target, or the one asked)."""
+    n = len(q)
+    want = [0.0] * n
+    for i in range(n):
+        if target is not None:
+            dist = target[i] - q[i]
+            b = braking_speed(abs(dist), amax[i] * BRAKING_MARGIN, dt)
+            vm = vmax[i]
+            b = vm if b > vm else b
+            want[i] = b if dist > 0.0 else (-b if dist < 0.0 else dist * 0.0)
+        elif target_velocity is not None:
+            want[i] = target_velocity[i]
+    return want
+
+
+def _accelerate(
+    want: list[float], v: list[float], amax: list[float], dt: float, *, coordinated: bool
+) -> list[float]:
+    """Step 2: toward ``want`` within the acceleration limits, joint by joint or all together.
+
+    Coordinated: every joint's change is scaled by one factor, so the joints keep their ratio
+    (a Cartesian jog keeps its direction).
+    """
+    n = len(v)
+    if coordinated:
+        k = 1.0
+        for i in range(n):
+            dv = abs(want[i] - v[i])
+            adt = amax[i] * dt
+            if dv > adt:
+                k = min(k, adt / dv)
+        return [v[i] + k * (want[i] - v[i]) for i in range(n)]
+    out = [0.0] * n
+    for i in range(n):
+        adt = amax[i] * dt
+        vi = v[i]
+        x = want[i]
+        x = vi - adt if x < vi - adt else x
+        out[i] = vi + adt if x > vi + adt else x
+    return out
+
+
+def _brake_and_move(
+    q_l: list[float],
+    v_new: list[float],
+    tgt_l: list[float] | None,
+    amax_l: list[float],
+    lower_l: list[float],
+    upper_l: list[float],
+    dt: float,
+) -> tuple[list[float], bool, bool, bool]:
+    """Step 3: never faster than the speed from which a joint can stop at its limit; move.
+
+    ``v_new`` becomes the velocity each joint realised. Returns the new positions, whether
+    every joint landed on its target, whether any moved, and whether a limit braked one.
+    """
+    n = len(q_l)
+    q_out = [0.0] * n
+    all_landed = tgt_l is not None
+    moving = False
+    braking = False
+    for i in range(n):
+        q, a = q_l[i], amax_l[i]
+        lo, hi = lower_l[i], upper_l[i]
+        x = v_new[i]
+        cap_hi = braking_speed(hi - q, a, dt)
+        if x > cap_hi:
+            x = cap_hi
+            braking = True
+        cap_lo = -braking_speed(q - lo, a, dt)
+        if x < cap_lo:
+            x = cap_lo
+            braking = True
+        q_new = q + x * dt
+        if tgt_l is not None:
+            t_i = tgt_l[i]
+            # Snap onto the target when it is that close and the snap keeps the joint
+            # able to stop at its limits (a target on a limit is approached, not snapped).
+            if abs(t_i - q_new) <= SNAP_FRACTION * a * dt * dt and (
+                cap_lo <= (t_i - q) / dt <= cap_hi
+            ):
+                q_new = t_i
+            if q_new != t_i:
+                all_landed = False
+        q_new = lo if q_new < lo else q_new
+        q_new = hi if q_new > hi else q_new
+        # The velocity actually realised (a snap or a clamp changes it by a hair).
+        x = (q_new - q) / dt
+        if x != 0.0:
+            moving = True
+        q_out[i] = q_new
+        v_new[i] = x
+    return q_out, all_landed, moving, braking
 
 
 class StreamLimiter:

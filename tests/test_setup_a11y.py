@@ -87,7 +87,7 @@ def test_every_tab_has_no_serious_accessibility_violation(browser: Any, tmp_path
         _wait("the page's additions", lambda: d.find_elements(By.TAG_NAME, "h1"))
         page._state_part.value = "chains.arm"  # the arm's sliders on the states tab
         page._show_sliders()
-        for tab in ("Questions", "Parts", "States", "Check & save", "YAML"):
+        for tab in ("Questions", "Parts", "States", "Frames & more", "Check & save", "YAML"):
             _tab(d, tab)
             _wait(f"the {tab} tab shown", lambda tab=tab: _shown(d, tab))
             if tab == "States":

@@ -155,32 +155,50 @@ class SimRobot(RobotDriver):
             self._homing_target = None
             self._homing_completion = None
         q_l = self._q.tolist()
+        v_l = self._servo(q_l, self._desired_velocity(q_l, now, dt), dt)
+        self._q[:] = q_l
+        self._v[:] = v_l
+        if self._homing_target is not None and self._homed_now(q_l, v_l, dt):
+            self._q[:] = self._homing_target
+            self._v[:] = 0.0
+            self._homing_target = None
+            self._sim_homed = True
+            self._homing_finished(True)
+
+    def _desired_velocity(self, q_l: list[float], now: float, dt: float) -> list[float]:
+        """The velocity the controller asks for: homing, the position or velocity command, or 0."""
         n = len(q_l)
         if self._homing_target is not None:
-            v_des_l = self._homing_velocity(q_l, dt)
-        elif self._pending_pos is not None:
-            pending = self._pending_pos.tolist()
-            aim = self._aim(pending, now)
-            v_des_l = [(aim[i] - q_l[i]) / dt for i in range(n)]
-            if pending == self._settle_on:
-                # A command held still: brake so as to land on it (the braking curve). Without
-                # this, short steps make the servo ring around the target.
-                for i in range(n):
-                    err = pending[i] - q_l[i]
-                    v_cap = braking_speed(abs(err), self._acc_l[i], dt)
-                    x = v_des_l[i]
-                    x = -v_cap if x < -v_cap else x
-                    v_des_l[i] = v_cap if x > v_cap else x
-            self._settle_on = pending
-        elif self._pending_vel is not None:
-            v_des_l = self._pending_vel.tolist()
-        else:
-            v_des_l = [0.0] * n
-        # Per joint in plain floats (several times faster than numpy calls on a few joints);
-        # the clamps propagate NaN as np.minimum / np.maximum do.
+            return self._homing_velocity(q_l, dt)
+        if self._pending_vel is not None and self._pending_pos is None:
+            return list(self._pending_vel.tolist())
+        if self._pending_pos is None:
+            return [0.0] * n
+        pending = self._pending_pos.tolist()
+        aim = self._aim(pending, now)
+        v_des_l = [(aim[i] - q_l[i]) / dt for i in range(n)]
+        if pending == self._settle_on:
+            # A command held still: brake so as to land on it (the braking curve). Without
+            # this, short steps make the servo ring around the target.
+            for i in range(n):
+                err = pending[i] - q_l[i]
+                v_cap = braking_speed(abs(err), self._acc_l[i], dt)
+                x = v_des_l[i]
+                x = -v_cap if x < -v_cap else x
+                v_des_l[i] = v_cap if x > v_cap else x
+        self._settle_on = pending
+        return v_des_l
+
+    def _servo(self, q_l: list[float], v_des_l: list[float], dt: float) -> list[float]:
+        """One step of the servos toward ``v_des_l``: speed, acceleration and limit braking.
+
+        Per joint in plain floats (several times faster than numpy calls on a few joints); the
+        clamps propagate NaN as np.minimum / np.maximum do. ``q_l`` becomes the new positions;
+        returns the new velocities.
+        """
         v_l = self._v.tolist()
         vmax_l, acc_l, lower_l, upper_l = self._vmax_l, self._acc_l, self._lower_l, self._upper_l
-        for i in range(n):
+        for i in range(len(q_l)):
             vm = vmax_l[i]
             x = v_des_l[i]
             x = -vm if x < -vm else x
@@ -203,14 +221,7 @@ class SimRobot(RobotDriver):
                 q, v = upper_l[i], 0.0
             q_l[i] = q
             v_l[i] = v
-        self._q[:] = q_l
-        self._v[:] = v_l
-        if self._homing_target is not None and self._homed_now(q_l, v_l, dt):
-            self._q[:] = self._homing_target
-            self._v[:] = 0.0
-            self._homing_target = None
-            self._sim_homed = True
-            self._homing_finished(True)
+        return v_l
 
     def _homing_velocity(self, q_l: list[float], dt: float) -> list[float]:
         """The velocity the homing controller asks for: toward home, braking to stop on it.

@@ -385,8 +385,8 @@ def batch_rows(samples: int, collision_configs: int, rounds: int) -> list[Row]:
         )
     )
     # pinocchio's own batch: computeCollisionsInParallel over a pool, one answer per
-    # configuration (any hit), on every CPU, with and without its broad phase. The checker's
-    # batch runs on one thread: these rows give pinocchio every CPU and robotspec one.
+    # configuration (any hit), on every CPU, with and without its broad phase; the checker's
+    # batch on as many threads (threads=), as the rows say (it ran on one before issue 34).
     threads = max(1, os.cpu_count() or 1)
     qmat = np.asfortranarray(np.array(cpqs).T)
     pool = pin.GeometryPool(model, gmodel, threads)
@@ -404,7 +404,7 @@ def batch_rows(samples: int, collision_configs: int, rounds: int) -> list[Row]:
         (pin_parallel, "computeCollisionsInParallel (GeometryPool)"),
         (pin_parallel_broad, "computeCollisionsInParallel (broad phase pool)"),
     ):
-        t = duel(lambda _: checker.in_collision_batch(cqs), [0], peer, [0], rounds)
+        t = duel(lambda _: checker.in_collision_batch(cqs, threads=threads), [0], peer, [0], rounds)
         rows.append(
             Row(
                 f"pr2: self-collision any hit, batch of {n}, {threads} threads (per config)",

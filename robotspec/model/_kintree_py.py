@@ -373,15 +373,23 @@ def _cos_sin(v: F64, cos: F64, sin: F64) -> None:
     sin /= t2
 
 
-def _run(t: Tree, q: F64, out: F64, bufs: tuple[F64, F64]) -> None:
-    """Every output pose of the samples of ``q`` (n, D) into ``out`` (n, B, 4, 4)."""
-    n = q.shape[0]
-    store, gathered = bufs
-    v = np.take(q.T, t.dof, axis=0)  # (motion rows, n)
+def _motions(t: Tree, q: F64) -> tuple[F64, Any]:
+    """Every motion row's value (rows, N) and every turn's ``exp(-i angle)``, for all samples.
+
+    Made once for the whole batch (a few whole-array operations), not once per step.
+    """
+    v = q[:, t.dof].T.copy()  # (motion rows, N)
     v *= t.mul[:, None]
     v += t.off[:, None]
-    turns = np.empty((t.n_turn, n), dtype=np.complex128)  # exp(-i angle) of every turn
+    turns = np.empty((t.n_turn, q.shape[0]), dtype=np.complex128)
     _cos_sin(v[: t.n_turn], turns.real, turns.imag)
+    return v, turns
+
+
+def _run(t: Tree, v: F64, turns: Any, out: F64, bufs: tuple[F64, F64]) -> None:
+    """Every output pose of one step into ``out`` (n, B, 4, 4), from its motions (see above)."""
+    n = v.shape[1]
+    store, gathered = bufs
     for g in t.groups:
         k = g.nodes.stop - g.nodes.start
         dst = store[g.nodes]
@@ -423,7 +431,8 @@ def fk(tree: object, q: object) -> F64:
     t = _tree_of(tree)
     qa = config(q, 1, t.n_dof)
     poses: F64 = np.empty((1, t.n_out, 4, 4))
-    _run(t, qa[None, :], poses, _buffers(t, 1))  # a batch of one: fk_batch's operations
+    v, turns = _motions(t, qa[None, :])
+    _run(t, v, turns, poses, _buffers(t, 1))  # a batch of one: fk_batch's operations
     pose: F64 = poses[0]
     return pose
 
@@ -440,10 +449,12 @@ def fk_batch(tree: object, q: object, out: Any = None, stream: bool = False) -> 
     else:
         check_out(out, shape)
     bufs = _buffers(t, min(n, _CHUNK))  # one set for every full step, reused
+    v, turns = _motions(t, qa)
     for lo in range(0, n, _CHUNK):
-        step = qa[lo : lo + _CHUNK]
-        fits = len(step) == bufs[0].shape[1]
-        _run(t, step, out[lo : lo + _CHUNK], bufs if fits else _buffers(t, len(step)))
+        hi = min(n, lo + _CHUNK)
+        fits = hi - lo == bufs[0].shape[1]
+        step = v[:, lo:hi], turns[:, lo:hi]
+        _run(t, *step, out[lo:hi], bufs if fits else _buffers(t, hi - lo))
     result: F64 = out
     return result
 

@@ -165,6 +165,22 @@ def _choose(d: Any, handle: Any, option: str) -> None:
     _wait(f"{option} chosen", lambda: handle.value == option)
 
 
+def _type(d: Any, label: str, text: str, handle: Any) -> None:
+    """Type ``text`` in the box labelled ``label`` (what it held first is selected and replaced).
+
+    The page's script ties a label to its box (aria-labelledby), as a screen reader finds it.
+    """
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+
+    xpath = f"//input[@aria-labelledby=//label[normalize-space()='{label}']/@id]"
+    box = _wait(f"the box '{label}'", lambda: d.find_element(By.XPATH, xpath))
+    d.execute_script("arguments[0].scrollIntoView({block: 'center'})", box)
+    box.send_keys(Keys.CONTROL, "a")
+    box.send_keys(text)
+    _wait(f"'{text}' typed", lambda: handle.value == text)
+
+
 _SHOW_3D = "document.querySelectorAll('canvas').forEach(c => c.style.display = '')"
 _HIDE_3D = "document.querySelectorAll('canvas').forEach(c => c.style.display = 'none')"
 
@@ -285,6 +301,24 @@ def test_scripted_picks_in_chromium_make_the_expected_spec(driver: Any, tmp_path
         _click_text(d, "save the state")
         _wait("park saved", lambda: "park" in session.part_states("chains.arm"))
         _shot(d, "setup-states.png")
+
+        # A frame added at the pick, its rotation typed wrong: refused at its box with why;
+        # then undone (the first undo says the refusal changed nothing, the second takes the
+        # frame back), so the saved spec is still the docs' one.
+        _tab(d, "Frames & more")
+        _type(d, "new frame name", "tcp", page._frame_name)
+        _type(d, "position xyz (m)", "0, 0, 0.1", page._frame_xyz)
+        _click_text(d, "add a frame at the picked link")
+        _wait("the frame added", lambda: "tcp: {parent: link_base" in session.snapshot.text)
+        _choose(d, page._rot_kind, "rpy")
+        _type(d, "rotation values", "0, 0, zero", page._rot_values)
+        _click_text(d, "set the rotation")
+        _wait("the refusal at its box", lambda: "'zero' is not a number" in body.text)
+        _shot(d, "setup-more.png")
+        _click_text(d, "undo")
+        _wait("nothing undone, and why", lambda: "nothing undone" in body.text)
+        _click_text(d, "undo")
+        _wait("the frame undone", lambda: "tcp" not in session.snapshot.text)
 
         # Garbage on the websocket does not end the server.
         d.execute_script(

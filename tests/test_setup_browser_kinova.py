@@ -12,7 +12,16 @@ import pytest
 
 from robotspec.compiler import check_spec
 from tests.conftest import erd_robots
-from tests.test_setup_browser import _choose, _click, _click_text, _click_tree, _tab, _wait, driver
+from tests.test_setup_browser import (
+    _choose,
+    _click,
+    _click_text,
+    _click_tree,
+    _tab,
+    _type,
+    _wait,
+    driver,
+)
 
 __all__ = ["driver"]  # the browser, from the xArm7's browser test
 
@@ -84,6 +93,12 @@ def test_a_wrist_camera_on_the_kinova_arm_through_the_page(driver: Any, tmp_path
         _wait("accepted", lambda: "accept_warnings:" in session.snapshot.text)
         _wait("no warning left", lambda: not session.validation.warnings)
         _wait("the YAML tab shows it", lambda: "accept_warnings" in page._yaml.content)
+        # Its reason changed in the entry's own line (accepted warnings, below).
+        _wait("the entry listed", lambda: page._acc_pick.value == SRDF_WARNING)
+        _type(d, "new reason", "the SRDF's robot-level pose", page._acc_reason)
+        _click_text(d, "change the reason")
+        _wait("the reason changed", lambda: "robot-level pose" in session.snapshot.text)
+        assert session.snapshot.text.count("because:") == 1
         _click_text(d, "save")
         _wait("saved", lambda: out.exists() and session.snapshot.saved)
     except Exception:

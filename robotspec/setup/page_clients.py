@@ -140,4 +140,7 @@ class ClientsPart(PageBase):
                     else "<small>no other tab has this page open</small>"
                 )
                 if self._presence[cid].content != text:
-                    self._presence[cid].content = text
+                    try:
+                        self._presence[cid].content = text
+                    except RuntimeError:  # that tab's handles went with it (it closed meanwhile)
+                        continue

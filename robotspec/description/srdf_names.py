@@ -13,13 +13,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection
 from dataclasses import dataclass, field, replace
+from typing import Protocol
 
 from robotspec.description.srdf import (
     DisabledCollision,
     DisableDefaultCollisions,
     EnabledCollision,
     EndEffector,
+    Group,
     GroupChain,
+    GroupState,
     PassiveJoint,
     Srdf,
     VirtualJoint,
@@ -31,6 +34,15 @@ __all__ = ["PrefixMapping", "map_prefixed_names", "self_pair_warnings"]
 
 #: How many renamings a warning shows before it says "and N more".
 SHOWN = 3
+
+
+#: Renames one name of a scope: (kind "link" or "joint", name, line) -> the name to use.
+_Rename = Callable[[str, str, int | None], str]
+
+
+class _Lined(Protocol):
+    @property
+    def line(self) -> int | None: ...
 
 
 @dataclass
@@ -94,66 +106,80 @@ def map_prefixed_names(
     """
     if not _has_prefixed_name(srdf):  # the common case: nothing to map, nothing to rebuild
         return PrefixMapping(srdf, (), (), frozenset())
-    link_set = set(links)
-    joint_set = set(joints) | {v.name for v in srdf.virtual_joints}
-    file = srdf.file
-    where = _short(file)
-    scopes: dict[str, _Scope] = {}
-    errors: list[RobotSpecError] = []
-    ambiguous: set[tuple[int | None, str]] = set()
+    ren = _Renamer(set(links), set(joints) | {v.name for v in srdf.virtual_joints}, srdf.file)
+    groups, states = _groups(srdf, ren), _group_states(srdf, ren)  # their scopes first
+    mapped = replace(_with_elements(srdf, ren), groups=groups, group_states=states)
+    warnings = [_warning(scope, srdf.file) for scope in ren.scopes.values() if scope.renamed]
+    warnings.sort(key=by_line)
+    errors = sorted(ren.errors, key=by_line)
+    if not warnings and not errors:
+        return PrefixMapping(srdf, (), (), frozenset())
+    return PrefixMapping(mapped, tuple(warnings), tuple(errors), frozenset(ren.ambiguous))
 
-    def mapper(scope_key: str, what: str, scope_line: int | None) -> Callable[..., str]:
-        scope = scopes.setdefault(scope_key, _Scope(what, scope_line))
 
-        def rename(kind: str, name: str, line: int | None) -> str:
-            known = link_set if kind == "link" else joint_set
-            if name in known:
-                return name
-            found = _candidates(name, known)
-            if not found:
-                return name
-            if len(found) > 1:
-                ambiguous.add((line, name))
-                choices = " or ".join(f"'{f}'" for f in found)
-                errors.append(
-                    SrdfError(
-                        f"{kind} '{name}' of {what} could be the URDF's {kind} {choices} "
-                        f"once a prefix is cut; write the URDF's name in {where}",
-                        file=file,
-                        line=line,
-                        kind=kind,
-                        name=name,
-                        suggestions=found,
-                    )
-                )
-                return name
-            target = found[0]
-            clash = next((s for s, t in scope.renamed.items() if t == target and s != name), None)
-            if clash is not None:
-                ambiguous.add((line, name))
-                errors.append(
-                    SrdfError(
-                        f"{kind}s '{clash}' and '{name}' of {what} would both be the URDF's "
-                        f"{kind} '{target}' once their prefixes are cut; keep one of them, "
-                        f"written '{target}', in {where}",
-                        file=file,
-                        line=line,
-                        kind=kind,
-                        name=name,
-                        suggestions=(target,),
-                    )
-                )
-                return name
-            scope.renamed[name] = target
-            scope.kinds.add(kind)
-            return target
+@dataclass
+class _Renamer:
+    """Cuts prefixes scope by scope, collecting the renamings, the errors and what stays."""
 
-        return rename
+    links: set[str]
+    joints: set[str]
+    file: str | None
+    scopes: dict[str, _Scope] = field(default_factory=dict)
+    errors: list[RobotSpecError] = field(default_factory=list)
+    ambiguous: set[tuple[int | None, str]] = field(default_factory=set)
 
-    group_lines = {g.name: g.line for g in srdf.groups}
+    def scoped(self, key: str, what: str, line: int | None) -> _Rename:
+        """A renamer for one scope (a group with its states, or one kind of element)."""
+        scope = self.scopes.setdefault(key, _Scope(what, line))
+        return lambda kind, name, at: self.rename(scope, kind, name, at)
+
+    def rename(self, scope: _Scope, kind: str, name: str, line: int | None) -> str:
+        """``name`` as the URDF's, when exactly one URDF name is it with a prefix cut."""
+        known = self.links if kind == "link" else self.joints
+        if name in known:
+            return name
+        found = _candidates(name, known)
+        if not found:
+            return name
+        where = _short(self.file)
+        if len(found) > 1:
+            choices = " or ".join(f"'{f}'" for f in found)
+            return self._keep(
+                f"{kind} '{name}' of {scope.what} could be the URDF's {kind} {choices} "
+                f"once a prefix is cut; write the URDF's name in {where}",
+                kind,
+                name,
+                line,
+                found,
+            )
+        target = found[0]
+        clash = next((s for s, t in scope.renamed.items() if t == target and s != name), None)
+        if clash is not None:
+            return self._keep(
+                f"{kind}s '{clash}' and '{name}' of {scope.what} would both be the URDF's "
+                f"{kind} '{target}' once their prefixes are cut; keep one of them, "
+                f"written '{target}', in {where}",
+                kind,
+                name,
+                line,
+                [target],
+            )
+        scope.renamed[name] = target
+        scope.kinds.add(kind)
+        return target
+
+    def _keep(self, message: str, kind: str, name: str, line: int | None, found: list[str]) -> str:
+        self.ambiguous.add((line, name))
+        self.errors.append(
+            SrdfError(message, file=self.file, line=line, kind=kind, name=name, suggestions=found)
+        )
+        return name
+
+
+def _groups(srdf: Srdf, ren: _Renamer) -> tuple[Group, ...]:
     groups = []
     for g in srdf.groups:
-        r = mapper(f"group:{g.name}", f"group '{g.name}'", g.line)
+        r = ren.scoped(f"group:{g.name}", f"group '{g.name}'", g.line)
         jl = _lines(g.joint_lines, len(g.joints), g.line)
         ll = _lines(g.link_lines, len(g.links), g.line)
         groups.append(
@@ -171,10 +197,16 @@ def map_prefixed_names(
                 ),
             )
         )
+    return tuple(groups)
+
+
+def _group_states(srdf: Srdf, ren: _Renamer) -> tuple[GroupState, ...]:
+    """Each state renamed in its group's scope (one warning per group, states included)."""
+    group_names = {g.name for g in srdf.groups}
     states = []
     for s in srdf.group_states:
-        key = f"group:{s.group}" if s.group in group_lines else f"state:{s.name}"
-        r = mapper(key, f"group '{s.group}'" if s.group else f"group_state '{s.name}'", s.line)
+        key = f"group:{s.group}" if s.group in group_names else f"state:{s.name}"
+        r = ren.scoped(key, f"group '{s.group}'" if s.group else f"group_state '{s.name}'", s.line)
         sl = _lines(s.joint_lines, len(s.joint_values), s.line)
         states.append(
             replace(
@@ -184,29 +216,23 @@ def map_prefixed_names(
                 ),
             )
         )
-    first = {
-        tag: next((x.line for x in items), None)
-        for tag, items in (
-            ("end_effector", srdf.end_effectors),
-            ("virtual_joint", srdf.virtual_joints),
-            ("passive_joint", srdf.passive_joints),
-            ("disable_collisions", srdf.disabled_collisions),
-            ("enable_collisions", srdf.enabled_collisions),
-            ("disable_default_collisions", srdf.disable_default_collisions),
-        )
-    }
+    return tuple(states)
 
-    def kind_mapper(tag: str) -> Callable[..., str]:
-        return mapper(tag, f"the <{tag}> elements", first[tag])
 
-    r_ee, r_vj = kind_mapper("end_effector"), kind_mapper("virtual_joint")
-    r_pj = kind_mapper("passive_joint")
-    r_dc, r_ec = kind_mapper("disable_collisions"), kind_mapper("enable_collisions")
-    r_dd = kind_mapper("disable_default_collisions")
-    mapped = replace(
+def _with_elements(srdf: Srdf, ren: _Renamer) -> Srdf:
+    """The other elements renamed, each kind one scope placed at its first element's line."""
+
+    def scope(tag: str, items: tuple[_Lined, ...]) -> _Rename:
+        return ren.scoped(tag, f"the <{tag}> elements", next((x.line for x in items), None))
+
+    r_ee = scope("end_effector", srdf.end_effectors)
+    r_vj = scope("virtual_joint", srdf.virtual_joints)
+    r_pj = scope("passive_joint", srdf.passive_joints)
+    r_dc = scope("disable_collisions", srdf.disabled_collisions)
+    r_ec = scope("enable_collisions", srdf.enabled_collisions)
+    r_dd = scope("disable_default_collisions", srdf.disable_default_collisions)
+    return replace(
         srdf,
-        groups=tuple(groups),
-        group_states=tuple(states),
         end_effectors=tuple(
             EndEffector(
                 e.name, r_ee("link", e.parent_link, e.line), e.group, e.parent_group, e.line
@@ -237,12 +263,6 @@ def map_prefixed_names(
             for d in srdf.disable_default_collisions
         ),
     )
-    warnings = [_warning(scope, file) for scope in scopes.values() if scope.renamed]
-    warnings.sort(key=by_line)
-    errors.sort(key=by_line)
-    if not warnings and not errors:
-        return PrefixMapping(srdf, (), (), frozenset())
-    return PrefixMapping(mapped, tuple(warnings), tuple(errors), frozenset(ambiguous))
 
 
 def _warning(scope: _Scope, file: str | None) -> RobotSpecError:

@@ -211,3 +211,46 @@ def test_a_passive_joint_and_a_collision_pair_are_undone_and_redone(tmp_path: Pa
     assert undone.startswith("undone: joint head_tilt_joint: passive")
     assert s.snapshot.text == before and not s.extras.passive and s.extras.srdf is None
     assert not next(r for r in passive_rows(s) if r.joint == "head_tilt_joint").passive
+
+
+def test_each_edit_is_its_own_lines_on_a_spec_nobody_specified(tmp_path: Path) -> None:
+    """The drafted Kinova: a frame added, moved and turned; a joint made passive."""
+    from robotspec.setup.passive import set_passive
+
+    spec = _kinova_spec(tmp_path)
+    before = spec.read_text()
+    s = SetupSession.open(str(spec), output=spec)
+    assert s.add_frame("grasp", "j2s6s200_end_effector", (0, 0, 0.05)).valid
+    assert _diff(before, s.snapshot.text) == [
+        "+  frames:",
+        "+    grasp: {parent: j2s6s200_end_effector, xyz: [0, 0, 0.05]}",
+    ]
+    added = s.snapshot.text
+    assert s.set_frame_position("grasp", (0, 0, 0.06)).valid
+    assert s.set_frame_rotation("grasp", "rpy", (0, 0, 3.1416)).valid
+    assert _diff(added, s.snapshot.text) == [
+        "-    grasp: {parent: j2s6s200_end_effector, xyz: [0, 0, 0.05]}",
+        "+    grasp: {parent: j2s6s200_end_effector, xyz: [0, 0, 0.06], rpy: [0, 0, 3.1416]}",
+    ]
+    with pytest.raises(SetupError, match="'base' is a link or frame already"):
+        s.add_frame("base", "j2s6s200_end_effector")
+    assert s.remove("frames.grasp").valid and s.snapshot.text == before  # its rotation too
+    with pytest.raises(SetupError, match="no moving joint 'j2s6s200_joint_finger_1'"):
+        set_passive(s, "j2s6s200_joint_finger_1", passive=True)  # a fixed joint
+    said = set_passive(s, "j2s6s200_joint_6", passive=True)
+    assert "kept in kinova.srdf" in said
+    diff = _diff(before, s.snapshot.text)
+    assert len(diff) == 2 and diff[1] == "+  srdf: kinova.srdf"
+    s.save()
+    assert "j2s6s200_joint_6" in (tmp_path / "kinova.srdf").read_text()
+    assert "<passive_joint" in (tmp_path / "kinova.srdf").read_text()
+
+
+def test_a_shipped_camera_turned_is_one_line_and_validate_says_why_not(tmp_path: Path) -> None:
+    erd_robots()
+    before = shipped_specs()["pr2"].read_text()
+    s = SetupSession.open("pr2", output=tmp_path / "pr2.yaml")
+    v = s.set_camera_axis("sensors.kinect", (1.0, 0.0, 0.0))
+    assert _diff(before, s.snapshot.text) == ["+    forward_facing_axis: [1, 0, 0]"]
+    assert any("is an optical frame by its rotation" in p.message for p in v.errors)
+    assert s.undo().valid and s.snapshot.text == before

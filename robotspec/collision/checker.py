@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from robotspec.arrays import F64, I64, real_array, real_number
+from robotspec.arrays import F64, real_array, real_number
 from robotspec.collision.compiled import Compiled, Scratch, compile_pairs
 from robotspec.collision.distances import (
     PairDistance,
@@ -39,18 +39,12 @@ from robotspec.collision.distances import (
     distance_rows,
     hull_functors,
 )
-from robotspec.collision.narrow import (
-    WALK_ALL,
-    WALK_DROP_FOUND,
-    WALK_FIRST,
-    batch_proofs_for,
-    narrow_block,
-)
+from robotspec.collision.narrow import WALK_ALL, WALK_DROP_FOUND, WALK_FIRST, batch_proofs_for
 from robotspec.collision.rules import CollisionRules, pair_key
+from robotspec.collision.scan import first_hit, place, scan_rows
 from robotspec.collision.shapes import GeometryModel, MeshLibrary, MissingMeshPolicy, import_coal
 from robotspec.collision.slices import checked_threads, run_in_slices
 from robotspec.errors import CollisionError, KinematicsError, RobotSpecError
-from robotspec.model import kincore
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
 
@@ -61,13 +55,6 @@ __all__ = ["PairDistance", "SelfCollisionChecker"]
 
 Bools = NDArray[np.bool_]
 Point = tuple[float, float, float]
-
-#: Samples per block in batch queries: bounds the memory of the pose arrays (~10 MB).
-_BLOCK = 512
-#: Room (m) beyond the margin by which a mesh pair must be proven apart before coal is skipped:
-#: coal's own collision test between triangles stops within about 1e-6 m, so a pair proven this far
-#: apart is one coal calls apart too, and the answers stay coal's.
-_APART_SLACK = 1e-5
 
 
 class SelfCollisionChecker:
@@ -233,19 +220,6 @@ class SelfCollisionChecker:
             )
         return mask
 
-    def _broad(
-        self, c: Compiled, qs: F64, margin: float, mask: NDArray[np.uint8] | None
-    ) -> tuple[I64, I64, F64]:
-        """Candidate (sample, geometry pair)s of ``qs`` and every geometry's pose (n, G, 4, 4).
-
-        A candidate's boxes come within ``margin``; every other pair is farther apart than that,
-        so the narrow phase on the candidates gives the exact answer.
-        """
-        kin = self.kinematics
-        bodies = kin.forward(qs[0]) if qs.shape[0] == 1 else kin.forward_batch(qs, threads=1)
-        rows, ks, poses = kincore.core().broad(c.broad, bodies, margin, mask)
-        return rows, ks, poses
-
     # ------------------------------------------------------------------------- queries
     def _scan(
         self,
@@ -278,49 +252,18 @@ class SelfCollisionChecker:
         mode = WALK_FIRST if first_only else WALK_DROP_FOUND if drop_found else WALK_ALL
         batch_proofs = batch_proofs_for(n, mode, threads)
 
+        kin = self.kinematics
         if threads == 1:
-            self._scan_rows(c, qs, hits, margin, geom_mask, mode, batch_proofs)
+            scan_rows(c, kin, self._scratch(c), qs, hits, margin, geom_mask, mode, batch_proofs)
             return hits
 
         def scan(lo: int, hi: int) -> None:
             mask = None if geom_mask is None else geom_mask.copy()  # drop_found narrows it
-            self._scan_rows(c, qs[lo:hi], hits[lo:hi], margin, mask, mode, batch_proofs)
+            scratch = self._scratch(c)  # this thread's
+            scan_rows(c, kin, scratch, qs[lo:hi], hits[lo:hi], margin, mask, mode, batch_proofs)
 
         run_in_slices(n, threads, scan)
         return hits
-
-    def _scan_rows(
-        self,
-        c: Compiled,
-        qs: F64,
-        hits: Bools,
-        margin: float,
-        geom_mask: NDArray[np.uint8] | None,
-        mode: int,
-        batch_proofs: bool,
-    ) -> None:
-        """Set ``hits`` (n, P) for the samples ``qs`` (n, D) on this thread (see :meth:`_scan`).
-
-        Block by block: kinematics, broad phase and the narrow phase's proofs are one C call
-        each with the GIL released (:func:`.narrow.walk`); Python only joins them and asks coal
-        about what the proofs leave. ``batch_proofs``: see :func:`.narrow.narrow_block`.
-        """
-        scratch = self._scratch(c)
-        req, _ = scratch.collision(margin)
-        found = np.zeros(len(self._pairs), dtype=np.uint8)
-        eps = margin + _APART_SLACK
-        hit_rows: list[int] = []
-        hit_pairs: list[int] = []
-        for start in range(0, qs.shape[0], _BLOCK):
-            block = qs[start : start + _BLOCK]
-            if mode == WALK_DROP_FOUND and start:
-                left = (found == 0)[c.pair_of]
-                geom_mask = left.astype(np.uint8) if geom_mask is None else geom_mask & left
-            rows, ks, poses = self._broad(c, block, margin, geom_mask)
-            rs, ps = narrow_block(c, scratch, req, poses, rows, ks, found, eps, mode, batch_proofs)
-            hit_rows += [start + r for r in rs] if start else rs
-            hit_pairs += ps
-        hits[hit_rows, hit_pairs] = True
 
     def in_collision(self, q: object, *, margin: float = 0.0) -> bool:
         """Whether any checked pair collides (or comes closer than ``margin``) at ``q``.
@@ -339,15 +282,7 @@ class SelfCollisionChecker:
         c = self._compiled
         if c is None:
             c = self._build()
-        rows, ks, poses = kincore.core().broad(c.broad, self.kinematics.forward(one), margin, None)
-        if not len(ks):
-            return False
-        scratch = self._scratch(c)
-        req, _ = scratch.collision(margin)
-        found = np.zeros(len(self._pairs), dtype=np.uint8)
-        eps = margin + _APART_SLACK
-        rs, _ = narrow_block(c, scratch, req, poses, rows, ks, found, eps, WALK_FIRST, False)
-        return bool(rs)
+        return first_hit(c, self.kinematics, self._scratch(c), one, margin, len(self._pairs))
 
     def colliding_pairs(self, q: object, *, margin: float = 0.0) -> tuple[tuple[str, str], ...]:
         """The checked pairs that collide (or are closer than ``margin``) at ``q``."""
@@ -412,11 +347,13 @@ class SelfCollisionChecker:
             functors = (self._distance_functors(c), self._hull_functors(c))
         none = np.zeros(len(c.pair_of), dtype=np.uint8)  # poses only, no broad phase
 
-        def place(block: F64) -> F64:
-            return self._broad(c, block, 0.0, none)[2]
+        kin = self.kinematics
+
+        def poses(block: F64) -> F64:
+            return place(c, kin, block, 0.0, none)[2]
 
         transforms = self._scratch(c).transforms
-        return distance_rows(c, functors, transforms, len(self._pairs), place, qs, with_points)
+        return distance_rows(c, functors, transforms, len(self._pairs), poses, qs, with_points)
 
     def distances(self, q: object) -> tuple[PairDistance, ...]:
         """Minimum distance and closest points of every checked pair at ``q``."""

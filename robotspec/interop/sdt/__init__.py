@@ -74,7 +74,7 @@ def to_sdt(
     from robotspec.interop.sdt.identity import build, checked_class, fit, named_class
     from robotspec.interop.sdt.recipe import robot_recipe
     from robotspec.interop.sdt.serial import run
-    from robotspec.interop.sdt.world import sdt_world
+    from robotspec.interop.sdt.world import building_world
 
     api = sdt_api()  # before anything is stored: without SDT, only the error
     recipe = robot_recipe(robot)
@@ -97,15 +97,15 @@ def to_sdt(
 
     def build_in_sdt() -> Any:
         cls = robot_class(recipe) if own is None else None
-        world = sdt_world(robot.world, drive=robot.drive_type)
-        if own is not None:
-            sdt_robot = build(api, own, recipe, world)
-        else:
-            sdt_robot = cls.from_world(world)  # type: ignore[union-attr]
-        if recipe.extra_hardware_joints:
-            with world.modify_world():
-                for name in recipe.extra_hardware_joints:
-                    world.get_connection_by_name(name).has_hardware_interface = True
+        # World and robot in one modification block: SDT syncs its collision shapes and
+        # compiles its kinematics once, not once per block (.world.building_world).
+        with building_world(robot.world, drive=robot.drive_type) as world:
+            if own is not None:
+                sdt_robot = build(api, own, recipe, world)
+            else:
+                sdt_robot = cls.from_world(world)  # type: ignore[union-attr]
+            for name in recipe.extra_hardware_joints:
+                world.get_connection_by_name(name).has_hardware_interface = True
         return sdt_robot
 
     # One build at a time, and never on a thread that will exit (.serial says why).

@@ -17,6 +17,7 @@ from semantic_digital_twin.datastructures import definitions
 from semantic_digital_twin.datastructures.field_of_view import FieldOfView
 from semantic_digital_twin.datastructures.joint_state import JointState
 from semantic_digital_twin.datastructures.prefixed_name import PrefixedName
+from semantic_digital_twin.exceptions import DuplicateRobotAssignmentsError
 from semantic_digital_twin.robots import robot_part_mixins as mixins
 from semantic_digital_twin.robots import robot_parts as parts
 from semantic_digital_twin.spatial_types import (
@@ -52,6 +53,7 @@ __all__ = [
     "DegreeOfFreedomLimits",
     "DerivativeMap",
     "DifferentialDrive",
+    "DuplicateRobotAssignmentsError",
     "FieldOfView",
     "FixedConnection",
     "HomogeneousTransformationMatrix",

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from robotspec.errors import RobotSpecError
+from robotspec.interop.sdt.backref import robot_of
 from robotspec.interop.sdt.recipe import PartRecipe, RobotRecipe
 from robotspec.interop.sdt.rules import setup_collision_rules
 
@@ -253,6 +254,7 @@ def _part_class(sdt: Any, part: PartRecipe, recipe: RobotRecipe, digest: str) ->
         "setup_default_configuration_in_world_below_robot_root": classmethod(_factory(sdt, part)),
         "setup_hardware_interfaces": _hardware(part),
         "setup_joint_states": _states(sdt, part),
+        "_robot": property(robot_of),  # SDT's back-reference without a query (.backref)
     }
     bases: list[Any]
     if part.kind == "neck":

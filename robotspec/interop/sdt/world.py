@@ -16,6 +16,8 @@ a mimic joint shares its leader's degree of freedom, with multiplier and offset.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -26,7 +28,7 @@ from robotspec.model.entities import ConnectionType
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
 from robotspec.model.world import World
 
-__all__ = ["sdt_world"]
+__all__ = ["building_world", "sdt_world"]
 
 
 def _limit(value: float) -> float | None:
@@ -85,6 +87,21 @@ def sdt_world(world: World, *, drive: str, prefix: str | None = None) -> Any:
     a planar joint becomes SDT's ``OmniDrive`` or ``DifferentialDrive``, a floating one its
     ``Connection6DoF``. A planar or floating joint elsewhere has no SDT kind and is refused.
     """
+    with building_world(world, drive=drive, prefix=prefix) as out:
+        pass
+    return out
+
+
+@contextmanager
+def building_world(world: World, *, drive: str, prefix: str | None = None) -> Iterator[Any]:
+    """:func:`sdt_world`'s world, its modification block still open for the caller's additions.
+
+    Why: SDT recomputes on every closed block (it rebuilds every body's Bullet collision
+    shapes, loading and testing each mesh, and compiles its forward kinematics again), so a
+    world filled in one block and given a robot in a second pays that twice. What the caller
+    adds inside the ``with`` is published with the world, in one block and one recomputation
+    (its history is one block, which replays as the two did).
+    """
     from robotspec.interop.sdt import sdt_api
 
     sdt = sdt_api()
@@ -96,7 +113,9 @@ def sdt_world(world: World, *, drive: str, prefix: str | None = None) -> Any:
     out = sdt.World()
     out.name = prefix
     try:
-        _fill(sdt, out, world, drive, pname)
+        with out.modify_world():
+            _fill(sdt, out, world, drive, pname)
+            yield out
     except Exception as exc:
         failure = mesh_failure(exc)  # SDT's mesh step failed: name it and the mesh file
         if failure is not None:
@@ -112,65 +131,61 @@ def sdt_world(world: World, *, drive: str, prefix: str | None = None) -> Any:
             kind="dependency",
             name="semantic_digital_twin",
         ) from exc
-    return out
 
 
 def _fill(sdt: Any, out: Any, world: World, drive: str, pname: Any) -> None:
     """Bodies, degrees of freedom and joints of ``world`` into the SDT world ``out``."""
-    with out.modify_world():
-        bodies = []
-        for b in world.bodies:
-            body = sdt.Body(name=pname(b.name))
-            body.visual = _shapes(sdt, b.visuals, body)
-            body.collision = _shapes(sdt, b.collisions, body)
-            bodies.append(body)
-        out.add_kinematic_structure_entity(bodies[world.root.index])
-        for b in bodies:
-            if b is not bodies[world.root.index]:
-                out.add_kinematic_structure_entity(b)
-        dofs: dict[int, Any] = {}
-        conns = sorted(world.connections, key=lambda c: c.mimic is not None)
-        for c in conns:
-            parent, child = bodies[c.parent], bodies[c.child]
-            origin = sdt.HomogeneousTransformationMatrix(
-                data=np.asarray(c.origin, dtype=float), reference_frame=parent
+    bodies = []
+    for b in world.bodies:
+        body = sdt.Body(name=pname(b.name))
+        body.visual = _shapes(sdt, b.visuals, body)
+        body.collision = _shapes(sdt, b.collisions, body)
+        bodies.append(body)
+    out.add_kinematic_structure_entity(bodies[world.root.index])
+    for b in bodies:
+        if b is not bodies[world.root.index]:
+            out.add_kinematic_structure_entity(b)
+    dofs: dict[int, Any] = {}
+    conns = sorted(world.connections, key=lambda c: c.mimic is not None)
+    for c in conns:
+        parent, child = bodies[c.parent], bodies[c.child]
+        origin = sdt.HomogeneousTransformationMatrix(
+            data=np.asarray(c.origin, dtype=float), reference_frame=parent
+        )
+        if c.type is ConnectionType.FIXED:
+            out.add_connection(
+                sdt.FixedConnection(
+                    name=pname(c.name),
+                    parent=parent,
+                    child=child,
+                    parent_T_connection_expression=origin,
+                )
             )
-            if c.type is ConnectionType.FIXED:
-                out.add_connection(
-                    sdt.FixedConnection(
-                        name=pname(c.name),
-                        parent=parent,
-                        child=child,
-                        parent_T_connection_expression=origin,
-                    )
+        elif c.type in (ConnectionType.PLANAR, ConnectionType.FLOATING):
+            out.add_connection(_base_joint(sdt, out, c.type, drive, parent, child, pname(c.name)))
+        else:
+            index = c.dofs[0]
+            if index not in dofs:
+                leader = c.mimic.leader if c.mimic is not None else c.name
+                dofs[index] = _dof(sdt, world, index, pname(leader))
+                out.add_degree_of_freedom(dofs[index])
+            kind = (
+                sdt.PrismaticConnection
+                if c.type is ConnectionType.PRISMATIC
+                else sdt.RevoluteConnection
+            )
+            out.add_connection(
+                kind(
+                    name=pname(c.name),
+                    parent=parent,
+                    child=child,
+                    parent_T_connection_expression=origin,
+                    multiplier=1.0 if c.mimic is None else c.mimic.multiplier,
+                    offset=0.0 if c.mimic is None else c.mimic.offset,
+                    axis=sdt.Vector3(*c.axis, reference_frame=parent),
+                    raw_dof=dofs[index],
                 )
-            elif c.type in (ConnectionType.PLANAR, ConnectionType.FLOATING):
-                out.add_connection(
-                    _base_joint(sdt, out, c.type, drive, parent, child, pname(c.name))
-                )
-            else:
-                index = c.dofs[0]
-                if index not in dofs:
-                    leader = c.mimic.leader if c.mimic is not None else c.name
-                    dofs[index] = _dof(sdt, world, index, pname(leader))
-                    out.add_degree_of_freedom(dofs[index])
-                kind = (
-                    sdt.PrismaticConnection
-                    if c.type is ConnectionType.PRISMATIC
-                    else sdt.RevoluteConnection
-                )
-                out.add_connection(
-                    kind(
-                        name=pname(c.name),
-                        parent=parent,
-                        child=child,
-                        parent_T_connection_expression=origin,
-                        multiplier=1.0 if c.mimic is None else c.mimic.multiplier,
-                        offset=0.0 if c.mimic is None else c.mimic.offset,
-                        axis=sdt.Vector3(*c.axis, reference_frame=parent),
-                        raw_dof=dofs[index],
-                    )
-                )
+            )
 
 
 def _base_joint(

@@ -22,8 +22,9 @@ hand (3+ fingers)  never: which branch is the thumb rests on names and geometry
 camera             a Gazebo camera sensor names its frame (and nothing about its axis is odd)
 torso, neck        never: both are found by where arms branch and what carries cameras
 drive              a Gazebo drive plugin names it, or an SRDF virtual joint states ``floating``
-                   (or ``fixed`` on a robot with no wheels, legs or rotors); a planar virtual
-                   joint says the base moves in the plane, not whether sideways: a question
+                   on a robot with legs, wheels or rotors (``fixed`` on one without); a
+                   floating one on a robot nothing moves is drafted ``fixed``, asked; a planar
+                   virtual joint says the base moves in the plane, not whether sideways: asked
 forward            never
 =================  ===========================================================================
 
@@ -123,13 +124,20 @@ def camera_question(stated: bool, found_by: str) -> str | None:
     return None if stated else found_by
 
 
+#: Why a floating virtual joint on a robot nothing moves is drafted fixed, and asked.
+_STILL = (
+    "the SRDF's virtual joint is floating, but no wheels, legs or rotors move the robot: fixed?"
+)
+
+
 def drive_question(virtual: str, moves: bool) -> str | None:
     """Why a drive taken from an SRDF virtual joint of type ``virtual`` is a question.
 
     ``moves``: whether the tree has wheels, legs or rotors (a base that may move).
     """
     if virtual == "floating":
-        return None
+        # An arm bolted down is often given a floating virtual joint by its MoveIt config.
+        return None if moves else _STILL
     if virtual == "fixed":
         return (
             "the SRDF's virtual joint is fixed, but the robot has wheels, legs or rotors"

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robotspec.model.entities import Body
+from robotspec.model.world import World
 from robotspec.spec.draft.confidence import gripper_question
 from robotspec.spec.draft.limbs import FINGER_WORDS, HAND_WORDS, is_named
 from robotspec.spec.draft.model import DraftFinger
@@ -81,6 +82,12 @@ def _finger_tip(tree: Tree, branch: Body) -> Body:
     if len(bare) == 1 and all(not world.child_bodies(k) for k in world.child_bodies(tip)):
         return bare[0]
     return tip
+
+
+def _moved(world: World, body: Body) -> bool:
+    """Whether ``body`` hangs on a moving joint."""
+    c = world.parent_connection(body)
+    return c is not None and not c.is_fixed
 
 
 def _dofs(tree: Tree, branch: Body) -> set[int]:
@@ -220,7 +227,9 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
     leaders: list[bool] = []
     for side in sides:
         ends = [_finger_tip(tree, k) for k in side]
-        tips.append(max(ends, key=lambda b: (world.depth(b), -b.index)))
+        # Of a linkage's two ends at one depth, the one a joint moves (Robotiq's finger tip on
+        # its mimic joint) is the tip, not the link fixed on the knuckle beside it.
+        tips.append(max(ends, key=lambda b: (world.depth(b), _moved(world, b), -b.index)))
         leaders.append(
             any(
                 c.is_active

@@ -267,7 +267,10 @@ def add_drive(d: Drafter) -> None:
     movable = d.tree.root is world.root
     if draft.drive is not None:  # the SRDF's virtual joint: stated, or a question (confidence)
         virtual = {"omni": "planar"}.get(draft.drive.type, draft.drive.type)
-        draft.drive.decide = drive_question(virtual, bool(wheels or len(legs) >= 2 or rotors))
+        moves = bool(wheels or len(legs) >= 2 or rotors)
+        draft.drive.decide = drive_question(virtual, moves)
+        if virtual == "floating" and not moves:  # nothing can float it: a base bolted down
+            draft.drive = DraftDrive("fixed", None, None, draft.drive.source, draft.drive.decide)
         return
     stated = stated_drive(d.tree, d.facts, wheels) if wheels and movable else None
     if stated is not None:  # what the transmissions or a Gazebo drive plugin say

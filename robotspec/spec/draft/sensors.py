@@ -152,12 +152,16 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
 #: Words naming a channel of a camera device (one device: one camera, on its colour channel).
 _CHANNELS = frozenset({"color", "colour", "rgb", "depth", "ir", "infra", "infra1", "infra2"})
 _COLOUR = frozenset({"color", "colour", "rgb"})
+#: Words naming one of a stereo pair; with a channel word, both are one device's.
+_SIDES = frozenset({"left", "right", "l", "r", "1", "2"})
 
 
 def _device(name: str) -> str:
     """A camera's device: its name without channel words (``head_cam_depth`` -> ``head_cam``)."""
     parts = [p for p in re.split(r"[^A-Za-z0-9]+", name.lower()) if p]
     kept = [p for p in parts if p not in _CHANNELS]
+    if set(parts) & _CHANNELS:  # an RGB-D device's infrared pair ('camera_left_ir'): one device
+        kept = [p for p in kept if p not in _SIDES]
     return "_".join(kept) or name
 
 

@@ -13,6 +13,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import ExitStack, contextmanager
+from functools import partial
 from pathlib import Path
 from types import FrameType
 from typing import TYPE_CHECKING
@@ -20,7 +21,10 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from robotspec.driver.mujoco_model import PlantModel
     from robotspec.driver.robot_info import RobotInfo
+    from robotspec.driver.script import LoadedScenario, StepResult
+    from robotspec.driver.sim import SimRobot
     from robotspec.driver.state import RobotState
+    from robotspec.render.plot import JointTrace
 
 __all__ = ["drive_target", "run_driver"]
 
@@ -141,23 +145,11 @@ def run_driver(
     else the kinematic simulation's. Raises the scenario's mismatches (located at the script)
     after printing the summary.
     """
-    from robotspec.driver.clock import RealClock, SimClock
-    from robotspec.driver.script import load_scenario, mismatch_errors, run_scenario
-    from robotspec.driver.sim import SimRobot
+    from robotspec.driver.script import load_scenario
     from robotspec.driver.statelog import StateLog
-    from robotspec.errors import RobotSpecError, RobotSpecErrors
 
     scenario = load_scenario(script) if script is not None else None
-    clock = SimClock() if virtual_time else RealClock()
-    if plant is None:
-        driver: SimRobot = SimRobot(info, clock=clock, update_period=1.0 / rate)
-        where = "in simulation"
-    else:
-        from robotspec.driver.mujoco_plant import MujocoSimRobot
-
-        driver = MujocoSimRobot(info, plant, clock=clock, update_period=1.0 / rate)
-        gravity = "gravity compensated" if plant.gravity_compensation else "gravity on"
-        where = f"on MuJoCo physics ({gravity})"
+    driver, where = _make_driver(info, plant, rate=rate, virtual_time=virtual_time)
     signals = _StopSignals()
     statelog = None
     if log is not None:
@@ -166,50 +158,118 @@ def run_driver(
     tty = sys.stdout.isatty()
     status = _StatusLine(tty)
     driver.add_state_listener(status)
-    trace = None
-    if plot is not None:
-        from robotspec.render.deps import require
-        from robotspec.render.plot import JointTrace
-
-        require("matplotlib", "matplotlib", "--plot")
-        trace = JointTrace(info.joint_names)
-        driver.add_state_listener(trace)
+    trace = _joint_trace(driver, info) if plot is not None else None
     name = info.device_info.device.name or fallback_name
     sys.stderr.write(
         f"driving {name} ({len(info.joint_info)} joints, {len(info.chains)} "
         f"chain{'s' if len(info.chains) != 1 else ''}) {where} at {rate:g} Hz"
         f"{' (virtual time)' if virtual_time else ''}; Ctrl-C stops\n"
     )
-    results = []
-    interrupted = False
-    stopped_by = "Ctrl-C"
+
+    served = None
+    if serve:
+        from robotspec.service.serve import serve_driver
+
+        served = partial(
+            serve_driver,
+            info=info,
+            port=port,
+            public=public,
+            node_name=node_name,
+            state_dir=state_dir,
+            duration=duration,
+            fallback_name=fallback_name,
+        )
     wall0 = time.perf_counter()
     try:
+        results, interrupted, stopped_by = _run(
+            driver, scenario, signals, status, duration=duration, served=served
+        )
+    finally:
+        status.clear()
+        if statelog is not None:
+            statelog.close()
+    ran = f"stopped by {stopped_by} after" if interrupted else "ran"
+    sys.stdout.write(_summary(driver, ran, time.perf_counter() - wall0, virtual_time) + "\n")
+    if statelog is not None:
+        sys.stdout.write(f"wrote {statelog.rows} states to {log}\n")
+    if trace is not None and plot is not None:
+        from robotspec.render.plot import plot_joint_trace
+
+        drawn = plot_joint_trace(trace, plot, title=f"{name}: positions (solid), commands (dashed)")
+        sys.stdout.write(f"wrote {plot} ({drawn.lines} lines, {drawn.samples} samples)\n")
+    if scenario is not None and script is not None:
+        _report_scenario(scenario, results, interrupted=interrupted, script=script)
+
+
+def _joint_trace(driver: SimRobot, info: RobotInfo) -> JointTrace:
+    """A listener that keeps every joint's position and command, for ``--plot``."""
+    from robotspec.render.deps import require
+    from robotspec.render.plot import JointTrace
+
+    require("matplotlib", "matplotlib", "--plot")
+    trace = JointTrace(info.joint_names)
+    driver.add_state_listener(trace)
+    return trace
+
+
+def _summary(driver: SimRobot, ran: str, wall: float, virtual_time: bool) -> str:
+    """The run's last line: steps, simulated and wall time, final mode and flags."""
+    st = driver.robot_state
+    sim_s = driver._stopwatch_ellapsed_s()
+    return (
+        f"{ran} {st.seqno} steps, "
+        f"{sim_s:.2f} s{' simulated' if virtual_time else ''} in {wall:.2f} s; "
+        f"final mode {st.command_mode.name}, flags 0x{int(st.flags):x}"
+    )
+
+
+def _make_driver(
+    info: RobotInfo, plant: PlantModel | None, *, rate: float, virtual_time: bool
+) -> tuple[SimRobot, str]:
+    """The simulated robot (kinematic, or MuJoCo's with ``plant``) and where it runs, in words."""
+    from robotspec.driver.clock import RealClock, SimClock
+    from robotspec.driver.sim import SimRobot
+
+    clock = SimClock() if virtual_time else RealClock()
+    if plant is None:
+        return SimRobot(info, clock=clock, update_period=1.0 / rate), "in simulation"
+    from robotspec.driver.mujoco_plant import MujocoSimRobot
+
+    gravity = "gravity compensated" if plant.gravity_compensation else "gravity on"
+    driver = MujocoSimRobot(info, plant, clock=clock, update_period=1.0 / rate)
+    return driver, f"on MuJoCo physics ({gravity})"
+
+
+def _run(
+    driver: SimRobot,
+    scenario: LoadedScenario | None,
+    signals: _StopSignals,
+    status: _StatusLine,
+    *,
+    duration: float | None,
+    served: Callable[[SimRobot], str | None] | None,
+) -> tuple[list[StepResult], bool, str]:
+    """Drive until the scenario ends, ``duration`` passes, or a stop signal.
+
+    ``served``: serve the driver over Robot Raconteur instead (it returns the stop signal).
+    Returns the scenario's step results, whether a signal stopped the run, and which.
+    """
+    from robotspec.driver.script import run_scenario
+
+    results: list[StepResult] = []
+    try:
         with ExitStack() as guard:
-            if not serve:  # the served path handles its signals itself
+            if served is None:  # the served path handles its signals itself
                 guard.enter_context(signals)
             driver.step()
-            if serve:
-                from robotspec.service.serve import serve_driver
-
-                stop_signal = serve_driver(
-                    driver,
-                    info,
-                    port=port,
-                    public=public,
-                    node_name=node_name,
-                    state_dir=state_dir,
-                    duration=duration,
-                    fallback_name=fallback_name,
-                )
+            if served is not None:
+                stop_signal = served(driver)
                 if stop_signal is not None:
-                    interrupted, stopped_by = True, stop_signal
+                    return results, True, stop_signal
             elif scenario is not None:
 
-                def report(r: object) -> None:
-                    from robotspec.driver.script import StepResult
-
-                    assert isinstance(r, StepResult)
+                def report(r: StepResult) -> None:
                     status.clear()
                     mark = "ok  " if r.ok else "FAIL"
                     extra = f": {r.detail or r.note}" if r.detail or r.note else ""
@@ -224,54 +284,41 @@ def run_driver(
                 while True:
                     driver.step()
     except KeyboardInterrupt:
-        interrupted = True
-        if signals.received:
-            stopped_by = signals.received[0]
-    finally:
-        status.clear()
-        if statelog is not None:
-            statelog.close()
-    st = driver.robot_state
-    sim_s = driver._stopwatch_ellapsed_s()
-    wall = time.perf_counter() - wall0
-    summary = (
-        f"{f'stopped by {stopped_by} after' if interrupted else 'ran'} {st.seqno} steps, "
-        f"{sim_s:.2f} s{' simulated' if virtual_time else ''} in {wall:.2f} s; "
-        f"final mode {st.command_mode.name}, flags 0x{int(st.flags):x}"
-    )
-    sys.stdout.write(summary + "\n")
-    if statelog is not None:
-        sys.stdout.write(f"wrote {statelog.rows} states to {log}\n")
-    if trace is not None and plot is not None:
-        from robotspec.render.plot import plot_joint_trace
+        return results, True, signals.received[0] if signals.received else "Ctrl-C"
+    return results, False, "Ctrl-C"
 
-        drawn = plot_joint_trace(trace, plot, title=f"{name}: positions (solid), commands (dashed)")
-        sys.stdout.write(f"wrote {plot} ({drawn.lines} lines, {drawn.samples} samples)\n")
-    if scenario is not None:
-        failed = mismatch_errors(scenario, results)
-        n_run = len(results)
-        n_steps = len(scenario.scenario.steps)
-        slowed = [str(r.index) for r in results if r.note]
-        sys.stdout.write(
-            f"scenario: {n_run - len(failed)} of {n_steps} steps as expected"
-            f"{'' if n_run == n_steps else f' ({n_steps - n_run} not run)'}"
-            + (
-                f"; {len(slowed)} trajector{'y' if len(slowed) == 1 else 'ies'} slowed to stay "
-                f"within the joint limits (step{'' if len(slowed) == 1 else 's'} "
-                f"{', '.join(slowed)})"
-                if slowed
-                else ""
-            )
-            + "\n"
+
+def _report_scenario(
+    scenario: LoadedScenario, results: list[StepResult], *, interrupted: bool, script: Path
+) -> None:
+    """Print how many steps went as expected; raise the mismatches, located at the script."""
+    from robotspec.driver.script import mismatch_errors
+    from robotspec.errors import RobotSpecError, RobotSpecErrors
+
+    failed = mismatch_errors(scenario, results)
+    n_run = len(results)
+    n_steps = len(scenario.scenario.steps)
+    slowed = [str(r.index) for r in results if r.note]
+    sys.stdout.write(
+        f"scenario: {n_run - len(failed)} of {n_steps} steps as expected"
+        f"{'' if n_run == n_steps else f' ({n_steps - n_run} not run)'}"
+        + (
+            f"; {len(slowed)} trajector{'y' if len(slowed) == 1 else 'ies'} slowed to stay "
+            f"within the joint limits (step{'' if len(slowed) == 1 else 's'} "
+            f"{', '.join(slowed)})"
+            if slowed
+            else ""
         )
-        if interrupted and n_run < n_steps:
-            failed.append(
-                RobotSpecError(f"scenario interrupted before step {n_run + 1}", file=str(script))
-            )
-        if failed:
-            if len(failed) == 1:
-                raise failed[0]
-            raise RobotSpecErrors(failed, summary=f"{script}: {len(failed)} steps not as expected")
+        + "\n"
+    )
+    if interrupted and n_run < n_steps:
+        failed.append(
+            RobotSpecError(f"scenario interrupted before step {n_run + 1}", file=str(script))
+        )
+    if failed:
+        if len(failed) == 1:
+            raise failed[0]
+        raise RobotSpecErrors(failed, summary=f"{script}: {len(failed)} steps not as expected")
 
 
 class _StatusLine:

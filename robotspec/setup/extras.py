@@ -7,7 +7,7 @@ All of it is one frozen value the session's history keeps with the draft, so *un
 frame's rotation or a pair toggled by hand exactly as it takes back a chain's tip.
 
 The text edits are made, in order, on the text the draft's changes gave, each through the
-round-trip editor (:func:`robotspec.setup.text_edit.edit_paths`), so each changes only its own
+round-trip editor (:func:`robotspec.setup.text_edit.apply_ops`), so each changes only its own
 lines. An ``accept_warnings`` entry is named by its ``at`` and ``says`` (:class:`Entry`), not
 its place in the list, which removing another entry changes.
 """
@@ -19,7 +19,7 @@ from typing import Any
 
 import yaml
 
-from robotspec.setup.text_edit import Elsewhere, Op, edit_paths
+from robotspec.setup.text_edit import Elsewhere, Op, _Text, apply_ops
 
 __all__ = ["DELETE", "Edit", "Entry", "Extras", "apply_edits"]
 
@@ -133,19 +133,21 @@ def apply_edits(
     A value set below a part (a frame's rotation) is made only while the part is in the text:
     a frame the draft removed since takes its rotation with it. No edits: ``text`` itself.
     """
+    t = _Text(text)  # one text, indexed again after each edit it takes
     for edit in edits:
-        data = yaml.safe_load(text)
+        root = t.index.root
+        data = None if root is None else yaml.SafeLoader("").construct_document(root)
         path = _resolve(data, edit.path)
         if path is None:
             continue
         if edit.kind == DELETE:
             if _has(data, path):
-                text = edit_paths(text, [Op("delete", path)], elsewhere=elsewhere, fixed=fixed)
+                apply_ops(t, [Op("delete", path)], elsewhere, fixed)
             continue
         if len(path) > 2 and not _has(data, path[:-1]):
             continue
         now = _get(data, path)
         if now == edit.value or (isinstance(edit.value, tuple) and list(edit.value) == now):
             continue  # as written already: its text stays
-        text = edit_paths(text, [Op("set", path, edit.value)], elsewhere=elsewhere, fixed=fixed)
-    return text
+        apply_ops(t, [Op("set", path, edit.value)], elsewhere, fixed)
+    return t.text

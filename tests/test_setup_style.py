@@ -112,3 +112,9 @@ def test_a_four_space_spec_of_a_robot_nobody_specified_gains_four_space_lines(
         '      because: "a robot-level pose"',
     ]
     assert s.validation.valid
+    # A new part takes the drafter's lines (their comments too), nested by the file's step.
+    text = s.snapshot.text
+    assert s.add_camera("wrist_camera", "j2s6s200_link_6").valid
+    new = _added(text, s.snapshot.text)
+    assert new[0].startswith("    wrist_camera:") and new[1] == "        type: camera"
+    assert all(line.startswith("        ") for line in new[1:]), new

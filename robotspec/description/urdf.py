@@ -31,7 +31,7 @@ from robotspec.model.geometry import (
 if TYPE_CHECKING:
     from robotspec.files.packages import PackageResolver
 from robotspec.description.mesh_report import MissingMesh, summarize_missing_meshes
-from robotspec.description.urdf_walk import JointRecord, ShapeRecord, walk_urdf
+from robotspec.description.urdf_walk import JointRecord, ShapeRecord, UrdfRecords, walk_urdf
 from robotspec.files.limits import limits
 from robotspec.files.reading import read_bounded
 from robotspec.files.xmlsafe import line_of, parse_xml_bytes, undeclared_prefixes
@@ -120,43 +120,69 @@ def world_from_urdf_xml(
         raise
     problems: list[RobotSpecError] = []
     missing: list[MissingMesh] = []
+    bodies = _bodies(records, file, resolver, meshes, problems, missing)
+    raise_collected(problems)
+    if missing and issues is not None:
+        issues.extend(summarize_missing_meshes(missing))
+    undeclared = _undeclared_prefixes(root, file)
+    if undeclared is not None and issues is not None:
+        issues.append(undeclared)
+    joints = {j.name: j for j in records.joints}
+    leaders = _resolve_mimics(joints, file)
+    dofs, own_dofs = _dofs(records, leaders)
+    body_index = {b.name: b.index for b in bodies}
+    connections = _connections(records, leaders, own_dofs, body_index, file, problems)
+    raise_collected(problems)
+    return World(records.name, bodies, connections, dofs, source=file)
+
+
+def _bodies(
+    records: UrdfRecords,
+    file: str,
+    resolver: PackageResolver | None,
+    meshes: MeshPolicy,
+    problems: list[RobotSpecError],
+    missing: list[MissingMesh],
+) -> list[Body]:
+    """One body per link, with its shapes (meshes resolved as ``meshes`` says)."""
     bodies: list[Body] = []
-    body_index: dict[str, int] = {}
     base = Path(file).parent
     for link in records.links:
         where = _Where(file, base, resolver, meshes, problems, missing, link.name)
-        visuals = _shapes(link.visuals, where)
-        collisions = _shapes(link.collisions, where)
-        body_index[link.name] = len(bodies)
         bodies.append(
             Body(
                 name=link.name,
                 index=len(bodies),
-                visuals=visuals,
-                collisions=collisions,
+                visuals=_shapes(link.visuals, where),
+                collisions=_shapes(link.collisions, where),
                 mass=link.mass,
                 line=line_of(link.element),
             )
         )
-    raise_collected(problems)
-    if missing and issues is not None:
-        issues.extend(summarize_missing_meshes(missing))
+    return bodies
+
+
+def _undeclared_prefixes(root: etree._Element, file: str) -> RobotSpecError | None:
+    """The warning for XML prefixes used without a declaration (Drake's), if any."""
     undeclared = undeclared_prefixes(root)
-    if undeclared and issues is not None:
-        names = ", ".join(f"'{p}:'" for p in undeclared)
-        issues.append(
-            DescriptionError(
-                f"XML prefix{'es' if len(undeclared) > 1 else ''} {names} used without a "
-                "declaration (as Drake writes them); read as extensions URDF does not use",
-                file=file,
-                line=line_of(root),
-                kind="xml",
-                name=undeclared[0],
-                severity="warning",
-            )
-        )
-    joints = {j.name: j for j in records.joints}
-    leaders = _resolve_mimics(joints, file)
+    if not undeclared:
+        return None
+    names = ", ".join(f"'{p}:'" for p in undeclared)
+    return DescriptionError(
+        f"XML prefix{'es' if len(undeclared) > 1 else ''} {names} used without a "
+        "declaration (as Drake writes them); read as extensions URDF does not use",
+        file=file,
+        line=line_of(root),
+        kind="xml",
+        name=undeclared[0],
+        severity="warning",
+    )
+
+
+def _dofs(
+    records: UrdfRecords, leaders: Mapping[str, tuple[str, float, float]]
+) -> tuple[list[DegreeOfFreedom], dict[str, tuple[int, ...]]]:
+    """The degrees of freedom of every moving joint that mimics none, and each joint's own."""
     dofs: list[DegreeOfFreedom] = []
     own_dofs: dict[str, tuple[int, ...]] = {}
     for j in records.joints:
@@ -178,6 +204,19 @@ def world_from_urdf_xml(
                 )
             )
         own_dofs[j.name] = tuple(range(start, len(dofs)))
+    return dofs, own_dofs
+
+
+def _connections(
+    records: UrdfRecords,
+    leaders: Mapping[str, tuple[str, float, float]],
+    own_dofs: Mapping[str, tuple[int, ...]],
+    body_index: Mapping[str, int],
+    file: str,
+    problems: list[RobotSpecError],
+) -> list[Connection]:
+    """One connection per joint; a mimic joint moves with its leader's one degree of freedom."""
+    joints = {j.name: j for j in records.joints}
     connections: list[Connection] = []
     for j in records.joints:
         jtype = _TYPES[j.type]
@@ -217,8 +256,7 @@ def world_from_urdf_xml(
                 line=line_of(j.element),
             )
         )
-    raise_collected(problems)
-    return World(records.name, bodies, connections, dofs, source=file)
+    return connections
 
 
 _TYPES = {t.value: t for t in ConnectionType}

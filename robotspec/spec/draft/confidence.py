@@ -91,23 +91,12 @@ def tool_frame_question(
     if not is_named_tcp(world, tool):
         return f"the tool frame '{tool.name}' by its name"
     if hand is not None:
-        if world.is_ancestor(hand, tool) or _rigid_with(world, tool, hand):
+        if world.is_ancestor(hand, tool):
             return None
         return f"the tool frame '{tool.name}' is named as a TCP but hangs beside the hand"
     if world.is_ancestor(tip, tool) and not tree.moves_below(tip):
         return None
     return f"the tool frame '{tool.name}' is named as a TCP but is not at the chain's end"
-
-
-def _rigid_with(world: World, a: Body, b: Body) -> bool:
-    """Whether ``a`` hangs on fixed joints from a body that ``b`` is fixed to (one rigid part)."""
-
-    def carrier(x: Body) -> Body:
-        while (c := world.parent_connection(x)) is not None and c.is_fixed:
-            x = world.bodies[c.parent]
-        return x
-
-    return carrier(a) is carrier(b)
 
 
 def gripper_question(coupled: bool, one_driven: bool) -> str | None:

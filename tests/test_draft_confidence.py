@@ -1,0 +1,124 @@
+"""The DECIDE rule (``robotspec/spec/draft/confidence.py``) on small layouts (issue 30, item 3).
+
+A part is unmarked only when a file states it; names, shapes and defaults keep their mark.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robotspec.spec.draft.confidence import drive_question, gripper_question
+from tests.test_draft_blind import _arm, _draft, _draft_srdf, _jaws, _joint, _link
+
+#: REP 103's optical rotation from a body frame.
+_OPTICAL = "-1.5708 0 -1.5708"
+
+
+def _mimic(parts: list[str], joint: str, leader: str) -> list[str]:
+    """``parts`` with ``joint`` made a mimic of ``leader``."""
+    tag = f'<joint name="{joint}" '
+    return [
+        p.replace("</joint>", f'<mimic joint="{leader}"/></joint>') if p.startswith(tag) else p
+        for p in parts
+    ]
+
+
+def _gripper(tcp_on: str | None, mimic: bool) -> list[str]:
+    parts = [
+        *_arm("wrist"),
+        _link("mount"),
+        _joint("mount_joint", "wrist", "mount", "fixed"),
+        _link("jaw_base", size=0.04),
+        _joint("jaw_base_joint", "mount", "jaw_base", "fixed", "0 0 0.03"),
+        *(p.replace(' 0.03 0"', ' 0.03 0.05"') for p in _jaws("jaw_base", 0.03)),
+    ]
+    if tcp_on is not None:
+        parts += [
+            '<link name="hand_tcp"/>',
+            _joint("tcp_j", tcp_on, "hand_tcp", "fixed", "0 0 0.1"),
+        ]
+    return _mimic(parts, "right_jaw_q", "left_jaw_q") if mimic else parts
+
+
+def test_a_mimic_coupled_gripper_with_a_tcp_on_the_hand_is_stated(tmp_path: Path) -> None:
+    (m,) = _draft(tmp_path, "stated", _gripper("jaw_base", mimic=True)).manipulators
+    assert m.is_gripper and m.tool_frame == "hand_tcp" and m.decide == []
+    # The facing follows from the tool frame and the tips: a plain comment, no question.
+    assert m.facing == "grasping along the hand's reach"
+
+
+def test_uncoupled_fingers_and_a_tcp_beside_the_hand_are_questions(tmp_path: Path) -> None:
+    (m,) = _draft(tmp_path, "free", _gripper("jaw_base", mimic=False)).manipulators
+    assert m.decide == [gripper_question(False, False)]
+    # A TCP on the mount beside the gripper, not on it: named so, but where is the question.
+    (m,) = _draft(tmp_path, "beside", _gripper("mount", mimic=True)).manipulators
+    assert m.tool_frame == "hand_tcp"
+    assert any("hangs beside the hand" in r for r in m.decide)
+
+
+def test_a_proposed_tool_frame_is_a_question_on_the_manipulator(tmp_path: Path) -> None:
+    d = _draft(tmp_path, "proposed", _gripper(None, mimic=True))
+    (m,) = d.manipulators
+    assert [f.name for f in d.frames] == [m.tool_frame]
+    assert m.decide == [f"its tool frame '{m.tool_frame}' is proposed (description.frames)"]
+
+
+def test_an_optical_frame_found_by_its_rotation_is_asked_and_an_ir_pair_is_its_device(
+    tmp_path: Path,
+) -> None:
+    # A RealSense's frames on a mount: colour, depth and the left/right infrared optical frames.
+    parts = [*_arm("wrist"), _link("camera_link", size=0.02)]
+    parts.append(_joint("camera_joint", "base", "camera_link", "fixed", "0.1 0 0.3"))
+    for i, channel in enumerate(("color", "depth", "left_ir", "right_ir")):
+        frame = f"camera_{channel}_optical_frame"
+        parts += [f'<link name="{frame}"/>']
+        parts.append(
+            _joint(f"{frame}_j", "camera_link", frame, "fixed", f"0 {0.015 * i} 0", rpy=_OPTICAL)
+        )
+    d = _draft(tmp_path, "rgbd", parts)
+    (cam,) = d.cameras
+    assert cam.body == "camera_color_optical_frame" and cam.optical
+    assert cam.decide == ["an optical frame by its rotation; no Gazebo sensor states it"]
+
+
+def test_a_floating_virtual_joint_on_a_bolted_arm_is_drafted_fixed_and_asked(
+    tmp_path: Path,
+) -> None:
+    vj = '<virtual_joint name="vj" type="floating" parent_frame="world" child_link="base"/>'
+    d = _draft_srdf(tmp_path, "bolted", _arm("wrist"), vj)
+    assert d.drive is not None and d.drive.type == "fixed" and d.drive.joint is None
+    assert d.drive.decide == drive_question("floating", moves=False)
+
+
+def test_the_rule_for_drives_and_grippers() -> None:
+    # Stated: a floating base that legs move, a fixed one nothing moves, a mimic-coupled pair.
+    assert drive_question("floating", moves=True) is None
+    assert drive_question("fixed", moves=False) is None
+    assert gripper_question(coupled=True, one_driven=True) is None
+    # Asked: a planar base (omni or differential?), a fixed one on wheels, uncoupled fingers.
+    assert drive_question("planar", moves=True) and drive_question("fixed", moves=True)
+    assert gripper_question(coupled=False, one_driven=True)
+
+
+def test_a_linkage_finger_ends_at_the_link_its_joints_move(tmp_path: Path) -> None:
+    # Robotiq 85: each side a driven (or mimic) knuckle carrying a finger on a fixed joint, and
+    # an inner knuckle carrying the finger tip on a mimic joint, both ends at one depth.
+    parts = [*_arm("wrist"), _link("palm", size=0.04)]
+    parts.append(_joint("palm_j", "wrist", "palm", "fixed"))
+    for side, y in (("left", 0.03), ("right", -0.03)):
+        tip_xyz = f"0 {y} 0.04"
+        parts += [
+            _link(f"{side}_knuckle"),
+            _joint(f"{side}_knuckle_q", "palm", f"{side}_knuckle", xyz=f"0 {y} 0.05", axis="1 0 0"),
+            _link(f"{side}_finger"),
+            _joint(f"{side}_finger_j", f"{side}_knuckle", f"{side}_finger", "fixed", f"0 {y} 0.01"),
+            _link(f"{side}_inner"),
+            _joint(f"{side}_inner_q", "palm", f"{side}_inner", xyz=f"0 {y / 2} 0.06", axis="1 0 0"),
+            _link(f"{side}_tip"),
+            _joint(f"{side}_tip_q", f"{side}_inner", f"{side}_tip", xyz=tip_xyz, axis="1 0 0"),
+        ]  # fmt: skip
+    for joint in ("right_knuckle_q", "left_inner_q", "right_inner_q", "left_tip_q", "right_tip_q"):
+        parts = _mimic(parts, joint, "left_knuckle_q")
+    (m,) = _draft(tmp_path, "linkage", parts).manipulators
+    assert m.is_gripper and m.thumb is not None and m.finger is not None
+    assert {m.thumb.tip, m.finger.tip} == {"left_tip", "right_tip"}

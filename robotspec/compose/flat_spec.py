@@ -7,6 +7,7 @@ A welded part's one unmounted manipulator is handed over to the chain nearest ab
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 from lxml import etree
@@ -48,25 +49,57 @@ def flat_spec(
 ) -> LoadedSpec | None:
     """The composed robot's spec: every part's semantics renamed, then the spec's own entries."""
     spec = loaded.spec
-    merged: dict[str, Any] = {s: {} for s in NAMED_SECTIONS}
-    owner: dict[tuple[str, str], str] = {}
-    velocity: dict[str, float] = {}
-    controlled: list[str] = []
-    any_controlled = False
-    disabled: list[str] = []
-    documents: list[LocatedYaml] = []
-    import_states = False
-    carried_before: set[str] = set()
+    merged = _Merged()
     for name in order:
-        part, n = parts[name], names_of[name]
+        merged.add(name, parts[name], names_of[name], diag)
+    data = _parts_data(loaded, merged, parts[order[0]], names_of[order[0]])
+    own = spec.model_dump(mode="json", exclude_unset=True)
+    _apply_own(data, own)
+    explicit = {c for c, chain in own.get("chains", {}).items() if "manipulator" in chain}
+    tips = {
+        g.name: g.chains[0].tip_link for g in (srdf.groups if srdf else ()) if len(g.chains) == 1
+    }
+    _hand_over_manipulators(data, explicit, tips, parts, order, merged.owner, robot, names_of)
+    # A part's manipulator that its own chain carried and no chain carries any more was
+    # replaced (by a hand, or by the composed spec's own choice): it is not the robot's.
+    carried = {c.get("manipulator") for c in data.get("chains", {}).values()}
+    for m in [m for m in data.get("manipulators", {}) if m in merged.carried_before - carried]:
+        if m not in own.get("manipulators", {}):
+            del data["manipulators"][m]
+    try:
+        flat = RobotSpec.model_validate(data)
+    except ValidationError as exc:
+        diag.add_all(validation_errors(exc, loaded.documents[0], RobotSpec, SpecError))
+        return None
+    return LoadedSpec(flat, loaded.file, (*loaded.documents, *merged.documents))
+
+
+@dataclass
+class _Merged:
+    """The parts' renamed semantics gathered part by part (a clash is an error, not a choice)."""
+
+    sections: dict[str, Any] = field(default_factory=lambda: {s: {} for s in NAMED_SECTIONS})
+    #: (section, key) -> the part it came from; ("torso", "") and ("neck", "") for those.
+    owner: dict[tuple[str, str], str] = field(default_factory=dict)
+    velocity: dict[str, float] = field(default_factory=dict)
+    controlled: list[str] = field(default_factory=list)
+    any_controlled: bool = False
+    disabled: list[str] = field(default_factory=list)
+    documents: list[LocatedYaml] = field(default_factory=list)
+    import_states: bool = False
+    #: Manipulators some part's own chain carries.
+    carried_before: set[str] = field(default_factory=set)
+
+    def add(self, name: str, part: Part, n: PartNames, diag: Diagnostics) -> None:
+        """Part ``name``'s semantics, renamed; what another part has already is an error."""
         sem = rename_semantics(part.data, n, part.facts)
         loc: Loc = ("parts", name)
-        carried_before.update(
+        self.carried_before.update(
             c["manipulator"] for c in sem.get("chains", {}).values() if c.get("manipulator")
         )
         for section in NAMED_SECTIONS:
             for key, value in sem.get(section, {}).items():
-                other = owner.get((section, key))
+                other = self.owner.get((section, key))
                 if other is not None:
                     diag.error(
                         loc,
@@ -76,52 +109,61 @@ def flat_spec(
                         kind="clash",
                     )
                     continue
-                owner[(section, key)] = name
-                merged[section][key] = value
+                self.owner[(section, key)] = name
+                self.sections[section][key] = value
         for key in ("torso", "neck"):
             if key in sem:
-                if key in merged:
+                if key in self.sections:
                     diag.error(
-                        loc, f"both part '{owner[(key, '')]}' and part '{name}' have a {key}"
+                        loc, f"both part '{self.owner[(key, '')]}' and part '{name}' have a {key}"
                     )
                     continue
-                owner[(key, "")] = name
-                merged[key] = sem[key]
-        velocity.update(sem.get("velocity_limits", {}).get("joints", {}))
+                self.owner[(key, "")] = name
+                self.sections[key] = sem[key]
+        self.velocity.update(sem.get("velocity_limits", {}).get("joints", {}))
         if "controlled_joints" in sem:
-            any_controlled = True
-            controlled += sem["controlled_joints"]
+            self.any_controlled = True
+            self.controlled += sem["controlled_joints"]
         else:
-            controlled += [n.joint(j) for j in part.facts.driven_joints]
-        disabled += sem.get("collision", {}).get("disabled_bodies", [])
-        import_states |= bool(sem.get("import_srdf_group_states"))
-        documents += [remap_marks(d, n) for d in part.documents]
-    base = parts[order[0]]
-    base_names = names_of[order[0]]
+            self.controlled += [n.joint(j) for j in part.facts.driven_joints]
+        self.disabled += sem.get("collision", {}).get("disabled_bodies", [])
+        self.import_states |= bool(sem.get("import_srdf_group_states"))
+        self.documents += [remap_marks(d, n) for d in part.documents]
+
+
+def _parts_data(
+    loaded: LoadedSpec, merged: _Merged, base: Part, base_names: PartNames
+) -> dict[str, Any]:
+    """The spec the parts make together, before the composed spec's own entries."""
+    spec = loaded.spec
     root = spec.root or base_names.link(base.spec_root or base.facts.roots[0])
     data: dict[str, Any] = {
         "name": spec.name,
         "description": {"urdf": str(loaded.file)},
         "root": root,
-        **{k: v for k, v in merged.items() if v},
+        **{k: v for k, v in merged.sections.items() if v},
     }
     if base.drive is not None:
         drive = dict(base.drive)
         if drive.get("joint"):
             drive["joint"] = base_names.joint(drive["joint"])
         data["drive"] = drive
-    if velocity:
-        data["velocity_limits"] = {"joints": velocity}
-    if any_controlled:
-        data["controlled_joints"] = controlled
+    if merged.velocity:
+        data["velocity_limits"] = {"joints": merged.velocity}
+    if merged.any_controlled:
+        data["controlled_joints"] = merged.controlled
     collision: dict[str, Any] = dict(base.collision)
-    if disabled:
-        collision["disabled_bodies"] = disabled
+    if merged.disabled:
+        collision["disabled_bodies"] = merged.disabled
     if collision:
         data["collision"] = collision
-    if import_states:
+    if merged.import_states:
         data["import_srdf_group_states"] = True
-    own = spec.model_dump(mode="json", exclude_unset=True)
+    return data
+
+
+def _apply_own(data: dict[str, Any], own: Mapping[str, Any]) -> None:
+    """The composed spec's own entries over the parts' (``parts`` and the like excepted)."""
     for key, value in own.items():
         if key in ("parts", "description", "robotspec", "extends"):
             continue
@@ -131,23 +173,6 @@ def flat_spec(
             data[key] = merge_data(data[key], value)
         else:
             data[key] = value
-    explicit = {c for c, chain in own.get("chains", {}).items() if "manipulator" in chain}
-    tips = {
-        g.name: g.chains[0].tip_link for g in (srdf.groups if srdf else ()) if len(g.chains) == 1
-    }
-    _hand_over_manipulators(data, explicit, tips, parts, order, owner, robot, names_of)
-    # A part's manipulator that its own chain carried and no chain carries any more was
-    # replaced (by a hand, or by the composed spec's own choice): it is not the robot's.
-    carried = {c.get("manipulator") for c in data.get("chains", {}).values()}
-    for m in [m for m in data.get("manipulators", {}) if m in carried_before - carried]:
-        if m not in own.get("manipulators", {}):
-            del data["manipulators"][m]
-    try:
-        flat = RobotSpec.model_validate(data)
-    except ValidationError as exc:
-        diag.add_all(validation_errors(exc, loaded.documents[0], RobotSpec, SpecError))
-        return None
-    return LoadedSpec(flat, loaded.file, (*loaded.documents, *documents))
 
 
 def _hand_over_manipulators(

@@ -25,9 +25,9 @@ from robotspec.arrays import F64
 from robotspec.errors import RobotSpecError
 from robotspec.export.mjcf import named_states
 from robotspec.export.mjcf_bodies import camera_frame
-from robotspec.interop.mujoco_fit import TOLERANCE, fit_frames, inverse
+from robotspec.interop.mujoco_fit import TOLERANCE, FrameFit, fit_frames, inverse
 from robotspec.interop.mujoco_matcher import Matcher
-from robotspec.interop.mujoco_model import read_model
+from robotspec.interop.mujoco_model import TheirModel, read_model
 from robotspec.interop.mujoco_names import NameMatch
 from robotspec.semantic import AbstractRobot
 
@@ -101,48 +101,9 @@ def annotate_mjcf(
     fit = fit_frames(*a.relative(qs, [their.body_poses(a.qpos(q)) for q in qs]), tolerance)
     if fit.failing(tolerance):
         raise a.diagnose(fit, qs)
-    fk0 = robot.kinematics.forward(qs[0])
-    root_inv = inverse(fk0[a.root])
-
-    def local(body: int, frame: F64) -> tuple[str, F64]:
-        """``frame`` (world pose at qs[0]) in their body that rigidly holds ``body``."""
-        b = a.owner(body, f"'{robot.world.bodies[body].name}'")
-        key = robot.world.bodies[b].name
-        return a.pairs[b], inverse(fit.offsets[key]) @ inverse(root_inv @ fk0[b]) @ (
-            root_inv @ frame
-        )
-
-    sites: list[Placed] = []
-    targets: list[tuple[str, str, int, F64]] = []
-    for m in robot.manipulators:
-        tool = m.tool_frame
-        body, pose = local(tool.index, fk0[tool.index])
-        name = their.add_site(tool.name, body, pose, a.notes)
-        sites.append(Placed(name, body, tool.name))
-        targets.append(("site", name, tool.index, np.eye(4)))
-    cameras: list[Placed] = []
-    for cam in robot.cameras:
-        frame = fk0[cam.root.index] @ camera_frame(cam)
-        body, pose = local(cam.root.index, frame)
-        fovy = math.degrees(cam.field_of_view.vertical_angle)
-        name = their.add_camera(cam.name, body, pose, fovy, a.notes)
-        cameras.append(Placed(name, body, cam.name))
-        targets.append(("camera", name, cam.root.index, camera_frame(cam)))
-    keys = []
-    for key, state in named_states(robot).items():
-        values = state.as_dict()
-        dofs = {robot.world.get_degree_of_freedom_by_name(n).index for n in values}
-        qpos = a.qpos(robot.world.configuration(values), only=dofs)
-        keys.append(their.add_key(key, qpos, a.notes))
-    added: list[tuple[str, str]] = []
-    if excludes:
-        for pair in sorted(tuple(sorted(p)) for p in robot.disabled_collision_pairs if len(p) == 2):
-            try:
-                ends = [a.pairs[a.owner(robot.world.get_body_by_name(n).index, n)] for n in pair]
-            except RobotSpecError:
-                continue  # a body below an unmatched joint: their model has no such body
-            if their.add_exclude(ends[0], ends[1]):
-                added.append((ends[0], ends[1]))
+    sites, cameras, targets = _place_frames(robot, their, a, fit, qs[0])
+    keys = _add_keys(robot, their, a)
+    added = _add_excludes(robot, their, a) if excludes else []
 
     def measure(model: Any = None) -> float:
         root = a.pairs[a.root]
@@ -175,3 +136,65 @@ def annotate_mjcf(
         notes=tuple(a.notes),
         check_file=check_file,
     )
+
+
+def _add_keys(robot: AbstractRobot, their: TheirModel, a: Matcher) -> list[str]:
+    """One keyframe per named state of the robot, over the joints the state names."""
+    keys = []
+    for key, state in named_states(robot).items():
+        values = state.as_dict()
+        dofs = {robot.world.get_degree_of_freedom_by_name(n).index for n in values}
+        qpos = a.qpos(robot.world.configuration(values), only=dofs)
+        keys.append(their.add_key(key, qpos, a.notes))
+    return keys
+
+
+def _add_excludes(robot: AbstractRobot, their: TheirModel, a: Matcher) -> list[tuple[str, str]]:
+    """The robot's disabled pairs as ``<exclude>`` of their bodies (those they have)."""
+    added: list[tuple[str, str]] = []
+    for pair in sorted(tuple(sorted(p)) for p in robot.disabled_collision_pairs if len(p) == 2):
+        try:
+            ends = [a.pairs[a.owner(robot.world.get_body_by_name(n).index, n)] for n in pair]
+        except RobotSpecError:
+            continue  # a body below an unmatched joint: their model has no such body
+        if their.add_exclude(ends[0], ends[1]):
+            added.append((ends[0], ends[1]))
+    return added
+
+
+def _place_frames(
+    robot: AbstractRobot, their: TheirModel, a: Matcher, fit: FrameFit, q0: F64
+) -> tuple[list[Placed], list[Placed], list[tuple[str, str, int, F64]]]:
+    """A site at each tool frame and a camera at each camera, in their bodies that hold ours.
+
+    Returns the sites, the cameras, and what each must match (kind, their name, our body,
+    the frame in our body) for the site error.
+    """
+    fk0 = robot.kinematics.forward(q0)
+    root_inv = inverse(fk0[a.root])
+
+    def local(body: int, frame: F64) -> tuple[str, F64]:
+        """``frame`` (world pose at q0) in their body that rigidly holds ``body``."""
+        b = a.owner(body, f"'{robot.world.bodies[body].name}'")
+        key = robot.world.bodies[b].name
+        return a.pairs[b], inverse(fit.offsets[key]) @ inverse(root_inv @ fk0[b]) @ (
+            root_inv @ frame
+        )
+
+    sites: list[Placed] = []
+    targets: list[tuple[str, str, int, F64]] = []
+    for m in robot.manipulators:
+        tool = m.tool_frame
+        body, pose = local(tool.index, fk0[tool.index])
+        name = their.add_site(tool.name, body, pose, a.notes)
+        sites.append(Placed(name, body, tool.name))
+        targets.append(("site", name, tool.index, np.eye(4)))
+    cameras: list[Placed] = []
+    for cam in robot.cameras:
+        frame = fk0[cam.root.index] @ camera_frame(cam)
+        body, pose = local(cam.root.index, frame)
+        fovy = math.degrees(cam.field_of_view.vertical_angle)
+        name = their.add_camera(cam.name, body, pose, fovy, a.notes)
+        cameras.append(Placed(name, body, cam.name))
+        targets.append(("camera", name, cam.root.index, camera_frame(cam)))
+    return sites, cameras, targets

@@ -1,7 +1,7 @@
 """What a user without the C accelerators pays: the numpy fallbacks against the C cores, one run.
 
-Run: ``python benchmarks/bench_fallback.py [--robot pr2] [--batch 2000] [--samples 2000] [--json]``
-(needs the dev extra: example-robot-data, coal; and the C cores built, to compare with).
+Run: ``python benchmarks/bench_fallback.py [--robot pr2] [--batch 2000] [--samples 2000] [--cpu]
+[--json]`` (needs the dev extra: example-robot-data, coal; and the C cores built, to compare with).
 
 Ours is the public API on the pure-Python cores (``robotspec/model/_kincore_py.py``,
 ``robotspec/collision/_meshcore_py.py``: what ``ROBOTSPEC_NO_ACCEL=1`` or an install without a
@@ -10,6 +10,12 @@ sides are built separately in this process, their answers compared before anythi
 timed in turns (rows.median_times). Ratio = C time / fallback time: the fraction of the
 accelerated speed a user without a compiler gets. The collision matrix (the ``robotspec
 collisions generate`` path) runs in this process (``processes=1``) on each side once.
+
+``--cpu`` times each call by this thread's CPU time (``time.thread_time``) instead of the wall
+clock: on a machine other processes keep busy, the wall clock counts the time this process waited
+for a CPU, which the numpy side (several times longer, more memory traffic) suffers more than the C
+side; the CPU time counts the work. Every call compared runs on this one thread (``threads=1``,
+``processes=1``), so nothing is left out. Give the load (``uptime``) with any figure.
 """
 
 from __future__ import annotations
@@ -23,6 +29,19 @@ from typing import Any
 
 import numpy as np
 from rows import Row, add_json_flag, median_times, print_rows
+
+
+def median_cpu_times(fns: list[Callable[[], object]], repeat: int) -> list[float]:
+    """:func:`rows.median_times` timed by this thread's CPU time (see ``--cpu``)."""
+    for fn in fns:
+        fn()
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for fn, out in zip(fns, times, strict=True):
+            t = time.thread_time()
+            fn()
+            out.append(time.thread_time() - t)
+    return [sorted(t)[len(t) // 2] for t in times]
 
 
 @contextmanager
@@ -42,6 +61,7 @@ def main() -> None:
     parser.add_argument("--batch", type=int, default=2000, help="configurations per FK batch")
     parser.add_argument("--samples", type=int, default=2000, help="collision matrix samples")
     parser.add_argument("--rounds", type=int, default=15, help="timing rounds (medians)")
+    parser.add_argument("--cpu", action="store_true", help="time by this thread's CPU time")
     add_json_flag(parser)
     args = parser.parse_args()
 
@@ -94,16 +114,18 @@ def main() -> None:
     for what, fn, tol, reps in cases:
         ours, peer = on("py", fn), on("c", fn)
         np.testing.assert_allclose(np.asarray(ours()), np.asarray(peer()), rtol=0, atol=tol)
-        t_ours, t_peer = median_times([on("py", fn, reps), on("c", fn, reps)], args.rounds)
+        timed = median_cpu_times if args.cpu else median_times
+        t_ours, t_peer = timed([on("py", fn, reps), on("c", fn, reps)], args.rounds)
         rows.append(Row(f"{label} {what}", t_ours / reps, "C accelerators", t_peer / reps))
 
     # The `robotspec collisions generate` path, once a side (seconds each).
     matrices, times = {}, {}
+    clock = time.thread_time if args.cpu else time.perf_counter
     for name in ("c", "py"):
         with using(*(c if name == "c" else py)):
-            t = time.perf_counter()
+            t = clock()
             matrices[name] = generate_for_robot(robot, samples=args.samples, seed=0, processes=1)
-            times[name] = time.perf_counter() - t
+            times[name] = clock() - t
     assert matrices["c"].disabled_pairs() == matrices["py"].disabled_pairs()
     rows.append(
         Row(

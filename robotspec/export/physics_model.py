@@ -21,6 +21,7 @@ result (:class:`~robotspec.driver.mujoco_model.PlantModel`), stays free of both.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from lxml import etree
@@ -30,6 +31,7 @@ from robotspec.driver.mujoco_model import PlantModel
 from robotspec.errors import RobotSpecError
 from robotspec.export.mjcf import MjcfExport
 from robotspec.export.mjcf_bodies import nums
+from robotspec.extras import MUJOCO, require
 from robotspec.semantic import AbstractRobot
 
 __all__ = ["plant_model"]
@@ -87,24 +89,13 @@ def _weld_joints(
     return welded
 
 
-def plant_model(
+def _start_values(
     robot: AbstractRobot,
     export: MjcfExport,
     chain_joints: Sequence[str],
-    initial: Sequence[float] | F64 | None = None,
-    *,
-    gravity_compensation: bool = False,
-) -> PlantModel:
-    """The MuJoCo model of ``export`` with ``chain_joints`` free and the rest as described above.
-
-    ``initial`` is the chain's starting configuration (default: the robot's default
-    configuration, as every other degree of freedom). ``gravity_compensation`` cancels gravity
-    on every body (``gravcomp``, as ``mjcf_export(..., gravity_compensation=True)`` does), so
-    one export serves both. Raises a
-    RobotSpecError naming the joint when a chain joint has no position servo in the export.
-    """
-    import mujoco  # type: ignore[import-untyped, unused-ignore]
-
+    initial: Sequence[float] | F64 | None,
+) -> tuple[dict[str, float], set[str]]:
+    """Each exported joint's value at the start (the chain at ``initial``), and the free ones."""
     world = robot.world
     q = world.default_configuration().copy()
     dof_index = {d.name: d.index for d in world.degrees_of_freedom}
@@ -124,6 +115,45 @@ def plant_model(
             free.add(j.name)
         else:
             values[j.name] = j.multiplier * float(q[j.dof]) + j.offset
+    return values, free
+
+
+def _kept_joints(root: etree._Element, chain_joints: Sequence[str]) -> set[str]:
+    """The chain and the mimic followers of a kept leader (their equality moves them)."""
+    keep = set(chain_joints)
+    couplings = [
+        (eq.get("joint1", ""), eq.get("joint2"))
+        for eq in root.iterfind("equality/joint")
+        if eq.get("joint2") is not None
+    ]
+    grown = True
+    while grown:
+        grown = False
+        for follower, leader in couplings:
+            if leader in keep and follower not in keep:
+                keep.add(follower)
+                grown = True
+    return keep
+
+
+def plant_model(
+    robot: AbstractRobot,
+    export: MjcfExport,
+    chain_joints: Sequence[str],
+    initial: Sequence[float] | F64 | None = None,
+    *,
+    gravity_compensation: bool = False,
+) -> PlantModel:
+    """The MuJoCo model of ``export`` with ``chain_joints`` free and the rest as described above.
+
+    ``initial`` is the chain's starting configuration (default: the robot's default
+    configuration, as every other degree of freedom). ``gravity_compensation`` cancels gravity
+    on every body (``gravcomp``, as ``mjcf_export(..., gravity_compensation=True)`` does), so
+    one export serves both. Raises a
+    RobotSpecError naming the joint when a chain joint has no position servo in the export.
+    """
+    mujoco: Any = require(MUJOCO, "--physics mujoco")
+    values, free = _start_values(robot, export, chain_joints, initial)
     servoed = set(export.actuated)
     missing = [n for n in chain_joints if n not in servoed]
     if missing:
@@ -138,21 +168,7 @@ def plant_model(
     keyframe = root.find("keyframe")
     if keyframe is not None:
         root.remove(keyframe)
-    # Kept: the chain and the mimic followers of a kept leader (their equality moves them).
-    keep = set(chain_joints)
-    couplings = [
-        (eq.get("joint1", ""), eq.get("joint2"))
-        for eq in root.iterfind("equality/joint")
-        if eq.get("joint2") is not None
-    ]
-    grown = True
-    while grown:
-        grown = False
-        for follower, leader in couplings:
-            if leader in keep and follower not in keep:
-                keep.add(follower)
-                grown = True
-    welded = _weld_joints(root, keep, servoed, values, free)
+    welded = _weld_joints(root, _kept_joints(root, chain_joints), servoed, values, free)
     if gravity_compensation:
         for body in root.iter("body"):
             body.set("gravcomp", "1")

@@ -27,11 +27,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from robotspec.errors import RobotSpecError
+from robotspec.interop.sdt.migrate_entries import (
+    camera_entry,
+    end_effector_entry,
+    velocity_limits,
+)
 from robotspec.interop.sdt.migrate_facts import drive_fact
 from robotspec.interop.sdt.migrate_parts import (
     base_root_note,
     build,
-    finger_names,
     forward_of,
     hardware_leaders,
     name_of,
@@ -39,13 +43,13 @@ from robotspec.interop.sdt.migrate_parts import (
     part_name,
     side_notes,
     spec_states,
-    vector3,
 )
 from robotspec.model.world import World
 from robotspec.spec.sdt import SDT_ROBOT_CLASSES
 
 if TYPE_CHECKING:
     from robotspec.description.load import Description
+    from robotspec.description.srdf import Srdf
 
 __all__ = ["Migration", "import_class", "migrate_files", "render", "spec_from_sdt"]
 
@@ -78,15 +82,39 @@ def spec_from_sdt(
     from robotspec.interop.sdt import sdt_api
 
     sdt = sdt_api()
+    robot, before = _built(sdt, cls, world)
+    if files is None:
+        from robotspec.description.load import load_description
+
+        files = load_description(urdf, srdf=srdf)
+    model, model_srdf = (files, None) if isinstance(files, World) else (files.world, files.srdf)
+    notes: list[str] = []
+    spec, forward = _head(sdt, cls, robot, (urdf, srdf), name, (model, model_srdf), notes)
+    names = {id(p): part_name(p, cls) for p in robot._robot_parts}
+    groups = _parts(sdt, robot, names, spec, notes)
+    notes.extend(side_notes(robot, groups["chains"], names, model, spec["root"], forward))
+    spec.update((key, value) for key, value in groups.items() if value)
+    hardware = hardware_leaders(robot, notes)
+    if hardware:
+        spec["controlled_joints"] = hardware
+    limits = velocity_limits(robot, before, notes)
+    if limits is not None:
+        spec["velocity_limits"] = limits
+    if srdf:
+        spec["collision"] = {"use_srdf": True}
+    return Migration(spec=_drop_empty(spec), notes=tuple(notes))
+
+
+def _built(sdt: Any, cls: type, world: Any) -> tuple[Any, dict[str, float | None]]:
+    """SDT's class set up on ``world`` (:func:`.migrate_parts.build`), or why it cannot be."""
     if not (isinstance(cls, type) and issubclass(cls, sdt.parts.AbstractRobot)):
         raise RobotSpecError(
             f"{cls!r} is not an SDT robot class (a subclass of "
             "semantic_digital_twin.robots.robot_parts.AbstractRobot)",
             kind="class",
         )
-    notes: list[str] = []
     try:
-        robot, before = build(cls, world)
+        return build(cls, world)
     except Exception as exc:  # SDT's own lookups (a body its class names, a part it expects)
         raise RobotSpecError(
             f"SDT's class {cls.__name__} cannot be built on this robot's world: "
@@ -94,11 +122,24 @@ def spec_from_sdt(
             kind="class",
             name=cls.__name__,
         ) from exc
-    if files is None:
-        from robotspec.description.load import load_description
 
-        files = load_description(urdf, srdf=srdf)
-    model, model_srdf = (files, None) if isinstance(files, World) else (files.world, files.srdf)
+
+def _head(
+    sdt: Any,
+    cls: type,
+    robot: Any,
+    description: tuple[str, str | None],
+    name: str | None,
+    files: tuple[World, Srdf | None],
+    notes: list[str],
+) -> tuple[dict[str, Any], tuple[float, float, float]]:
+    """The spec's robot-level keys (name, SDT class, files, root, forward, drive) and forward.
+
+    What the class says of its base goes here: which way it faces, and, from the files, how it
+    moves (:func:`.migrate_facts.drive_fact`); where it roots its mobile base, when that is
+    not the base body ``to_sdt`` derives (:func:`.base.base_body`), is a note.
+    """
+    (urdf, srdf), (model, model_srdf) = description, files
     spec: dict[str, Any] = {"robotspec": 1, "name": name or cls.__name__}
     if SDT_ROBOT_CLASSES.get(cls.__name__) == cls.__module__.rpartition(".")[2] and (
         cls.__module__.startswith("semantic_digital_twin.robots.")
@@ -116,111 +157,42 @@ def spec_from_sdt(
     if drive.note is not None:
         notes.append(drive.note)
     if base is not None:
-        notes.extend(base_root_note(robot, base, sdt))
-    chains: dict[str, Any] = {}
-    manipulators: dict[str, Any] = {}
-    sensors: dict[str, Any] = {}
-    names = {id(p): part_name(p, cls) for p in robot._robot_parts}
+        notes.extend(base_root_note(base, model, spec["root"]))
+    return spec, forward
+
+
+def _parts(
+    sdt: Any, robot: Any, names: dict[int, str], spec: dict[str, Any], notes: list[str]
+) -> dict[str, dict[str, Any]]:
+    """Every part of the built robot as its spec entry.
+
+    The torso and neck go into ``spec``; the rest is returned as its ``chains``,
+    ``manipulators`` and ``sensors``.
+    """
+    out: dict[str, dict[str, Any]] = {"chains": {}, "manipulators": {}, "sensors": {}}
     for part in robot._robot_parts:
         kind = part_kind(part, sdt)
         pname = names[id(part)]
         states = spec_states(part.setup_joint_states(), notes, pname)
         carried = [names[id(s)] for s in getattr(part, "sensors", [])]
+        if kind in ("Torso", "Neck", "Arm"):
+            ends = {"root": name_of(part.root), "tip": name_of(part.tip)}
         if kind == "Torso":
-            spec["torso"] = {"root": name_of(part.root), "tip": name_of(part.tip), "states": states}
+            spec["torso"] = {**ends, "states": states}
         elif kind == "Neck":
-            spec["neck"] = {
-                "root": name_of(part.root),
-                "tip": name_of(part.tip),
-                "sensors": carried,
-                "states": states,
-            }
+            spec["neck"] = {**ends, "sensors": carried, "states": states}
         elif kind == "Arm":
-            chain: dict[str, Any] = {"root": name_of(part.root), "tip": name_of(part.tip)}
-            if part.end_effector is not None:
-                chain["manipulator"] = names[id(part.end_effector)]
-            chain.update({"sensors": carried, "states": states})
-            chains[pname] = chain
+            tool = part.end_effector
+            held = {} if tool is None else {"manipulator": names[id(tool)]}
+            out["chains"][pname] = {**ends, **held, "sensors": carried, "states": states}
         elif kind == "EndEffector":
-            q = part.front_facing_orientation.to_np()
-            m: dict[str, Any] = {
-                "type": "generic",
-                "root": name_of(part.root),
-                "tool_frame": name_of(part.tool_frame),
-                "front_facing_orientation": [float(x) for x in q[:4]],
-                "states": states,
-            }
-            fingers = list(getattr(part, "fingers", []))
-            if len(fingers) == 2:
-                thumb = part.thumb
-                (other,) = [f for f in fingers if f is not thumb]
-                m["type"] = "parallel_gripper"
-                m["thumb"] = {"root": name_of(thumb.root), "tip": name_of(thumb.tip)}
-                m["finger"] = {"root": name_of(other.root), "tip": name_of(other.tip)}
-            elif len(fingers) > 2:
-                thumb = part.thumb
-                m["type"] = "hand"
-                m["thumb"] = {"root": name_of(thumb.root), "tip": name_of(thumb.tip)}
-                short = finger_names([names.get(id(f)) or name_of(f.root) for f in fingers])
-                named: dict[str, Any] = {}
-                for f, key in zip(fingers, short, strict=True):
-                    if f is thumb:
-                        continue
-                    key = key if key != "thumb" else name_of(f.root)
-                    while key in named:
-                        key += "_"
-                    named[key] = {"root": name_of(f.root), "tip": name_of(f.tip)}
-                m["fingers"] = named
-            elif fingers:
-                notes.append(
-                    f"{pname}: one finger; a spec's hand has a thumb and another finger, so it "
-                    "is a generic manipulator"
-                )
-            manipulators[pname] = m
+            entry = end_effector_entry(part, pname, names, states, notes)
+            out["manipulators"][pname] = entry
         elif kind == "Camera":
-            fov = part.field_of_view
-            sensors[pname] = {
-                "type": "camera",
-                "body": name_of(part.root),
-                "forward_facing_axis": vector3(part.forward_facing_axis),
-                "field_of_view": {
-                    "vertical": float(fov.vertical_angle),
-                    "horizontal": float(fov.horizontal_angle),
-                },
-                "minimal_height": float(part.minimal_height),
-                "maximal_height": float(part.maximal_height),
-                "default": bool(part.default_camera),
-            }
+            out["sensors"][pname] = camera_entry(part)
         elif kind == "Sensor":
-            sensors[pname] = {"type": "generic", "body": name_of(part.root)}
-    notes.extend(side_notes(robot, chains, names, model, spec["root"], forward))
-    for key, value in (("chains", chains), ("manipulators", manipulators), ("sensors", sensors)):
-        if value:
-            spec[key] = value
-    hardware = hardware_leaders(robot, notes)
-    if hardware:
-        spec["controlled_joints"] = hardware
-    limits: dict[str, float] = {}
-    for c in robot._one_dof_connections:
-        after, was = c.raw_dof.limits.upper.velocity, before.get(name_of(c))
-        if c.raw_dof.name.name != c.name.name or after is None or after == was:
-            continue  # a mimic joint (its leader carries the limit), or unchanged
-        if was is not None and after > was:
-            notes.append(
-                f"velocity limit of '{name_of(c)}': SDT raises it from {was} to {after}; "
-                "robotspec's limits only tighten, so the URDF's stays"
-            )
-            continue
-        limits[name_of(c)] = float(after)
-    if limits:
-        common = max(set(limits.values()), key=list(limits.values()).count)
-        spec["velocity_limits"] = {
-            "default": common,
-            "joints": {j: v for j, v in limits.items() if v != common},
-        }
-    if srdf:
-        spec["collision"] = {"use_srdf": True}
-    return Migration(spec=_drop_empty(spec), notes=tuple(notes))
+            out["sensors"][pname] = {"type": "generic", "body": name_of(part.root)}
+    return out
 
 
 def _drop_empty(data: Any) -> Any:

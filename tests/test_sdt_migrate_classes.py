@@ -83,9 +83,9 @@ def test_stretch_drives_differentially_faces_minus_y_and_keeps_its_base_root(
     spec = migration.spec
     assert spec["drive"] == {"type": "differential"}  # two wheels, not omni
     assert spec["forward"] == [0.0, -1.0, 0.0]  # StretchMobileBase.forward_axis
-    assert any(
-        n.startswith("mobile base: SDT's class roots it at 'base_link'") for n in migration.notes
-    )
+    # SDT's base root is the body the files give (the root, base_link, with the base's
+    # geometry), so nothing is noted: to_sdt roots it there too, not at the torso's mast.
+    assert not any(n.startswith("mobile base:") for n in migration.notes)
     errors = _validate_errors(spec, tmp_path / "stretch.yaml", urdf)
     _only_sdt_faults(errors)
     assert any("joint 'joint_lift' does not move chain 'arm'" in e for e in errors)
@@ -97,6 +97,8 @@ def test_icub3_states_no_drive_and_its_sides_are_the_geometrys(tmp_path: Path) -
     spec = migration.spec
     assert "drive" not in spec  # legs: nothing in its files says how it moves
     assert any(n.startswith("drive: SDT's class gives") for n in migration.notes)
+    (base,) = [n for n in migration.notes if n.startswith("mobile base:")]
+    assert "roots it at 'l_hip_1'" in base  # one leg's hip: noted, never copied
     # SDT returns the right arm for both sides: kept only as a note, never written.
     assert not any("side" in chain for chain in spec["chains"].values())
     (sides,) = [n for n in migration.notes if n.startswith("sides:")]
@@ -159,3 +161,4 @@ def test_the_migrated_stretch_is_sdts_stretch_on_a_differential_drive(tmp_path: 
     assert _validate_errors(spec, path, urdf) == []
     robot = to_sdt(compile_robot(path, package_paths=[urdf.parent]))
     assert type(robot) is Stretch and isinstance(robot.drive, DifferentialDrive)
+    assert robot.mobile_base.root.name.name == "base_link"  # as SDT's StretchMobileBase

@@ -85,6 +85,19 @@ def test_a_mimic_leader_moves_the_chain_of_its_follower() -> None:
     assert [s.joints for s in torso.states][1] == (("arm_lift_joint", 0.34),)
 
 
+def test_the_mobile_base_starts_at_the_base_body_sdts_classes_name() -> None:
+    # The body with the base's collision geometry (coraplex plans with its box): SDT's PR2,
+    # TIAGo and HSR-B classes name base_link, below a bare base_footprint root; for TIAGo the
+    # torso starts elsewhere (torso_fixed_link), where the base used to be rooted.
+    erd_robots()
+    for name in ("pr2", "tiago", "hsrb"):
+        robot = _robot(name)
+        assert not robot.root.collisions
+        (base,) = robot_recipe(robot).slot("mobile_base")
+        assert base.root == "base_link", name
+    assert _robot("tiago").torso.root.name == "torso_fixed_link"
+
+
 def test_states_keep_their_sdt_kind_and_the_rest_is_reported() -> None:
     robot = _pr2()
     recipe = robot_recipe(robot)

@@ -3,7 +3,7 @@
 Why apart from :mod:`robotspec.interop.sdt.migrate`: these read one aspect each of an SDT robot
 built by its own class (duck-typed, so this module imports no SDT), and each decides what the
 class really states: a mimic's state or hardware interface belongs to its leader, SDT's guess
-of the arms' sides yields to the geometry, a mobile base the spec cannot place is noted.
+of the arms' sides yields to the geometry, a mobile base rooted off the base body is noted.
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ from __future__ import annotations
 import re
 from typing import TYPE_CHECKING, Any
 
+from robotspec.interop.sdt.base import base_body
 from robotspec.interop.sdt.migrate_facts import arm_offsets, geometric_left
 
 if TYPE_CHECKING:
@@ -136,19 +137,20 @@ def forward_of(base: Any) -> tuple[float, float, float]:
     return (x, y, z)
 
 
-def base_root_note(robot: Any, base: Any, sdt: Any) -> list[str]:
-    """A note when SDT's mobile base starts at a body the spec cannot place it at.
+def base_root_note(base: Any, world: World, root: str) -> list[str]:
+    """A note when SDT's mobile base starts at a body other than the robot's base body.
 
-    Why: a spec has no mobile-base part; ``to_sdt`` roots the base where the torso starts (the
-    robot's root without a torso). Where SDT's class roots it elsewhere, the spec says so.
+    Why: a spec names no mobile base; ``to_sdt`` roots it at the base body the files give
+    (:func:`.base.base_body`), which is the body SDT's wheeled classes name. Where SDT's class
+    names another (iCub 3: a hip), the note says so; the spec does not copy it.
     """
-    torso = next((p for p in robot._robot_parts if part_kind(p, sdt) == "Torso"), None)
-    where, why = (robot.root, "the robot's root") if torso is None else (torso.root, "the torso's")
-    if name_of(base.root) == name_of(where):
+    ours = base_body(world, root)
+    if name_of(base.root) == ours:
         return []
     return [
-        f"mobile base: SDT's class roots it at '{name_of(base.root)}'; a spec names no mobile base "
-        f"and to_sdt roots it at '{name_of(where)}' ({why} root)"
+        f"mobile base: SDT's class roots it at '{name_of(base.root)}'; to_sdt roots it at the "
+        f"robot's base body '{ours}' (the root, or the body welded below it that carries the "
+        "base's collision geometry); a spec names no mobile base"
     ]
 
 

@@ -19,6 +19,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
+from robotspec.interop.sdt.base import base_body
 from robotspec.semantic import Camera, Hand, KinematicChain, ParallelGripper
 
 if TYPE_CHECKING:
@@ -283,8 +284,8 @@ def robot_recipe(robot: AbstractRobot) -> RobotRecipe:
     manipulator its arm's ``EndEffector`` (a parallel gripper ``HasTwoFingers[thumb,
     finger]``, a hand ``HasFingers[thumb, *fingers]``, or ``HasTwoFingers`` for a thumb and
     one finger); cameras ``Camera`` (other sensors ``Sensor``) on the neck or arm that carries
-    them, else on the robot; a robot whose base moves gets a ``MobileBase`` rooted where the
-    torso starts (the robot's root without a torso) holding the torso. Arms hang below the
+    them, else on the robot; a robot whose base moves gets a ``MobileBase`` rooted at its base
+    body (:func:`.base.base_body`) holding the torso. Arms hang below the
     torso when there is one (one arm ``HasOneArm``, two ``HasLeftRightArm`` in robotspec's
     left/right order, more ``HasArms``). Hardware interfaces go on the controlled joints that
     move a chain (a spec's ``controlled_joints`` when it names them); states keep their SDT
@@ -355,11 +356,10 @@ def robot_recipe(robot: AbstractRobot) -> RobotRecipe:
     else:
         body_slots = upper
     if robot.drive is not None:
-        base_root = robot.torso.root.name if robot.torso is not None else robot.root.name
         base = PartRecipe(
             kind="mobile_base",
             name="mobile_base",
-            root=base_root,
+            root=base_body(robot.world, robot.root.name),
             children=tuple(s for s in body_slots if s[0] == "torso"),
         )
         top.append(("mobile_base", (base,)))

@@ -320,26 +320,8 @@ class _Walk:
                     name=name,
                 )
             )
-        ends: list[str] = []
         parts = _children(el)
-        for role in ("parent", "child"):
-            ref = parts.get(role)
-            link = None if ref is None else ref.get("link")
-            if not link:
-                self.error(f"joint '{name}' has no <{role} link=...>", el, kind="joint", name=name)
-            elif link not in links:
-                self.errors.append(
-                    NotFoundError(
-                        "link",
-                        link,
-                        links,
-                        where=f"{_short(self.file)} ({role} of joint '{name}')",
-                        file=self.file,
-                        line=line_of(ref if ref is not None else el),
-                    )
-                )
-            else:
-                ends.append(link)
+        ends = self.joint_ends(el, name, parts, links)
         origin = self.origin(parts.get("origin"), f"joint '{name}'")
         axis = (1.0, 0.0, 0.0)
         axis_el = parts.get("axis")
@@ -352,26 +334,9 @@ class _Walk:
                     )
                 axis = (xyz[0], xyz[1], xyz[2])
         limit = parts.get("limit")
-        lower = upper = vel = eff = None
         if jtype in ("revolute", "prismatic") and limit is None:
             self.error(f"{jtype} joint '{name}' has no <limit>", el, kind="joint", name=name)
-        if limit is not None:
-            lower = self.number(limit, "lower", f"joint '{name}': limit lower")
-            upper = self.number(limit, "upper", f"joint '{name}': limit upper")
-            vel = self.number(limit, "velocity", f"joint '{name}': limit velocity")
-            eff = self.number(limit, "effort", f"joint '{name}': limit effort")
-            if jtype in ("revolute", "prismatic") and lower is not None and upper is not None:
-                if lower > upper:
-                    self.error(
-                        f"joint '{name}': limit lower {exact(lower)} is greater than upper "
-                        f"{exact(upper)}",
-                        limit,
-                        kind="joint",
-                        name=name,
-                    )
-            for value, label in ((vel, "velocity"), (eff, "effort")):
-                if value is not None and value < 0:
-                    self.error(f"joint '{name}': limit {label} must not be negative", limit)
+        lower, upper, vel, eff = self.joint_limit(limit, name, jtype)
         mimic = None
         mimic_el = parts.get("mimic")
         if mimic_el is not None:
@@ -399,6 +364,55 @@ class _Walk:
             mimic,
             limit is not None,
         )
+
+    def joint_ends(
+        self, el: etree._Element, name: str, parts: dict[str, etree._Element], links: dict[str, int]
+    ) -> list[str]:
+        """The joint's parent and child links, each present and a link of the file."""
+        ends: list[str] = []
+        for role in ("parent", "child"):
+            ref = parts.get(role)
+            link = None if ref is None else ref.get("link")
+            if not link:
+                self.error(f"joint '{name}' has no <{role} link=...>", el, kind="joint", name=name)
+            elif link not in links:
+                self.errors.append(
+                    NotFoundError(
+                        "link",
+                        link,
+                        links,
+                        where=f"{_short(self.file)} ({role} of joint '{name}')",
+                        file=self.file,
+                        line=line_of(ref if ref is not None else el),
+                    )
+                )
+            else:
+                ends.append(link)
+        return ends
+
+    def joint_limit(
+        self, limit: etree._Element | None, name: str, jtype: str | None
+    ) -> tuple[float | None, float | None, float | None, float | None]:
+        """``<limit>``'s lower, upper, velocity and effort (None where absent), checked."""
+        if limit is None:
+            return None, None, None, None
+        lower = self.number(limit, "lower", f"joint '{name}': limit lower")
+        upper = self.number(limit, "upper", f"joint '{name}': limit upper")
+        vel = self.number(limit, "velocity", f"joint '{name}': limit velocity")
+        eff = self.number(limit, "effort", f"joint '{name}': limit effort")
+        if jtype in ("revolute", "prismatic") and lower is not None and upper is not None:
+            if lower > upper:
+                self.error(
+                    f"joint '{name}': limit lower {exact(lower)} is greater than upper "
+                    f"{exact(upper)}",
+                    limit,
+                    kind="joint",
+                    name=name,
+                )
+        for value, label in ((vel, "velocity"), (eff, "effort")):
+            if value is not None and value < 0:
+                self.error(f"joint '{name}': limit {label} must not be negative", limit)
+        return lower, upper, vel, eff
 
     def mimics(self, joints: dict[str, etree._Element]) -> None:
         for name, el in joints.items():

@@ -36,6 +36,46 @@ _VIRTUAL_TYPES = {"planar": "planar", "floating": "floating"}
 def srdf_from_robot(robot: AbstractRobot) -> Srdf:
     """The SRDF of ``robot``; every name it writes exists in the robot's URDF (plus the drive)."""
     w = robot.world
+    groups, end_effectors, manip_groups = _groups(robot)
+    states, need_whole = _states(robot, {g.name for g in groups}, manip_groups)
+    if need_whole or not groups:
+        joints = tuple(c.name for c in robot.controlled_connections)
+        groups.append(Group(WHOLE_ROBOT_GROUP, joints=joints))
+    virtual: list[VirtualJoint] = []
+    drive = robot.drive
+    if drive is not None and drive.type.value in _VIRTUAL_TYPES:
+        virtual.append(
+            VirtualJoint(
+                drive.name,
+                _VIRTUAL_TYPES[drive.type.value],
+                w.bodies[drive.parent].name,
+                w.bodies[drive.child].name,
+            )
+        )
+    passive: tuple[PassiveJoint, ...] = ()
+    if robot.srdf is not None:
+        passive = tuple(
+            PassiveJoint(p.name) for p in robot.srdf.passive_joints if w.has_connection(p.name)
+        )
+    return Srdf(
+        robot_name=w.name,
+        groups=tuple(groups),
+        group_states=tuple(states),
+        end_effectors=tuple(end_effectors),
+        virtual_joints=tuple(virtual),
+        passive_joints=passive,
+        disabled_collisions=_disabled_collisions(robot),
+        disable_default_collisions=tuple(
+            DisableDefaultCollisions(name) for name in sorted(robot.disabled_collision_bodies)
+        ),
+    )
+
+
+def _groups(robot: AbstractRobot) -> tuple[list[Group], list[EndEffector], dict[str, str]]:
+    """A group per chain (fingers aside) and per manipulator, an end effector per manipulator.
+
+    Returns the groups, the end effectors, and each manipulator's group name.
+    """
     groups: list[Group] = []
     end_effectors: list[EndEffector] = []
     chain_groups: dict[str, str] = {}
@@ -53,7 +93,7 @@ def srdf_from_robot(robot: AbstractRobot) -> Srdf:
         group_name = m.name if m.name not in taken else f"{m.name}_group"
         taken.add(group_name)
         manip_groups[m.name] = group_name
-        links = tuple(b.name for b in w.subtree(m.root))
+        links = tuple(b.name for b in robot.world.subtree(m.root))
         groups.append(Group(group_name, links=links))
         owner = carried_by.get(m.name)
         parent_link = owner.tip.name if owner is not None else _parent_link(robot, m.root.name)
@@ -65,9 +105,15 @@ def srdf_from_robot(robot: AbstractRobot) -> Srdf:
                 parent_group=None if owner is None else chain_groups.get(owner.name),
             )
         )
+    return groups, end_effectors, manip_groups
+
+
+def _states(
+    robot: AbstractRobot, group_names: set[str], manip_groups: dict[str, str]
+) -> tuple[list[GroupState], bool]:
+    """Each joint state against its part's group; whether one needs the whole-robot group."""
     states: list[GroupState] = []
     need_whole = False
-    group_names = {g.name for g in groups}
     for key, state in robot.joint_states.items():
         # Keys are "part.state" (right_arm.park, torso.low) or a robot-level "state".
         part = key.split(".", 1)[0] if "." in key else ""
@@ -77,25 +123,16 @@ def srdf_from_robot(robot: AbstractRobot) -> Srdf:
         states.append(
             GroupState(state.name, group, tuple((j, (float(v),)) for j, v in state.joints))
         )
-    if need_whole or not groups:
-        joints = tuple(c.name for c in robot.controlled_connections)
-        groups.append(Group(WHOLE_ROBOT_GROUP, joints=joints))
-    virtual: list[VirtualJoint] = []
-    drive = robot.drive
-    if drive is not None and drive.type.value in _VIRTUAL_TYPES:
-        virtual.append(
-            VirtualJoint(
-                drive.name,
-                _VIRTUAL_TYPES[drive.type.value],
-                w.bodies[drive.parent].name,
-                w.bodies[drive.child].name,
-            )
-        )
+    return states, need_whole
+
+
+def _disabled_collisions(robot: AbstractRobot) -> tuple[DisabledCollision, ...]:
+    """The robot's disabled pairs in body order, each with its SRDF reason (else "User")."""
     reasons: dict[frozenset[str], str] = {}
     if robot.srdf is not None:
         for d in robot.srdf.disabled_collisions:
             reasons.setdefault(frozenset((d.link1, d.link2)), d.reason or "User")
-    order = {b.name: i for i, b in enumerate(w.bodies)}
+    order = {b.name: i for i, b in enumerate(robot.world.bodies)}
     disabled = []
     for pair in robot.disabled_collision_pairs:
         if len(pair) != 2:
@@ -103,23 +140,7 @@ def srdf_from_robot(robot: AbstractRobot) -> Srdf:
         a, b = sorted(pair, key=lambda n: order.get(n, len(order)))
         disabled.append(DisabledCollision(a, b, reasons.get(pair, "User")))
     disabled.sort(key=lambda d: (order.get(d.link1, 0), order.get(d.link2, 0)))
-    passive: tuple[PassiveJoint, ...] = ()
-    if robot.srdf is not None:
-        passive = tuple(
-            PassiveJoint(p.name) for p in robot.srdf.passive_joints if w.has_connection(p.name)
-        )
-    return Srdf(
-        robot_name=w.name,
-        groups=tuple(groups),
-        group_states=tuple(states),
-        end_effectors=tuple(end_effectors),
-        virtual_joints=tuple(virtual),
-        passive_joints=passive,
-        disabled_collisions=tuple(disabled),
-        disable_default_collisions=tuple(
-            DisableDefaultCollisions(name) for name in sorted(robot.disabled_collision_bodies)
-        ),
-    )
+    return tuple(disabled)
 
 
 def _parent_link(robot: AbstractRobot, body: str) -> str:

@@ -36,7 +36,7 @@
  * INTERFACE): bump both whenever an entry point's arguments or results change. The module exports
  * it as INTERFACE, and robotspec/accel.py refuses a module whose number differs (a stale build).
  */
-#define MESHCORE_INTERFACE 2
+#define MESHCORE_INTERFACE 3
 
 /* A tree from vertices (V, 3) and triangles (T, 3); NULL with an exception set on bad input. */
 static Tree *tree_new(PyObject *vobj, PyObject *fobj) {
@@ -396,8 +396,8 @@ static PyObject *int64_array(const int64_t *v, npy_intp n) {
  * The narrow phase of a block of broad-phase candidates (rows non-decreasing), in one call with
  * the GIL released (see walk_rows): which (row, body pair)s are proven to collide, and which
  * candidates (indices into rows/pairs, in order) coal must decide. mode 0: every colliding body
- * pair; 1: a row ends at its first; 2: body pairs set in found (uint8, written) are skipped and
- * set when proven. Arrays are numpy's, read in place (no conversion: the checker made them).
+ * pair; 1: a row ends at its first proven collision or at its first candidate left to coal; 2:
+ * body pairs set in found (uint8, written) are skipped and set when proven. Arrays are numpy's, read in place (no conversion: the checker made them).
  * Why: the narrow phase once ran in Python between C calls, holding the GIL, so two threads
  * checking a batch took turns (issue 34).
  */

@@ -553,8 +553,8 @@ typedef struct {
  * release the GIL for the whole block): a pair of meshes proven crossing is a collision of its
  * body pair, one proven apart is dropped, and what is neither (no proof, or not two meshes) is
  * left to coal, unless its body pair already collides in that row. WALK_FIRST ends a row at its
- * first proven collision and leaves nothing of that row to coal (it collides whatever coal
- * says). 0, or -1 when out of memory.
+ * first proven collision, or at its first candidate left to coal (the caller asks coal, then
+ * walks the rest of the row again when coal finds no collision). 0, or -1 when out of memory.
  */
 static int walk_rows(const MeshSet *s, const WalkIn *in, uint8_t *found, double eps, int mode,
                      Scratch *st, WalkOut *out) {
@@ -575,6 +575,14 @@ static int walk_rows(const MeshSet *s, const WalkIn *in, uint8_t *found, double 
                 if (res < 0) return -1;
             }
             out->code[c] = (uint8_t)res;
+            if (res == 0 && mode == WALK_FIRST) {
+                /* Coal decides this one before the row goes on: touching meshes, which the
+                 * proofs cannot settle, are the costliest to prove, and coal often finds them
+                 * colliding (the caller walks the rest of the row again if it does not). */
+                out->open[out->n_open++] = c;
+                row_done = 1;
+                break;
+            }
             if (res != 2) continue;
             out->stamp[p] = r;
             out->hit_row[out->n_hit] = r;

@@ -19,7 +19,7 @@ __all__ = ["CHOICE", "INTERFACE", "accelerated", "core"]
 #: The version of the calls into ``_meshcore.c`` (its ``MESHCORE_INTERFACE``): bump both together
 #: whenever an entry point's arguments or results change (a stale core is refused, see
 #: robotspec/accel.py).
-INTERFACE = 2
+INTERFACE = 3
 #: The C mesh proofs and the fallback that proves nothing.
 CHOICE = CoreChoice("robotspec.collision._meshcore", "robotspec.collision._meshcore_py", INTERFACE)
 #: The mesh core in use, loaded on the first call (the choice's own method: queries call it

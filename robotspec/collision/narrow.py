@@ -55,6 +55,8 @@ UNKNOWN, APART, CROSS, UNTRIED = 0, 1, 2, -1
 #: What a walk reports per row (the mesh core's modes): every colliding body pair; the first one
 #: only; every body pair not found colliding before (in any row: ``found`` is read and written).
 WALK_ALL, WALK_FIRST, WALK_DROP_FOUND = 0, 1, 2
+#: No candidate (an index array).
+_NONE = np.zeros(0, dtype=np.int64)
 #: Fewest samples of an any-hit block whose fallback proofs go in waves (see narrow_block).
 _WAVES_FROM = 64
 #: Candidates of a block from which the fallback's mesh proofs run in one call, not one by one.
@@ -243,6 +245,38 @@ def walk(
     )
     hit_rows: list[int] = hr.tolist()
     hit_pairs: list[int] = hp.tolist()
+    if mode == WALK_FIRST:
+        # One candidate per row waits for coal; a row coal finds free is walked on after it.
+        while len(left):
+            cand = (rows[left].tolist(), ks[left].tolist(), [UNKNOWN] * len(left))
+            rs, ps = block_hits(
+                c, scratch, req, poses, cand, None, eps, first_only=True, drop_found=False
+            )
+            hit_rows += rs
+            hit_pairs += ps
+            on = left[~np.isin(rows[left], rs)]
+            ends = np.searchsorted(rows, rows[on], side="right")
+            rest = np.concatenate(
+                [np.arange(a + 1, b) for a, b in zip(on, ends, strict=True)] + [_NONE]
+            )
+            if not len(rest):
+                break
+            hr, hp, sub = fn(
+                c.meshes,
+                poses,
+                rows[rest],
+                ks[rest],
+                c.pair_geom1,
+                c.pair_geom2,
+                c.pair_of,
+                found,
+                eps,
+                mode,
+            )
+            hit_rows += hr.tolist()
+            hit_pairs += hp.tolist()
+            left = rest[sub]
+        return hit_rows, hit_pairs
     if len(left):
         drop = mode == WALK_DROP_FOUND
         seen = found.astype(np.bool_).tolist() if drop else None

@@ -7,6 +7,7 @@ Nothing here checks anything; :func:`robotspec.compiler.build.build_robot` only 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TypedDict
 
@@ -169,34 +170,7 @@ def assemble(b: Build, r: Resolved, robot_class: type[AbstractRobot]) -> Abstrac
                 states=_part_states(b, "neck"),
             )
         )
-    for name, c in spec.chains.items():
-        cr, ct = r.chains[name]
-        sensors_of = [sensors[s] for s in c.sensors]
-        if c.manipulator is not None:
-            robot.add_arm(
-                Arm(
-                    name=name,
-                    root=cr,
-                    world=w,
-                    tip=ct,
-                    manipulator=manipulators[c.manipulator],
-                    sensors=sensors_of,
-                    states=_part_states(b, name),
-                    side=c.side,
-                )
-            )
-            continue
-        robot.add_kinematic_chain(
-            KinematicChain(
-                name=name,
-                root=cr,
-                world=w,
-                tip=ct,
-                sensors=sensors_of,
-                states=_part_states(b, name),
-            ),
-            warn=False,
-        )
+    _add_chains(robot, b, r, sensors, manipulators)
     carried = {s.name for ch in robot.kinematic_chains for s in ch.sensors}
     for name, sensor in sensors.items():
         if name not in carried:
@@ -246,4 +220,43 @@ def check_forward(b: Build) -> None:
             ("forward",),
             f"must be horizontal (z = 0) in the root's frame: the robot faces along the "
             f"ground, not {list(f)}",
+        )
+
+
+def _add_chains(
+    robot: AbstractRobot,
+    b: Build,
+    r: Resolved,
+    sensors: Mapping[str, Sensor],
+    manipulators: Mapping[str, Manipulator],
+) -> None:
+    """Each spec chain as an arm (when it carries a manipulator) or a plain kinematic chain."""
+    spec, w = b.spec, b.world
+    for name, c in spec.chains.items():
+        cr, ct = r.chains[name]
+        sensors_of = [sensors[s] for s in c.sensors]
+        if c.manipulator is not None:
+            robot.add_arm(
+                Arm(
+                    name=name,
+                    root=cr,
+                    world=w,
+                    tip=ct,
+                    manipulator=manipulators[c.manipulator],
+                    sensors=sensors_of,
+                    states=_part_states(b, name),
+                    side=c.side,
+                )
+            )
+            continue
+        robot.add_kinematic_chain(
+            KinematicChain(
+                name=name,
+                root=cr,
+                world=w,
+                tip=ct,
+                sensors=sensors_of,
+                states=_part_states(b, name),
+            ),
+            warn=False,
         )

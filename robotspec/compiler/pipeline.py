@@ -12,7 +12,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from robotspec.compiler.arm_sides import check_arm_sides
 from robotspec.compiler.build import Build, build_robot
@@ -24,6 +24,10 @@ from robotspec.semantic import AbstractRobot
 from robotspec.shipped import package_data
 from robotspec.spec.load import LoadedSpec
 from robotspec.spec.models import RobotSpec
+
+if TYPE_CHECKING:
+    from robotspec.compose.assembly import Composition
+    from robotspec.files.packages import PackageResolver
 
 __all__ = ["CompileResult", "compile_loaded", "load_camera_presets"]
 
@@ -249,7 +253,7 @@ def compile_loaded(
     ``world``), cross-checks the SRDF, adds the spec's frames and base connection, then resolves
     and checks every part; all problems of the spec are raised together.
     """
-    from robotspec.description.load import load_description, resolve_file
+    from robotspec.description.load import resolve_file
     from robotspec.spec.load import check_package_paths
 
     check_package_paths(loaded, package_paths)
@@ -263,6 +267,46 @@ def compile_loaded(
     desc_spec = spec.files
     diag = Diagnostics(loaded)
     paths = [*desc_spec.package_paths, *map(str, package_paths)]
+    base_world, resolver, urdf_name = _base_world(loaded, composition, world, paths, diag)
+    srdf = None if composition is None else composition.srdf
+    if composition is None and desc_spec.srdf is not None:
+        from robotspec.description.srdf_reader import load_srdf
+
+        try:
+            srdf = load_srdf(resolve_file(desc_spec.srdf, loaded.folder, resolver), strict=False)
+        except RobotSpecError as exc:
+            diag.add_all(exc, ("description", "srdf"))
+    if srdf is not None:
+        srdf = _check_srdf(srdf, base_world, urdf_name, diag, own_file=composition is None)
+    prepared = _prepare_world(loaded, base_world, srdf, diag, add_drive=world is None)
+    build = Build(
+        loaded=loaded, world=prepared, diag=diag, srdf=srdf, presets=load_camera_presets()
+    )
+    robot = build_robot(build, robot_class)
+    check_arm_sides(robot, loaded.spec.chains, diag)
+    diag.accept(loaded.spec.accept_warnings)
+    diag.raise_if_failed(strict=strict)
+    return CompileResult(
+        loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))
+    )
+
+
+def _base_world(
+    loaded: LoadedSpec,
+    composition: Composition | None,
+    world: World | None,
+    paths: list[str],
+    diag: Diagnostics,
+) -> tuple[World, PackageResolver, str]:
+    """The world the spec describes, its package resolver and the URDF's file name.
+
+    From the composed parts' joined tree, from the spec's URDF, or the caller's ``world``
+    (``from_world``: the spec's URDF is not read again, and the SRDF is found next to the
+    world's source file or on the package path).
+    """
+    from robotspec.description.load import load_description
+
+    desc_spec = loaded.spec.files
     if world is None and composition is not None:
         from robotspec.description.urdf import world_from_urdf_xml
 
@@ -298,33 +342,13 @@ def compile_loaded(
         # from_world: the caller's world is the description; the spec's URDF is not read
         # again (it may not even be on this machine's package path). The SRDF is found next
         # to the world's source file or on the package path.
-        from robotspec.files.packages import PackageResolver
+        from robotspec.files.packages import PackageResolver as Resolver
 
         source = Path(world.source) if world.source else None
         folder = loaded.folder
         extra = [p if Path(p).is_absolute() else folder / p for p in paths]
-        resolver = PackageResolver.create(
+        resolver = Resolver.create(
             source if source is not None and source.is_file() else None, extra_paths=extra
         )
         base_world, urdf_name = world, (world.source or world.name).rsplit("/", 1)[-1]
-    srdf = None if composition is None else composition.srdf
-    if composition is None and desc_spec.srdf is not None:
-        from robotspec.description.srdf_reader import load_srdf
-
-        try:
-            srdf = load_srdf(resolve_file(desc_spec.srdf, loaded.folder, resolver), strict=False)
-        except RobotSpecError as exc:
-            diag.add_all(exc, ("description", "srdf"))
-    if srdf is not None:
-        srdf = _check_srdf(srdf, base_world, urdf_name, diag, own_file=composition is None)
-    prepared = _prepare_world(loaded, base_world, srdf, diag, add_drive=world is None)
-    build = Build(
-        loaded=loaded, world=prepared, diag=diag, srdf=srdf, presets=load_camera_presets()
-    )
-    robot = build_robot(build, robot_class)
-    check_arm_sides(robot, loaded.spec.chains, diag)
-    diag.accept(loaded.spec.accept_warnings)
-    diag.raise_if_failed(strict=strict)
-    return CompileResult(
-        loaded=loaded, robot=robot, warnings=tuple(diag.in_file_order(diag.warnings))
-    )
+    return base_world, resolver, urdf_name

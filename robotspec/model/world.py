@@ -64,39 +64,8 @@ class World:
         #: Velocity limits as loaded, of the DOFs whose limit was tightened since (by name).
         self.loaded_velocity_limits: dict[str, float] = {}
         _check_indices(bodies, connections, dofs, source)
-        parent_conn = [-1] * len(bodies)
-        problems: list[DescriptionError] = []
-        for c in connections:
-            if parent_conn[c.child] != -1:
-                other = connections[parent_conn[c.child]].name
-                problems.append(
-                    DescriptionError(
-                        f"link '{bodies[c.child].name}' has two parent joints "
-                        f"('{other}' and '{c.name}')",
-                        file=source,
-                        line=c.line,
-                        kind="link",
-                        name=bodies[c.child].name,
-                    )
-                )
-            else:
-                parent_conn[c.child] = c.index
-        raise_collected(problems)
-        roots = [b.index for b in bodies if parent_conn[b.index] == -1]
-        if not roots:
-            raise DescriptionError(
-                "the joints form a cycle: no link is without a parent", file=source, kind="cycle"
-            )
-        if len(roots) > 1:
-            names = ", ".join(f"'{bodies[i].name}'" for i in roots[:6])
-            more = "" if len(roots) <= 6 else f" and {len(roots) - 6} more"
-            raise DescriptionError(
-                f"the description has {len(roots)} root links ({names}{more}); "
-                "a robot must be one tree",
-                file=source,
-                kind="root",
-            )
-        order = _topological_order(bodies, connections, parent_conn, roots[0], source)
+        parent_conn, root = _parents_and_root(bodies, connections, source)
+        order = _topological_order(bodies, connections, parent_conn, root, source)
         # Re-index into topological order so every array below is parent-before-child.
         # Records already in place are kept as they are (a copy per record is most of the
         # build time of a large, already ordered description).
@@ -536,6 +505,45 @@ def _check_indices(
         if dof.index != i:
             raise ValueError(f"dof '{dof.name}' has index {dof.index}, expected {i}")
     raise_collected(problems)
+
+
+def _parents_and_root(
+    bodies: Sequence[Body], connections: Sequence[Connection], source: str | None
+) -> tuple[list[int], int]:
+    """Each body's parent connection (-1 at the root) and the one root; else why not a tree."""
+    parent_conn = [-1] * len(bodies)
+    problems: list[DescriptionError] = []
+    for c in connections:
+        if parent_conn[c.child] != -1:
+            other = connections[parent_conn[c.child]].name
+            problems.append(
+                DescriptionError(
+                    f"link '{bodies[c.child].name}' has two parent joints "
+                    f"('{other}' and '{c.name}')",
+                    file=source,
+                    line=c.line,
+                    kind="link",
+                    name=bodies[c.child].name,
+                )
+            )
+        else:
+            parent_conn[c.child] = c.index
+    raise_collected(problems)
+    roots = [b.index for b in bodies if parent_conn[b.index] == -1]
+    if not roots:
+        raise DescriptionError(
+            "the joints form a cycle: no link is without a parent", file=source, kind="cycle"
+        )
+    if len(roots) > 1:
+        names = ", ".join(f"'{bodies[i].name}'" for i in roots[:6])
+        more = "" if len(roots) <= 6 else f" and {len(roots) - 6} more"
+        raise DescriptionError(
+            f"the description has {len(roots)} root links ({names}{more}); "
+            "a robot must be one tree",
+            file=source,
+            kind="root",
+        )
+    return parent_conn, roots[0]
 
 
 def _topological_order(

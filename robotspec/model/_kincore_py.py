@@ -62,25 +62,20 @@ _CHUNK = 256
 
 
 # ----------------------------------------------------------------------------------- helpers
-def _compose(a: F64, b: F64) -> F64:
-    """``a @ b`` of stacked poses without their last row (..., 3, 4), term by term.
+def _placed(rows4: F64, b: F64) -> F64:
+    """Poses (N, G, 4, 4) from body rows ``rows4`` (3, 4, N, G) times ``b`` (G, 4, 4).
 
-    Why not ``np.matmul``: on a batch it is one small product per pose (tens of thousands of
-    calls inside numpy); six whole-array operations are several times cheaper.
+    The C core's ``mul34``, term by term in its order (so the same bits), computed row and column
+    first, so that every operation runs along the samples and geometries; one copy puts the
+    poses in their layout.
     """
-    out = a[..., :, 0:1] * b[..., 0:1, :]
-    out += a[..., :, 1:2] * b[..., 1:2, :]
-    out += a[..., :, 2:3] * b[..., 2:3, :]
-    out[..., 3] += a[..., 3]
-    return out
-
-
-def _full(m: F64) -> F64:
-    """Poses (..., 3, 4) with their last row 0 0 0 1 put back: (..., 4, 4)."""
-    out = np.empty((*m.shape[:-2], 4, 4))
-    out[..., :3, :] = m
-    out[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
-    return out
+    bt = b[:, :3].transpose(1, 2, 0)[:, :, None, :]  # (3, 4, 1, G)
+    out = rows4[:, 0, None] * bt[0] + rows4[:, 1, None] * bt[1] + rows4[:, 2, None] * bt[2]
+    out[:, 3] += rows4[:, 3]
+    poses = np.empty((*rows4.shape[2:], 4, 4))
+    poses[..., :3, :] = out.transpose(2, 3, 0, 1)
+    poses[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+    return poses
 
 
 # --------------------------------------------------------------------------------- a chain
@@ -267,33 +262,32 @@ def geoms(
     return g
 
 
-def _obb_separated(fa: F64, ha: F64, fb: F64, hb: F64) -> np.ndarray[Any, np.dtype[np.bool_]]:
+def _obb_separated(a: F64, ca: F64, ha: F64, b: F64, cb: F64, hb: F64) -> Any:
     """Per candidate: whether one of fifteen separating axes parts the two oriented boxes.
 
-    Frames fa, fb (K, 4, 4), half extents ha, hb (K, 3): the C core's test, term by term.
+    Rotations a, b (3, 3, K), centres ca, cb and half extents ha, hb (3, K): the C core's test,
+    term by term, candidates last (so every operation runs along them).
     """
-    d = fb[:, :3, 3] - fa[:, :3, 3]
-    a, b = fa[:, :3, :3], fb[:, :3, :3]
-    r = (
-        a[:, 0, :, None] * b[:, 0, None, :]
-        + a[:, 1, :, None] * b[:, 1, None, :]
-        + a[:, 2, :, None] * b[:, 2, None, :]
-    )
+    d = cb - ca
+    r = a[0][:, None] * b[0][None] + a[1][:, None] * b[1][None] + a[2][:, None] * b[2][None]
     ar = np.abs(r) + 1e-9
-    t = a[:, 0, :] * d[:, 0, None] + a[:, 1, :] * d[:, 1, None] + a[:, 2, :] * d[:, 2, None]
-    rhs = ha + ar[:, :, 0] * hb[:, 0, None] + ar[:, :, 1] * hb[:, 1, None]
-    sep = (np.abs(t) > rhs + ar[:, :, 2] * hb[:, 2, None]).any(axis=1)
-    tb = t[:, 0, None] * r[:, 0, :] + t[:, 1, None] * r[:, 1, :] + t[:, 2, None] * r[:, 2, :]
-    rhs = ha[:, 0, None] * ar[:, 0, :] + ha[:, 1, None] * ar[:, 1, :]
-    sep |= (np.abs(tb) > rhs + ha[:, 2, None] * ar[:, 2, :] + hb).any(axis=1)
+    t = a[0] * d[0] + a[1] * d[1] + a[2] * d[2]
+    rhs = ha + ar[:, 0] * hb[0] + ar[:, 1] * hb[1]
+    far = np.abs(t) > rhs + ar[:, 2] * hb[2]
+    sep = far[0] | far[1] | far[2]
+    tb = t[0] * r[0] + t[1] * r[1] + t[2] * r[2]
+    rhs = ha[0] * ar[0] + ha[1] * ar[1]
+    far = np.abs(tb) > rhs + ha[2] * ar[2] + hb
+    sep |= far[0] | far[1] | far[2]
     y1, y2 = [1, 2, 0], [2, 0, 1]
     for x in range(3):
         x1, x2 = (x + 1) % 3, (x + 2) % 3
-        lhs = np.abs(t[:, x2, None] * r[:, x1, :] - t[:, x1, None] * r[:, x2, :])
-        rhs = ha[:, x1, None] * ar[:, x2, :] + ha[:, x2, None] * ar[:, x1, :]
-        rhs = rhs + hb[:, y1] * ar[:, x][:, y2] + hb[:, y2] * ar[:, x][:, y1]
-        sep |= (lhs > rhs).any(axis=1)
-    return np.asarray(sep, dtype=np.bool_)
+        lhs = np.abs(t[x2] * r[x1] - t[x1] * r[x2])
+        rhs = ha[x1] * ar[x2] + ha[x2] * ar[x1]
+        rhs = rhs + hb[y1] * ar[x][y2] + hb[y2] * ar[x][y1]
+        far = lhs > rhs
+        sep |= far[0] | far[1] | far[2]
+    return sep
 
 
 def broad(geoms: object, body_poses: Any, margin: float, mask: Any) -> tuple[Any, Any, Any]:
@@ -304,30 +298,32 @@ def broad(geoms: object, body_poses: Any, margin: float, mask: Any) -> tuple[Any
         bp = bp[None]
     if bp.shape[1:] != (g.n_body, 4, 4):
         raise ValueError("body poses have the wrong shape")
-    keep = np.ones(len(g.g1), dtype=np.bool_)
+    keep = None
     if mask is not None:
         m = from_any(mask, np.uint8, 1, 1)
         if m.size != len(g.g1):
             raise ValueError("pair mask has the wrong size")
         keep = m != 0
     bodies = bp[:, g.body]  # (N, G, 4, 4)
-    poses = _full(_compose(bodies[..., :3, :], g.body_T_geom[:, :3]))  # the C core's terms
-    rot = bodies[..., :3, :3]
+    rows4 = bodies[..., :3, :].transpose(2, 3, 0, 1)  # (row, column, N, G), a view
+    poses = _placed(rows4, g.body_T_geom)
+    # Box bounds, axis first: (3, N, G), the C core's sums in its order.
     c, h = g.center, g.half
-    cen = rot[..., 0] * c[:, 0, None] + rot[..., 1] * c[:, 1, None] + rot[..., 2] * c[:, 2, None]
-    cen = cen + bodies[..., :3, 3]
-    hw = (
-        np.abs(rot[..., 0]) * h[:, 0, None]
-        + np.abs(rot[..., 1]) * h[:, 1, None]
-        + np.abs(rot[..., 2]) * h[:, 2, None]
-    )
+    cen = rows4[:, 0] * c[:, 0] + rows4[:, 1] * c[:, 1] + rows4[:, 2] * c[:, 2] + rows4[:, 3]
+    hw = np.abs(rows4[:, 0]) * h[:, 0] + np.abs(rows4[:, 1]) * h[:, 1]
+    hw += np.abs(rows4[:, 2]) * h[:, 2]
     lo, hi = cen - hw - margin, cen + hw
-    i, j = g.g1[keep], g.g2[keep]
-    meet = ((lo[:, i] <= hi[:, j]) & (lo[:, j] <= hi[:, i])).all(axis=2)  # (N, P kept)
-    rows, at = np.nonzero(meet)
+    pairs = np.arange(len(g.g1)) if keep is None else np.flatnonzero(keep)
+    i, j = g.g1[pairs], g.g2[pairs]
+    meet = (lo[:, :, i] <= hi[:, :, j]) & (lo[:, :, j] <= hi[:, :, i])  # (3, N, P kept)
+    rows, at = np.nonzero(meet[0] & meet[1] & meet[2])
+    if not len(rows):  # no bounds meet: no box test to run
+        return rows.astype(np.int64), at.astype(np.int64), poses
     i, j = i[at], j[at]
-    frames = bodies[rows[:, None], np.stack([i, j], axis=1)].copy()  # (K, 2, 4, 4)
-    frames[..., :3, 3] = cen[rows[:, None], np.stack([i, j], axis=1)]
-    sep = _obb_separated(frames[:, 0], h[i] + margin / 2.0, frames[:, 1], h[j] + margin / 2.0)
-    pairs = np.flatnonzero(keep)[at]
-    return rows[~sep].astype(np.int64), pairs[~sep].astype(np.int64), poses
+    frame_a = bodies[rows, i, :3, :3].transpose(1, 2, 0)  # (3, 3, K)
+    frame_b = bodies[rows, j, :3, :3].transpose(1, 2, 0)
+    half = margin / 2.0
+    sep = _obb_separated(
+        frame_a, cen[:, rows, i], (h[i] + half).T, frame_b, cen[:, rows, j], (h[j] + half).T
+    )
+    return rows[~sep].astype(np.int64), pairs[at][~sep].astype(np.int64), poses

@@ -114,62 +114,7 @@ def load_part(
     loc: Loc = ("parts", name)
     try:
         if ps.spec is not None:
-            path = spec_path(ps.spec, loaded.folder)
-            if path is None:
-                candidates = [
-                    *shipped_spec_files(),
-                    *(f.name for f in loaded.folder.glob("*.yaml")),
-                ]
-                diag.not_found(
-                    (*loc, "spec"),
-                    "spec",
-                    ps.spec,
-                    candidates,
-                    "this folder or the shipped robots and parts",
-                )
-                return None
-            if path.resolve() in seen:
-                chain = " -> ".join(p.name for p in (*seen, path.resolve()))
-                diag.error((*loc, "spec"), f"parts include each other: {chain}")
-                return None
-            part_loaded = load_spec(path, allowed=package_paths)
-            check_package_paths(part_loaded, package_paths)
-            if part_loaded.spec.parts:
-                # A part may itself be composed: the one loop inside compose/, by design.
-                from robotspec.compose.assembly import compose
-
-                inner = compose(part_loaded, package_paths=package_paths, _seen=seen)
-                flat = inner.loaded
-                tree, file, resolver, srdf = inner.urdf, path, inner.resolver, inner.srdf
-            else:
-                flat = part_loaded
-                tree, file, resolver, srdf = description_tree(
-                    part_loaded.spec.files,
-                    part_loaded.folder,
-                    package_paths,
-                    share_crawls_with=share,
-                )
-            spec = flat.spec
-            data = spec.model_dump(mode="json", exclude_unset=True)
-            return Part(
-                name=name,
-                spec=ps,
-                file=file,
-                tree=tree,
-                srdf=srdf,
-                resolver=resolver,
-                facts=tree_facts(tree),
-                data=data,
-                documents=flat.documents,
-                use_srdf=spec.collision.use_srdf,
-                spec_root=spec.root,
-                drive=data.get("drive"),
-                collision={
-                    k: v
-                    for k, v in data.get("collision", {}).items()
-                    if k in ("buffer_distance", "violated_distance")
-                },
-            )
+            return _spec_part(name, ps, ps.spec, loaded, diag, package_paths, seen, share)
         assert ps.urdf is not None  # PartSpec checks one of spec/urdf is given
         part_desc = DescriptionSpec(
             urdf=ps.urdf, srdf=ps.srdf, xacro_args=ps.xacro_args, package_paths=ps.package_paths
@@ -182,6 +127,80 @@ def load_part(
         key = "spec" if ps.spec is not None else "urdf"
         diag.add_all(exc, (*loc, key))
         return None
+
+
+def _spec_part(
+    name: str,
+    ps: PartSpec,
+    ref: str,
+    loaded: LoadedSpec,
+    diag: Diagnostics,
+    package_paths: Sequence[str | Path],
+    seen: tuple[Path, ...],
+    share: PackageResolver | None,
+) -> Part | None:
+    """A part given by a spec (``spec: ur5``): its own description, semantics and rules.
+
+    A spec that is itself composed is composed first; a part that includes its includer is
+    refused, naming the loop.
+    """
+    loc: Loc = ("parts", name)
+    path = spec_path(ref, loaded.folder)
+    if path is None:
+        candidates = [
+            *shipped_spec_files(),
+            *(f.name for f in loaded.folder.glob("*.yaml")),
+        ]
+        diag.not_found(
+            (*loc, "spec"),
+            "spec",
+            ref,
+            candidates,
+            "this folder or the shipped robots and parts",
+        )
+        return None
+    if path.resolve() in seen:
+        chain = " -> ".join(p.name for p in (*seen, path.resolve()))
+        diag.error((*loc, "spec"), f"parts include each other: {chain}")
+        return None
+    part_loaded = load_spec(path, allowed=package_paths)
+    check_package_paths(part_loaded, package_paths)
+    if part_loaded.spec.parts:
+        # A part may itself be composed: the one loop inside compose/, by design.
+        from robotspec.compose.assembly import compose
+
+        inner = compose(part_loaded, package_paths=package_paths, _seen=seen)
+        flat = inner.loaded
+        tree, file, resolver, srdf = inner.urdf, path, inner.resolver, inner.srdf
+    else:
+        flat = part_loaded
+        tree, file, resolver, srdf = description_tree(
+            part_loaded.spec.files,
+            part_loaded.folder,
+            package_paths,
+            share_crawls_with=share,
+        )
+    spec = flat.spec
+    data = spec.model_dump(mode="json", exclude_unset=True)
+    return Part(
+        name=name,
+        spec=ps,
+        file=file,
+        tree=tree,
+        srdf=srdf,
+        resolver=resolver,
+        facts=tree_facts(tree),
+        data=data,
+        documents=flat.documents,
+        use_srdf=spec.collision.use_srdf,
+        spec_root=spec.root,
+        drive=data.get("drive"),
+        collision={
+            k: v
+            for k, v in data.get("collision", {}).items()
+            if k in ("buffer_distance", "violated_distance")
+        },
+    )
 
 
 # ------------------------------------------------------------------------------------ ordering

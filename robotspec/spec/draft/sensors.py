@@ -31,7 +31,8 @@ CAMERA_WORDS = frozenset(
 NOT_CAMERA_WORDS = frozenset(
     {"imu", "laser", "lidar", "scan", "hokuyo", "accelerometer", "accel", "gyro", "range"}
     | {"sonar", "ft", "force", "torque", "contact", "velodyne", "ultrasound", "projector"}
-    | {"gps", "magnetometer", "bumper", "led", "axis"}
+    | {"gps", "magnetometer", "bumper", "led", "axis", "light", "lamp", "microphone", "mic"}
+    | {"speaker", "flashlight", "thermal_sensor"}
 )
 #: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
 _OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
@@ -130,6 +131,7 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
                 or cam.name.startswith(k.name + "_")
                 or k.name.startswith(cam.name + "_")
                 or _device(k.name) == device
+                or _pair(tree, cam, k)
             )
             for k in kept
         )
@@ -160,9 +162,28 @@ def _device(name: str) -> str:
     """A camera's device: its name without channel words (``head_cam_depth`` -> ``head_cam``)."""
     parts = [p for p in re.split(r"[^A-Za-z0-9]+", name.lower()) if p]
     kept = [p for p in parts if p not in _CHANNELS]
-    if set(parts) & _CHANNELS:  # an RGB-D device's infrared pair ('camera_left_ir'): one device
-        kept = [p for p in kept if p not in _SIDES]
     return "_".join(kept) or name
+
+
+#: How far apart (m) the frames of one RGB-D device may be (a RealSense's are 1.5 to 5 cm).
+DEVICE_SPAN = 0.1
+
+
+def _pair(tree: Tree, a: CameraFound, b: CameraFound) -> bool:
+    """Whether two channel frames are one RGB-D device's infrared pair ('camera_left_ir').
+
+    Named alike but for a side word, with a channel word, and a few centimetres apart: two
+    depth cameras on a robot's two sides (ANYmal's) are two devices.
+    """
+    words_a = [p for p in re.split(r"[^A-Za-z0-9]+", a.name.lower()) if p]
+    words_b = [p for p in re.split(r"[^A-Za-z0-9]+", b.name.lower()) if p]
+    if not (set(words_a) | set(words_b)) & _CHANNELS:
+        return False
+    strip = _CHANNELS | _SIDES
+    if [p for p in words_a if p not in strip] != [p for p in words_b if p not in strip]:
+        return False
+    gap = float(np.linalg.norm(tree.position(a.body) - tree.position(b.body)))
+    return gap <= DEVICE_SPAN
 
 
 def _rigid_root(tree: Tree, body: Body) -> Body:

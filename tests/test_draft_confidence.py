@@ -122,3 +122,20 @@ def test_a_linkage_finger_ends_at_the_link_its_joints_move(tmp_path: Path) -> No
     (m,) = _draft(tmp_path, "linkage", parts).manipulators
     assert m.is_gripper and m.thumb is not None and m.finger is not None
     assert {m.thumb.tip, m.finger.tip} == {"left_tip", "right_tip"}
+
+
+def test_two_depth_cameras_on_two_sides_are_two_devices_and_a_light_is_none(
+    tmp_path: Path,
+) -> None:
+    # ANYmal's left and right depth cameras: named alike but for the side, 40 cm apart; a
+    # payload's light turned as optical frames are is no camera.
+    parts = list(_arm("wrist"))
+    for name, y in (("depth_camera_left", 0.2), ("depth_camera_right", -0.2), ("payload", 0.0)):
+        frame = f"{name}_depth_optical_frame" if name != "payload" else "payload_light"
+        parts += [f'<link name="{frame}"/>']
+        parts.append(_joint(f"{frame}_j", "base", frame, "fixed", f"0.1 {y} 0.3", rpy=_OPTICAL))
+    cams = _draft(tmp_path, "sides", parts).cameras
+    assert sorted(c.body for c in cams) == [
+        "depth_camera_left_depth_optical_frame",
+        "depth_camera_right_depth_optical_frame",
+    ]

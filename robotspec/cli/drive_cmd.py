@@ -89,6 +89,71 @@ def drive(
     ] = None,
 ) -> None:
     """Run a simulated robot driver loop (Robot Raconteur AbstractRobot semantics)."""
+    _check_options(
+        sim=sim,
+        spec=spec,
+        chain=chain,
+        physics=physics,
+        gravity_compensation=gravity_compensation,
+        log=log,
+        serve=serve,
+        port=port,
+        public=public,
+        node_name=node_name,
+        state_dir=state_dir,
+        script=script,
+        virtual_time=virtual_time,
+    )
+    from robotspec.cli.driving import drive_target, run_driver
+
+    plant = None
+    if physics is Physics.mujoco:
+        from robotspec.cli.physics import physics_target
+
+        assert spec is not None and chain is not None  # checked above
+        target = physics_target(
+            spec, chain, package_path or (), gravity_compensation=gravity_compensation
+        )
+        for note in target.exported.notes:
+            sys.stderr.write(f"note: {note}\n")
+        info, fallback_name, plant = target.exported.info, f"{spec}_{chain}", target.plant
+    else:
+        info, fallback_name = drive_target(sim, spec, chain, package_path)
+    run_driver(
+        info,
+        fallback_name,
+        plant=plant,
+        rate=rate,
+        duration=duration,
+        script=script,
+        log=log,
+        plot=plot,
+        virtual_time=virtual_time,
+        serve=serve,
+        port=port,
+        public=public,
+        node_name=node_name,
+        state_dir=state_dir,
+    )
+
+
+def _check_options(
+    *,
+    sim: Path | None,
+    spec: str | None,
+    chain: str | None,
+    physics: Physics,
+    gravity_compensation: bool,
+    log: Path | None,
+    serve: bool,
+    port: int | None,
+    public: bool,
+    node_name: str | None,
+    state_dir: Path | None,
+    script: Path | None,
+    virtual_time: bool,
+) -> None:
+    """Refuse combinations of options that cannot run (a usage error, exit code 2)."""
     if sim is None and spec is None:
         raise typer.BadParameter("give --sim ROBOTINFO.yaml (or --spec SPEC --chain NAME)")
     if sim is not None and spec is not None:
@@ -124,35 +189,3 @@ def drive(
     )
     if problem:
         raise typer.BadParameter(problem)
-
-    from robotspec.cli.driving import drive_target, run_driver
-
-    plant = None
-    if physics is Physics.mujoco:
-        from robotspec.cli.physics import physics_target
-
-        assert spec is not None and chain is not None  # checked above
-        target = physics_target(
-            spec, chain, package_path or (), gravity_compensation=gravity_compensation
-        )
-        for note in target.exported.notes:
-            sys.stderr.write(f"note: {note}\n")
-        info, fallback_name, plant = target.exported.info, f"{spec}_{chain}", target.plant
-    else:
-        info, fallback_name = drive_target(sim, spec, chain, package_path)
-    run_driver(
-        info,
-        fallback_name,
-        plant=plant,
-        rate=rate,
-        duration=duration,
-        script=script,
-        log=log,
-        plot=plot,
-        virtual_time=virtual_time,
-        serve=serve,
-        port=port,
-        public=public,
-        node_name=node_name,
-        state_dir=state_dir,
-    )

@@ -43,6 +43,7 @@ from robotspec.errors import DescriptionError, PathOutsideRootsError, RobotSpecE
 from robotspec.files.limits import limits
 from robotspec.files.packages import PackageResolver
 from robotspec.files.reading import read_bounded, read_head, refuse_entities
+from robotspec.files.xacro_legacy import prefix_legacy_tags
 from robotspec.files.xacro_sandbox import Budget, math_limits, unbounded_math
 
 __all__ = ["process_xacro"]
@@ -113,7 +114,7 @@ def _guarded_open(resolver: PackageResolver, xacro: Any, budget: Budget) -> Call
                 name=str(filename),
             ) from None
         refuse_entities(data, path, DescriptionError)
-        return io.BytesIO(data)
+        return io.BytesIO(prefix_legacy_tags(data))  # ROS 1's unprefixed <macro>, <property>
 
     return guarded
 

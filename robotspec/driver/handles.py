@@ -7,9 +7,10 @@ internals; the generator's methods step or wait on the driver that made it.
 from __future__ import annotations
 
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from robotspec.arrays import F64
 from robotspec.driver.errors import (
@@ -20,13 +21,11 @@ from robotspec.driver.stretch import Stretch
 from robotspec.driver.trajectory import TrajectoryInterpolator
 from robotspec.errors import DriverError
 
-if TYPE_CHECKING:
-    from robotspec.driver.robot_driver import RobotDriver
-    from robotspec.driver.robot_driver_motion import MotionCommands
-
 __all__ = [
     "Completion",
+    "HomingDriver",
     "HomingGenerator",
+    "TrajectoryDriver",
     "TrajectoryGenerator",
     "TrajectoryStatus",
 ]
@@ -34,6 +33,39 @@ __all__ = [
 
 #: ``Next()`` returns ``running`` after this long without an outcome (reference: 5 s).
 NEXT_TIMEOUT_S = 5.0
+
+
+class _Locked(Protocol):
+    @property
+    def _lock(self) -> AbstractContextManager[object]: ...
+    def _wait_for(self, predicate: Callable[[], bool], timeout: float) -> None: ...
+
+
+class TrajectoryDriver(_Locked, Protocol):
+    """What a trajectory generator needs of its driver (the driver's motion commands).
+
+    Why a protocol: the driver module makes generators; naming its class here would tie this
+    module and the driver's into a loop.
+    """
+
+    @property
+    def _traj_active(self) -> TrajectoryTask | None: ...
+    @property
+    def _state_seqno(self) -> int: ...
+    def _abort_trajectory(self, task: TrajectoryTask) -> None: ...
+    def _cancel_trajectory(self, task: TrajectoryTask) -> None: ...
+
+
+class HomingDriver(_Locked, Protocol):
+    """What a homing generator needs of its driver: start homing, and halt."""
+
+    def home(self, wait: bool = True) -> Completion:
+        """Start homing; with ``wait``, return when homed."""
+        ...
+
+    def halt(self) -> None:
+        """Stop motion (command mode ``halt``)."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -108,7 +140,7 @@ class TrajectoryGenerator:
     Also a Python iterator: ``for status in gen: ...``.
     """
 
-    def __init__(self, driver: MotionCommands, task: TrajectoryTask) -> None:
+    def __init__(self, driver: TrajectoryDriver, task: TrajectoryTask) -> None:
         self._driver = driver
         self._task = task
 
@@ -202,7 +234,7 @@ class HomingGenerator:
     ``halt``): a waiting ``Next()`` then fails with OperationAborted.
     """
 
-    def __init__(self, driver: RobotDriver) -> None:
+    def __init__(self, driver: HomingDriver) -> None:
         self._driver = driver
         self._completion: Completion | None = None
         self._reported = False

@@ -139,3 +139,18 @@ def test_two_depth_cameras_on_two_sides_are_two_devices_and_a_light_is_none(
         "depth_camera_left_depth_optical_frame",
         "depth_camera_right_depth_optical_frame",
     ]
+
+
+def test_a_pan_tilt_head_without_a_camera_is_drafted_as_a_marked_chain(tmp_path: Path) -> None:
+    # Booster T1's head: links 'h1', 'h2', a yaw then a pitch on top of the body; no camera
+    # frame, so no neck a spec can hold, but the question must be asked (a marked chain).
+    parts = [
+        *_arm("wrist"),
+        _link("h1"),
+        _joint("h_yaw", "base", "h1", xyz="0 0 0.4", axis="0 0 1"),
+        _link("h2"),
+        _joint("h_pitch", "h1", "h2", xyz="0 0 0.05", axis="0 1 0"),
+    ]
+    d = _draft(tmp_path, "pantilt", parts)
+    head = next(c for c in d.chains if c.joints == {"h_yaw", "h_pitch"})
+    assert (head.role, head.root, head.tip) == ("chain", "base", "h2") and head.decide

@@ -155,7 +155,8 @@ def _add_head(d: Drafter, limb_tops: list[Body]) -> None:
             continue
         if any(c.type.value not in ("revolute", "continuous") for c in seg.joints):
             continue
-        if not any(words(b.name) & HEAD_WORDS for b in seg.bodies):
+        named = any(words(x.name) & HEAD_WORDS for x in (*seg.bodies, *seg.joints))
+        if not (named or _pan_tilt(d, seg.joints)):
             continue
         if any(world.is_ancestor(top, seg.start) for top in limb_tops):
             continue
@@ -176,6 +177,23 @@ def _add_head(d: Drafter, limb_tops: list[Body]) -> None:
         )
         d.draft.chains.append(head)
         return
+
+
+def _pan_tilt(d: Drafter, joints: tuple[Connection, ...] | list[Connection]) -> bool:
+    """Whether 2-3 revolute joints turn about the vertical and then a level axis, upwards.
+
+    Why: a head whose links are named nothing a reader knows (Booster T1's 'H1', 'H2') is
+    still a pan and a tilt on top of the body; its run ends higher than it starts.
+    """
+    if not 2 <= len(joints) <= 3:
+        return False
+    axes = [np.abs(d.tree.axis_in_root(c)) for c in joints]
+    if not (axes[0][2] > 0.9 and any(a[2] < 0.1 for a in axes[1:])):
+        return False
+    world = d.world
+    start = d.tree.position(world.bodies[joints[0].parent])
+    end = d.tree.position(world.bodies[joints[-1].child])
+    return bool(end[2] >= start[2] - 1e-9)
 
 
 def add_torso(d: Drafter) -> None:

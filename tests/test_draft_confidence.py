@@ -154,3 +154,21 @@ def test_a_pan_tilt_head_without_a_camera_is_drafted_as_a_marked_chain(tmp_path:
     d = _draft(tmp_path, "pantilt", parts)
     head = next(c for c in d.chains if c.joints == {"h_yaw", "h_pitch"})
     assert (head.role, head.root, head.tip) == ("chain", "base", "h2") and head.decide
+
+
+def test_an_optical_frame_tilted_down_and_a_frame_named_after_its_model_are_cameras(
+    tmp_path: Path,
+) -> None:
+    # A camera looking 30 degrees down at the floor ahead (REP 103's rotation, then a tilt about
+    # its x axis), and an Orbbec Astra's body frame named after its model (on the arm).
+    parts = [
+        *_arm("wrist"),
+        '<link name="front_optical"/>',
+        _joint("front_j", "base", "front_optical", "fixed", "0.2 0 0.3", rpy="-2.0944 0 -1.5708"),
+        '<link name="astra_link"/>',
+        _joint("astra_j", "link1", "astra_link", "fixed", "0.2 0 0.1"),
+    ]
+    cams = {c.body: c for c in _draft(tmp_path, "tilted", parts).cameras}
+    assert set(cams) == {"front_optical", "astra_link"}
+    assert cams["front_optical"].optical and not cams["astra_link"].optical
+    assert all(c.decide for c in cams.values())  # no sensor states either: both asked

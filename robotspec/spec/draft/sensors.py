@@ -1,12 +1,13 @@
 """Cameras and the neck that points them.
 
-A frame is an *optical* frame when its rotation from its parent is REP 103's (z forward, x right,
-y down), whatever its name; a frame named as a camera without that rotation is a camera looking
-along its x axis. IMUs, lasers, range finders and force sensors are never cameras, whatever their
-rotation. One device often has several frames (PR2's ``wide_stereo`` with its simulated left and
-right cameras, an Xtion's ``rgb`` and ``depth`` channels): one camera per device, its shortest-named
-optical frame. The neck is the run of one to three revolute joints that carries cameras and ends
-the branch it is on (four for a run whose links are named as a head's).
+A frame is an *optical* frame when its rotation from its parent is REP 103's (z forward, x
+right, y down), or that rotation tilted up or down (x still right), whatever its name; a frame
+named as a camera without that rotation is a camera looking along its x axis. IMUs, lasers,
+range finders and force sensors are never cameras, whatever their rotation. One device often
+has several frames (PR2's ``wide_stereo`` with its simulated left and right cameras, an Xtion's
+``rgb`` and ``depth`` channels): one camera per device, its shortest-named optical frame. The
+neck is the run of one to three revolute joints that carries cameras and ends the branch it is
+on (four for a run whose links are named as a head's).
 """
 
 from __future__ import annotations
@@ -27,6 +28,10 @@ __all__ = ["CameraFound", "NeckFound", "find_cameras", "find_neck"]
 CAMERA_WORDS = frozenset(
     {"camera", "cam", "optical", "rgb", "rgbd", "xtion", "kinect", "realsense", "stereo"}
     | {"webcam", "zed", "eye", "vision", "d435", "d415", "asus"}
+    # Device models a frame is often named after.
+    | {"d405", "d435i", "d455", "d457", "l515", "zed2", "zed2i", "zedm", "kinect2", "azure"}
+    | {"astra", "orbbec", "femto", "gemini", "primesense", "carmine", "oak", "mynteye"}
+    | {"flir", "basler", "ximea", "pointgrey", "bumblebee"}
 )
 NOT_CAMERA_WORDS = frozenset(
     {"imu", "laser", "lidar", "scan", "hokuyo", "accelerometer", "accel", "gyro", "range"}
@@ -36,6 +41,8 @@ NOT_CAMERA_WORDS = frozenset(
 )
 #: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
 _OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+#: The cosine within which a tilted optical frame's z axis stays of its parent's x (60 degrees).
+_TILT = 0.5
 _STEM = re.compile(r"(_optical)?(_frame|_link)?$")
 
 
@@ -70,7 +77,12 @@ def is_optical(tree: Tree, body: Body) -> bool:
     c = tree.world.parent_connection(body)
     if c is None or not c.is_fixed:
         return False
-    return bool(np.allclose(c.origin[:3, :3], _OPTICAL, atol=1e-3))
+    rot = c.origin[:3, :3]
+    if np.allclose(rot, _OPTICAL, atol=1e-3):
+        return True
+    # An optical frame tilted down or up (a camera looking at the floor ahead): x still points
+    # right (-y of the parent), z ahead within 60 degrees of the parent's x.
+    return bool(np.allclose(rot[:, 0], _OPTICAL[:, 0], atol=1e-3) and rot[0, 2] > _TILT)
 
 
 def _stem(name: str) -> str:

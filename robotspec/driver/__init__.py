@@ -5,7 +5,9 @@ document; upstream ``abstract_robot.py`` of robotraconteur-abstract-robot 0.2.2)
 reference's defects fixed (listed in ``docs/driver.md``).
 Modules, one job each:
 
-* :mod:`~robotspec.driver.robot_info` -- the RobotInfo YAML as validated, located models;
+* :mod:`~robotspec.driver.robot_info` -- the RobotInfo YAML as validated, located models (the
+  models in :mod:`~robotspec.driver.robot_info_models`, the cross-field checks in
+  :mod:`~robotspec.driver.robot_info_checks`);
 * :mod:`~robotspec.driver.state` -- command modes, state flags and frozen state snapshots;
 * :mod:`~robotspec.driver.commands` -- validation of client commands and the send-path guard;
 * :mod:`~robotspec.driver.profiles` -- online motion profiles: jogs and stream limiting, with

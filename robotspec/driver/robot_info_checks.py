@@ -1,6 +1,6 @@
 """Cross-field checks of a RobotInfo that pydantic cannot locate well, each at its YAML line.
 
-Why a module of its own: the models (:mod:`robotspec.driver.robot_info`) check one field at a
+Why a module of its own: the models (:mod:`robotspec.driver.robot_info_models`) check one field at a
 time; what spans fields (array lengths against a chain's joint count, joint numbers against
 ``joint_info``, names the service will serve) is checked here, after validation, and every
 problem found is reported at once, as an error or (where the reference accepts it silently) a
@@ -19,7 +19,7 @@ from robotspec.errors import RobotInfoError
 from robotspec.files.yamlio import LocatedYaml
 
 if TYPE_CHECKING:
-    from robotspec.driver.robot_info import KinChainInfo, RobotInfo, Vector3
+    from robotspec.driver.robot_info_models import KinChainInfo, RobotInfo, Vector3
 
 __all__ = ["MAX_OFFSET_M", "UNIT_TOL", "semantic_checks"]
 

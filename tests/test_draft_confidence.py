@@ -122,6 +122,8 @@ def test_a_linkage_finger_ends_at_the_link_its_joints_move(tmp_path: Path) -> No
     (m,) = _draft(tmp_path, "linkage", parts).manipulators
     assert m.is_gripper and m.thumb is not None and m.finger is not None
     assert {m.thumb.tip, m.finger.tip} == {"left_tip", "right_tip"}
+    # Mimic-coupled, but each side ends at two links: which is the tip is asked.
+    assert any("several end links" in r for r in m.decide)
 
 
 def test_two_depth_cameras_on_two_sides_are_two_devices_and_a_light_is_none(

@@ -240,6 +240,13 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
     # Stated only when a mimic tag couples the two sides, one driving the other (confidence).
     moved = [set().union(*(_dofs(tree, k) for k in side)) for side in sides]
     decide = gripper_question(bool(moved[0] & moved[1]), leaders[0] != leaders[1])
+    # Which link is a finger's tip is the files' answer only when each side ends once.
+    ends = [
+        sum(1 for k in side for b in world.subtree(k) if not world.child_bodies(b))
+        for side in sides
+    ]
+    if decide is None and max(ends) > 1:
+        decide = "a finger with several end links: its tip is the deepest one a joint moves"
     if leaders[0] != leaders[1]:
         thumb_i = 0 if leaders[0] else 1
     else:

@@ -124,3 +124,16 @@ def test_the_annotate_command_says_the_same_for_mujoco(
     monkeypatch.setitem(sys.modules, "mujoco", None)
     with pytest.raises(RobotSpecError, match=r"^error: robotspec annotate mjcf needs MuJoCo; "):
         read_model(tmp_path / "robot.xml")
+
+
+def test_drawing_from_python_says_the_same_for_pillow(monkeypatch: pytest.MonkeyPatch) -> None:
+    _needs_robots()
+    from robotspec.compiler import compile_robot
+    from robotspec.render import build_scene, render_scene
+
+    robot = compile_robot("ur5")
+    scene = build_scene(robot)
+    monkeypatch.setitem(sys.modules, "PIL", None)
+    with pytest.raises(RobotSpecError) as info:
+        render_scene(scene, robot.world.default_configuration())
+    assert str(info.value) == _documented()["PIL"]

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.arrays import F64
+from robotspec.extras import PILLOW, require_present
 from robotspec.render.raster import ViewCamera, flat_shade, rasterize
 from robotspec.render.scene import LegendEntry, RobotScene, Segment
 
@@ -83,7 +84,8 @@ def _hex(c: tuple[int, int, int]) -> str:
 
 
 def render_scene(scene: RobotScene, q: F64, options: RenderOptions | None = None) -> Picture:
-    """Draw ``scene`` at configuration ``q``."""
+    """Draw ``scene`` at configuration ``q`` (needs Pillow, the ``view`` extra)."""
+    require_present(PILLOW, "render")
     opts = options or RenderOptions()
     poses = scene.poses(q)
     verts, faces, colours, bodies = _world_triangles(scene, poses)

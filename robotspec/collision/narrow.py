@@ -5,10 +5,13 @@ meshes are first proven apart or crossing by the C mesh core (tens of times chea
 when they nearly touch); coal's ``ComputeCollision`` decides every candidate the proofs leave.
 
 With the C mesh core, :func:`walk` proves a whole block in one C call without the GIL (every
-row's candidates in order, each row stopped at its first proven crossing when only "does it
-collide" is asked) and leaves coal the few candidates it cannot prove. Why: on the PR2 coal is
-asked about one candidate in a thousand, so the GIL is held only for a few Python steps per
-block, and threads checking a batch run side by side instead of taking turns (issue 34).
+row's candidates in order) and leaves coal the few candidates it cannot prove. When only "does
+it collide" is asked, a row stops at its first proven crossing, or at its first candidate left
+to coal, and is walked on (one more C call for all such rows) only when coal finds that one
+free: touching meshes are the costliest to prove and coal often finds them colliding. Why one
+C call: on the PR2 coal is asked about one candidate in a thousand, so the GIL is held only for
+a few Python steps per block, and threads checking a batch run side by side instead of taking
+turns (issue 34).
 
 Without it (the fallback core proves nothing) two ways walk the candidates, with the same
 answers (:func:`narrow_block` picks one):

@@ -243,54 +243,43 @@ def walk(
     fn = getattr(meshcore.core(), "walk", None)
     if fn is None or c.meshes is None:
         return None
-    hr, hp, left = fn(
-        c.meshes, poses, rows, ks, c.pair_geom1, c.pair_geom2, c.pair_of, found, eps, mode
-    )
+
+    def proofs(sel: I64 | None) -> tuple[I64, I64, I64]:
+        """The walk over candidates ``sel`` (all: None): proven hits, indices left to coal."""
+        r, k = (rows, ks) if sel is None else (rows[sel], ks[sel])
+        hr, hp, left = fn(
+            c.meshes, poses, r, k, c.pair_geom1, c.pair_geom2, c.pair_of, found, eps, mode
+        )
+        return hr, hp, left if sel is None else sel[left]
+
+    hr, hp, left = proofs(None)
     hit_rows: list[int] = hr.tolist()
     hit_pairs: list[int] = hp.tolist()
-    if mode == WALK_FIRST:
-        # One candidate per row waits for coal; a row coal finds free is walked on after it.
-        while len(left):
-            cand = (rows[left].tolist(), ks[left].tolist(), [UNKNOWN] * len(left))
-            rs, ps = block_hits(
-                c, scratch, req, poses, cand, None, eps, first_only=True, drop_found=False
-            )
-            hit_rows += rs
-            hit_pairs += ps
-            on = left[~np.isin(rows[left], rs)]
-            ends = np.searchsorted(rows, rows[on], side="right")
-            rest = np.concatenate(
-                [np.arange(a + 1, b) for a, b in zip(on, ends, strict=True)] + [_NONE]
-            )
-            if not len(rest):
-                break
-            hr, hp, sub = fn(
-                c.meshes,
-                poses,
-                rows[rest],
-                ks[rest],
-                c.pair_geom1,
-                c.pair_geom2,
-                c.pair_of,
-                found,
-                eps,
-                mode,
-            )
-            hit_rows += hr.tolist()
-            hit_pairs += hp.tolist()
-            left = rest[sub]
-        return hit_rows, hit_pairs
-    if len(left):
-        drop = mode == WALK_DROP_FOUND
-        seen = found.astype(np.bool_).tolist() if drop else None
+    first = mode == WALK_FIRST
+    drop = mode == WALK_DROP_FOUND
+    seen = found.astype(np.bool_).tolist() if drop and len(left) else None
+    while len(left):
         cand = (rows[left].tolist(), ks[left].tolist(), [UNKNOWN] * len(left))
         rs, ps = block_hits(
-            c, scratch, req, poses, cand, seen, eps, first_only=mode == WALK_FIRST, drop_found=drop
+            c, scratch, req, poses, cand, seen, eps, first_only=first, drop_found=drop
         )
-        if drop:
-            found[ps] = 1
         hit_rows += rs
         hit_pairs += ps
+        if drop:
+            found[ps] = 1
+        if not first:
+            break
+        # Any hit: one candidate per row waited for coal; the rows coal found free walk on.
+        on = left[~np.isin(rows[left], rs)]
+        ends = np.searchsorted(rows, rows[on], side="right")
+        rest = np.concatenate(
+            [np.arange(i + 1, e) for i, e in zip(on, ends, strict=True)] + [_NONE]
+        )
+        if not len(rest):
+            break
+        hr, hp, left = proofs(rest)
+        hit_rows += hr.tolist()
+        hit_pairs += hp.tolist()
     return hit_rows, hit_pairs
 
 

@@ -180,12 +180,14 @@ def _add_head(d: Drafter, limb_tops: list[Body]) -> None:
 
 
 def _pan_tilt(d: Drafter, joints: tuple[Connection, ...] | list[Connection]) -> bool:
-    """Whether 2-3 revolute joints turn about the vertical and then a level axis, upwards.
+    """Whether 2-3 revolute (limited) joints turn about the vertical, then a level axis, upwards.
 
     Why: a head whose links are named nothing a reader knows (Booster T1's 'H1', 'H2') is
     still a pan and a tilt on top of the body; its run ends higher than it starts.
     """
-    if not 2 <= len(joints) <= 3:
+    if not 2 <= len(joints) <= 3 or any(c.type.value != "revolute" for c in joints):
+        return False  # a caster's steer and wheel (continuous) are no head
+    if any(c.child in {w.child for w in d.wheels} for c in joints):
         return False
     axes = [np.abs(d.tree.axis_in_root(c)) for c in joints]
     if not (axes[0][2] > 0.9 and any(a[2] < 0.1 for a in axes[1:])):
@@ -193,7 +195,7 @@ def _pan_tilt(d: Drafter, joints: tuple[Connection, ...] | list[Connection]) -> 
     world = d.world
     start = d.tree.position(world.bodies[joints[0].parent])
     end = d.tree.position(world.bodies[joints[-1].child])
-    return bool(end[2] >= start[2] - 1e-9)
+    return bool(end[2] > start[2] + 1e-3)
 
 
 def add_torso(d: Drafter) -> None:

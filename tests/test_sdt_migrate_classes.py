@@ -118,6 +118,8 @@ def test_justins_mimic_joints_get_no_hardware_interface(tmp_path: Path) -> None:
     mimics = {c.name for c in world.connections if c.is_mimic}
     assert len(mimics) == 8 and not mimics.intersection(controlled)
     assert any("left 'right_arm', right 'right_arm'" in n for n in migration.notes)
+    # Its base is SDT's base_link: base_footprint's 1 mm placeholder box is no geometry to SDT.
+    assert not any(n.startswith("mobile base:") for n in migration.notes)
     _only_sdt_faults(_validate_errors(migration.spec, tmp_path / "justin.yaml", urdf))
 
 

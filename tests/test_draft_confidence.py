@@ -174,3 +174,13 @@ def test_an_optical_frame_tilted_down_and_a_frame_named_after_its_model_are_came
     assert set(cams) == {"front_optical", "astra_link"}
     assert cams["front_optical"].optical and not cams["astra_link"].optical
     assert all(c.decide for c in cams.values())  # no sensor states either: both asked
+
+
+def test_a_finger_ending_at_a_bare_frame_is_asked(tmp_path: Path) -> None:
+    # PR2's right finger tip carries 'l_finger_tip_frame': the frame is taken for the tip, but
+    # the files do not say it is the finger's tip rather than a frame past the pad.
+    parts = _gripper("jaw_base", mimic=True)
+    parts += ['<link name="pad_frame"/>', _joint("pad_j", "right_jaw", "pad_frame", "fixed")]
+    (m,) = _draft(tmp_path, "padframe", parts).manipulators
+    assert m.finger is not None and m.finger.tip == "pad_frame"
+    assert any("bare frame at the finger's end" in r for r in m.decide)

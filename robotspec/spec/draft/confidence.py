@@ -18,7 +18,8 @@ tool frame         the SRDF end effector's parent link is a bare frame on the ha
                    part that carries the fingers (or below it), or, without a hand, below the
                    chain's tip with no moving joint below it
 parallel gripper   its two fingers are coupled by a ``mimic`` tag (one driven, one mimicking it)
-                   and each finger ends at one link (a linkage's several ends: which is the tip?)
+                   and each finger ends at one link with a shape (a linkage's several ends,
+                   or a bare frame past the pad: which is the tip?)
 hand (3+ fingers)  never: which branch is the thumb rests on names and geometry
 camera             a Gazebo camera sensor names its frame (and nothing about its axis is odd)
 torso, neck        never: both are found by where arms branch and what carries cameras

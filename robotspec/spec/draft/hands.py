@@ -247,6 +247,9 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
     ]
     if decide is None and max(ends) > 1:
         decide = "a finger with several end links: its tip is the deepest one a joint moves"
+    bare = [t.name for t in tips if not own_geometry(t)]
+    if decide is None and bare:  # a frame at the pad's end, named by whoever wrote it (PR2's)
+        decide = f"the finger tip '{bare[0]}' is a bare frame at the finger's end, not its pad"
     if leaders[0] != leaders[1]:
         thumb_i = 0 if leaders[0] else 1
     else:

@@ -17,10 +17,13 @@ load: the first ``to_sdt`` (its SDT world, the part classes, whose type hints kr
 then, and the robot) against the first ``PR2.from_world`` of SDT's class on its parsed world
 (whose classes' hints were resolved when its module was imported). Both sides import the same
 SDT modules first, SDT's ``pr2`` module included (the class the PR2 spec names; a PyCRAM
-program has it imported), and both pay SDT's first entity query (krrood imports its query
-backends, pandas among them, on the first one: about 1 s). Each round starts one new process
-per side, the two sides interleaved, round by round; the mesh decomposition cache is warm (the
-in-process rounds run first).
+program has it imported). SDT's ``from_world`` runs SDT's first entity query (a part's
+``_robot``), on which krrood imports its query backends, pandas among them (about 1 s);
+``to_sdt``'s parts answer ``_robot`` without a query (``robotspec.interop.sdt.backref``), so
+it does not. A program that runs entity queries of its own pays that import at its first one,
+so a second pair of rows imports the backends before the clock on both sides: what each side
+pays beyond it. Each round starts one new process per side and case, interleaved, round by
+round; the mesh decomposition cache is warm (the in-process rounds run first).
 
 Run: ``python benchmarks/bench_sdt.py [--repeat N]`` in the SDT environment (the ``sdt`` extra
 and example-robot-data; without giskardpy, tests/sdt_stand_ins supplies its one helper).
@@ -57,6 +60,7 @@ def _new_process(code: str, repeat: int) -> float:
 _FIRST_OURS = """
 import sys, time, warnings
 warnings.simplefilter("ignore")
+{pre}
 from robotspec.robots import PR2
 import robotspec.interop.sdt._api
 import semantic_digital_twin.robots.pr2
@@ -70,6 +74,7 @@ print(time.perf_counter() - t)
 _FIRST_SDT = """
 import sys, time, warnings
 warnings.simplefilter("ignore")
+{pre}
 sys.path.insert(0, {here!r})
 from bench_sdt import _sdt_world
 from semantic_digital_twin.robots.pr2 import PR2
@@ -81,18 +86,37 @@ print(time.perf_counter() - t)
 """
 
 
-def _first_builds(urdf: Path, repeat: int) -> tuple[list[float], list[float]]:
-    """Seconds of the first build in a new process, per round: (to_sdt, SDT's from_world)."""
+#: Imported before the clock in the second case: krrood's query backends (pandas, ...).
+_BACKENDS = "import krrood.entity_query_language.backends"
+
+First = dict[str, tuple[list[float], list[float]]]
+
+
+def _first_builds(urdf: Path, repeat: int) -> First:
+    """Seconds of the first build in a new process, per round: (to_sdt, SDT's from_world).
+
+    Two cases, keyed ``""`` (as a program starts) and ``"backends"`` (krrood's query backends
+    imported first on both sides), all four processes of a round interleaved.
+    """
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([*sys.path[1:], str(STAND_INS)]))
     here = str(Path(__file__).resolve().parent)
-    codes = (_FIRST_OURS, _FIRST_SDT.format(here=here, urdf=str(urdf)))
-    out: tuple[list[float], list[float]] = ([], [])
+    cases = {"": "", "backends": _BACKENDS}
+    out: First = {case: ([], []) for case in cases}
     for _ in range(repeat):
-        for code, times in zip(codes, out, strict=True):
-            run = subprocess.run(
-                [sys.executable, "-c", code], check=True, env=env, capture_output=True, text=True
+        for case, pre in cases.items():
+            codes = (
+                _FIRST_OURS.format(pre=pre),
+                _FIRST_SDT.format(pre=pre, here=here, urdf=str(urdf)),
             )
-            times.append(float(run.stdout.split()[-1]))
+            for code, times in zip(codes, out[case], strict=True):
+                run = subprocess.run(
+                    [sys.executable, "-c", code],
+                    check=True,
+                    env=env,
+                    capture_output=True,
+                    text=True,
+                )
+                times.append(float(run.stdout.split()[-1]))
     return out
 
 
@@ -175,22 +199,25 @@ def main() -> None:
     print_rows(rows, args.json)
 
 
-def _first_rows(first: tuple[list[float], list[float]]) -> list[Row]:
-    ours, theirs = first
-    print(
-        "first build, per round (to_sdt / SDT's from_world, s): "
-        + ", ".join(f"{a:.3f}/{b:.3f}" for a, b in zip(ours, theirs, strict=True)),
-        file=sys.stderr,
-    )
-    return [
-        Row(
-            "PR2: first to_sdt in a new process (median)",
-            statistics.median(ours),
-            "SDT: first PR2.from_world in a new process",
-            statistics.median(theirs),
-        ),
-        Row("PR2: same, min", min(ours), "SDT: same, min", min(theirs)),
-    ]
+def _first_rows(first: First) -> list[Row]:
+    rows = []
+    for case, (ours, theirs) in first.items():
+        what = ", query backends imported first" if case else ""
+        print(
+            f"first build{what}, per round (to_sdt / SDT's from_world, s): "
+            + ", ".join(f"{a:.3f}/{b:.3f}" for a, b in zip(ours, theirs, strict=True)),
+            file=sys.stderr,
+        )
+        rows += [
+            Row(
+                f"PR2: first to_sdt in a new process{what} (median)",
+                statistics.median(ours),
+                "SDT: first PR2.from_world in a new process",
+                statistics.median(theirs),
+            ),
+            Row(f"PR2: same{what}, min", min(ours), "SDT: same, min", min(theirs)),
+        ]
+    return rows
 
 
 if __name__ == "__main__":

@@ -241,11 +241,11 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
     moved = [set().union(*(_dofs(tree, k) for k in side)) for side in sides]
     decide = gripper_question(bool(moved[0] & moved[1]), leaders[0] != leaders[1])
     # Which link is a finger's tip is the files' answer only when each side ends once.
-    ends = [
+    leaves = [
         sum(1 for k in side for b in world.subtree(k) if not world.child_bodies(b))
         for side in sides
     ]
-    if decide is None and max(ends) > 1:
+    if decide is None and max(leaves) > 1:
         decide = "a finger with several end links: its tip is the deepest one a joint moves"
     bare = [t.name for t in tips if not own_geometry(t)]
     if decide is None and bare:  # a frame at the pad's end, named by whoever wrote it (PR2's)

@@ -155,7 +155,8 @@ def _add_head(d: Drafter, limb_tops: list[Body]) -> None:
             continue
         if any(c.type.value not in ("revolute", "continuous") for c in seg.joints):
             continue
-        named = any(words(x.name) & HEAD_WORDS for x in (*seg.bodies, *seg.joints))
+        names = [b.name for b in seg.bodies] + [c.name for c in seg.joints]
+        named = any(words(n) & HEAD_WORDS for n in names)
         if not (named or _pan_tilt(d, seg.joints)):
             continue
         if any(world.is_ancestor(top, seg.start) for top in limb_tops):

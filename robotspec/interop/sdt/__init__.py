@@ -5,9 +5,12 @@
 checked. Needs the ``sdt`` extra (``pip install 'robotspec[sdt]'``); importing this package
 does not import SDT, calling :func:`to_sdt` does. See ``docs/sdt.md``.
 
-Modules, one job each: :mod:`.recipe` decides the mapping as plain data (no SDT),
-:mod:`.world` copies the world model into an SDT world, :mod:`.classes` generates and holds
-the part classes, :mod:`._api` is the one place SDT is imported.
+Modules, one job each: :mod:`.recipe` decides the mapping as plain data (no SDT), with
+:mod:`.base` the mobile base's body; :mod:`.world` copies the world model into an SDT world,
+:mod:`.classes` generates and holds the part classes (:mod:`.backref`: a part's robot without
+a query; :mod:`.store`: recipes kept for fresh processes), :mod:`.identity` makes a robot an
+instance of a named SDT class, :mod:`.serial` runs builds one at a time, :mod:`._api` is the
+one place SDT is imported.
 """
 
 from __future__ import annotations

@@ -19,22 +19,19 @@ otherwise). The registry is guarded by a lock: two threads never build one class
 from __future__ import annotations
 
 import copyreg
-import json
-import os
 import re
 import sys
-import tempfile
 import threading
 import types
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from robotspec.errors import RobotSpecError
 from robotspec.interop.sdt.backref import robot_of
 from robotspec.interop.sdt.recipe import PartRecipe, RobotRecipe
 from robotspec.interop.sdt.rules import setup_collision_rules
+from robotspec.interop.sdt.store import class_store, remember, stored, stores
 
 if TYPE_CHECKING:
     # Not used here: krrood resolves the type hints SDT's classes import only for type
@@ -53,8 +50,6 @@ _BUILT: dict[str, type] = {}
 #: Guards ``_BUILT``, the module's attributes and the metaclasses (re-entrant: a robot's
 #: class builds its part classes inside it).
 _LOCK = threading.RLock()
-#: Folders recipes were stored in by this process (``to_sdt(..., class_store=...)``).
-_STORES: list[Path] = []
 #: One metaclass per SDT metaclass: the generated classes' own, whose reducer pickles a class
 #: with its recipe.
 _METAS: dict[type, type] = {}
@@ -345,52 +340,11 @@ def _robot_class(sdt: Any, recipe: RobotRecipe, name: str, digest: str) -> type:
 
 
 # ------------------------------------------------------------------- fresh processes
-def class_store(folder: str | os.PathLike[str] | None = None) -> Path | None:
-    """Where recipes are kept: ``folder``, else ``$ROBOTSPEC_SDT_CLASSES``, else nowhere."""
-    if folder is not None:
-        return Path(folder)
-    env = os.environ.get("ROBOTSPEC_SDT_CLASSES")
-    return Path(env) if env else None
-
-
-def remember(recipe: RobotRecipe, folder: str | os.PathLike[str] | None = None) -> Path | None:
-    """Store ``recipe`` (once, atomically) where :func:`class_store` says; None: nowhere."""
-    store = class_store(folder)
-    if store is None:
-        return None
-    path = store / f"{recipe.digest()}.json"
-    with _LOCK:
-        if folder is not None and store not in _STORES:
-            _STORES.append(store)
-        if not path.is_file():
-            store.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(dir=store, suffix=".tmp")
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                json.dump(recipe.to_json(), f)
-            os.replace(tmp, path)
-    return path
-
-
-def _stored(path: Path) -> RobotRecipe:
-    """The recipe stored at ``path``, or a RobotSpecError naming the damaged file."""
-    try:
-        return RobotRecipe.from_json(json.loads(path.read_text(encoding="utf-8")))
-    except (OSError, ValueError, KeyError, TypeError, IndexError) as exc:
-        raise RobotSpecError(
-            f"the stored SDT class recipe {path} is damaged ({type(exc).__name__}: {exc}); "
-            "delete it, and to_sdt(robot, class_store=...) writes it again",
-            file=path,
-            kind="file",
-        ) from exc
-
-
 def __getattr__(name: str) -> type:
     """A class this process has not built yet, rebuilt from its stored recipe."""
     match = re.search(r"_([0-9a-f]{10})$", name)
     with _LOCK:
-        env = class_store()
-        stores = [*_STORES, *([env] if env is not None else [])]
-        paths = [] if match is None else [s / f"{match.group(1)}.json" for s in stores]
+        paths = [] if match is None else [s / f"{match.group(1)}.json" for s in stores()]
         path = next((p for p in paths if p.is_file()), None)
         if path is None:
             raise AttributeError(
@@ -398,7 +352,7 @@ def __getattr__(name: str) -> type:
                 "robotspec.interop.sdt.to_sdt(robot) (or an unpickle of it), and no stored "
                 "recipe has its digest (docs/sdt.md: where class recipes are kept)"
             )
-        robot_class(_stored(path))
+        robot_class(stored(path))
         if name not in _BUILT:
             raise AttributeError(f"the stored recipe {path} makes no class {name!r}")
         return _BUILT[name]

@@ -14,9 +14,10 @@ way the robot faces (``forward:`` drafted when its limbs or cameras say it is no
 the drafts come is measured against hand-written ground truth by ``tools/draft_score.py``.
 
 One module per job: ``tree`` (segments and the default pose), ``limbs`` (arms, legs), ``hands``
-(grippers, tool frames), ``sensors`` (cameras, neck), ``srdf_groups`` (what the SRDF says),
-``build`` (joining them), ``render`` (YAML that survives any name), ``paths`` (portable file
-references).
+(grippers), ``fingers`` (hands of three or more fingers), ``tool_frames``, ``manipulators`` (what
+hangs at a chain's end), ``sensors`` (cameras, neck), ``srdf_groups`` (what the SRDF says),
+``confidence`` (when a part carries a DECIDE mark: only where no file states it), ``build``
+(joining them), ``render`` (YAML that survives any name), ``paths`` (portable file references).
 """
 
 from __future__ import annotations

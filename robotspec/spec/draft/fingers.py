@@ -1,0 +1,161 @@
+"""A hand of three or more fingers: which branch is the thumb, and the others by name.
+
+Split from ``hands`` (parallel grippers and tool frames): a thumb is found by its name, else by
+where its base lies against the other fingers' (off their row, or alone across the palm), which
+is a guess the draft marks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robotspec.model.entities import Body
+from robotspec.model.world import World
+from robotspec.spec.draft.model import DraftFinger
+from robotspec.spec.draft.tool_frames import bare_fixed_leaf
+from robotspec.spec.draft.tree import Tree, words
+
+__all__ = ["FINGER_NAMES", "Fingers", "find_fingers", "finger_tip", "hand_branches"]
+
+
+def hand_branches(tree: Tree, hand: Body) -> tuple[Body, list[Body]]:
+    """Where the hand first splits (below its single links), and the moving branches there."""
+    body = hand
+    while True:
+        kids = tree.moving_children(body)
+        if len(kids) != 1:
+            break
+        body = kids[0]
+    return body, [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
+
+
+def _has_geometry(tree: Tree, body: Body) -> bool:
+    return any(b.collisions or b.visuals for b in tree.world.subtree(body))
+
+
+def finger_tip(tree: Tree, branch: Body) -> Body:
+    """The deepest body of a finger branch that a moving joint carries, with geometry if any.
+
+    Geometry first: PR2's xacro hangs a bare frame on a prismatic joint below the finger tip.
+    """
+    world: World = tree.world
+    inside = world.subtree(branch)
+    moved = [b for b in inside if (c := world.parent_connection(b)) is not None and not c.is_fixed]
+    # A fixed tip link with geometry is the finger's tip (Baxter's 'r_gripper_l_finger_tip');
+    # collision geometry first: a leaf with a look only is a decoration (HSR-B's vacuum pad).
+    solid = [b for b in inside if b.collisions] or [b for b in inside if b.visuals]
+    tip = max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
+    # A bare frame the URDF fixes at the end of the last phalanx is the tip it names (Ability's
+    # 'index_tip', D'Claw's 'link_f1_head'): the only bare leaf hanging there.
+    bare = [k for k in world.child_bodies(tip) if bare_fixed_leaf(world, k)]
+    if len(bare) == 1 and all(not world.child_bodies(k) for k in world.child_bodies(tip)):
+        return bare[0]
+    return tip
+
+
+#: Names of a hand's fingers besides the thumb, as links often carry them.
+FINGER_NAMES = ("index", "middle", "ring", "pinky", "little")
+
+
+@dataclass(frozen=True)
+class Fingers:
+    """A hand of three or more finger branches: its thumb and the others by name."""
+
+    split: Body
+    thumb: DraftFinger
+    fingers: dict[str, DraftFinger]
+    decide: str | None
+
+
+def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
+    """The fingers of a hand at or below ``hand`` that splits into three or more branches.
+
+    The thumb is the branch named so; else the one whose base lies farthest from the others'
+    (it opposes them), which is a guess. The others are named by their links (``index``,
+    ``middle``...) or numbered.
+    """
+    world = tree.world
+    body, branches = hand_branches(tree, hand)
+    if len(branches) < 3:
+        return None
+    names = [{w for b in world.subtree(k) for w in words(b.name)} for k in branches]
+    named = [i for i, n in enumerate(names) if "thumb" in n]
+    decide = None
+    if len(named) == 1:
+        thumb_i = named[0]
+    else:
+        at = [tree.position(k) for k in branches]
+
+        def apart(i: int) -> tuple[float, float]:
+            # The others' bases on one line (a palm's row of fingers), this one off it.
+            others = at[:i] + at[i + 1 :]
+            return (-round(_line_residual(others), 6), _off_line(at[i], others))
+
+        thumb_i = max(range(len(at)), key=apart)
+        decide = "the thumb is the finger whose base lies off the row of the others'"
+        alone = _alone_on_a_side(tree, body, branches)
+        if alone is not None and _no_clear_row(at):
+            # Bases on a circle (D'Claw's three fingers): no row; the one opposing the others
+            # across the palm is the thumb.
+            thumb_i = alone
+            decide = "the thumb is the finger alone on its side of the palm, opposing the others"
+    fingers: dict[str, DraftFinger] = {}
+    count = 0
+    for i, k in enumerate(branches):
+        if i == thumb_i:
+            continue
+        count += 1
+        label = next((w for w in FINGER_NAMES if w in names[i]), f"finger_{count}")
+        while label in fingers:
+            label = f"{label}_{count}"
+        fingers[label] = DraftFinger(k.name, finger_tip(tree, k).name)
+    thumb = branches[thumb_i]
+    out = Fingers(body, DraftFinger(thumb.name, finger_tip(tree, thumb).name), fingers, decide)
+    # A finger starts at its first link past the palm; one of a single link has no chain to
+    # write (Tiago's), and the hand is then drafted as a generic one.
+    if any(f.root == f.tip for f in (out.thumb, *out.fingers.values())):
+        return None
+    return out
+
+
+#: Off-row distances closer than this ratio tell no row of fingers from a thumb.
+ROW_RATIO = 1.25
+
+
+def _no_clear_row(at: list[np.ndarray]) -> bool:
+    """Whether no base lies clearly farther off the others' row than the next one does."""
+    offs = sorted(
+        (_off_line(p, at[:i] + at[i + 1 :]) for i, p in enumerate(at)),
+        reverse=True,
+    )
+    return len(offs) >= 2 and offs[0] < ROW_RATIO * offs[1]
+
+
+def _alone_on_a_side(tree: Tree, split: Body, branches: list[Body]) -> int | None:
+    """The one branch whose base lies on the other side of the palm's x-z plane (its y sign)."""
+    inv = np.linalg.inv(tree.poses[split.index])
+    ys = [float((inv @ tree.poses[k.index])[1, 3]) for k in branches]
+    for sign in (1.0, -1.0):
+        side = [i for i, y in enumerate(ys) if sign * y > 1e-3]
+        rest = [i for i, y in enumerate(ys) if sign * y < -1e-3]
+        if len(side) == 1 and len(rest) == len(ys) - 1:
+            return side[0]
+    return None
+
+
+def _line_residual(points: list[np.ndarray]) -> float:
+    """How far ``points`` are from lying on one line (the spread across their principal axis)."""
+    pts = np.asarray(points)
+    s = np.linalg.svd(pts - pts.mean(axis=0), compute_uv=False)
+    return float(np.sqrt(np.sum(s[1:] ** 2)))
+
+
+def _off_line(p: np.ndarray, others: list[np.ndarray]) -> float:
+    """How far ``p`` lies from the line the ``others`` best lie on (their principal axis)."""
+    pts = np.asarray(others)
+    centre = pts.mean(axis=0)
+    _, _, vt = np.linalg.svd(pts - centre)
+    d = p - centre
+    return float(np.linalg.norm(d - (d @ vt[0]) * vt[0]))

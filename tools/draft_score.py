@@ -28,8 +28,8 @@ Whether a wrong item carried a ``DECIDE`` mark (``RobotScore.unmarked`` lists th
 not): an extra drafted chain, camera, gripper, torso, neck, drive or facing by its own mark; a
 missed chain, torso or neck when a drafted chain over some of its joints is marked (the
 question the user is asked is then the one that finds it); a missed tool frame or
-gripper when some drafted manipulator is marked; a missed camera when a drafted camera rigidly
-fixed to the same link (another frame of the same device: its depth channel, its mount) is
+gripper when some drafted manipulator is marked; a missed camera when a drafted camera of the
+same device (rigidly fixed to the same link, within 10 cm: its depth channel, its mount) is
 marked (the question asked about that camera is the one that finds it), else never.
 """
 
@@ -241,8 +241,15 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
     return s
 
 
+#: How far apart (m) two frames of one camera device may be.
+DEVICE_SPAN = 0.1
+
+
 def _same_device(world: object, a: str, b: str) -> bool:
-    """Whether links ``a`` and ``b`` are rigidly fixed to one link (fixed joints up to it)."""
+    """Whether links ``a`` and ``b`` are one device's: fixed to one link, within 10 cm."""
+    import numpy as np
+
+    from robotspec.model.kinematics import Kinematics
     from robotspec.model.world import World
 
     assert isinstance(world, World)
@@ -255,7 +262,11 @@ def _same_device(world: object, a: str, b: str) -> bool:
             body = world.bodies[c.parent]
         return body
 
-    return carrier(a) is carrier(b)
+    if carrier(a) is not carrier(b):
+        return False
+    poses = Kinematics(world).forward(world.default_configuration())
+    ia, ib = world.get_body_by_name(a).index, world.get_body_by_name(b).index
+    return float(np.linalg.norm(poses[ia][:3, 3] - poses[ib][:3, 3])) <= DEVICE_SPAN
 
 
 def score_missing(truth: Truth) -> RobotScore:

@@ -280,3 +280,17 @@ def test_thousands_of_camera_sensors_are_bounded_work(tmp_path: Path) -> None:
     d = _draft(_urdf(tmp_path, links + sensors), tmp_path)
     assert time.thread_time() - start < 60.0  # CPU of this thread only; quadratic is minutes
     assert len(d.cameras) == 50 and MAX_SENSORS < 2_000  # one per link
+
+
+def test_an_ackermann_plugin_is_a_differential_drive_asked(tmp_path: Path) -> None:
+    # LIMO in its Ackermann mode: a car-like base moves no sideways, but robotspec has no
+    # Ackermann kind: differential, its nearest, with the question.
+    plugin = (
+        '<gazebo><plugin filename="libgazebo_ros_ackerman.so" name="car">'
+        "<leftRearJoint>rl_joint</leftRearJoint><rightRearJoint>rr_joint</rightRearJoint>"
+        "</plugin></gazebo>"
+    )
+    body = _wheel("rl", 0.2) + _wheel("rr", -0.2) + plugin
+    d = _draft(_urdf(tmp_path, body), tmp_path)
+    assert d.drive is not None and d.drive.type == "differential"
+    assert d.drive.decide == "an Ackermann (car-like) drive: differential is the nearest kind"

@@ -34,6 +34,8 @@ _DRIVE_PLUGINS = (
     ("diff_drive", "differential"),
     ("diffdrive", "differential"),
     ("tracked_vehicle", "differential"),
+    # Car-like steering moves no sideways either: robotspec's nearest kind (the draft asks).
+    ("ackerman", "differential"),
     ("mecanum", "omni"),
     ("planar_move", "omni"),
     ("omni", "omni"),

@@ -71,7 +71,11 @@ def stated_drive(tree: Tree, facts: FileFacts, wheels: list[Connection]) -> Draf
     world = tree.world
     for plugin in facts.actuation.drives:
         if all(world.has_connection(w) for w in plugin.wheels):
-            return DraftDrive(plugin.kind, source=f"the Gazebo drive plugin '{plugin.plugin}'")
+            car = "ackerman" in plugin.plugin.lower()  # stated, but not a kind robotspec has
+            why = "an Ackermann (car-like) drive: differential is the nearest kind" if car else None
+            return DraftDrive(
+                plugin.kind, source=f"the Gazebo drive plugin '{plugin.plugin}'", decide=why
+            )
     names = {c.name for c in wheels}
     driven = [c for c in wheels if facts.actuation.velocity_only(c.name)]
     if not driven or len(driven) == len(names) == 2:

@@ -23,8 +23,9 @@ parallel gripper   its two fingers are coupled by a ``mimic`` tag (one driven, o
 hand (3+ fingers)  never: which branch is the thumb rests on names and geometry
 camera             a Gazebo camera sensor names its frame (and nothing about its axis is odd)
 torso, neck        never: both are found by where arms branch and what carries cameras
-drive              a Gazebo drive plugin names it (an Ackermann one: asked, no such kind), or an SRDF virtual joint states ``floating``
-                   on a robot with legs, wheels or rotors (``fixed`` on one without); a
+drive              a Gazebo drive plugin names it (an Ackermann one is asked: no such kind),
+                   or an SRDF virtual joint states ``floating`` on a robot with legs, wheels
+                   or rotors (``fixed`` on one without); a
                    floating one on a robot nothing moves is drafted ``fixed``, asked; a planar
                    virtual joint says the base moves in the plane, not whether sideways: asked
 forward            never

@@ -241,7 +241,7 @@ def test_threads_build_one_class(tmp_path: Path) -> None:
     from dataclasses import replace
 
     from robotspec.interop.sdt.classes import robot_class
-    from robotspec.interop.sdt.recipe import robot_recipe
+    from robotspec.interop.sdt.mapping import robot_recipe
 
     robot, _ = _robot("pr2")
     recipe = replace(robot_recipe(robot), name="PR2_threads")  # a class not built yet

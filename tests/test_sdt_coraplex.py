@@ -333,7 +333,7 @@ def test_without_a_class_no_alternative_applies() -> None:
 
     from robotspec.interop.sdt import to_sdt
     from robotspec.interop.sdt.classes import robot_class
-    from robotspec.interop.sdt.recipe import robot_recipe
+    from robotspec.interop.sdt.mapping import robot_recipe
 
     robot, tiago = _shipped("tiago")
     generated = robot_class(robot_recipe(robot))

@@ -160,8 +160,8 @@ def test_sdts_missing_cylinder_mesh_is_named_not_a_crash(monkeypatch: pytest.Mon
 def test_a_hand_of_four_fingers_migrates_as_a_hand() -> None:
     from robotspec.compiler import compile_robot
     from robotspec.interop.sdt.classes import robot_class
+    from robotspec.interop.sdt.mapping import robot_recipe
     from robotspec.interop.sdt.migrate import spec_from_sdt
-    from robotspec.interop.sdt.recipe import robot_recipe
     from robotspec.interop.sdt.world import sdt_world
 
     erd_robots()

@@ -1,4 +1,4 @@
-"""The SDT mapping as data (robotspec.interop.sdt.recipe): runs without SDT installed.
+"""The SDT mapping as data (robotspec.interop.sdt.mapping, .recipe): runs without SDT installed.
 
 What each robotspec part becomes in SDT, which joints get hardware interfaces, which states
 keep an SDT kind, and that importing robotspec (or the bridge package) never imports SDT.
@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 
 from robotspec.errors import RobotSpecError
-from robotspec.interop.sdt.recipe import STATE_KINDS, RobotRecipe, robot_recipe
+from robotspec.interop.sdt.mapping import STATE_KINDS, robot_recipe
+from robotspec.interop.sdt.recipe import RobotRecipe
 from robotspec.semantic import AbstractRobot
 from tests.conftest import erd_robots, shared_path
 
@@ -150,7 +151,7 @@ def test_a_robot_gives_equal_recipes_and_json_keeps_them() -> None:
 
 def test_importing_robotspec_and_the_bridge_does_not_import_sdt() -> None:
     code = (
-        "import sys, robotspec, robotspec.interop.sdt, robotspec.interop.sdt.recipe\n"
+        "import sys, robotspec, robotspec.interop.sdt, robotspec.interop.sdt.mapping\n"
         "robotspec.load_robot\n"
         "print(sorted(m for m in sys.modules if m.startswith('semantic_digital_twin')))\n"
     )

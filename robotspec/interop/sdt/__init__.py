@@ -5,12 +5,12 @@
 checked. Needs the ``sdt`` extra (``pip install 'robotspec[sdt]'``); importing this package
 does not import SDT, calling :func:`to_sdt` does. See ``docs/sdt.md``.
 
-Modules, one job each: :mod:`.recipe` decides the mapping as plain data (no SDT), with
-:mod:`.base` the mobile base's body; :mod:`.world` copies the world model into an SDT world,
-:mod:`.classes` generates and holds the part classes (:mod:`.backref`: a part's robot without
-a query; :mod:`.store`: recipes kept for fresh processes), :mod:`.identity` makes a robot an
-instance of a named SDT class, :mod:`.serial` runs builds one at a time, :mod:`._api` is the
-one place SDT is imported.
+Modules, one job each: :mod:`.mapping` decides the mapping as plain data (no SDT): the
+:mod:`.recipe` each class is made from, with :mod:`.base` the mobile base's body;
+:mod:`.world` copies the world model into an SDT world; :mod:`.classes` generates and holds
+the part classes (:mod:`.backref`: a part's robot without a query; :mod:`.store`: recipes
+kept for fresh processes); :mod:`.identity` makes a robot an instance of a named SDT class;
+:mod:`.serial` runs builds one at a time; :mod:`._api` is the one place SDT is imported.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def to_sdt(
 
     The world holds robotspec's bodies, joints, limits (velocity limits as tightened by the
     spec) and the base drive; the robot's parts are SDT's kinds, with robotspec's sides,
-    axes, cameras, states and collision rules (see :func:`.recipe.robot_recipe`). What has no
+    axes, cameras, states and collision rules (see :func:`.mapping.robot_recipe`). What has no
     place in SDT is left out with an :class:`SdtBridgeWarning` each. The robot is returned;
     its world is ``result._world``.
 
@@ -75,7 +75,7 @@ def to_sdt(
     """
     from robotspec.interop.sdt.classes import remember, robot_class
     from robotspec.interop.sdt.identity import build, checked_class, fit, named_class
-    from robotspec.interop.sdt.recipe import robot_recipe
+    from robotspec.interop.sdt.mapping import robot_recipe
     from robotspec.interop.sdt.serial import run
     from robotspec.interop.sdt.world import building_world
 

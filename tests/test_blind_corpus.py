@@ -128,3 +128,8 @@ def test_the_holdout_is_measured_as_totals_only(
     assert "x/secret_tune" in capsys.readouterr().out
     with pytest.raises(SystemExit):
         measure.main(["--half", "holdout", "--only", "x/secret_holdout"])
+    # A group of five ids (e.g. the robots one round added) is measured as totals only too.
+    group = ["x/secret_holdout", "a/1", "a/2", "a/3", "a/4"]
+    assert measure.main(["--half", "holdout", "--only", *group]) == 0
+    out = capsys.readouterr().out
+    assert "secret" not in out and "| holdout | 1 | 0/1 (0 %) |" in out

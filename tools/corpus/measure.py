@@ -56,6 +56,8 @@ __all__ = ["BLIND_TRUTH", "CorpusRobot", "corpus_robots", "main", "measure_robot
 #: The truths of the blind corpus.
 BLIND_TRUTH = REPO / "tests" / "data" / "blind_truth"
 HALVES = ("tune", "holdout")
+#: The smallest holdout group whose totals may be printed: a group's totals, never one robot's.
+MIN_HOLDOUT_GROUP = 5
 
 
 @dataclass(frozen=True)
@@ -200,10 +202,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``python -m tools.corpus.measure [--half tune|holdout]``."""
     parser = argparse.ArgumentParser(prog="python -m tools.corpus.measure", description=__doc__)
     parser.add_argument("--half", choices=HALVES, default="tune")
-    parser.add_argument("--only", nargs="*", default=None, help="tune robots to measure (ids)")
+    parser.add_argument(
+        "--only",
+        nargs="*",
+        default=None,
+        help="robots to measure (ids); on the holdout half a group of at least "
+        f"{MIN_HOLDOUT_GROUP}, totals only (e.g. the robots a round added, never seen drafted)",
+    )
     args = parser.parse_args(argv)
-    if args.half == "holdout" and args.only:
-        parser.error("--only is for the tune half: the holdout is measured whole")
+    if args.half == "holdout" and args.only is not None and len(set(args.only)) < MIN_HOLDOUT_GROUP:
+        parser.error(
+            f"--only on the holdout half takes at least {MIN_HOLDOUT_GROUP} ids: "
+            "its totals must never be one robot's score"
+        )
     robots, skipped = corpus_robots()
     for msg in skipped:
         sys.stderr.write(f"skipped: {msg}\n")

@@ -174,7 +174,9 @@ def _type(d: Any, label: str, text: str, handle: Any) -> None:
     from selenium.webdriver.common.keys import Keys
 
     xpath = f"//input[@aria-labelledby=//label[normalize-space()='{label}']/@id]"
-    box = _wait(f"the box '{label}'", lambda: d.find_element(By.XPATH, xpath))
+    box = _wait(  # once shown: a box in a folder still opening refuses keys
+        f"the box '{label}'", lambda: (e := d.find_element(By.XPATH, xpath)).is_displayed() and e
+    )
     d.execute_script("arguments[0].scrollIntoView({block: 'center'})", box)
     box.send_keys(Keys.CONTROL, "a")
     box.send_keys(text)

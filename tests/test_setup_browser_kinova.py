@@ -65,7 +65,13 @@ def test_a_wrist_camera_on_the_kinova_arm_through_the_page(driver: Any, tmp_path
         # viser's label names no input (its 'for' is not the input's id); the page's script
         # ties them (aria-labelledby), as a screen reader finds the box, so does the test.
         boxes = "//input[@aria-labelledby=//label[normalize-space()='name']/@id]"
-        name = _wait("the name box", lambda: d.find_element(By.XPATH, boxes))
+        # Found once it is shown: the folder opening is animated, and a box still hidden
+        # refuses keys ("element not interactable", seen under load).
+        name = _wait(
+            "the name box shown",
+            lambda: (e := d.find_element(By.XPATH, boxes)).is_displayed() and e,
+        )
+        d.execute_script("arguments[0].scrollIntoView({block: 'center'})", name)
         name.clear()
         name.send_keys("wrist_camera")
         _wait("the name typed", lambda: page._new_name.value == "wrist_camera")
@@ -86,7 +92,10 @@ def test_a_wrist_camera_on_the_kinova_arm_through_the_page(driver: Any, tmp_path
         _wait("an empty reason refused at its box", lambda: "give the reason" in body.text)
         assert "accept_warnings" not in session.snapshot.text
         boxes = "//input[@aria-labelledby=//label[normalize-space()='because']/@id]"
-        because = _wait("the reason box", lambda: d.find_element(By.XPATH, boxes))
+        because = _wait(
+            "the reason box shown",
+            lambda: (e := d.find_element(By.XPATH, boxes)).is_displayed() and e,
+        )
         because.send_keys("arm_up is a pose of the whole robot")
         _wait("the reason typed", lambda: page._because.value.endswith("whole robot"))
         _click_text(d, "accept with reason")

@@ -267,10 +267,11 @@ def walk(
         hit_pairs += ps
         if drop:
             found[ps] = 1
-        if not first:
+        if not first or len(rs) == len(left):  # any hit: every waiting row has its hit
             break
         # Any hit: one candidate per row waited for coal; the rows coal found free walk on.
-        on = left[~np.isin(rows[left], rs)]
+        hit = set(rs)
+        on = left[[r not in hit for r in rows[left].tolist()]]
         ends = np.searchsorted(rows, rows[on], side="right")
         rest = np.concatenate(
             [np.arange(i + 1, e) for i, e in zip(on, ends, strict=True)] + [_NONE]

@@ -195,8 +195,8 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
     want_cams = list(t.get("cameras") or [])
     have_cams = [c.body for c in draft.cameras]
     for body in want_cams:
-        near = [c for c in draft.cameras if c.decide and _same_device(world, c.body, body)]
-        s.add("cameras", body in have_cams, f"{body} not a camera", marked=bool(near))
+        asked = [c for c in draft.cameras if c.decide and _same_device(world, c.body, body)]
+        s.add("cameras", body in have_cams, f"{body} not a camera", marked=bool(asked))
     for cam in draft.cameras:
         if cam.body not in want_cams:
             s.add(

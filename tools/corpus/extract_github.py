@@ -176,12 +176,17 @@ def install_shares(robot: GithubRobot) -> None:
         tmp = dest.with_name(package + ".partial")
         shutil.rmtree(tmp, ignore_errors=True)
         tmp.mkdir(parents=True)
+        root = robot.folder.resolve()
         for rel in paths:
             src = robot.folder / rel
+            # The tree is a third party's: a path must stay inside it, and a link it planted is
+            # copied as a link, never as the file it points at (copy2 would follow it).
+            if src.is_symlink() or not src.resolve().is_relative_to(root):
+                raise ValueError(f"{robot.id}: share path {rel!r} is a link or leaves the tree")
             if src.is_dir():
                 shutil.copytree(src, tmp / src.name, symlinks=True)
             else:
-                shutil.copy2(src, tmp / src.name)
+                shutil.copy2(src, tmp / src.name, follow_symlinks=False)
         tmp.rename(dest)
 
 

@@ -27,8 +27,6 @@ Run it (minutes; prints one line per robot that fails, then the counts)::
 from __future__ import annotations
 
 import argparse
-import os
-import re
 import subprocess
 import sys
 import tempfile
@@ -39,6 +37,8 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
+
+from tools.corpus.measure import noted_package_paths, run_cli  # noqa: E402
 
 __all__ = ["KEPT_APART", "Outcome", "SweepRobot", "main", "robots", "sweep_one"]
 
@@ -65,7 +65,6 @@ KEPT_APART = frozenset(
     }
 )
 SOURCES = ("erd", "wheels", "shared")
-_NOTE_P = re.compile(r"-P (\S+)")
 #: How long one command may take (s): a hang, not a slow machine (2 cores shared by many).
 TIMEOUT = 900
 
@@ -172,19 +171,7 @@ def robots(sources: Sequence[str] = SOURCES) -> list[SweepRobot]:
 
 
 def _cli(args: Sequence[str], cwd: Path) -> subprocess.CompletedProcess[str]:
-    env = dict(os.environ, NO_COLOR="1", COLUMNS="200")
-    try:
-        return subprocess.run(
-            [sys.executable, "-m", "robotspec", *args],
-            cwd=cwd,
-            capture_output=True,
-            text=True,
-            env=env,
-            check=False,
-            timeout=TIMEOUT,
-        )
-    except subprocess.TimeoutExpired:
-        return subprocess.CompletedProcess(args, 124, "", f"timed out after {TIMEOUT} s")
+    return run_cli(args, cwd, timeout=TIMEOUT)
 
 
 def _last(text: str) -> str:
@@ -207,9 +194,7 @@ def sweep_one(robot: SweepRobot, tmp: Path) -> Outcome:
         crash = "Traceback" in init.stderr or init.returncode not in (0, 1)
         status = "crash" if crash else "refused"
         return Outcome(robot, status, with_p, _last(init.stderr))
-    allow = [
-        p for ln in init.stderr.splitlines() if ln.startswith("note:") for p in _NOTE_P.findall(ln)
-    ]
+    allow = noted_package_paths(init.stderr)
     check = _cli(["validate", str(spec), *(a for p in allow for a in ("-P", p))], tmp)
     if check.returncode == 0:
         return Outcome(robot, "valid", with_p, "")

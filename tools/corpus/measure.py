@@ -51,7 +51,16 @@ from tools.draft_score import (  # noqa: E402
     score_missing,
 )
 
-__all__ = ["BLIND_TRUTH", "CorpusRobot", "corpus_robots", "main", "measure_robot", "totals_lines"]
+__all__ = [
+    "BLIND_TRUTH",
+    "CorpusRobot",
+    "corpus_robots",
+    "main",
+    "measure_robot",
+    "noted_package_paths",
+    "run_cli",
+    "totals_lines",
+]
 
 #: The truths of the blind corpus.
 BLIND_TRUTH = REPO / "tests" / "data" / "blind_truth"
@@ -124,16 +133,30 @@ def corpus_robots(quiet: bool = True) -> tuple[list[CorpusRobot], list[str]]:
 _NOTE_P = re.compile(r"-P (\S+)")
 
 
-def _cli(args: Sequence[str], cwd: Path) -> subprocess.CompletedProcess[str]:
+def run_cli(
+    args: Sequence[str], cwd: Path, timeout: float | None = None
+) -> subprocess.CompletedProcess[str]:
+    """``robotspec ARGS`` in ``cwd`` as a user's shell runs it (exit code 124 past ``timeout``)."""
     env = dict(os.environ, NO_COLOR="1", COLUMNS="200")
-    return subprocess.run(
-        [sys.executable, "-m", "robotspec", *args],
-        cwd=cwd,
-        capture_output=True,
-        text=True,
-        env=env,
-        check=False,
-    )
+    try:
+        return subprocess.run(
+            [sys.executable, "-m", "robotspec", *args],
+            cwd=cwd,
+            capture_output=True,
+            text=True,
+            env=env,
+            check=False,
+            timeout=timeout,
+        )
+    except subprocess.TimeoutExpired:
+        return subprocess.CompletedProcess(list(args), 124, "", f"timed out after {timeout} s")
+
+
+def noted_package_paths(init_stderr: str) -> list[str]:
+    """The ``-P FOLDER``s init's notes ask ``validate`` for (what a user copies from them)."""
+    return [
+        p for ln in init_stderr.splitlines() if ln.startswith("note:") for p in _NOTE_P.findall(ln)
+    ]
 
 
 def measure_robot(robot: CorpusRobot, truth: Truth, tmp: Path) -> tuple[RobotScore, str]:
@@ -151,13 +174,12 @@ def measure_robot(robot: CorpusRobot, truth: Truth, tmp: Path) -> tuple[RobotSco
         args += ["-P", str(pp)]
     for key, value in robot.xacro_args.items():
         args += ["--xacro-arg", f"{key}={value}"]
-    init = _cli(args, tmp)
+    init = run_cli(args, tmp)
     if init.returncode != 0 or not spec.is_file():
         last = (init.stderr.strip().splitlines() or ["init failed"])[-1]
         return score_missing(truth), f"init: {last}"
-    note = [ln for ln in init.stderr.splitlines() if ln.startswith("note:")]
-    allow = [p for ln in note for p in _NOTE_P.findall(ln)]
-    check = _cli(["validate", str(spec), *(a for p in allow for a in ("-P", p))], tmp)
+    allow = noted_package_paths(init.stderr)
+    check = run_cli(["validate", str(spec), *(a for p in allow for a in ("-P", p))], tmp)
     valid = check.returncode == 0
     problem = "" if valid else "validate: " + " ".join(check.stdout.split())[:300]
     try:

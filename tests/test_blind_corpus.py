@@ -133,3 +133,32 @@ def test_the_holdout_is_measured_as_totals_only(
     assert measure.main(["--half", "holdout", "--only", *group]) == 0
     out = capsys.readouterr().out
     assert "secret" not in out and "| holdout | 1 | 0/1 (0 %) |" in out
+
+
+def test_shares_stay_inside_the_third_partys_tree(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A manifest's share paths are copied out of a repository nobody here wrote: a file link
+    # planted there, or a path leaving the tree, is refused; a link inside a folder stays a link.
+    from tools.corpus import extract_github as eg
+
+    monkeypatch.setattr(eg, "cache_root", lambda: tmp_path)
+    secret = tmp_path / "secret.txt"
+    secret.write_text("not the robot's")
+
+    def robot(share: dict[str, tuple[str, ...]]) -> eg.GithubRobot:
+        return eg.GithubRobot("gh/x", "o/r", "c", "a.urdf", None, {}, (), "tune", "", share)
+
+    tree = robot({}).folder
+    (tree / "pkg" / "urdf").mkdir(parents=True)
+    (tree / "pkg" / "urdf" / "a.xacro").write_text("<robot/>")
+    (tree / "pkg" / "urdf" / "inner").symlink_to(secret)
+    (tree / "planted").symlink_to(secret)
+    eg.install_shares(robot({"pkg": ("pkg/urdf",)}))
+    copied = tree / "_share" / "pkg" / "urdf"
+    assert (copied / "a.xacro").read_text() == "<robot/>"
+    assert (copied / "inner").is_symlink()
+    for bad in ("planted", "../secret.txt"):
+        with pytest.raises(ValueError, match="link or leaves the tree"):
+            eg.install_shares(robot({"other": (bad,)}))
+    assert not (tree / "_share" / "other").exists()

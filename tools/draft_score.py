@@ -31,6 +31,11 @@ question the user is asked is then the one that finds it); a missed tool frame o
 gripper when some drafted manipulator is marked; a missed camera when a drafted camera of the
 same device (rigidly fixed to the same link, within 10 cm: its depth channel, its mount) is
 marked (the question asked about that camera is the one that finds it), else never.
+
+Which rule of ``robotspec/spec/draft/confidence.py`` left an item unmarked (``RobotScore.rules``:
+per rule, the items it left unmarked and how many of those are wrong): a drafted item's own
+``stated``; a missed item's, the rules that left the drafted items near it unmarked (``(nothing
+asks)`` when none is near); ``(no rule)`` for an unmarked item no rule states (a leak).
 """
 
 from __future__ import annotations
@@ -43,6 +48,7 @@ from typing import Any
 
 __all__ = [
     "CATEGORIES",
+    "MARKED",
     "TRUTH",
     "RobotScore",
     "Truth",
@@ -50,13 +56,25 @@ __all__ = [
     "main",
     "score_draft",
     "score_lines",
-    "score_missing",
 ]
 
 #: The ground truth files.
 TRUTH = Path(__file__).resolve().parents[1] / "tests" / "data" / "draft_truth"
 #: The categories, in the table's order.
 CATEGORIES = ("valid", "chains", "tool frames", "grippers/hands", "cameras", "torso/neck/drive")
+#: The rule table's rows for marked items, unmarked ones no rule states, missed ones none asks.
+MARKED, NO_RULE, NOTHING = "(marked DECIDE)", "(no rule)", "(nothing asks)"
+
+
+def _rule_of(items: Sequence[Any], prefix: str = "") -> str | None:
+    """The rules that left ``items`` (drafted near a missed one) unmarked, joined."""
+    if not items:
+        return NOTHING
+    found: list[str] = []
+    for item in items:
+        stated = item.stated if isinstance(item.stated, tuple) else (item.stated,)
+        found += [r for r in stated if r and r.startswith(prefix) and r not in found]
+    return " + ".join(found) or None
 
 
 @dataclass(frozen=True)
@@ -90,15 +108,29 @@ class RobotScore:
     wrong: list[str] = field(default_factory=list)
     #: The wrong items the draft states without a ``DECIDE`` mark (a subset of ``wrong``).
     unmarked: list[str] = field(default_factory=list)
+    #: Per confidence rule (``MARKED`` for items with a mark): [items, wrong among them].
+    rules: dict[str, list[int]] = field(default_factory=dict)
 
-    def add(self, category: str, right: bool, what: str, marked: bool = True) -> None:
+    def add(
+        self,
+        category: str,
+        right: bool,
+        what: str,
+        marked: bool = True,
+        rule: str | None = None,
+    ) -> None:
         """Count one item of ``category``; ``what`` says what was wrong when it is not right.
 
         ``marked``: whether the draft item this concerns carries a ``DECIDE`` mark (or the draft
         says nothing there); a wrong item without one is also listed in ``unmarked``.
+        ``rule``: the confidence rule that left it unmarked (``None``: no rule did).
         """
         got, of = self.counts.get(category, (0, 0))
         self.counts[category] = (got + int(right), of + 1)
+        if category != "valid":
+            per = self.rules.setdefault(MARKED if marked else rule or NO_RULE, [0, 0])
+            per[0] += 1
+            per[1] += int(not right)
         if not right:
             self.wrong.append(f"{category}: {what}")
             if not marked:
@@ -133,11 +165,14 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
             matched.add(hit)
         # A miss is marked when a drafted chain over some of its joints asks to be checked.
         near = [d for d in draft.chains if d.joints & want[1]]
+        if hit is not None:
+            near = [draft.chains[hit]]
         s.add(
             "chains",
             hit is not None,
             f"{name} ({c['root']} -> {c['tip']}) not drafted",
             marked=any(d.decide for d in near),
+            rule=_rule_of(near),
         )
     for i, (_, _, name) in enumerate(drafted):
         if i not in matched:
@@ -146,6 +181,7 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
                 False,
                 f"drafted {name}, not a chain of the truth",
                 marked=bool(draft.chains[i].decide),
+                rule=draft.chains[i].stated,
             )
     # Tool frames and grippers.
     frames = {f.name: f.parent for f in draft.frames}
@@ -156,12 +192,19 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
     for name, m in (t.get("manipulators") or {}).items():
         tool = m.get("tool_frame")
         if isinstance(tool, dict):
-            ok = any(frames.get(d.tool_frame) == tool["parent"] for d in draft.manipulators)
+            hits = [d for d in draft.manipulators if frames.get(d.tool_frame) == tool["parent"]]
             shown = f"a new frame on {tool['parent']}"
         else:
-            ok = any(d.tool_frame == tool for d in draft.manipulators)
+            hits = [d for d in draft.manipulators if d.tool_frame == tool]
             shown = str(tool)
-        s.add("tool frames", ok, f"{name}: {shown}", marked=any_marked)
+        ok = bool(hits)
+        s.add(
+            "tool frames",
+            ok,
+            f"{name}: {shown}",
+            marked=any(d.decide for d in hits) if ok else any_marked,
+            rule=_rule_of(hits[:1] or draft.manipulators, "tool frame"),
+        )
         if m.get("type") in ("parallel_gripper", "hand"):
             tips = frozenset(m["fingers"])
             want_thumb = m.get("thumb")  # a hand's; a gripper's two tips are unordered
@@ -180,7 +223,10 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
                 "grippers/hands",
                 hit_g is not None,
                 f"{name}: {what}fingers {sorted(tips)}",
-                marked=any_marked,
+                marked=bool(hit_g.decide) if hit_g is not None else any_marked,
+                rule=_rule_of([hit_g], "gripper")
+                if hit_g is not None
+                else _rule_of(draft.manipulators),
             )
     for g in grippers:
         if g.name not in used:
@@ -190,13 +236,22 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
                 False,
                 f"drafted {g.name} as {kind}, not one",
                 marked=bool(g.decide),
+                rule=_rule_of([g], "gripper"),
             )
     # Cameras.
     want_cams = list(t.get("cameras") or [])
     have_cams = [c.body for c in draft.cameras]
     for body in want_cams:
-        asked = [c for c in draft.cameras if c.decide and _same_device(world, c.body, body)]
-        s.add("cameras", body in have_cams, f"{body} not a camera", marked=bool(asked))
+        same = [c for c in draft.cameras if c.body == body]
+        if not same:
+            same = [c for c in draft.cameras if _same_device(world, c.body, body)]
+        s.add(
+            "cameras",
+            body in have_cams,
+            f"{body} not a camera",
+            marked=any(c.decide for c in same),
+            rule=_rule_of(same),
+        )
     for cam in draft.cameras:
         if cam.body not in want_cams:
             s.add(
@@ -204,6 +259,7 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
                 False,
                 f"drafted {cam.body}, not a camera of the truth",
                 marked=bool(cam.decide),
+                rule=cam.stated,
             )
     # Torso, neck, drive.
     for key in ("torso", "neck"):
@@ -213,11 +269,16 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
             continue
         want_j = None if want_part is None else joints(want_part["root"], want_part["tip"])
         have_j = None if have_part is None else have_part.joints
-        if have_part is not None:
-            marked = bool(have_part.decide)
-        else:  # a missed torso or neck, as a missed chain: a marked chain over its joints asks
-            marked = any(d.decide for d in draft.chains if d.joints & (want_j or frozenset()))
-        s.add("torso/neck/drive", want_j == have_j, f"{key}: {sorted(have_j or [])}", marked=marked)
+        near = [have_part] if have_part is not None else []
+        if have_part is None:  # a missed torso or neck, as a missed chain: a marked chain asks
+            near = [d for d in draft.chains if d.joints & (want_j or frozenset())]
+        s.add(
+            "torso/neck/drive",
+            want_j == have_j,
+            f"{key}: {sorted(have_j or [])}",
+            marked=any(d.decide for d in near),
+            rule=_rule_of(near),
+        )
     want_fwd = tuple(float(v) for v in t.get("forward") or (1.0, 0.0, 0.0))
     have_fwd = draft.forward or (1.0, 0.0, 0.0)
     if want_fwd != (1.0, 0.0, 0.0) or have_fwd != (1.0, 0.0, 0.0):
@@ -237,6 +298,7 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         ok,
         f"drive: {d.type if d is not None else None}",
         marked=d is not None and bool(d.decide),
+        rule=None if d is None else d.stated,
     )
     return s
 
@@ -267,31 +329,6 @@ def _same_device(world: object, a: str, b: str) -> bool:
     poses = Kinematics(world).forward(world.default_configuration())
     ia, ib = world.get_body_by_name(a).index, world.get_body_by_name(b).index
     return float(np.linalg.norm(poses[ia][:3, 3] - poses[ib][:3, 3])) <= DEVICE_SPAN
-
-
-def score_missing(truth: Truth) -> RobotScore:
-    """The score of a robot ``init`` drafted nothing for: every item of its truth is wrong.
-
-    Nothing is counted as stated without a mark: a failed ``init`` says so loudly.
-    """
-    t = truth.data
-    s = RobotScore(truth.robot)
-    s.add("valid", False, "no draft")
-    for name in t.get("chains") or {}:
-        s.add("chains", False, f"{name}: no draft")
-    for name, m in (t.get("manipulators") or {}).items():
-        s.add("tool frames", False, f"{name}: no draft")
-        if m.get("type") in ("parallel_gripper", "hand"):
-            s.add("grippers/hands", False, f"{name}: no draft")
-    for body in t.get("cameras") or []:
-        s.add("cameras", False, f"{body}: no draft")
-    for key in ("torso", "neck"):
-        if t.get(key) is not None:
-            s.add("torso/neck/drive", False, f"{key}: no draft")
-    if tuple(t.get("forward") or (1.0, 0.0, 0.0)) != (1.0, 0.0, 0.0):
-        s.add("torso/neck/drive", False, "forward: no draft")
-    s.add("torso/neck/drive", False, "drive: no draft")
-    return s
 
 
 def _tips(m: object, hand: bool) -> tuple[str | None, frozenset[str]]:

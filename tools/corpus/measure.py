@@ -43,12 +43,12 @@ if str(REPO) not in sys.path:  # ``python tools/corpus/measure.py`` as well as `
 
 from tools.draft_score import (  # noqa: E402
     CATEGORIES,
+    MARKED,
     RobotScore,
     Truth,
     load_truths,
     score_draft,
     score_lines,
-    score_missing,
 )
 
 __all__ = [
@@ -58,7 +58,9 @@ __all__ = [
     "main",
     "measure_robot",
     "noted_package_paths",
+    "rule_lines",
     "run_cli",
+    "score_missing",
     "totals_lines",
 ]
 
@@ -215,6 +217,45 @@ def totals_lines(scores: Sequence[RobotScore], label: str) -> list[str]:
     ]
 
 
+def score_missing(truth: Truth) -> RobotScore:
+    """The score of a robot ``init`` drafted nothing for: every item of its truth is wrong.
+
+    Nothing is counted as stated without a mark: a failed ``init`` says so loudly.
+    """
+    t = truth.data
+    s = RobotScore(truth.robot)
+    s.add("valid", False, "no draft")
+    for name in t.get("chains") or {}:
+        s.add("chains", False, f"{name}: no draft")
+    for name, m in (t.get("manipulators") or {}).items():
+        s.add("tool frames", False, f"{name}: no draft")
+        if m.get("type") in ("parallel_gripper", "hand"):
+            s.add("grippers/hands", False, f"{name}: no draft")
+    for body in t.get("cameras") or []:
+        s.add("cameras", False, f"{body}: no draft")
+    for key in ("torso", "neck"):
+        if t.get(key) is not None:
+            s.add("torso/neck/drive", False, f"{key}: no draft")
+    if tuple(t.get("forward") or (1.0, 0.0, 0.0)) != (1.0, 0.0, 0.0):
+        s.add("torso/neck/drive", False, "forward: no draft")
+    s.add("torso/neck/drive", False, "drive: no draft")
+    return s
+
+
+def rule_lines(scores: Sequence[RobotScore]) -> list[str]:
+    """Per confidence rule: the items it left unmarked and how many of those are wrong."""
+    per: dict[str, list[int]] = {}
+    for s in scores:
+        for rule, (n, bad) in s.rules.items():
+            got = per.setdefault(rule, [0, 0])
+            got[0] += n
+            got[1] += bad
+    lines = ["| rule (what left the item unmarked) | items | wrong |", "| --- | --- | --- |"]
+    for rule in sorted(per, key=lambda r: (r == MARKED, r)):
+        lines.append(f"| {rule} | {per[rule][0]} | {per[rule][1]} |")
+    return lines
+
+
 def _truths() -> dict[str, Truth]:
     """The blind corpus's truths by robot id."""
     return {t.robot: t for t in load_truths(BLIND_TRUTH)}
@@ -259,7 +300,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stdout.write("\n".join(totals_lines(scores, "holdout")) + "\n")
         return 0
     lines = score_lines(scores)
-    lines += ["", *totals_lines(scores, args.half)]
+    lines += ["", *totals_lines(scores, args.half), "", *rule_lines(scores)]
     unmarked = [f"- {s.robot}: {w}" for s in scores for w in s.unmarked]
     if unmarked:
         lines += ["", "Wrong without a DECIDE mark:", "", *unmarked]

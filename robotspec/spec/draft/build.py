@@ -12,7 +12,7 @@ from robotspec.description.srdf import Srdf
 from robotspec.model.entities import Body
 from robotspec.model.world import World
 from robotspec.spec.draft.base import own_base, own_drive, wheel_joints
-from robotspec.spec.draft.confidence import chain_question
+from robotspec.spec.draft.confidence import CHAIN_SRDF, chain_question
 from robotspec.spec.draft.driven import stated_wheels
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.hands import find_fingers, find_gripper
@@ -195,6 +195,8 @@ class Drafter:
                     )
                 elif q := chain_question(self.srdf, gc.group.name, gc.tip.name, agrees):
                     c.decide.append(q)  # confirmed, but nothing in the SRDF hangs on it
+                else:
+                    c.stated = CHAIN_SRDF
                 out.append((c, limb))
         rest = [lb for i, lb in enumerate(limbs) if i not in used]
         for kind in ("arm", "leg"):

@@ -31,6 +31,11 @@ drive              a Gazebo drive plugin names it (an Ackermann one is asked: no
 forward            never
 =================  ===========================================================================
 
+Each row that leaves an item unmarked has a code (``CHAIN_SRDF``, ``TOOL_SRDF``...): the draft
+item records it (``stated``, never written into the spec), so that the corpus measure counts,
+per rule, how many items it left unmarked and how many of those were wrong. A rule that leaves
+wrong items unmarked on robots seen for the first time is too broad.
+
 A manipulator's ``front_facing_orientation`` follows from its tool frame and fingers (the way
 from the hand's root to its tips, in the tool frame): it is written with that reason as a plain
 comment, and marked only when the hand gives no way to face (a default).
@@ -45,13 +50,49 @@ from robotspec.spec.draft.tool_frames import is_bare_frame, is_named_tcp
 from robotspec.spec.draft.tree import Tree
 
 __all__ = [
+    "CAMERA_GAZEBO",
+    "CHAIN_SRDF",
+    "DRIVE_FIXED",
+    "DRIVE_FLOATING",
+    "DRIVE_PLUGIN",
+    "GRIPPER_MIMIC",
+    "RULES",
+    "TOOL_AT_END",
+    "TOOL_ON_HAND",
+    "TOOL_SRDF",
     "camera_question",
     "chain_question",
+    "drive_plugin_question",
     "drive_question",
+    "drive_rule",
     "gripper_question",
     "srdf_carries",
     "tool_frame_question",
+    "tool_frame_verdict",
 ]
+
+# The rules that leave an item unmarked, one code per row of the table above.
+CHAIN_SRDF = "chain: SRDF group the tree confirms, an end effector on it"
+TOOL_SRDF = "tool frame: the SRDF end effector's parent link"
+TOOL_ON_HAND = "tool frame: a TCP name on the hand"
+TOOL_AT_END = "tool frame: a TCP name at the chain's end"
+GRIPPER_MIMIC = "gripper: fingers a mimic tag couples"
+CAMERA_GAZEBO = "camera: a Gazebo sensor"
+DRIVE_PLUGIN = "drive: a Gazebo drive plugin"
+DRIVE_FLOATING = "drive: a floating SRDF virtual joint, a robot that moves"
+DRIVE_FIXED = "drive: a fixed SRDF virtual joint, a robot that does not move"
+#: Every rule, in the table's order.
+RULES = (
+    CHAIN_SRDF,
+    TOOL_SRDF,
+    TOOL_ON_HAND,
+    TOOL_AT_END,
+    GRIPPER_MIMIC,
+    CAMERA_GAZEBO,
+    DRIVE_PLUGIN,
+    DRIVE_FLOATING,
+    DRIVE_FIXED,
+)
 
 
 def srdf_carries(srdf: Srdf | None, group: str, tip: str) -> str | None:
@@ -75,6 +116,33 @@ def chain_question(srdf: Srdf | None, group: str | None, tip: str, tree_agrees: 
     return None
 
 
+def tool_frame_verdict(
+    world: World,
+    tool: Body,
+    *,
+    hand: Body | None,
+    tip: Body,
+    srdf_parent: Body | None,
+    tree: Tree,
+) -> tuple[str | None, str | None]:
+    """(question, rule): why a tool frame the URDF has is asked, or the rule that states it.
+
+    ``hand``: where the hand's fingers hang (the gripper's root, or the hand the tree found);
+    ``tip``: the chain's tip; ``srdf_parent``: the SRDF end effector's parent link.
+    """
+    if srdf_parent is not None and tool is srdf_parent and is_bare_frame(world, tool):
+        return None, TOOL_SRDF
+    if not is_named_tcp(world, tool):
+        return f"the tool frame '{tool.name}' by its name", None
+    if hand is not None:
+        if world.is_ancestor(hand, tool):
+            return None, TOOL_ON_HAND
+        return f"the tool frame '{tool.name}' is named as a TCP but hangs beside the hand", None
+    if world.is_ancestor(tip, tool) and not tree.moves_below(tip):
+        return None, TOOL_AT_END
+    return f"the tool frame '{tool.name}' is named as a TCP but is not at the chain's end", None
+
+
 def tool_frame_question(
     world: World,
     tool: Body,
@@ -84,22 +152,10 @@ def tool_frame_question(
     srdf_parent: Body | None,
     tree: Tree,
 ) -> str | None:
-    """Why a tool frame the URDF has is a question, or ``None`` when the files state it.
-
-    ``hand``: where the hand's fingers hang (the gripper's root, or the hand the tree found);
-    ``tip``: the chain's tip; ``srdf_parent``: the SRDF end effector's parent link.
-    """
-    if srdf_parent is not None and tool is srdf_parent and is_bare_frame(world, tool):
-        return None
-    if not is_named_tcp(world, tool):
-        return f"the tool frame '{tool.name}' by its name"
-    if hand is not None:
-        if world.is_ancestor(hand, tool):
-            return None
-        return f"the tool frame '{tool.name}' is named as a TCP but hangs beside the hand"
-    if world.is_ancestor(tip, tool) and not tree.moves_below(tip):
-        return None
-    return f"the tool frame '{tool.name}' is named as a TCP but is not at the chain's end"
+    """Why a tool frame the URDF has is a question, or ``None`` when the files state it."""
+    return tool_frame_verdict(world, tool, hand=hand, tip=tip, srdf_parent=srdf_parent, tree=tree)[
+        0
+    ]
 
 
 def gripper_question(coupled: bool, one_driven: bool) -> str | None:
@@ -137,3 +193,17 @@ def drive_question(virtual: str, moves: bool) -> str | None:
             else None
         )
     return f"the SRDF's {virtual} virtual joint moves the base in the plane: omni, or differential?"
+
+
+def drive_rule(virtual: str, moves: bool) -> str | None:
+    """The rule that states a drive from an SRDF virtual joint (``None``: it is asked)."""
+    if drive_question(virtual, moves) is not None:
+        return None
+    return DRIVE_FLOATING if virtual == "floating" else DRIVE_FIXED
+
+
+def drive_plugin_question(plugin: str) -> str | None:
+    """Why a drive a Gazebo drive plugin names is a question (an Ackermann one: no such kind)."""
+    if "ackerman" in plugin.lower():
+        return "an Ackermann (car-like) drive: differential is the nearest kind"
+    return None

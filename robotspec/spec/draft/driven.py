@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from robotspec.model.entities import Connection, ConnectionType
+from robotspec.spec.draft.confidence import DRIVE_PLUGIN, drive_plugin_question
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.model import DraftDrive
 from robotspec.spec.draft.tree import Tree
@@ -71,10 +72,12 @@ def stated_drive(tree: Tree, facts: FileFacts, wheels: list[Connection]) -> Draf
     world = tree.world
     for plugin in facts.actuation.drives:
         if all(world.has_connection(w) for w in plugin.wheels):
-            car = "ackerman" in plugin.plugin.lower()  # stated, but not a kind robotspec has
-            why = "an Ackermann (car-like) drive: differential is the nearest kind" if car else None
+            why = drive_plugin_question(plugin.plugin)  # Ackermann: not a kind robotspec has
             return DraftDrive(
-                plugin.kind, source=f"the Gazebo drive plugin '{plugin.plugin}'", decide=why
+                plugin.kind,
+                source=f"the Gazebo drive plugin '{plugin.plugin}'",
+                decide=why,
+                stated=DRIVE_PLUGIN if why is None else None,
             )
     names = {c.name for c in wheels}
     driven = [c for c in wheels if facts.actuation.velocity_only(c.name)]

@@ -14,7 +14,7 @@ import numpy as np
 
 from robotspec.model.entities import Body
 from robotspec.model.world import World
-from robotspec.spec.draft.confidence import tool_frame_question
+from robotspec.spec.draft.confidence import GRIPPER_MIMIC, TOOL_SRDF, tool_frame_verdict
 from robotspec.spec.draft.hands import (
     Gripper,
     facing_quaternion,
@@ -63,6 +63,7 @@ def manipulator(
     if hand is not None and not world.is_ancestor(tip, hand):
         hand = None
     decide: list[str] = []
+    rules: list[str] = []  # confidence's rules that state what is drafted without a question
     gripper, why = find_gripper(tree, hand) if hand is not None else (None, "no hand")
     top = gripper.root if gripper is not None else (hand or tip)
     others = frozenset(
@@ -107,7 +108,11 @@ def manipulator(
         tool_name = tool.name
         # Stated or a question: confidence's rule (above the hand: said already).
         at_hand = gripper.root if gripper is not None else hand
-        q = tool_frame_question(world, tool, hand=at_hand, tip=tip, srdf_parent=stated, tree=tree)
+        q, rule = tool_frame_verdict(
+            world, tool, hand=at_hand, tip=tip, srdf_parent=stated, tree=tree
+        )
+        if not decide and q is None:
+            rules.append(rule or TOOL_SRDF)
         if not decide and q is not None:
             jaw = tool is fixed_jaw(world, top)  # a one-jaw gripper's: by where it is
             decide.append(f"the tool frame '{tool.name}' at the fixed jaw's end" if jaw else q)
@@ -169,6 +174,8 @@ def manipulator(
         m.source = f"{gripper.found} below '{gripper.root.name}'"
         if gripper.decide:
             decide.append(gripper.decide)
+        else:
+            rules.append(GRIPPER_MIMIC)
     elif (
         hand is not None
         and chain.role != "leg"
@@ -187,6 +194,7 @@ def manipulator(
         elif hand is not None:
             decide.append(f"a generic hand: {why}")
     m.joints = hand_joints(tree, top)
+    m.stated = tuple(rules)
     _facing(self, m, gripper, tip, frame)
     self.draft.manipulators.append(m)
     chain.manipulator = m.name

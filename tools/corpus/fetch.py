@@ -49,9 +49,13 @@ MANIFEST = Path(__file__).resolve().parents[2] / "tests" / "data" / "blind_corpu
 #: The keys a manifest entry may have.
 KEYS = frozenset({"id", "source", "urdf", "srdf", "xacro_args", "package_paths", "half", "what"})
 #: Wheels built only for an old Python (no build for the one in use): pip downloads the build for
-#: this (python version, platform); only their data files (the robots) are read, never imported.
-OLD_PYTHON_WHEELS: Mapping[tuple[str, str], tuple[str, str]] = MappingProxyType(
-    {("roboschool", "1.0.49"): ("37", "manylinux1_x86_64")}
+#: this (python version, platform or None for any); only their data files (the robots) are read,
+#: never imported.
+OLD_PYTHON_WHEELS: Mapping[tuple[str, str], tuple[str, str | None]] = MappingProxyType(
+    {
+        ("roboschool", "1.0.49"): ("37", "manylinux1_x86_64"),
+        ("rofunc", "0.0.2.6"): ("38", None),
+    }
 )
 
 
@@ -134,7 +138,8 @@ def fetch(package: str, version: str, quiet: bool = False) -> Path:
         cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--only-binary=:all:"]
         if (package, version) in OLD_PYTHON_WHEELS:
             python_version, platform = OLD_PYTHON_WHEELS[package, version]
-            cmd += ["--python-version", python_version, "--platform", platform]
+            cmd += ["--python-version", python_version]
+            cmd += ["--platform", platform] if platform else []
         cmd += ["-d", tmp, f"{package}=={version}"]
         if quiet:
             cmd.append("-q")

@@ -78,6 +78,7 @@ def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
     """
     world = tree.world
     body, branches = hand_branches(tree, hand)
+    branches = _through_plates(tree, branches)
     if len(branches) < 3:
         return None
     names = [{w for b in world.subtree(k) for w in words(b.name)} for k in branches]
@@ -114,10 +115,34 @@ def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
     thumb = branches[thumb_i]
     out = Fingers(body, DraftFinger(thumb.name, finger_tip(tree, thumb).name), fingers, decide)
     # A finger starts at its first link past the palm; one of a single link has no chain to
-    # write (Tiago's), and the hand is then drafted as a generic one.
+    # write (Tiago's, Mia's one-joint digits), and the hand is then drafted as a generic one.
     if any(f.root == f.tip for f in (out.thumb, *out.fingers.values())):
         return None
     return out
+
+
+#: Branches from one palm that make a hand whose one-link branches are fingers too.
+MIN_DIGITS = 4
+
+
+def _through_plates(tree: Tree, branches: list[Body]) -> list[Body]:
+    """Each branch, or the finger branches of a palm plate it is (Schunk SVH's ring and pinky).
+
+    A plate moves on its own joint and splits into two or more branches that each bend
+    (two or more moving links): the fingers are those, not the plate.
+    """
+    world = tree.world
+    out: list[Body] = []
+    for k in branches:
+        split, subs = hand_branches(tree, k)
+        bending = [s for s in subs if sum(1 for b in world.subtree(s) if _moves(world, b)) >= 2]
+        out += bending if len(subs) >= 2 and len(bending) == len(subs) else [k]
+    return out
+
+
+def _moves(world: World, body: Body) -> bool:
+    c = world.parent_connection(body)
+    return c is not None and not c.is_fixed
 
 
 #: Off-row distances closer than this ratio tell no row of fingers from a thumb.

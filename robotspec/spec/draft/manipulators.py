@@ -15,6 +15,7 @@ import numpy as np
 from robotspec.model.entities import Body
 from robotspec.model.world import World
 from robotspec.spec.draft.confidence import GRIPPER_MIMIC, TOOL_SRDF, tool_frame_verdict
+from robotspec.spec.draft.fingers import MIN_DIGITS
 from robotspec.spec.draft.hands import (
     Gripper,
     facing_quaternion,
@@ -258,13 +259,18 @@ def lone_hand(self: Drafter) -> DraftManipulator | None:
 
     if gripper is not None and (rolls(gripper.thumb_tip) or rolls(gripper.finger_tip)):
         gripper = None
-    # Fingers have phalanges: a branch of one joint (a rotor, a wheel) is not one.
-    branches = [
+    # Fingers have phalanges: a branch of one joint (a rotor, a wheel) is not one, unless the
+    # palm has MIN_DIGITS of them on limited joints (a five-finger hand's one-joint digits).
+    kids = [
         k
         for k in tree.moving_children(split)
-        if sum(1 for b in world.subtree(k) if not _fixed_above(world, b)) >= 2
-        and not any(b.index in wheels for b in world.subtree(k))
+        if not any(b.index in wheels for b in world.subtree(k))
     ]
+    branches = [
+        k for k in kids if sum(1 for b in world.subtree(k) if not _fixed_above(world, b)) >= 2
+    ]
+    if len(kids) >= MIN_DIGITS and all(_limited(world, k) for k in kids):
+        branches = kids
     named = any(is_named(b.name, HAND_WORDS | FINGER_WORDS) for b in world.subtree(split))
     small = hand_span(tree, split) <= MAX_HAND_SPAN
     if gripper is None and not (len(branches) >= 2 and (small or named)):
@@ -303,6 +309,12 @@ def _bare_frames(world: World, body: Body) -> list[Body]:
             if not (k.collisions or k.visuals):
                 out.append(k)
     return out
+
+
+def _limited(world: World, body: Body) -> bool:
+    """Whether ``body`` moves on a joint with limits on both sides (a digit; never a rotor)."""
+    c = world.parent_connection(body)
+    return c is not None and c.type.value in ("revolute", "prismatic")
 
 
 def _fixed_above(world: World, body: Body) -> bool:

@@ -170,6 +170,8 @@ def _add_head(d: Drafter, limb_tops: list[Body]) -> None:
         joints = frozenset(c.name for c in seg.joints if c.is_active)
         if not joints or any(c.joints & joints for c in d.draft.chains):
             continue
+        if any(m.joints & joints for m in d.draft.manipulators):
+            continue  # a finger of a drafted hand (Barrett's), never a head
         first, last = seg.joints[0], seg.joints[-1]
         head = DraftChain(
             unique("head", d.names),

@@ -1,0 +1,118 @@
+"""Drafts of shapes the blind corpus's robots showed at first sight (issue 30), on small layouts.
+
+Each layout is the shape of a mistake the drafter made on robots it had never seen (measured
+before any change): a palm plate carrying two fingers, a hand whose digits flex on one joint
+each, a three-finger hand taken for a head. The rule that leaves an item unmarked is recorded on
+the draft (``stated``) and never written into the spec.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robotspec.spec.draft import render_draft
+from robotspec.spec.draft.confidence import GRIPPER_MIMIC, RULES, TOOL_ON_HAND
+from tests.test_draft_blind import _draft, _joint, _link
+
+
+def _digit(prefix: str, parent: str, xyz: str, joints: int = 2, mimic: str = "") -> list[str]:
+    """A finger of ``joints`` moving links from ``parent`` (its tip: ``{prefix}_{joints}``)."""
+    out: list[str] = []
+    above = parent
+    for i in range(1, joints + 1):
+        out.append(_link(f"{prefix}_{i}", size=0.01))
+        j = _joint(f"{prefix}_q{i}", above, f"{prefix}_{i}", xyz=xyz if i == 1 else "0 0 0.03")
+        if mimic and i == 1:
+            j = j.replace("</joint>", f'<mimic joint="{mimic}"/></joint>')
+        out.append(j)
+        above = f"{prefix}_{i}"
+    return out
+
+
+def test_a_palm_plate_carrying_two_fingers_gives_both_fingers(tmp_path: Path) -> None:
+    # Schunk SVH: ring and little finger sit on a plate that turns on its own joint; the hand
+    # has five fingers, not four with the plate as one of them.
+    parts = [
+        _link("base", size=0.05),
+        _link("palm", size=0.04),
+        _joint("mount", "base", "palm", kind="fixed"),
+        *_digit("thumb", "palm", "0.03 -0.03 0.02"),
+        *_digit("index", "palm", "0.03 0.02 0.06"),
+        *_digit("middle", "palm", "0.01 0.02 0.06"),
+        _link("plate", size=0.01),
+        _joint("plate_joint", "palm", "plate", xyz="-0.02 0.02 0.04"),
+        *_digit("ring", "plate", "0.0 0.0 0.02"),
+        *_digit("pinky", "plate", "-0.02 0.0 0.02"),
+    ]
+    d = _draft(tmp_path, "svh", parts)
+    (m,) = d.manipulators
+    assert m.is_hand and m.thumb is not None
+    assert m.thumb.tip == "thumb_2"
+    assert {f.tip for f in m.fingers.values()} == {"index_2", "middle_2", "ring_2", "pinky_2"}
+
+
+def test_a_hand_alone_whose_digits_flex_on_one_joint_is_a_hand_not_nothing(
+    tmp_path: Path,
+) -> None:
+    # Mia: five digits of one joint each (two mimic a third) and a TCP frame among the tips.
+    # The spec cannot write a finger of one link, so the hand is generic, asked, with its TCP.
+    parts = [
+        _link("flange", size=0.05),
+        _link("palm", size=0.04),
+        _joint("palm_mount", "flange", "palm", kind="fixed"),
+        '<link name="hand_tcp"/>',
+        _joint("tcp_joint", "palm", "hand_tcp", kind="fixed", xyz="0 0 0.13"),
+        *_digit("thumb", "palm", "0.03 -0.03 0.02", joints=2),
+        *_digit("index", "palm", "0.03 0.02 0.06", joints=1),
+        *_digit("middle", "palm", "0.01 0.02 0.06", joints=1),
+        *_digit("ring", "palm", "-0.01 0.02 0.06", joints=1, mimic="middle_q1"),
+        *_digit("little", "palm", "-0.03 0.02 0.06", joints=1, mimic="middle_q1"),
+    ]
+    d = _draft(tmp_path, "mia", parts)
+    (m,) = d.manipulators
+    assert m.tool_frame == "hand_tcp"
+    assert m.decide  # a generic hand: a question
+    assert d.lone_hand == m.name
+
+
+def test_a_finger_of_a_hand_alone_is_never_a_head(tmp_path: Path) -> None:
+    # Barrett BH8: three fingers of two or three joints from the palm; a finger whose joints
+    # pan and tilt is still the hand's, not a head drafted beside it.
+    parts = [
+        _link("palm", size=0.05),
+        *_digit("f1", "palm", "0.03 0.02 0.05", joints=3),
+        *_digit("f2", "palm", "-0.03 0.02 0.05", joints=3),
+        *_digit("f3", "palm", "0 -0.03 0.05", joints=2),
+    ]
+    d = _draft(tmp_path, "bh8", parts)
+    assert [m.is_hand for m in d.manipulators] == [True]
+    assert not any(c.name.startswith("head") for c in d.chains)
+
+
+def test_the_rule_that_leaves_an_item_unmarked_is_recorded_not_written(tmp_path: Path) -> None:
+    # An arm whose gripper's fingers a mimic tag couples, with a TCP frame on the gripper:
+    # stated by two rules; the draft records them and the spec's text does not carry them.
+    parts = [_link("base", size=0.05)]
+    above = "base"
+    for i in range(1, 7):
+        parts += [_link(f"arm_{i}", size=0.03), _joint(f"arm_q{i}", above, f"arm_{i}")]
+        above = f"arm_{i}"
+    parts += [
+        _link("gripper_base", size=0.03),
+        _joint("gripper_mount", above, "gripper_base", kind="fixed"),
+        '<link name="tool0"/>',
+        _joint("tcp", "gripper_base", "tool0", kind="fixed", xyz="0 0 0.1"),
+        _link("left_finger", size=0.01),
+        _joint("left_q", "gripper_base", "left_finger", kind="prismatic", xyz="0 0.02 0.05"),
+        _link("right_finger", size=0.01),
+        _joint(
+            "right_q", "gripper_base", "right_finger", kind="prismatic", xyz="0 -0.02 0.05"
+        ).replace("</joint>", '<mimic joint="left_q" multiplier="-1"/></joint>'),
+    ]
+    d = _draft(tmp_path, "arm", parts)
+    (m,) = d.manipulators
+    assert m.tool_frame == "tool0"
+    assert not m.decide
+    assert m.stated == (TOOL_ON_HAND, GRIPPER_MIMIC)
+    text = render_draft(d)
+    assert not any(rule in text for rule in RULES)

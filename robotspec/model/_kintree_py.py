@@ -30,6 +30,7 @@ see tests/test_fallback_batch.py), the products being summed in another order.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -83,11 +84,49 @@ def tree_size(tree: object) -> tuple[int, int]:
     return t.n_out, t.n_dof
 
 
-def _buffers(t: Tree, n: int) -> tuple[F64, F64]:
-    """A step's store (node poses, root set to the identity, then extra poses) and gather."""
+def _buffers(t: Tree, n: int) -> tuple[F64, F64, Any]:
+    """A step's store (node poses, root set to the identity, then extra poses) and gathers.
+
+    The last is the body poses in body order (B, n), whole 128-byte poses, made once for every
+    step: a fresh array of that size per step is fresh pages, which the kernel clears first.
+    """
     store = np.empty((t.n_nodes + len(t.extra_node), n, 4, 4))
     store[0] = np.eye(4)
-    return store, np.empty((len(t.extra_node), n, 4, 4))
+    return store, np.empty((len(t.extra_node), n, 4, 4)), np.empty((t.n_out, n), dtype="V128")
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where a step's poses go among the bodies (body order, the result's).
+
+    ``runs``: per node with extra poses, (node, its extra poses, their bodies) for each stretch
+    of consecutive bodies; ``node_out`` and ``node_at``: the bodies that are a node's pose, and
+    that node's slot. Why: the extra poses (49 of the PR2's 83 bodies) are written straight into
+    the bodies' order instead of into the store and gathered from it, one pass over the
+    memory fewer (a batch's step moves megabytes: it is bound by memory, not arithmetic).
+    """
+
+    runs: tuple[tuple[int, slice, slice], ...]
+    node_out: Any
+    node_at: Any
+
+
+def _layout(t: Tree) -> Layout:
+    """The :class:`Layout` of ``t`` (a few microseconds: made once per batch)."""
+    at = np.asarray(t.at)
+    body_of = np.zeros(t.n_nodes + len(t.extra_node), dtype=np.int64)
+    body_of[at] = np.arange(len(at))  # slot -> body (read for the extra slots: one body each)
+    runs: list[tuple[int, slice, slice]] = []
+    for node, run in t.extra_runs:
+        bodies = body_of[t.n_nodes + np.arange(run.start, run.stop)].tolist()
+        first = 0
+        for k in range(1, len(bodies) + 1):
+            if k == len(bodies) or bodies[k] != bodies[k - 1] + 1:
+                extras = slice(run.start + first, run.start + k)
+                runs.append((node, extras, slice(bodies[first], bodies[k - 1] + 1)))
+                first = k
+    node_out = np.flatnonzero(at < t.n_nodes)
+    return Layout(tuple(runs), node_out, at[node_out])
 
 
 def _cos_sin(v: F64, cos: F64, sin: F64) -> None:
@@ -121,10 +160,17 @@ def _motions(t: Tree, q: F64) -> tuple[F64, Any]:
     return v, turns
 
 
-def _run(t: Tree, v: F64, turns: Any, out: F64, bufs: tuple[F64, F64]) -> None:
-    """Every output pose of one step into ``out`` (n, B, 4, 4), from its motions (see above)."""
+def _run(
+    t: Tree, v: F64, turns: Any, out: F64, bufs: tuple[F64, F64, Any], layout: Layout | None
+) -> None:
+    """Every output pose of one step into ``out`` (n, B, 4, 4), from its motions (see above).
+
+    ``layout`` (a batch's steps): where each extra pose goes among the bodies, so the products
+    write them there and only the nodes' poses are gathered; None (a few samples): everything is
+    gathered.
+    """
     n = v.shape[1]
-    store, gathered = bufs
+    store, gathered, ordered = bufs
     for g in t.groups:
         k = g.nodes.stop - g.nodes.start
         dst = store[g.nodes]
@@ -149,17 +195,20 @@ def _run(t: Tree, v: F64, turns: Any, out: F64, bufs: tuple[F64, F64]) -> None:
             cols *= turns[g.motion][:, :, None]
         else:  # a slide: column 3 += v column k
             dst[..., 3] += dst[..., g.column] * v[g.motion][:, :, None]
-    n_extra = len(t.extra_node)
-    extra = store[t.n_nodes :].reshape(n_extra, 4 * n, 4)
-    if n < _GATHER_BELOW:  # a few samples: one gather and one product for all
+    poses = store.reshape(len(store), n, 16).view("V128")[..., 0]
+    if layout is None:  # a few samples: one gather and one product for all extra poses
+        n_extra = len(t.extra_node)
+        extra = store[t.n_nodes :].reshape(n_extra, 4 * n, 4)
         np.take(store, t.extra_node, axis=0, out=gathered, mode="clip")
         np.matmul(gathered.reshape(n_extra, 4 * n, 4), t.extra_pose, out=extra)
-    else:  # a product per node, its poses broadcast: no copy of them
-        for node, run in t.extra_runs:
-            np.matmul(store[node].reshape(4 * n, 4), t.extra_pose[run], out=extra[run])
+        np.take(poses, t.at, axis=0, out=ordered, mode="clip")  # (t.at is in range: no check)
+    else:  # a product per node, its poses broadcast, written at the bodies' places in order
+        in_order = ordered.view(np.float64).reshape(t.n_out, 4 * n, 4)
+        for node, run, at in layout.runs:
+            np.matmul(store[node].reshape(4 * n, 4), t.extra_pose[run], out=in_order[at])
+        ordered[layout.node_out] = poses[layout.node_at]
     # Whole poses (128 bytes) moved at once into the result's layout.
-    poses = store.reshape(len(store), n, 16).view("V128")[..., 0]
-    out.reshape(n, t.n_out, 16).view("V128")[..., 0][...] = np.take(poses, t.at, axis=0).T
+    out.reshape(n, t.n_out, 16).view("V128")[..., 0][...] = ordered.T
 
 
 def fk(tree: object, q: object) -> F64:
@@ -167,7 +216,7 @@ def fk(tree: object, q: object) -> F64:
     qa = config(q, 1, t.n_dof)
     poses: F64 = np.empty((1, t.n_out, 4, 4))
     v, turns = _motions(t, qa[None, :])
-    _run(t, v, turns, poses, _buffers(t, 1))  # a batch of one: fk_batch's operations
+    _run(t, v, turns, poses, _buffers(t, 1), None)  # a batch of one: fk_batch's operations
     pose: F64 = poses[0]
     return pose
 
@@ -185,11 +234,13 @@ def fk_batch(tree: object, q: object, out: Any = None, stream: bool = False) -> 
         check_out(out, shape)
     bufs = _buffers(t, min(n, _CHUNK))  # one set for every full step, reused
     v, turns = _motions(t, qa)
+    layout = None if n < _GATHER_BELOW else _layout(t)
     for lo in range(0, n, _CHUNK):
         hi = min(n, lo + _CHUNK)
         fits = hi - lo == bufs[0].shape[1]
         step = v[:, lo:hi], turns[:, lo:hi]
-        _run(t, *step, out[lo:hi], bufs if fits else _buffers(t, hi - lo))
+        where = None if hi - lo < _GATHER_BELOW else layout
+        _run(t, *step, out[lo:hi], bufs if fits else _buffers(t, hi - lo), where)
     result: F64 = out
     return result
 

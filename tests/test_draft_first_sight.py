@@ -12,7 +12,7 @@ from pathlib import Path
 
 from robotspec.spec.draft import render_draft
 from robotspec.spec.draft.confidence import GRIPPER_MIMIC, RULES, TOOL_ON_HAND
-from tests.test_draft_blind import _draft, _joint, _link
+from tests.test_draft_blind import _WHEEL, _draft, _draft_srdf, _joint, _link
 
 
 def _digit(prefix: str, parent: str, xyz: str, joints: int = 2, mimic: str = "") -> list[str]:
@@ -116,3 +116,52 @@ def test_the_rule_that_leaves_an_item_unmarked_is_recorded_not_written(tmp_path:
     assert m.stated == (TOOL_ON_HAND, GRIPPER_MIMIC)
     text = render_draft(d)
     assert not any(rule in text for rule in RULES)
+
+
+def _mobile_arm_with_gripper() -> list[str]:
+    """A two-wheel base with a 4-joint arm, a marker frame and two mimic-coupled jaws on link5."""
+    parts = [_link("base_footprint", size=0.2)]
+    for side, y in (("left", 0.15), ("right", -0.15)):
+        parts += [
+            _link(f"wheel_{side}", _WHEEL),
+            _joint(
+                f"wheel_{side}_joint", "base_footprint", f"wheel_{side}", "continuous", f"0 {y} 0"
+            ),
+        ]
+    parts += [_link("link1", size=0.03), _joint("arm_mount", "base_footprint", "link1", "fixed")]
+    for i in range(2, 6):
+        parts += [_link(f"link{i}", size=0.03), _joint(f"joint{i - 1}", f"link{i - 1}", f"link{i}")]
+    jaw = _joint("jaw_l", "link5", "jaw_left", "prismatic", "0.1 0.02 0")
+    mimic = _joint("jaw_r", "link5", "jaw_right", "prismatic", "0.1 -0.02 0", axis="0 -1 0")
+    parts += [
+        # the TCP as the file has it: a marker box to look at, no collision shape
+        _link("end_effector_link", size=0.01),
+        _joint("end_effector_joint", "link5", "end_effector_link", "fixed", "0.13 0 0"),
+        _link("jaw_left", size=0.01),
+        jaw,
+        _link("jaw_right", size=0.01),
+        mimic.replace("</joint>", '<mimic joint="jaw_l"/></joint>'),
+    ]
+    return parts
+
+
+def test_an_srdf_group_ending_at_a_frame_beside_the_fingers_ends_where_both_hang(
+    tmp_path: Path,
+) -> None:
+    # TurtleBot3 with OpenMANIPULATOR-X: the SRDF's 'arm' group lists the fixed joint to
+    # 'end_effector_link', a frame on link5 beside the jaws; its end effector's parent is link5.
+    # The SRDF's fixed virtual joint is the planner's: the wheels say the base moves (asked).
+    srdf = (
+        '<group name="arm"><joint name="joint1"/><joint name="joint2"/><joint name="joint3"/>'
+        '<joint name="joint4"/><joint name="end_effector_joint"/></group>'
+        '<group name="gripper"><joint name="jaw_l"/><joint name="jaw_r"/></group>'
+        '<end_effector name="tcp" parent_link="link5" group="gripper"/>'
+        '<virtual_joint name="vj" type="fixed" parent_frame="odom" child_link="base_footprint"/>'
+    )
+    d = _draft_srdf(tmp_path, "tb3", _mobile_arm_with_gripper(), srdf)
+    (arm,) = d.chains
+    assert arm.tip == "link5"
+    (m,) = d.manipulators
+    assert m.is_gripper and m.tool_frame == "end_effector_link"
+    assert {m.thumb.tip, m.finger.tip} == {"jaw_left", "jaw_right"}  # type: ignore[union-attr]
+    assert d.drive is not None and d.drive.type == "differential" and d.drive.decide

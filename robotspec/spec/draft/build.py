@@ -263,7 +263,7 @@ class Drafter:
             owners = [
                 (c, lb)
                 for c, lb in chains
-                if world.is_ancestor(c.tip, start)
+                if (world.is_ancestor(c.tip, start) or _frame_beside(world, c.tip, start))
                 and (ee.parent_group is None or c.group in (None, ee.parent_group))
             ]
             named = [
@@ -275,6 +275,14 @@ class Drafter:
                 self.draft.notes.append(f"end effector {ee.name!r} is on no drafted chain")
                 continue
             chain, limb = pick[0]
+            if _frame_beside(world, chain.tip, start):
+                # The group ends at a frame beside the hand (TurtleBot3's 'end_effector_link'
+                # on link5, beside the fingers): the chain ends where both hang, the frame is
+                # the hand's tool frame.
+                tip = world.get_body_by_name(chain.tip)
+                up = world.parent_connection(tip)
+                assert up is not None  # a frame beside the hand hangs on a fixed joint
+                chain.tip, chain.group = world.bodies[up.parent].name, None
             if chain.manipulator is not None:
                 self.draft.notes.append(
                     f"end effector {ee.name!r}: chain {chain.name!r} has one already"
@@ -296,6 +304,20 @@ class Drafter:
             m = self.manipulator(chain, limb, name, hand_start, parent)
             if m is not None:
                 m.source = f"the SRDF end effector '{ee.name}' ({m.source})"
+
+
+def _frame_beside(world: World, tip_name: str, start: Body) -> bool:
+    """Whether the chain's tip is a frame fixed on a link above ``start`` (not on it).
+
+    A frame: a leaf on a fixed joint with no collision shape (a marker's look at most).
+    """
+    tip = world.get_body_by_name(tip_name)
+    up = world.parent_connection(tip)
+    if up is None or not up.is_fixed or world.child_bodies(tip) or tip.collisions:
+        return False
+    if world.is_ancestor(tip, start):
+        return False
+    return world.is_ancestor(world.bodies[up.parent], start)
 
 
 def draft_spec(

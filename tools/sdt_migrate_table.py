@@ -2,9 +2,11 @@
 
 Why a tool: the table in docs/sdt.md ("Every class SDT 26.7 ships") must be reproducible. For
 each of SDT 26.7's 13 robot classes it finds the robot's URDF where this machine has one
-(example-robot-data, the shared robot files, the ``pycram-robotics`` 1.0.4 wheel unpacked
-where ``tools/corpus`` keeps wheels), migrates the class, validates the written spec and sorts
-each error by whose fault it is. Run it in the SDT environment::
+(example-robot-data, the shared robot files, the ``hello-robot-stretch-urdf`` 0.1.2 and
+``pycram-robotics`` 1.0.4 wheels unpacked where ``tools/corpus`` keeps wheels, the IAI fork
+of ``hsr_description`` extracted from the search tool's mirror as the blind corpus's GitHub
+robots are), migrates the class, validates the written spec and sorts each error by whose
+fault it is. Run it in the SDT environment::
 
     .venv-sdt/bin/python -m tools.sdt_migrate_table            # every class
     .venv-sdt/bin/python -m tools.sdt_migrate_table Stretch   # one
@@ -27,6 +29,16 @@ from tools.corpus.fetch import cache_root
 ROOT = Path(__file__).resolve().parents[1]
 PYCRAM = "pypi/pycram-robotics==1.0.4/pycram_robotics-1.0.4.data/data/lib/python3.10/"
 PYCRAM += "site-packages/pycram/resources/robots"
+#: Hello Robot's own Stretch URDFs (Clear BSD): the RE2 with the dex wrist has every frame
+#: SDT's ``Stretch`` names; preferred to pycram-robotics' copy where a vendor's package has it.
+STRETCH = "pypi/hello-robot-stretch-urdf==0.1.2/stretch_urdf/RE2V0/"
+STRETCH += "stretch_description_RE2V0_tool_stretch_dex_wrist.urdf"
+
+#: SDT's HSRB class names ``hand_gripper_tool_frame``, which only the IAI fork's URDF has (the
+#: shared HSR-B is hsr-project's and TRI's). Pinned like the blind corpus's robots: the tree is
+#: extracted once into the corpus cache (``tools.corpus.extract_github``), never committed. Its
+#: meshes are ``package://hsr_meshes``, found in the shared HSR-B's folder.
+HSRB_FORK = ("code-iai/hsr_description", "ec886faaf19e4c81ebef22f54cb1ad6fb65b22b2")
 
 #: Whose fault each kind of validate error is, by its message.
 FAULTS = (
@@ -47,6 +59,19 @@ def _erd() -> Path | None:
     return Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data")))
 
 
+def hsrb_fork() -> Path | None:
+    """The IAI fork's tree at :data:`HSRB_FORK`, extracted from its mirror if need be, or None."""
+    from tools.corpus.extract_github import extract, mirror_of
+
+    repo, commit = HSRB_FORK
+    dest = cache_root() / "github" / f"{repo.replace('/', '+')}@{commit}"
+    if not dest.is_dir():
+        if mirror_of(repo) is None:
+            return None
+        extract(repo, commit, dest)
+    return dest
+
+
 def sources() -> dict[str, tuple[Path | None, Path | None, list[Path]]]:
     """Class name -> (URDF, SRDF, package paths) as found on this machine (None: absent)."""
     erd, wheel = _erd(), cache_root() / PYCRAM
@@ -57,14 +82,14 @@ def sources() -> dict[str, tuple[Path | None, Path | None, list[Path]]]:
         out["PR2"] = (pr2 / "urdf/pr2.urdf", pr2 / "srdf/pr2.srdf", [erd.parent])
         g1 = erd / "robots/g1_description/urdf/g1_29dof_with_hand_rev_1_0.urdf"
         out["UnitreeG1"] = (g1, None, [erd.parent])
-    hsrb = shared / "hsrb"
-    out["HSRB"] = (
-        hsrb / "hsrb4s.urdf",
+    hsrb, fork = shared / "hsrb", hsrb_fork()
+    out["HSRB"] = (  # without the fork, no URDF: the shared one lacks the class's frame
+        None if fork is None else fork / "robots/hsrb4s.urdf",
         hsrb / "hsrb_moveit_config/config/hsrb.srdf",
         [hsrb],
     )
-    for name, file in (
-        ("Stretch", "stretch_description.urdf"),
+    out["Stretch"] = (cache_root() / STRETCH, None, [])
+    for name, file in (  # no package but PyCRAM's has these (docs/sdt.md says why)
         ("ICub3", "iCub3.urdf"),
         ("Justin", "rollin_justin.urdf"),
         ("Tiago", "tiago_dual.urdf"),

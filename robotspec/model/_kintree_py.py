@@ -152,11 +152,20 @@ def _motions(t: Tree, q: F64) -> tuple[F64, Any]:
 
     Made once for the whole batch (a few whole-array operations), not once per step.
     """
-    v = q[:, t.dof].T.copy()  # (motion rows, N)
-    v *= t.mul[:, None]
+    n = q.shape[0]
+    v = q[:, t.dof].T.copy() if n < _GATHER_BELOW else np.ascontiguousarray(q.T)[t.dof]
+    v *= t.mul[:, None]  # (motion rows, N)
     v += t.off[:, None]
-    turns = np.empty((t.n_turn, q.shape[0]), dtype=np.complex128)
-    _cos_sin(v[: t.n_turn], turns.real, turns.imag)
+    turns = np.empty((t.n_turn, n), dtype=np.complex128)
+    if n < _GATHER_BELOW:
+        _cos_sin(v[: t.n_turn], turns.real, turns.imag)
+        return v, turns
+    # A batch: the quotients in whole rows, then one copy each into the complex parts (their
+    # views interleave; computing in them costs twice as much). The same operations, so the
+    # same bits as a single configuration's.
+    cos, sin = np.empty((2, t.n_turn, n))
+    _cos_sin(v[: t.n_turn], cos, sin)
+    turns.real, turns.imag = cos, sin
     return v, turns
 
 

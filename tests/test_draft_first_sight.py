@@ -165,3 +165,30 @@ def test_an_srdf_group_ending_at_a_frame_beside_the_fingers_ends_where_both_hang
     assert m.is_gripper and m.tool_frame == "end_effector_link"
     assert {m.thumb.tip, m.finger.tip} == {"jaw_left", "jaw_right"}  # type: ignore[union-attr]
     assert d.drive is not None and d.drive.type == "differential" and d.drive.decide
+
+
+def _two_joint_branches(words: tuple[str, str]) -> list[str]:
+    """A body with two 2-joint branches (left +y, right -y), each 0.3 m long, named by words."""
+    parts = [_link("body", size=0.2)]
+    for side, y in (("l", 0.2), ("r", -0.2)):
+        upper, lower = (f"{side}_{w}" for w in words)
+        parts += [
+            _link(f"{side}_shoulder_link", size=0.02),
+            _joint(f"{side}_pitch", "body", f"{side}_shoulder_link", xyz=f"0 {y} 0.3"),
+            _link(upper, size=0.02),
+            _joint(f"{side}_roll", f"{side}_shoulder_link", upper, axis="1 0 0", xyz="0 0 -0.01"),
+            _link(lower, size=0.02),
+            _joint(f"{side}_elbow", upper, lower, "fixed", xyz="0 0 -0.3"),
+        ]
+    return parts
+
+
+def test_two_joints_make_an_arm_when_its_links_say_so(tmp_path: Path) -> None:
+    # Quori: shoulder pitch and roll, the elbow fixed; a 2-joint branch is an arm only by its
+    # links' names (structure cannot tell it from an antenna), and asked.
+    d = _draft(tmp_path, "quori", _two_joint_branches(("arm_upper", "arm_lower")))
+    arms = sorted(c.name for c in d.chains if c.role == "arm")
+    assert arms == ["left_arm", "right_arm"]
+    assert all(c.decide for c in d.chains)
+    plain = _draft(tmp_path, "antennas", _two_joint_branches(("stalk", "tuft")))
+    assert not [c for c in plain.chains if c.role == "arm"]

@@ -142,8 +142,10 @@ def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Lim
         if c is not None and not c.is_fixed:
             moving.append(c)
     actuated = [c for c in moving if c.is_active]
-    # Two joints make a leg when its links say so (Solo-8's hip and knee: 'FL_upperleg').
-    fewest = MIN_LIMB_JOINTS - int(_count(bodies, LEG_WORDS) >= 2)
+    # Two joints make a leg when its links say so (Solo-8's hip and knee: 'FL_upperleg'), and
+    # an arm (Quori's shoulder pitch and roll: 'l_arm_upper', 'l_arm_lower').
+    named_limb = _count(bodies, LEG_WORDS) >= 2 or _count(bodies, ARM_WORDS) >= 2
+    fewest = MIN_LIMB_JOINTS - int(named_limb)
     # The link where the run splits into fingers is a palm whatever its name (xArm7's Ability
     # hand: 'thumb_base' carries every finger); only the links above it must not be fingers'.
     palm = cut is None and bodies[-1] is seg.end and len(tree.moving_children(seg.end)) >= 2

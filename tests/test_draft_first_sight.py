@@ -192,3 +192,68 @@ def test_two_joints_make_an_arm_when_its_links_say_so(tmp_path: Path) -> None:
     assert all(c.decide for c in d.chains)
     plain = _draft(tmp_path, "antennas", _two_joint_branches(("stalk", "tuft")))
     assert not [c for c in plain.chains if c.role == "arm"]
+
+
+def _six_joint_arm(last: str = "link_6") -> list[str]:
+    parts = [_link("base_link", size=0.05)]
+    above = "base_link"
+    for i in range(1, 7):
+        name = last if i == 6 else f"link_{i}"
+        parts += [_link(name, size=0.03), _joint(f"j{i}", above, name, xyz="0 0 0.1")]
+        above = name
+    return parts
+
+
+def test_a_bare_arm_whose_last_mesh_is_missing_gets_a_frame_to_place(tmp_path: Path) -> None:
+    # HEXFELLOW Firefly: the last link's mesh (the gripper itself) names a package the wheel
+    # lacks. Where the flange is cannot be measured: a new frame at the link's origin, asked.
+    mesh = '<visual><geometry><mesh filename="package://absent_pkg/meshes/gp80.STL"/></geometry></visual>'
+    parts = _six_joint_arm()
+    parts[-2] = _link("link_6", mesh)
+    d = _draft(tmp_path, "firefly", parts)
+    (m,) = d.manipulators
+    (frame,) = d.frames
+    assert (frame.parent, frame.xyz, m.tool_frame) == ("link_6", (0.0, 0.0, 0.0), frame.name)
+    assert m.decide
+
+
+def _hand_on(parent: str) -> list[str]:
+    """A palm fixed on ``parent`` by a joint named as a flange, with three 2-joint fingers."""
+    return [
+        _link("palm", size=0.04),
+        _joint("flange-palm", parent, "palm", "fixed"),
+        *_digit("thumb", "palm", "0.03 -0.03 0.02"),
+        *_digit("index", "palm", "0.03 0.02 0.06"),
+        *_digit("middle", "palm", "0.01 0.02 0.06"),
+    ]
+
+
+def test_a_hand_is_not_its_own_tcp_by_the_name_of_its_mount_joint(tmp_path: Path) -> None:
+    # Schunk SIH on a UR5e: 'flange-palm' joins the palm (which carries the fingers) to the
+    # flange, beside ROS-Industrial's 'tool0' (the arm's flange frame, not the hand's TCP).
+    parts = [
+        *_six_joint_arm("wrist_3"),
+        _link("flange", size=0.02),
+        _joint("wrist_3-flange", "wrist_3", "flange", "fixed", xyz="0 0 0.05"),
+        '<link name="tool0"/>',
+        _joint("flange-tool0", "flange", "tool0", "fixed", xyz="0 0 0.001"),
+        *_hand_on("flange"),
+    ]
+    d = _draft(tmp_path, "sih", parts)
+    (m,) = d.manipulators
+    assert m.is_hand and m.tool_frame not in ("palm", "tool0")
+    assert [f.parent for f in d.frames] == ["palm"]
+
+
+def test_a_tcp_on_the_base_a_hand_alone_is_fixed_to_is_its_tool_frame(tmp_path: Path) -> None:
+    # qb SoftHand: the palm is fixed on 'hand_base', which also carries the URDF's TCP frame.
+    parts = [
+        _link("hand_base", size=0.05),
+        *_hand_on("hand_base"),
+        '<link name="hand_end_effector_link"/>',
+        _joint("ee_joint", "hand_base", "hand_end_effector_link", "fixed", xyz="0 0 0.14"),
+    ]
+    d = _draft(tmp_path, "softhand", parts)
+    (m,) = d.manipulators
+    assert m.is_hand and m.tool_frame == "hand_end_effector_link"
+    assert m.decide  # beside the hand: asked

@@ -37,7 +37,12 @@ from robotspec.spec.draft.limbs import (
 from robotspec.spec.draft.model import DraftChain, DraftFrame, DraftManipulator
 from robotspec.spec.draft.naming import unique
 from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset
-from robotspec.spec.draft.tool_frames import fixed_jaw, frame_at_tips, is_bare_frame
+from robotspec.spec.draft.tool_frames import (
+    fixed_jaw,
+    frame_at_tips,
+    is_bare_frame,
+    is_named_tcp,
+)
 
 if TYPE_CHECKING:
     from robotspec.spec.draft.build import Drafter
@@ -81,15 +86,20 @@ def manipulator(
     # So is a TCP frame beside a gripper whose own link (carrying the fingers) was the only
     # name found (Alicia-M's 'tool0' on the wrist beside 'grasp_base').
     carrying = tool is not None and gripper is not None and tool is gripper.root
+    # A hand of fingers too, for a frame named as a TCP only (qb SoftHand's
+    # 'qbhand_end_effector_link' on the base the palm is fixed to).
+    fingered = gripper is None and hand is not None and find_fingers(tree, hand) is not None
     mount = top
-    while (tool is None or carrying) and gripper is not None and mount is not tip:
+    while (tool is None or carrying) and (gripper is not None or fingered) and mount is not tip:
         up = world.parent_connection(mount)
         if up is None or not up.is_fixed:
             break
         mount = world.bodies[up.parent]
-        beside = find_tool_frame(tree, mount, others, prefer, leaf=carrying)
+        beside = find_tool_frame(tree, mount, others, prefer, leaf=carrying or fingered)
         if beside is not None and (world.child_bodies(beside) or world.is_ancestor(beside, top)):
             beside = None  # the mount itself, a flange above the gripper: not beside it
+        if beside is not None and fingered and not _hand_tcp(world, beside):
+            beside = None
         if beside is not None:
             tool, top, carrying = beside, mount, False
     # A tool frame above the hand (a flange, a wrist F/T sensor) only when the hand has no
@@ -158,6 +168,19 @@ def manipulator(
     elif hand is None and (up := world.parent_connection(top)) is not None and up.is_fixed:
         tool_name = top.name  # the flange link the chain ends at, past its last joint
         decide.append(f"the tool frame '{tool_name}': the link past the arm's last joint")
+    elif hand is None and not tree.moves_below(top) and _shape_unknown(top):
+        # A bare arm's last link whose shape is not loaded (its meshes missing): where the
+        # flange is cannot be measured, so the frame starts at the link's origin, asked.
+        tool_name = unique(
+            "flange" if name == "tool" else f"{name}_flange", self.names | set(world.body_names)
+        )
+        frame = DraftFrame(
+            tool_name,
+            top.name,
+            (0.0, 0.0, 0.0),
+            "the last link's shape is not loaded: "
+            "at its origin; move it out to where the tool is bolted",
+        )
     else:
         tool_name = top.name
         decide.append("no tool frame link found; add one under description.frames")
@@ -309,6 +332,22 @@ def _bare_frames(world: World, body: Body) -> list[Body]:
             if not (k.collisions or k.visuals):
                 out.append(k)
     return out
+
+
+def _hand_tcp(world: World, frame: Body) -> bool:
+    """Whether ``frame``, beside a hand of fingers, is its TCP: named so, and not a flange.
+
+    ROS-Industrial's ``tool0`` is the arm's flange, where a tool is bolted: beside a mounted
+    hand (UR's 'tool0' beside Schunk SIH's palm) it is not the hand's TCP; qb SoftHand's
+    'qbhand_end_effector_link' on the base its palm is fixed to is.
+    """
+    return is_named_tcp(world, frame) and not frame.name.lower().endswith("tool0")
+
+
+def _shape_unknown(body: Body) -> bool:
+    """Whether ``body``'s shape is not loaded: none, or only meshes whose files were not found."""
+    shapes = (*body.visuals, *body.collisions)
+    return all(getattr(s.geometry, "path", "") is None for s in shapes)
 
 
 def _limited(world: World, body: Body) -> bool:

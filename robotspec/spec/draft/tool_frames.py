@@ -66,6 +66,14 @@ def own_geometry(body: Body) -> bool:
     return bool(body.collisions or body.visuals)
 
 
+def _carries_moving(world: World, body: Body) -> bool:
+    """Whether a moving joint hangs on ``body`` (fingers, jaws)."""
+    return any(
+        (c := world.parent_connection(k)) is not None and not c.is_fixed
+        for k in world.child_bodies(body)
+    )
+
+
 def _matches(hint: str, name: tuple[str, set[str]]) -> bool:
     """Whether a name (lower-cased, and its words) holds a hint: inside it, or as a word."""
     if "_" in hint or len(hint) > 4:
@@ -126,7 +134,9 @@ def find_tool_frame(
     for b in candidates:
         c = world.parent_connection(b)
         names[b.index] = [_named_as(b.name)]
-        if c is not None and c.is_fixed:
+        # A link fingers hang on is named by its own name only: its joint to the arm is the
+        # flange it is bolted to (Schunk SIH's 'flange-palm'), not a TCP.
+        if c is not None and c.is_fixed and not _carries_moving(world, b):
             names[b.index].append(_named_as(c.name))
     for hint in TOOL_HINTS:
         hits = [b for b in candidates if any(_matches(hint, n) for n in names[b.index])]

@@ -6,8 +6,8 @@ wrong arm sides copied into the spec (iCub 3 and Justin return the right arm for
 derived front-facing axis written beside the orientation. After migration, ``validate`` must
 name only the class's own faults (its states outside the joints' limits, its camera heights).
 
-The robots' URDFs, never dependencies and never copied here: the shared HSR-B (with the IAI
-tool frame SDT's class names); the Stretch from Hello Robot's own ``hello-robot-stretch-urdf``
+The robots' URDFs, never dependencies and never copied here: the shared HSR-B (the test adds the
+IAI tool frame SDT's class names); the Stretch from Hello Robot's own ``hello-robot-stretch-urdf``
 0.1.2 wheel (Clear BSD; its RE2 with the dex wrist, which has every frame SDT's class names);
 iCub 3 and Justin from the ``pycram-robotics`` 1.0.4 wheel (GPLv3), the URDFs PyCRAM's classes
 were written against, since no other package has them (``icub-models`` 3.2.0 has no iCub 3 and

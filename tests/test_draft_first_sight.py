@@ -257,3 +257,26 @@ def test_a_tcp_on_the_base_a_hand_alone_is_fixed_to_is_its_tool_frame(tmp_path: 
     (m,) = d.manipulators
     assert m.is_hand and m.tool_frame == "hand_end_effector_link"
     assert m.decide  # beside the hand: asked
+
+
+def test_four_driven_wheels_named_omni_make_an_omni_base(tmp_path: Path) -> None:
+    # Summit-XLS: four continuous wheels on parallel axles, each with a velocity transmission;
+    # parallel axles cannot tell skid steer from mecanum, the wheels' meshes ('omni_wheel_1')
+    # can. The same base with plain wheels stays a skid steer (differential), both asked.
+    def base(mesh: str) -> list[str]:
+        parts = [_link("chassis", size=0.3)]
+        for i, xyz in enumerate(("0.2 0.2 0", "0.2 -0.2 0", "-0.2 0.2 0", "-0.2 -0.2 0")):
+            shape = f'<visual><geometry><mesh filename="{mesh}_{i}.dae"/></geometry></visual>'
+            parts += [
+                _link(f"wheel_{i}", _WHEEL + shape),
+                _joint(f"wheel_{i}_joint", "chassis", f"wheel_{i}", "continuous", xyz),
+                f'<transmission name="t{i}"><type>transmission_interface/SimpleTransmission'
+                f'</type><joint name="wheel_{i}_joint"><hardwareInterface>hardware_interface/'
+                f"VelocityJointInterface</hardwareInterface></joint></transmission>",
+            ]
+        return parts
+
+    omni = _draft(tmp_path, "summit", base("omni_wheel"))
+    assert omni.drive is not None and omni.drive.type == "omni" and omni.drive.decide
+    skid = _draft(tmp_path, "skid", base("tyre"))
+    assert skid.drive is not None and skid.drive.type == "differential" and skid.drive.decide

@@ -147,9 +147,10 @@ def test_base_joints_over_two_wheels_on_fixed_joints_are_differential(tmp_path: 
     d = _draft(tmp_path, "planar_base", parts)
     assert d.drive is not None and d.drive.type == "differential"
     assert "2 wheels on fixed joints" in d.drive.decide
-    # Four wheels on fixed joints and no moving base: the files state no drive, so it is asked.
+    # Four wheels on fixed joints and no moving base (Neobotix MPO-500): the file models the
+    # wheels for their look only, the robot still drives on them: omni, asked.
     still = [_link("base_link")]
     for i, xyz in enumerate(("0.2 0.2 0", "0.2 -0.2 0", "-0.2 0.2 0", "-0.2 -0.2 0")):
         still += _wheel(f"wheel_{i}_link", "base_link", xyz)
     d = _draft(tmp_path, "wheels_held", still)
-    assert d.drive is not None and d.drive.type == "fixed" and "4 wheels" in d.drive.decide
+    assert d.drive is not None and d.drive.type == "omni" and "4 wheels" in d.drive.decide

@@ -15,10 +15,11 @@ from __future__ import annotations
 import numpy as np
 
 from robotspec.model.entities import Connection, ConnectionType
+from robotspec.model.world import World
 from robotspec.spec.draft.confidence import DRIVE_PLUGIN, drive_plugin_question
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.model import DraftDrive
-from robotspec.spec.draft.tree import Tree
+from robotspec.spec.draft.tree import Tree, words
 
 __all__ = ["stated_drive", "stated_wheels"]
 
@@ -64,6 +65,29 @@ def _one_axle_direction(tree: Tree, wheels: list[Connection]) -> bool:
     return all(abs(float(a @ first)) / (np.linalg.norm(a) or 1.0) > _PARALLEL for a in axes)
 
 
+#: Words a wheel's link or mesh carries when it rolls sideways too (rollers on its rim).
+_OMNI_WORDS = frozenset({"omni", "mecanum", "swedish"})
+
+
+def _omni_wheels(world: World, wheels: list[Connection]) -> bool:
+    """Whether every wheel's link or mesh file is named as an omni or mecanum wheel.
+
+    Parallel axles cannot tell a skid-steer base from a mecanum one; the wheel's own model
+    can (Summit-XLS's 'omni_wheel_1.dae').
+    """
+
+    def named(c: Connection) -> bool:
+        body = world.bodies[c.child]
+        found = set(words(body.name))
+        for shape in (*body.visuals, *body.collisions):
+            uri = getattr(shape.geometry, "uri", None)
+            if isinstance(uri, str):
+                found |= words(uri.rsplit("/", 1)[-1].rsplit(".", 1)[0])
+        return bool(found & _OMNI_WORDS)
+
+    return bool(wheels) and all(named(c) for c in wheels)
+
+
 def stated_drive(tree: Tree, facts: FileFacts, wheels: list[Connection]) -> DraftDrive | None:
     """The drive the files state (a Gazebo drive plugin) or their driven wheels suggest.
 
@@ -83,7 +107,10 @@ def stated_drive(tree: Tree, facts: FileFacts, wheels: list[Connection]) -> Draf
     driven = [c for c in wheels if facts.actuation.velocity_only(c.name)]
     if not driven or len(driven) == len(names) == 2:
         return None
-    if any(_steered(tree, c) for c in driven):
+    if _omni_wheels(world, driven):
+        kind = "omni"
+        why = f"{len(driven)} wheel joints driven in velocity, their wheels named omni or mecanum"
+    elif any(_steered(tree, c) for c in driven):
         kind = "omni"
         why = f"{len(driven)} wheel joints driven in velocity on a turning base: omni?"
     elif _one_axle_direction(tree, driven):

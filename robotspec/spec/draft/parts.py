@@ -318,8 +318,10 @@ def add_drive(d: Drafter) -> None:
         why = f"{len(legs)} legs" if len(legs) >= 2 else f"{len(rotors)} rotors"
         draft.drive = DraftDrive("floating", None, None, "the URDF tree", f"{why}: floating")
     elif movable and (held := fixed_wheels(world)):  # MPO-500: no joint of the base moves
-        why = f"{len(held)} wheels on fixed joints (none turns) and no drive stated: fixed?"
-        draft.drive = DraftDrive("fixed", None, None, "the URDF tree", why)
+        # The file models the wheels only for their look; the robot still drives on them.
+        kind = "differential" if len(held) == 2 else "omni"
+        why = f"{len(held)} wheels on fixed joints (none turns in this file): {kind}?"
+        draft.drive = DraftDrive(kind, None, None, "the URDF tree", why)
     else:
         draft.drive = DraftDrive(
             "fixed", None, None, "the URDF tree", "no wheels, legs or rotors: a fixed base"

@@ -280,3 +280,17 @@ def test_four_driven_wheels_named_omni_make_an_omni_base(tmp_path: Path) -> None
     assert omni.drive is not None and omni.drive.type == "omni" and omni.drive.decide
     skid = _draft(tmp_path, "skid", base("tyre"))
     assert skid.drive is not None and skid.drive.type == "differential" and skid.drive.decide
+
+
+def test_rotors_on_revolute_joints_are_never_a_hands_digits(tmp_path: Path) -> None:
+    # Iris: four rotors on 'revolute' joints limited to +-1e16 rad; one-joint branches are a
+    # hand's digits only on ranges a digit could have.
+    parts = [_link("frame", size=0.3)]
+    for i, xyz in enumerate(("0.2 0.2 0.05", "0.2 -0.2 0.05", "-0.2 0.2 0.05", "-0.2 -0.2 0.05")):
+        joint = _joint(f"spinner_{i}_joint", "frame", f"spinner_{i}", xyz=xyz, axis="0 0 1")
+        parts += [
+            _link(f"spinner_{i}", size=0.05),
+            joint.replace('lower="-1" upper="1"', 'lower="-1e16" upper="1e16"'),
+        ]
+    d = _draft(tmp_path, "quad", parts)
+    assert not d.manipulators

@@ -15,6 +15,14 @@ render the very text ``init`` wrote::
     python -m tools.corpus.measure                  # the tune half: per-robot rows and totals
     python -m tools.corpus.measure --half holdout   # the held-out half: totals only
 
+On the tune half a second table follows the totals: for each rule of
+``robotspec/spec/draft/confidence.py`` that leaves an item unmarked (a file states it), how many
+items it left unmarked and how many of those are wrong; ``(marked DECIDE)`` counts the items that
+carry a mark, ``(nothing asks)`` missed items no drafted item near them asks about, and
+``(no rule)`` unmarked items no rule states (a leak). A rule whose unmarked items turn out wrong
+on robots seen for the first time (``--only`` the robots a round added, before any change) is
+too broad and must be narrowed.
+
 The protocol is enforced here: for the ``holdout`` half nothing per robot is printed (no rows,
 no wrong items, no drafts, no error messages), only the totals by category. Never change the
 drafter because of a holdout result.

@@ -8,6 +8,7 @@ Whether each decision is stated by the files or a question is ``confidence``'s r
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -350,10 +351,17 @@ def _shape_unknown(body: Body) -> bool:
     return all(getattr(s.geometry, "path", "") is None for s in shapes)
 
 
+#: The widest range (rad or m) of a digit's joint; a rotor's (Iris's 'revolute' +-1e16) is wider.
+MAX_DIGIT_RANGE = 2 * math.pi
+
+
 def _limited(world: World, body: Body) -> bool:
-    """Whether ``body`` moves on a joint with limits on both sides (a digit; never a rotor)."""
+    """Whether ``body`` moves on a joint whose range a digit's could be (never a rotor's)."""
     c = world.parent_connection(body)
-    return c is not None and c.type.value in ("revolute", "prismatic")
+    if c is None or c.type.value not in ("revolute", "prismatic") or not c.dofs:
+        return False
+    dof = world.degrees_of_freedom[c.dofs[0]]
+    return dof.is_bounded and dof.upper - dof.lower <= MAX_DIGIT_RANGE
 
 
 def _fixed_above(world: World, body: Body) -> bool:

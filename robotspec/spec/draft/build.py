@@ -38,6 +38,7 @@ from robotspec.spec.draft.srdf_groups import (
     group_notes,
 )
 from robotspec.spec.draft.tree import Tree, words
+from robotspec.spec.draft.unassigned import find_questions
 
 __all__ = ["Drafter", "draft_spec"]
 
@@ -358,4 +359,5 @@ def draft_spec(
     add_torso(d)
     add_drive(d)
     add_states(d)
+    d.draft.questions = find_questions(d)  # after every part: what none of them covers
     return d.draft

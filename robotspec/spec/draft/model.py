@@ -17,6 +17,7 @@ __all__ = [
     "DraftFinger",
     "DraftFrame",
     "DraftManipulator",
+    "DraftQuestion",
     "JointState",
 ]
 
@@ -142,6 +143,20 @@ class DraftDrive:
     stated: str | None = None
 
 
+@dataclass(frozen=True)
+class DraftQuestion:
+    """A ``DECIDE`` question about something no drafted part covers (``unassigned``).
+
+    ``section``: the spec section it is written in (``chains``, ``manipulators``, ``sensors``);
+    ``joints`` and ``links``: what it names, read by the corpus measure (never written).
+    """
+
+    section: str
+    text: str
+    joints: frozenset[str] = frozenset()
+    links: frozenset[str] = frozenset()
+
+
 @dataclass
 class Draft:
     """Everything ``render_draft`` writes; see the detectors for how each part is found."""
@@ -171,6 +186,8 @@ class Draft:
     #: Warnings a person accepted in ``robotspec setup``: (at, says, because), written as new
     #: ``accept_warnings`` entries by the assistant (``setup/accept.py``), not by the drafter.
     accepted: list[tuple[str, str, str]] = field(default_factory=list)
+    #: Questions about what no drafted part covers, written as comments in their sections.
+    questions: list[DraftQuestion] = field(default_factory=list)
 
     @property
     def arms(self) -> list[DraftChain]:

@@ -140,6 +140,19 @@ def _manipulator(out: list[str], m: DraftManipulator) -> None:
     _states(out, m.states, "    ")
 
 
+def _questions(out: list[str], d: Draft, section: str, *, written: bool) -> None:
+    """The draft's questions of ``section`` as comments (after the section's entries).
+
+    ``written``: whether the section has entries; otherwise a comment names it first.
+    """
+    asked = [q for q in d.questions if q.section == section]
+    if not asked:
+        return
+    if not written:
+        out.append(f"# {section}: none drafted")
+    out += [f"  # DECIDE: {comment(q.text)}" for q in asked]
+
+
 def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
     """The draft as commented YAML; it validates as written (warnings allowed)."""
     out: list[str] = [
@@ -198,10 +211,12 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
         out.append(f"chains: {{}}  # a hand alone: {comment(d.lone_hand)} is on no chain")
     else:
         out.append("chains: {}  # DECIDE: no arm or leg found; add root/tip pairs")
+    _questions(out, d, "chains", written=True)
     if d.manipulators:
         out.append("manipulators:")
         for m in d.manipulators:
             _manipulator(out, m)
+    _questions(out, d, "manipulators", written=bool(d.manipulators))
     if d.cameras:
         out.append("sensors:")
         h, v = PLACEHOLDER_FOV
@@ -243,6 +258,7 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
                 out.append(f"    maximal_height: {_num(cam.maximal_height)}")
             if cam.default:
                 out.append("    default: true")
+    _questions(out, d, "sensors", written=bool(d.cameras))
     if d.states:
         out.append("states:")
         for name, values in d.states.items():

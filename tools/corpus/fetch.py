@@ -56,6 +56,8 @@ OLD_PYTHON_WHEELS: Mapping[tuple[str, str], tuple[str, str | None]] = MappingPro
         ("roboschool", "1.0.49"): ("37", "manylinux1_x86_64"),
         ("rofunc", "0.0.2.6"): ("38", None),
         ("physicalai-rebot-b601-plugin", "0.8.0"): ("312", None),
+        ("physicalai-trossen-plugin", "0.2.0"): ("312", None),
+        ("arx5-interface", "0.1.5"): ("312", "manylinux_2_28_x86_64"),
     }
 )
 

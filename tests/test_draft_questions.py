@@ -24,14 +24,20 @@ from tests.test_draft_blind import _arm, _draft, _jaws, _joint, _link
 
 @contextmanager
 def _leaving_out(
-    monkeypatch: pytest.MonkeyPatch, *, chains: bool = False, manipulators: bool = False
+    monkeypatch: pytest.MonkeyPatch,
+    *,
+    chains: bool = False,
+    manipulators: bool = False,
+    torso: bool = False,
 ) -> Iterator[None]:
-    """Draft as if the drafter had missed the chains and/or the manipulators."""
+    """Draft as if the drafter had missed the chains, the manipulators or the torso."""
     real = build.find_questions
 
     def dropped(d: build.Drafter) -> list[object]:
         if chains:
             d.draft.chains = []
+        if torso:
+            d.draft.torso = None
         if manipulators:
             d.draft.manipulators = []
             for c in d.draft.chains:
@@ -125,7 +131,21 @@ def test_a_passive_joint_beside_the_arm_is_asked(tmp_path: Path) -> None:
     d = _draft(tmp_path, "bellows", parts)
     (q,) = d.questions
     assert q.joints == {"bellows_joint"} and q.links == {"bellows"}
-    assert "a gripper? a tool? a passive joint?" in q.text
+    assert "a tool? a sensor's mount? a passive joint?" in q.text
+
+
+def test_a_lift_under_the_arm_left_out_is_asked_as_a_torso(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    parts = [p.replace('parent link="base"', 'parent link="column"') for p in _gripper_arm()] + [
+        _link("column", size=0.05),
+        _joint("lift_joint", "base", "column", "prismatic", "0 0 0.1", "0 0 1"),
+    ]
+    with _leaving_out(monkeypatch, torso=True):
+        d = _draft(tmp_path, "lift", parts)
+    (q,) = d.questions
+    assert q.joints == {"lift_joint"} and q.section == CHAINS
+    assert "a torso (it carries " in q.text
 
 
 def test_wheels_and_casters_are_the_drive_not_questions(tmp_path: Path) -> None:

@@ -46,6 +46,8 @@ _LIMB_JOINTS = 3
 _DEVICE_SPAN = 0.1
 #: Joints named at most this many in a question; longer lists are written first .. last.
 _SHOWN = 4
+#: Words naming a rotor's joint (a drone's): it moves the robot, it is no part.
+_ROTORS = frozenset({"rotor", "rotors", "propeller", "prop"})
 _TOKENS = re.compile(r"[^a-z0-9]+")
 
 
@@ -104,8 +106,8 @@ def _joint_questions(d: Drafter) -> list[DraftQuestion]:
     for c in world.connections:
         if not (c.is_active and c.is_1dof) or c.index in covered or c.child not in tree.inside:
             continue  # a floating or planar joint moves the whole robot: the drive's
-        if c.child == tree.root.index or _caster(d, c):
-            continue
+        if c.child == tree.root.index or _caster(d, c) or _ROTORS & words(c.name):
+            continue  # a caster follows the base; a rotor lifts it (the drive's)
         loose.append(c)
     if not loose:
         return []
@@ -156,7 +158,10 @@ def _subtree_question(d: Drafter, runs: list[list[Connection]]) -> DraftQuestion
     leaves = sum(1 for c in joints if not _has_loose_below(world, c, joints))
     trunk = _trunk(world, joints) if len(runs) == 1 else 0
     names = [c.name for c in joints]
-    if trunk >= _LIMB_JOINTS:
+    below = _carries_chains(d, joints)
+    if below and len(runs) == 1 and leaves == 1:
+        section, guess = CHAINS, f"a torso (it carries {below})? a passive joint?"
+    elif trunk >= _LIMB_JOINTS:
         section, guess = CHAINS, "an arm? a leg? a head?"
         if leaves >= 2:
             guess += f" with {leaves} branches at its end: a hand or a gripper?"
@@ -164,10 +169,26 @@ def _subtree_question(d: Drafter, runs: list[list[Connection]]) -> DraftQuestion
         section, guess = MANIPULATORS, f"a hand ({leaves} branches)?"
     elif len(joints) >= _LIMB_JOINTS and leaves == 1:
         section, guess = CHAINS, "an arm? a leg? a head?"
+    elif len(joints) == 2 and leaves == 1:
+        section, guess = CHAINS, "a short arm? a head? a tool? a passive joint?"
+    elif len(joints) == 1:
+        section, guess = MANIPULATORS, "a tool? a sensor's mount? a passive joint?"
     else:
-        section, guess = MANIPULATORS, "a gripper? a tool? a passive joint?"
+        section, guess = MANIPULATORS, "a gripper? a tool? passive joints?"
     text = f"joints {_span(names)} ({top} -> {deepest.name}) belong to no part: {guess}"
     return DraftQuestion(section, text, frozenset(names), frozenset(links))
+
+
+def _carries_chains(d: Drafter, joints: list[Connection]) -> str:
+    """The drafted chains below the last of ``joints`` (a torso's), named; "" when none."""
+    world = d.world
+    last = world.bodies[joints[-1].child]
+    names = [
+        c.name
+        for c in d.draft.chains
+        if world.has_body(c.root) and world.is_ancestor(last, world.get_body_by_name(c.root))
+    ]
+    return ", ".join(names[:_SHOWN])
 
 
 def _trunk(world: object, joints: list[Connection]) -> int:

@@ -16,6 +16,7 @@ import numpy as np
 
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
+from robotspec.spec.draft.jaws import one_jaw
 from robotspec.spec.draft.tree import Segment, Tree, words
 
 __all__ = [
@@ -129,7 +130,9 @@ def _hand_joint(tree: Tree, c: Connection) -> bool:
 def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Limb | None:
     world = tree.world
     cut = hand_cut(tree, seg)
-    jaw = cut is not None and _one_jaw(tree, seg, cut)
+    jaw = cut is not None and one_jaw(tree, seg, cut)
+    if cut is None and len(seg.bodies) >= 2 and one_jaw(tree, seg, len(seg.bodies) - 1, False):
+        cut, jaw = len(seg.bodies) - 1, True  # a jaw by its shape and swing (Spot's 'fngr')
     if cut is not None and jaw:
         cut -= 1  # the moving jaw is the hand's; the link carrying both jaws is the hand
     # The joint that moves the hand is the arm's last (a wrist roll turning 'gripper_link').
@@ -208,29 +211,6 @@ def _lifts(tree: Tree, actuated: list[Connection]) -> int:
 VERTICAL = 0.9
 
 
-def _one_jaw(tree: Tree, seg: Segment, cut: int) -> bool:
-    """Whether the hand found at ``cut`` is a gripper's one moving jaw (Darwin-OP's).
-
-    Why: such a jaw hangs, with nothing below it, on a link that also carries the fixed jaw (a
-    fixed leaf with geometry reaching at least as far out); the joint turning it is the
-    gripper's, not the arm's last, and the link carrying both jaws is the hand.
-    """
-    world = tree.world
-    jaw = seg.bodies[cut]
-    c = world.parent_connection(jaw)
-    if cut == 0 or jaw is not seg.end or world.child_bodies(jaw) or c is None or c.is_fixed:
-        return False
-    carrier = seg.bodies[cut - 1]
-    hinge = float(np.linalg.norm(c.origin[:3, 3]))
-    for k in world.child_bodies(carrier):
-        f = world.parent_connection(k)
-        if k is jaw or f is None or not f.is_fixed or world.child_bodies(k):
-            continue
-        if k.collisions and float(np.linalg.norm(f.origin[:3, 3])) >= hinge:
-            return True
-    return False
-
-
 #: Words of a camera's frames (a run carrying one and nothing else is a neck, not an arm).
 LOOK_WORDS = frozenset({"camera", "cam", "optical", "rgb", "rgbd", "depth", "stereo", "kinect"})
 
@@ -286,7 +266,35 @@ def find_limbs(tree: Tree) -> list[Limb]:
         limb = _limb(tree, seg, low, base)
         if limb is not None:
             limbs.append(limb)
-    return limbs
+    return _without_digits(tree, limbs)
+
+
+#: Arms from one link that, each within a hand's span, are a hand's digits (a five-finger hand).
+MIN_DIGIT_ARMS = 4
+
+
+def _without_digits(tree: Tree, limbs: list[Limb]) -> list[Limb]:
+    """``limbs`` less the arms that are a hand's fingers: four or more from one link, each short.
+
+    Why: a hand whose fingers have four joints each (Tesollo's DG-5F) looks like a star of
+    arms; no robot carries four arms or more from one link that each stay within a hand's
+    span and none of whose links is named as an arm's.
+    """
+    world = tree.world
+    by_start: dict[int, list[Limb]] = {}
+    for lb in limbs:
+        if lb.kind == "arm":
+            by_start.setdefault(lb.segment.start.index, []).append(lb)
+    drop: set[int] = set()
+    for group in by_start.values():
+        if len(group) < MIN_DIGIT_ARMS:
+            continue
+        firsts = [world.bodies[lb.segment.joints[0].child] for lb in group]
+        if all(hand_span(tree, b) <= MAX_HAND_SPAN for b in firsts) and not any(
+            _named(lb.segment.bodies, ARM_WORDS) for lb in group
+        ):
+            drop |= {id(lb) for lb in group}
+    return [lb for lb in limbs if id(lb) not in drop]
 
 
 #: Most joints of a run above a branch that still make an arm's shoulder (a camera head beside).

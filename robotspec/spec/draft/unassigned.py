@@ -55,9 +55,9 @@ def _covered(d: Drafter) -> set[int]:
     """Indices of the connections some drafted part (or the drive) accounts for."""
     world, draft = d.world, d.draft
     names: set[str] = set()
-    for c in [*draft.chains, draft.torso, draft.neck]:
-        if c is not None:
-            names |= c.joints
+    for part in [*draft.chains, draft.torso, draft.neck]:
+        if part is not None:
+            names |= part.joints
     if draft.drive is not None:
         names |= {j for j in (draft.drive.joint, *(draft.drive.joints or ())) if j}
     base = d.own_base
@@ -69,9 +69,9 @@ def _covered(d: Drafter) -> set[int]:
     for m in draft.manipulators:
         if world.has_body(m.root):
             for b in world.subtree(world.get_body_by_name(m.root)):
-                c = world.parent_connection(b)
-                if c is not None and b.name != m.root:
-                    out.add(c.index)
+                up = world.parent_connection(b)
+                if up is not None and b.name != m.root:
+                    out.add(up.index)
     return out
 
 
@@ -116,23 +116,23 @@ def _joint_questions(d: Drafter) -> list[DraftQuestion]:
     # joints between them (a covered joint ends the walk).
     groups: dict[int, list[Connection]] = {}
     for c in loose:
-        top = c
+        highest = c
         body = world.bodies[c.parent]
         while (up := world.parent_connection(body)) is not None and body is not tree.root:
             if up.is_active and up.index not in loose_ids:
                 break
             if up.index in loose_ids:
-                top = up
+                highest = up
             body = world.bodies[up.parent]
-        groups.setdefault(top.index, []).append(c)
+        groups.setdefault(highest.index, []).append(c)
     # Short runs hanging from one link are one device's (a hand's fingers, a gripper's jaws).
     by_parent: dict[int, list[list[Connection]]] = {}
     out: list[DraftQuestion] = []
-    for top, joints in groups.items():
+    for top_index, joints in groups.items():
         if len(joints) >= _LIMB_JOINTS:
             out.append(_subtree_question(d, [joints]))
         else:
-            by_parent.setdefault(world.connections[top].parent, []).append(joints)
+            by_parent.setdefault(world.connections[top_index].parent, []).append(joints)
     for runs in by_parent.values():
         out.append(_subtree_question(d, runs))
     out.sort(key=lambda q: min(world.get_connection_by_name(j).index for j in q.joints))

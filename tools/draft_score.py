@@ -230,6 +230,7 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
     used: set[str] = set()
     for name, m in (t.get("manipulators") or {}).items():
         tool = m.get("tool_frame")
+        tool_parent: str | None
         if isinstance(tool, dict):
             hits = [d for d in draft.manipulators if frames.get(d.tool_frame) == tool["parent"]]
             shown = f"a new frame on {tool['parent']}"
@@ -237,7 +238,7 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         else:
             hits = [d for d in draft.manipulators if d.tool_frame == tool]
             shown = str(tool)
-            up = world.parent_connection(tool) if world.has_body(str(tool)) else None
+            up = world.parent_connection(str(tool)) if world.has_body(str(tool)) else None
             tool_parent = world.bodies[up.parent].name if up is not None else None
         ok = bool(hits)
         # The manipulator's links: its root's subtree (a truth names its root rarely), else the

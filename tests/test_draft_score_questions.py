@@ -110,3 +110,21 @@ def test_a_neck_without_a_camera_is_scored_as_the_chain_a_valid_spec_writes(
     # A camera at or below the neck's tip makes it a neck.
     seeing = {"neck": head, "cameras": ["wrist_camera"]}
     assert _neck_as_chain(seeing, desc.world) is seeing
+
+
+def test_a_missed_chain_inside_a_marked_manipulator_is_marked(tmp_path: Path) -> None:
+    # Legs drafted as a hand alone (Mini Pupper 2): the hand at the root holds the legs' joints,
+    # and the question on the hand is the one that finds them.
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text('<robot name="r">' + "".join(_gripper_arm()) + "</robot>")
+    draft, desc = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
+    draft.chains, draft.questions = [], []
+    (m,) = draft.manipulators
+    m.root = "base"
+    m.decide = ["a hand alone (no arm): rooted at the robot's root"]
+    truth = Truth("r", "t/r", {"robot": "t/r", "chains": {"arm": _ARM}})
+    s = score_draft(truth, draft, desc.world, True)
+    assert s.counts["chains"] == (0, 1) and s.unmarked == []
+    m.decide = []  # an unmarked manipulator asks nothing
+    s = score_draft(truth, draft, desc.world, True)
+    assert "chains: arm (base -> wrist) not drafted" in s.unmarked

@@ -27,10 +27,12 @@ the draft has it:
 Whether a wrong item carried a ``DECIDE`` mark (``RobotScore.unmarked`` lists those that did
 not): an extra drafted chain, camera, gripper, torso, neck, drive or facing by its own mark; a
 missed chain, torso or neck when a drafted chain over some of its joints is marked (the
-question the user is asked is then the one that finds it); a missed tool frame or
-gripper when some drafted manipulator is marked; a missed camera when a drafted camera of the
-same device (rigidly fixed to the same link, within 10 cm: its depth channel, its mount) is
-marked (the question asked about that camera is the one that finds it), else never.
+question the user is asked is then the one that finds it), or a drafted manipulator whose
+subtree holds some of its joints (legs drafted as a hand: the hand's question finds them); a
+missed tool frame or gripper when some drafted manipulator is marked; a missed camera when a
+drafted camera of the same device (rigidly fixed to the same link, within 10 cm: its depth
+channel, its mount) is marked (the question asked about that camera is the one that finds it),
+else never.
 
 A missed item is also marked when a ``DECIDE`` question about what the draft leaves out names
 it (``Draft.questions``, from ``robotspec/spec/draft/unassigned.py``; counted in the rule table
@@ -178,6 +180,17 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
     asked_joints = frozenset(j for q in questions for j in q.joints)
     asked_links = frozenset(link for q in questions for link in q.links)
 
+    def held(m: Any) -> frozenset[str]:
+        """The moving joints below a drafted manipulator's root (what its question covers)."""
+        if not world.has_body(m.root):
+            return frozenset()
+        root = world.get_body_by_name(m.root)
+        return frozenset(
+            c.name
+            for b in world.subtree(root)
+            if b is not root and (c := world.parent_connection(b)) is not None and c.is_active
+        )
+
     def links_asked(root: str, extra: str | None = None) -> bool:
         """Whether a question names a link of ``root``'s subtree (or ``extra``)."""
         if extra is not None and extra in asked_links:
@@ -202,7 +215,8 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         if hit is not None:
             matched.add(hit)
         # A miss is marked when a drafted chain over some of its joints asks to be checked.
-        near = [d for d in draft.chains if d.joints & want[1]]
+        near: list[Any] = [d for d in draft.chains if d.joints & want[1]]
+        near += [m for m in draft.manipulators if held(m) & want[1]]
         if hit is not None:
             near = [draft.chains[hit]]
         s.add(
@@ -325,6 +339,7 @@ def score_draft(truth: Truth, draft: object, world: object, valid: bool) -> Robo
         near = [have_part] if have_part is not None else []
         if have_part is None:  # a missed torso or neck, as a missed chain: a marked chain asks
             near = [d for d in draft.chains if d.joints & (want_j or frozenset())]
+            near += [m for m in draft.manipulators if held(m) & (want_j or frozenset())]
         s.add(
             "torso/neck/drive",
             want_j == have_j,

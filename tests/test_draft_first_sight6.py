@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tests.test_draft_blind import _arm, _draft, _joint, _link
+from tests.test_draft_blind import _WHEEL, _arm, _draft, _joint, _link
 
 
 def _box_link(name: str, size: str, at: str) -> str:
@@ -78,3 +78,114 @@ def test_five_four_joint_fingers_on_one_palm_are_a_hand_not_five_arms(tmp_path: 
     assert not d.chains
     (m,) = d.manipulators
     assert m.root == "palm" and m.thumb is not None and len(m.fingers) == 4
+
+
+def _wheeled_legs(wheel_range: str) -> list[str]:
+    """A body on four 3-joint legs (abduction, hip, knee), each knee carrying a wheel on a
+    revolute joint about y of range ``wheel_range`` (nothing named as a wheel)."""
+    lower, upper = wheel_range.split()
+    parts = [_link("base", size=0.3)]
+    corners = {"lf": (0.2, 0.1), "rf": (0.2, -0.1), "lh": (-0.2, 0.1), "rh": (-0.2, -0.1)}
+    for leg, (x, y) in corners.items():
+        parts += [
+            _link(f"{leg}_hip", size=0.03),
+            _joint(f"{leg}_haa", "base", f"{leg}_hip", xyz=f"{x} {y} 0", axis="1 0 0"),
+            _link(f"{leg}_thigh", size=0.03),
+            _joint(f"{leg}_hfe", f"{leg}_hip", f"{leg}_thigh", xyz="0 0 -0.02"),
+            _link(f"{leg}_calf", size=0.03),
+            _joint(f"{leg}_kfe", f"{leg}_thigh", f"{leg}_calf", xyz="0 0 -0.2"),
+            _link(f"{leg}_roll", _WHEEL),
+            f'<joint name="{leg}_whl" type="revolute"><parent link="{leg}_calf"/>'
+            f'<child link="{leg}_roll"/><origin xyz="0 0 -0.2"/><axis xyz="0 1 0"/>'
+            f'<limit lower="{lower}" upper="{upper}" effort="1" velocity="1"/></joint>',
+        ]  # fmt: skip
+    return parts
+
+
+def test_wheels_at_four_legs_ends_roll_the_robot_and_the_legs_end_at_their_axles(
+    tmp_path: Path,
+) -> None:
+    # LimX P311D's shape: each leg's last joint turns a wheel (revolute to +-1000 rad, a
+    # continuous joint written with limits), hung on a knee that turns about a level axis (not
+    # a caster's swivel). The legs end at the calves; four parallel unsteered wheels: skid steer.
+    d = _draft(tmp_path, "wheel_legs", _wheeled_legs("-1000 1000"))
+    legs = {c.name: c for c in d.chains}
+    assert len(legs) == 4 and all(c.role == "leg" for c in legs.values())
+    assert {c.tip for c in legs.values()} == {"lf_calf", "rf_calf", "lh_calf", "rh_calf"}
+    assert not any(j.endswith("_whl") for c in legs.values() for j in c.joints)
+    assert d.drive is not None and d.drive.type == "differential" and d.drive.decide
+
+
+def test_a_foot_joint_of_a_limited_range_stays_the_legs(tmp_path: Path) -> None:
+    # The same shape with a range a leg's joint may have (ANYmal B's +-3 pi): no wheels.
+    d = _draft(tmp_path, "ankle_legs", _wheeled_legs("-9.42 9.42"))
+    assert {c.tip for c in d.chains} == {"lf_roll", "rf_roll", "lh_roll", "rh_roll"}
+    assert d.drive is not None and d.drive.type == "floating"
+
+
+def test_four_parallel_wheels_on_a_chassis_stay_an_omni_guess(tmp_path: Path) -> None:
+    # RoboMaster S1's shape: four continuous wheels on the chassis itself, parallel axles,
+    # nothing named mecanum: skid steer and mecanum look alike, so omni stays the (asked) guess.
+    parts = [_link("chassis", size=0.3)]
+    for i, (x, y) in enumerate(((0.1, 0.1), (0.1, -0.1), (-0.1, 0.1), (-0.1, -0.1)), 1):
+        parts += [
+            _link(f"w{i}", _WHEEL),
+            _joint(f"w{i}_j", "chassis", f"w{i}", "continuous", f"{x} {y} 0", "0 1 0"),
+        ]
+    d = _draft(tmp_path, "chassis", parts)
+    assert d.drive is not None and d.drive.type == "omni" and d.drive.decide
+
+
+def test_short_legs_ending_on_feet_at_the_ground_are_legs_not_fingers(tmp_path: Path) -> None:
+    # Mini Pupper 2's shape: four 3-joint legs 12 cm long (a finger's length), their links
+    # numbered ('lf1'..'lf3'), each ending at a fixed '*foot' link, the lowest points of the
+    # robot: legs of a small quadruped, not a hand's fingers.
+    parts = [_link("base", size=0.1)]
+    corners = {"lf": (0.1, 0.05), "rf": (0.1, -0.05), "lb": (-0.1, 0.05), "rb": (-0.1, -0.05)}
+    for leg, (x, y) in corners.items():
+        parts += [
+            _link(f"{leg}1", size=0.01),
+            _joint(f"{leg}_1", "base", f"{leg}1", xyz=f"{x} {y} 0", axis="1 0 0"),
+            _link(f"{leg}2", size=0.01),
+            _joint(f"{leg}_2", f"{leg}1", f"{leg}2", xyz=f"0 {y / 2.5} 0"),
+            _link(f"{leg}3", size=0.01),
+            _joint(f"{leg}_3", f"{leg}2", f"{leg}3", xyz="0 0 -0.05"),
+            _link(f"{leg}foot", size=0.01),
+            _joint(f"{leg}_foot", f"{leg}3", f"{leg}foot", "fixed", "0 0 -0.05"),
+        ]
+    d = _draft(tmp_path, "small_quadruped", parts)
+    assert not d.manipulators
+    assert sorted(c.tip for c in d.chains) == ["lbfoot", "lffoot", "rbfoot", "rffoot"]
+    assert all(c.role == "leg" for c in d.chains)
+    assert d.drive is not None and d.drive.type == "floating"
+
+
+def _gripper_arm(finger_y: float) -> list[str]:
+    """A 4-joint arm, a gripper link fixed on its end, two prismatic fingers (one a mimic)
+    hinged ``finger_y`` to each side of the gripper link's origin, their pads 4 cm out."""
+    parts = [*_arm("wrist"), _link("grip", size=0.03)]
+    parts.append(_joint("grip_mount", "wrist", "grip", "fixed"))
+    for side, sign in (("l", 1), ("r", -1)):
+        pad = '<origin xyz="0 0 0.04"/><geometry><box size="0.01 0.01 0.02"/></geometry>'
+        joint = _joint(f"{side}_q", "grip", f"{side}_pad", "prismatic", f"0 {sign * finger_y} 0")
+        if side == "r":
+            joint = joint.replace("</joint>", '<mimic joint="l_q" multiplier="-1"/></joint>')
+        parts += [f'<link name="{side}_pad"><collision>{pad}</collision></link>', joint]
+    return parts
+
+
+def test_fingers_hinged_at_the_grippers_origin_get_a_new_tool_frame(tmp_path: Path) -> None:
+    # myCobot's parallel gripper: both jaws' joints sit at the gripper link's origin (their
+    # shapes say where they are): the gripper link is not a frame between the tips.
+    d = _draft(tmp_path, "jaws_at_origin", _gripper_arm(0.0))
+    (m,) = d.manipulators
+    (frame,) = [f for f in d.frames if f.name == m.tool_frame]
+    assert frame.parent == "grip" and m.decide
+
+
+def test_a_gripper_link_between_its_fingers_is_its_tool_frame(tmp_path: Path) -> None:
+    # Fetch's gripper: the fingers hinge 3 cm to each side of 'gripper_link', which lies
+    # between them: it is the tool frame the URDF has, no new one.
+    d = _draft(tmp_path, "link_between", _gripper_arm(0.03))
+    (m,) = d.manipulators
+    assert m.tool_frame == "grip" and not d.frames

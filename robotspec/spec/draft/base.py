@@ -110,7 +110,7 @@ def _wheel_shaped(body: Body, axis: np.ndarray) -> bool:
     return False
 
 
-def _on_a_swivel(world: World, c: Connection) -> bool:
+def _on_a_swivel(world: World, c: Connection, poses: np.ndarray | None = None) -> bool:
     """Whether the wheel joint ``c`` hangs from a body another turning joint moves (a caster).
 
     Why: a caster's wheel is a flat cylinder on a level continuous joint like a driven wheel,
@@ -118,10 +118,18 @@ def _on_a_swivel(world: World, c: Connection) -> bool:
     look like a six-wheeled omni base.
     """
     above = world.parent_connection(world.bodies[c.parent])
-    return above is not None and above.type in (
-        ConnectionType.CONTINUOUS,
-        ConnectionType.REVOLUTE,
-    )
+    if above is None or above.type not in (ConnectionType.CONTINUOUS, ConnectionType.REVOLUTE):
+        return False
+    if poses is None:
+        return True
+    # A swivel turns about the vertical; a knee above a wheel (a wheel-legged robot's, LimX's)
+    # turns about a level axis, and the wheel at the leg's end is driven.
+    up = poses[above.child][:3, :3] @ np.asarray(above.axis, dtype=np.float64)
+    return abs(float(up[2])) / (float(np.linalg.norm(up)) or 1.0) > SWIVEL_VERTICAL
+
+
+#: How vertical (the cosine to z) the axis of a joint above a wheel must be to be a swivel.
+SWIVEL_VERTICAL = 0.7
 
 
 def wheel_joints(world: World, poses: np.ndarray | None = None) -> list[Connection]:
@@ -141,19 +149,32 @@ def wheel_joints(world: World, poses: np.ndarray | None = None) -> list[Connecti
         if "wheel" in words(c.name):
             out.append(c)
             continue
-        if c.type is not ConnectionType.CONTINUOUS:
+        if c.type is not ConnectionType.CONTINUOUS and not _turns_round(world, c):
             continue
-        if _on_a_swivel(world, c):
-            continue  # a caster's wheel: it rolls where its swivel lets it, nobody drives it
         axis = np.asarray(c.axis, dtype=np.float64)
         if not _wheel_shaped(world.bodies[c.child], axis):
             continue
         if poses is None:
             poses = Kinematics(world).forward(world.default_configuration())
+        if _on_a_swivel(world, c, poses):
+            continue  # a caster's wheel: it rolls where its swivel lets it, nobody drives it
         level = poses[c.child][:3, :3] @ axis
         if abs(float(level[2])) < 0.3:
             out.append(c)
     return out
+
+
+#: A revolute joint allowed more than this (rad: ten turns) is a continuous one written with
+#: limits (LimX's wheels: +-1000 rad); a leg's joints may turn +-3 pi (ANYmal B's), not more.
+MANY_TURNS = 20 * np.pi
+
+
+def _turns_round(world: World, c: Connection) -> bool:
+    """Whether ``c`` is revolute with a range of several turns (LimX's wheels: +-1000 rad)."""
+    if c.type is not ConnectionType.REVOLUTE or not c.dofs:
+        return False
+    dof = world.degrees_of_freedom[c.dofs[0]]
+    return not dof.is_bounded or dof.upper - dof.lower > MANY_TURNS
 
 
 def fixed_wheels(world: World) -> list[Connection]:

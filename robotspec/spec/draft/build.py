@@ -115,7 +115,7 @@ class Drafter:
         self.wheels = stated_wheels(self.tree, self.facts, wheel_joints(world, self.tree.poses))
         if own is not None:
             drive = own_drive(world, own, self.wheels)
-        self.limbs = find_limbs(self.tree)
+        self.limbs = find_limbs(self.tree, frozenset(c.name for c in self.wheels))
         self.forward, forward_why = facing(self.tree, self.limbs)
         self.draft = Draft(
             name=name,

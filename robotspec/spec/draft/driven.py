@@ -21,7 +21,7 @@ from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.model import DraftDrive
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["stated_drive", "stated_wheels"]
+__all__ = ["counted_drive", "stated_drive", "stated_wheels"]
 
 #: The cosine within which two wheel axes are one direction (an axle), or an axis is level.
 _PARALLEL = 0.99
@@ -122,3 +122,26 @@ def stated_drive(tree: Tree, facts: FileFacts, wheels: list[Connection]) -> Draf
     else:
         kind, why = "omni", f"{len(driven)} wheel joints driven in velocity, axles turned: omni?"
     return DraftDrive(kind, source="the URDF's transmissions", decide=why)
+
+
+def counted_drive(tree: Tree, wheels: list[Connection]) -> str:
+    """The drive the wheels' shape suggests when no file says which are driven (asked).
+
+    Two wheels: differential. More, each at the end of a leg (moving joints above it, none
+    about the vertical) on parallel axles: a wheel-legged robot rolling skid steer, a
+    differential drive (LimX's P311D). Otherwise omni: four wheels on a chassis may be
+    mecanum whatever their names (RoboMaster S1's), asked either way.
+    """
+    if len(wheels) == 2:
+        return "differential"
+    world = tree.world
+    if _omni_wheels(world, wheels) or not _one_axle_direction(tree, wheels):
+        return "omni"
+    for c in wheels:
+        above = world.bodies[c.parent]
+        if above is tree.root or not world.is_ancestor(tree.root, above):
+            return "omni"
+        moving = [k for k in world.compute_chain_of_connections(tree.root, above) if not k.is_fixed]
+        if not moving or any(abs(float(tree.axis_in_root(k)[2])) >= 1 - _LEVEL for k in moving):
+            return "omni"  # on the chassis, or steered about the vertical (a swerve module)
+    return "differential"

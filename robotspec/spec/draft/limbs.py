@@ -127,7 +127,9 @@ def _hand_joint(tree: Tree, c: Connection) -> bool:
     return bool(named & HAND_WORDS) and not named & (AXIS_WORDS | ARM_WORDS)
 
 
-def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Limb | None:
+def _limb(
+    tree: Tree, seg: Segment, low: float, base: Body | None, wheels: frozenset[str]
+) -> Limb | None:
     world = tree.world
     cut = hand_cut(tree, seg)
     jaw = cut is not None and one_jaw(tree, seg, cut)
@@ -145,6 +147,8 @@ def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Lim
         if c is not None and not c.is_fixed:
             moving.append(c)
     actuated = [c for c in moving if c.is_active]
+    while actuated and actuated[-1].name in wheels:
+        actuated.pop()  # a wheel at a leg's end rolls the robot: the leg ends at its axle
     # Two joints make a leg when its links say so (Solo-8's hip and knee: 'FL_upperleg'), and
     # an arm (Quori's shoulder pitch and roll: 'l_arm_upper', 'l_arm_lower').
     named_limb = _count(bodies, LEG_WORDS) >= 2 or _count(bodies, ARM_WORDS) >= 2
@@ -155,7 +159,10 @@ def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Lim
     if len(actuated) < fewest or _named(bodies[:-1] if palm else bodies, FINGER_WORDS):
         return None
     reach = tree.length(seg, None if jaw else upto)  # with its jaw, as far as it reaches
-    if reach < MIN_LIMB_LENGTH:
+    # Shorter is a finger, unless named as a leg and reaching the ground (Mini Pupper's legs).
+    below = tuple(world.subtree(seg.end))  # with the foot fixed at its end ('lffoot')
+    footed = _count(below, LEG_WORDS) > 0 and tree.position(seg.end)[2] - low < FOOT_CLEARANCE
+    if reach < MIN_LIMB_LENGTH and not footed:
         return None
     # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.
     root = seg.start if base is None else base
@@ -185,7 +192,7 @@ def _limb(tree: Tree, seg: Segment, low: float, base: Body | None = None) -> Lim
         return None  # a pan/tilt unit pointing cameras: a neck (see sensors.find_neck)
     joints = frozenset(c.name for c in actuated)
     z_tip, z_root = tree.position(tip)[2], tree.position(root)[2]
-    legs_named = _count(bodies, LEG_WORDS) > _count(bodies, ARM_WORDS)
+    legs_named = footed or _count(bodies, LEG_WORDS) > _count(bodies, ARM_WORDS)
     grounded = hand is None and z_tip - low < FOOT_CLEARANCE and z_root - z_tip > LEG_DROP
     if legs_named or grounded:
         why = "its links are named as a leg's" if legs_named else "it ends on the ground"
@@ -246,7 +253,7 @@ def _pan_tilt(tree: Tree, seg: Segment) -> bool:
     return any(words(b.name) & LOOK_WORDS for b in world.subtree(seg.end))
 
 
-def find_limbs(tree: Tree) -> list[Limb]:
+def find_limbs(tree: Tree, wheels: frozenset[str] = frozenset()) -> list[Limb]:
     """Every arm and leg of the tree, top-down; runs inside a found hand are fingers, not limbs."""
     world = tree.world
     low = tree.lowest_z()
@@ -263,7 +270,7 @@ def find_limbs(tree: Tree) -> list[Limb]:
             seg = Segment(above.start, above.bodies + seg.bodies, above.joints + seg.joints)
         # Joined, it starts at its own base: the link above its first joint, not above mounts.
         base = world.bodies[seg.joints[0].parent] if joined else None
-        limb = _limb(tree, seg, low, base)
+        limb = _limb(tree, seg, low, base, wheels)
         if limb is not None:
             limbs.append(limb)
     return _without_digits(tree, limbs)

@@ -134,20 +134,25 @@ def manipulator(
             :3, 3
         ] / 2
         local = np.linalg.inv(tree.poses[gripper.root.index]) @ np.append(mid, 1.0)
-        if float(np.linalg.norm(local[:3])) < ON_ROOT:
+        apart = (
+            tree.poses[gripper.thumb_tip.index][:3, 3] - tree.poses[gripper.finger_tip.index][:3, 3]
+        )
+        if float(np.linalg.norm(local[:3])) < ON_ROOT and float(np.linalg.norm(apart)) >= ON_ROOT:
             # The gripper's own link sits between its finger tips (Fetch's 'gripper_link'):
-            # it is the tool frame the URDF has, not a new one at the same place.
+            # it is the tool frame the URDF has, not a new one at the same place. Not when the
+            # fingers are hinged at its origin too (myCobot's jaws): the URDF says nothing there.
             tool_name = gripper.root.name
             decide.append(f"the tool frame '{tool_name}': between the finger tips")
         elif at := frame_at_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip)):
             tool_name = at.name  # a bare frame the URDF puts between the tips
             decide.append(f"the tool frame '{tool_name}': a frame between the finger tips")
         else:
+            xyz = between_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip))
+            why = "between the finger tips in the default pose"
+            if xyz == (0.0, 0.0, 0.0):
+                why = "the fingers hinge at the gripper's origin: move it out between their tips"
             frame = DraftFrame(
-                tool_name,
-                gripper.root.name,
-                between_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip)),
-                "the URDF has no tool frame: between the finger tips in the default pose",
+                tool_name, gripper.root.name, xyz, f"the URDF has no tool frame: {why}"
             )
     elif hand is not None and (center := hand_center(tree, top)) is not None:
         tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))

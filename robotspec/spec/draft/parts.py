@@ -21,7 +21,7 @@ from robotspec.spec.draft.confidence import (
     drive_question,
     drive_rule,
 )
-from robotspec.spec.draft.driven import stated_drive
+from robotspec.spec.draft.driven import counted_drive, stated_drive
 from robotspec.spec.draft.limbs import HEAD_WORDS, beside_branch
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
 from robotspec.spec.draft.naming import unique
@@ -311,7 +311,7 @@ def add_drive(d: Drafter) -> None:
         if planner and stated.decide is None:  # the files disagree: asked
             stated.decide, stated.stated = f"{stated.source}, but the SRDF's is fixed", None
     elif wheels and movable:
-        kind = "differential" if len(wheels) == 2 else "omni"
+        kind = counted_drive(d.tree, wheels)
         why = f"{len(wheels)} wheel joints" + (f", {len(casters)} steered casters" * bool(casters))
         draft.drive = DraftDrive(kind, None, None, "the URDF tree", f"{why}: {kind}?")
     elif (len(legs) >= 2 or rotors) and movable:

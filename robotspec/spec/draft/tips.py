@@ -178,6 +178,10 @@ def between_tips(tree: Tree, root: Body, tips: Sequence[Body]) -> tuple[float, f
     at = [np.asarray(tree.poses[t.index][:3, 3], dtype=np.float64) for t in tips]
     mid = np.mean(at, axis=0)
     reach = mid - tree.poses[root.index][:3, 3]
+    if float(np.linalg.norm(reach)) < 1e-6:
+        # Tips hinged at the root's own origin (myCobot's jaws): no way to reach along is
+        # known (their meshes' units may be anything), so the frame stays there, asked.
+        return (0.0, 0.0, 0.0)
     ends = np.mean([far_end(tree, t, reach) for t in tips], axis=0)
     local = np.linalg.inv(tree.poses[root.index]) @ np.append(ends, 1.0)
     x, y, z = (round(float(v), 4) for v in local[:3])

@@ -7,10 +7,11 @@ told nothing. After every part is drafted, this module looks at what is left:
 * moving joints (not mimics, not wheels or casters, not the base's own joints) that belong to no
   chain, torso, neck or manipulator, one question per subtree they form: a serial run of three
   or more is "an arm? a leg? a head?", several branches hanging together are "a hand?", a short
-  run is "a gripper? a tool?";
+  run is "a tool? a passive joint?", a run carrying drafted chains "a torso?";
 * frames that look like cameras and are no drafted camera's device: a Gazebo sensor of an
-  image kind the draft did not take, or a link without geometry named as a camera or an
-  optical frame; one question per device (frames fixed to one link within 10 cm).
+  image kind the draft did not take, or a link named as a camera (with or without a shape: on
+  the tune half and example-robot-data, shaped ones all sit beside a drafted camera); one
+  question per device (frames fixed to one link within 10 cm).
 
 A robot whose every moving joint is covered gets no question. Each question carries its subject
 (the joints and links it names) for the corpus measure, which counts a missed item as asked
@@ -246,7 +247,7 @@ def _camera_questions(d: Drafter) -> list[DraftQuestion]:
         if world.has_body(link) and any(k in kind for k in _IMAGE_KINDS):
             why[world.get_body_by_name(link).index] = f"a Gazebo '{kind}' sensor"
     for b in world.bodies:
-        if b.index in why or b.visuals or b.collisions or b is tree.root:
+        if b.index in why or b is tree.root:
             continue
         w = words(b.name) | set(_TOKENS.split(b.name.lower()))
         if w & NOT_CAMERA_WORDS or not (w & CAMERA_WORDS):

@@ -189,3 +189,66 @@ def test_a_gripper_link_between_its_fingers_is_its_tool_frame(tmp_path: Path) ->
     d = _draft(tmp_path, "link_between", _gripper_arm(0.03))
     (m,) = d.manipulators
     assert m.tool_frame == "grip" and not d.frames
+
+
+def test_a_rigid_forearm_fixed_past_the_last_joint_ends_the_chain_with_a_frame_on_it(
+    tmp_path: Path,
+) -> None:
+    # Quori's arm: two shoulder joints, then a fixed elbow hanging the lower arm 15 cm out,
+    # beside a cover piece fixed at the upper arm's origin. The chain ends at the lower arm
+    # and its tool frame is a new one at the far end of its shape (25 cm along it).
+    forearm = '<origin xyz="0 0 -0.125"/><geometry><box size="0.04 0.04 0.25"/></geometry>'
+    parts = [
+        _link("body", size=0.3),
+        _link("shoulder", size=0.03),
+        _joint("shoulder_pitch", "body", "shoulder", xyz="0 0.2 0.4"),
+        _link("arm_upper", size=0.03),
+        _joint("shoulder_roll", "shoulder", "arm_upper", xyz="0 0 0", axis="1 0 0"),
+        _link("cover", size=0.02),
+        _joint("cover_j", "arm_upper", "cover", "fixed", "0 0 0"),
+        f'<link name="arm_lower"><collision>{forearm}</collision></link>',
+        _joint("elbow", "arm_upper", "arm_lower", "fixed", "0 0 -0.15"),
+    ]
+    d = _draft(tmp_path, "rigid_forearm", parts)
+    (arm,) = d.chains
+    assert arm.tip == "arm_lower" and arm.joints == {"shoulder_pitch", "shoulder_roll"}
+    (m,) = d.manipulators
+    (frame,) = [f for f in d.frames if f.name == m.tool_frame]
+    assert frame.parent == "arm_lower" and frame.xyz == (0.0, 0.0, -0.25)
+
+
+def test_a_frame_ending_an_arm_turned_as_optical_frames_are_is_no_camera(tmp_path: Path) -> None:
+    # Wolfgang-OP's wrist: the bare frame past the arm's last joint is turned exactly as a
+    # REP 103 optical frame; it ends the arm (its tip and tool frame), so it is not a camera.
+    parts = [*_arm("wrist"), '<link name="wrist_frame"/>']
+    parts.append(
+        _joint("wrist_fix", "wrist", "wrist_frame", "fixed", "0 0 0.1", rpy="-1.5708 0 -1.5708")
+    )
+    d = _draft(tmp_path, "wrist_frame", parts)
+    (arm,) = d.chains
+    assert arm.tip == "wrist_frame"
+    assert not d.cameras
+
+
+def test_a_floating_joint_from_the_world_is_not_the_torsos(tmp_path: Path) -> None:
+    # CURI's file hangs its base from 'world' by a floating joint; the torso is the yaw joint
+    # between the base and where the arms branch, starting on the base, not at the world.
+    parts = [
+        '<link name="world"/>',
+        _link("base", size=0.4),
+        '<joint name="reference" type="floating"><parent link="world"/><child link="base"/>'
+        "</joint>",
+        _link("chest", size=0.1),
+        _joint("waist_yaw", "base", "chest", xyz="0 0 0.5", axis="0 0 1"),
+    ]
+    joints = (("shoulder", "0 1 0"), ("elbow", "0 1 0"), ("wrist", "0 0 1"))
+    for side, y in (("left", 0.2), ("right", -0.2)):
+        above = "chest"
+        for i, (part, axis) in enumerate(joints):
+            xyz = f"0 {y if i == 0 else 0} 0.15"
+            parts.append(_link(f"{side}_{part}", size=0.03))
+            parts.append(_joint(f"{side}_j{i}", above, f"{side}_{part}", xyz=xyz, axis=axis))
+            above = f"{side}_{part}"
+    d = _draft(tmp_path, "floating_base", parts)
+    assert d.torso is not None
+    assert d.torso.joints == {"waist_yaw"} and d.torso.root == "base"

@@ -16,6 +16,7 @@ import numpy as np
 
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
+from robotspec.spec.draft.ends import chain_end
 from robotspec.spec.draft.jaws import one_jaw
 from robotspec.spec.draft.tree import Segment, Tree, words
 
@@ -324,51 +325,6 @@ def _beside_heads(tree: Tree, above: Segment, seg: Segment) -> bool:
     if _pan_tilt(tree, seg):
         return False
     return all(len(s.actuated) <= 3 and _pan_tilt(tree, s) for s in others)
-
-
-#: Words of a link that ends a chain past its last joint (a flange, a tool, a foot).
-END_WORDS = frozenset({"flange", "tool", "tool0", "ee", "eef", "tcp", "foot", "sole", "toe"})
-#: How far off the last joint's axis (m) a fixed child may sit and still be on it.
-ON_AXIS = 1e-3
-
-
-def chain_end(tree: Tree, tip: Body, hand: Body | None) -> Body:
-    """Where a chain ends: the flange, tool or foot link one fixed joint past its last joint.
-
-    Why: a chain ends at the link a tool or the ground is met on (``docs/getting-started.md``:
-    Panda's ``panda_link8``), not one fixed joint short at the last moving link. One step:
-    toward the hand when there is one (never the hand itself), else to the fixed child below
-    which nothing moves (never into a finger); of several, the only one on the last joint's
-    axis, else the only one named as an end. Otherwise the last moving link.
-    """
-    world = tree.world
-    up = world.parent_connection(tip)
-    axis = None if up is None or up.is_fixed else np.asarray(up.axis, dtype=np.float64)
-    kids = [k for k in world.child_bodies(tip) if (c := world.parent_connection(k)) and c.is_fixed]
-    if hand is not None:
-        nxt = next((k for k in kids if world.is_ancestor(k, hand)), None)
-        return tip if nxt is None or nxt is hand else nxt
-    kids = [k for k in kids if not tree.moves_below(k)]
-    return _pick_end(tree, kids, axis) or tip
-
-
-def _pick_end(tree: Tree, kids: list[Body], axis: np.ndarray | None) -> Body | None:
-    """The fixed child a chain ends at: the only one, the one on the axis, or the one named so."""
-    if len(kids) <= 1:
-        return kids[0] if kids else None
-    if axis is not None:
-        on_axis = []
-        for k in kids:
-            c = tree.world.parent_connection(k)
-            assert c is not None
-            at = c.origin[:3, 3]
-            off = at - float(at @ axis) * axis
-            if float(np.linalg.norm(off)) < ON_AXIS and float(np.linalg.norm(at)) > ON_AXIS:
-                on_axis.append(k)
-        if len(on_axis) == 1:
-            return on_axis[0]
-    named = [k for k in kids if words(k.name) & END_WORDS]
-    return named[0] if len(named) == 1 else None
 
 
 def beside_branch(world: World, body: Body, tip: Body | str) -> bool:

@@ -37,7 +37,7 @@ from robotspec.spec.draft.limbs import (
 )
 from robotspec.spec.draft.model import DraftChain, DraftFrame, DraftManipulator
 from robotspec.spec.draft.naming import unique
-from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset
+from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset, rigid_end
 from robotspec.spec.draft.tool_frames import (
     fixed_jaw,
     frame_at_tips,
@@ -171,6 +171,20 @@ def manipulator(
         flange_name = "flange" if name == "tool" else f"{name}_flange"
         tool_name = unique(flange_name, self.names | set(world.body_names))
         frame = DraftFrame(tool_name, top.name, flange, f"the URDF has no tool frame: {FLANGE}")
+    elif (
+        hand is None
+        and (up := world.parent_connection(top)) is not None
+        and up.is_fixed
+        and (end := rigid_end(tree, top)) is not None
+    ):
+        # A rigid link hung out past the last joint (Quori's lower arm on its fixed elbow):
+        # no flange link; the tool is met at the far end of its shape.
+        tool_name = unique(
+            "flange" if name == "tool" else f"{name}_flange", self.names | set(world.body_names)
+        )
+        frame = DraftFrame(
+            tool_name, top.name, end, "the URDF has no tool frame: the far end of the last link"
+        )
     elif hand is None and (up := world.parent_connection(top)) is not None and up.is_fixed:
         tool_name = top.name  # the flange link the chain ends at, past its last joint
         decide.append(f"the tool frame '{tool_name}': the link past the arm's last joint")

@@ -25,7 +25,7 @@ from robotspec.spec.draft.driven import counted_drive, stated_drive
 from robotspec.spec.draft.limbs import HEAD_WORDS, beside_branch
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftDrive
 from robotspec.spec.draft.naming import unique
-from robotspec.spec.draft.sensors import find_cameras, find_neck
+from robotspec.spec.draft.sensors import CAMERA_WORDS, find_cameras, find_neck
 from robotspec.spec.draft.srdf_groups import state_values
 from robotspec.spec.draft.stated_cameras import fill_stated
 from robotspec.spec.draft.tree import words
@@ -44,7 +44,17 @@ _BY_ROTATION = "an optical frame by its rotation; no Gazebo sensor states it"
 def add_sensors(d: Drafter) -> None:
     """Cameras, the neck that carries the head's cameras, and the arms that carry the rest."""
     tree, world, draft = d.tree, d.world, d.draft
-    found = find_cameras(tree)
+    # A frame turned as optical frames are but ending a limb (Wolfgang's 'l_wrist', the arm's
+    # tip and tool frame) is the limb's, not a camera: its rotation alone said camera.
+    ends = {c.tip for c in draft.chains} | {m.tool_frame for m in draft.manipulators}
+    found = [
+        f
+        for f in find_cameras(tree)
+        if f.stated is not None
+        or not f.optical
+        or f.body.name not in ends
+        or words(f.body.name) & CAMERA_WORDS
+    ]
     name_of: dict[str, str] = {}
     for seen in found:
         cam = DraftCamera(unique(seen.name, d.names), seen.body.name, seen.optical)
@@ -219,7 +229,13 @@ def add_torso(d: Drafter) -> None:
     root = d.tree.root
     if not world.is_ancestor(root, branch):
         return
-    path = [c for c in world.compute_chain_of_connections(root, branch) if not c.is_fixed]
+    # A floating or planar joint moves the whole robot (CURI's 'reference' from 'world'): the
+    # drive's, never the torso's.
+    path = [
+        c
+        for c in world.compute_chain_of_connections(root, branch)
+        if not c.is_fixed and c.type.value not in ("floating", "planar")
+    ]
     why = f"the joints between the root and where the arms branch ('{branch.name}')"
     if not path:  # rooted where the arms branch (Booster T1's trunk): the waist below it
         path, why = _waist(d, branch)

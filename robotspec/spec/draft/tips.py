@@ -19,7 +19,8 @@ from robotspec.errors import RobotSpecError
 from robotspec.files.meshes import read_vertices as mesh_vertices
 from robotspec.model.entities import Body
 from robotspec.model.geometry import Box, Capsule, Cylinder, Mesh, Shape, Sphere
-from robotspec.spec.draft.tree import Tree
+from robotspec.spec.draft.ends import END_WORDS
+from robotspec.spec.draft.tree import Tree, words
 
 __all__ = [
     "FLANGE",
@@ -27,6 +28,7 @@ __all__ = [
     "between_tips",
     "far_end",
     "flange_offset",
+    "rigid_end",
     "mesh_vertices",
     "shape_points",
 ]
@@ -185,4 +187,36 @@ def between_tips(tree: Tree, root: Body, tips: Sequence[Body]) -> tuple[float, f
     ends = np.mean([far_end(tree, t, reach) for t in tips], axis=0)
     local = np.linalg.inv(tree.poses[root.index]) @ np.append(ends, 1.0)
     x, y, z = (round(float(v), 4) for v in local[:3])
+    return (x + 0.0, y + 0.0, z + 0.0)
+
+
+#: How far out (m) a fixed last link must hang to be a rigid part of the arm, not a flange.
+RIGID_OUT = 0.05
+#: The farthest (m) a rigid last link's shape may reach; farther, its mesh is not to scale.
+RIGID_MAX = 0.5
+
+
+def rigid_end(tree: Tree, link: Body) -> tuple[float, float, float] | None:
+    """Where a rigid link past an arm's last joint ends: its shape's far end the way it hangs.
+
+    ``None`` when it is not one: a bare frame or a flange plate (on a fixed joint less than
+    RIGID_OUT out), or named as an end (a flange, a tool). A shape reaching farther than
+    RIGID_MAX, or not out at all, gives the link's origin (its mesh is not to scale or placed
+    elsewhere), still a frame on the link that a person moves.
+    """
+    c = tree.world.parent_connection(link)
+    if c is None or not c.is_fixed or not (link.collisions or link.visuals):
+        return None
+    if words(link.name) & END_WORDS:
+        return None
+    out = c.origin[:3, :3].T @ c.origin[:3, 3]  # the offset, in the link's frame
+    n = float(np.linalg.norm(out))
+    if n < RIGID_OUT:
+        return None
+    way = out / n
+    points = _body_points(tree, link)
+    reach = float(np.max(points @ way)) if len(points) else 0.0
+    if not MIN_REACH <= reach <= RIGID_MAX:
+        return (0.0, 0.0, 0.0)
+    x, y, z = (round(float(v), 4) for v in reach * way)
     return (x + 0.0, y + 0.0, z + 0.0)

@@ -242,7 +242,7 @@ def test_any_names_round_trip_through_the_draft_yaml(names: list[str]) -> None:
     data = yaml.safe_load(text)  # never breaks, whatever the names hold
     # Only the keys the draft writes, nothing a name injected.
     allowed = {"robotspec", "name", "description", "root", "drive", "torso", "neck", "chains"}
-    allowed |= {"manipulators", "sensors", "states"}
+    allowed |= {"manipulators", "sensors", "states", "accept_warnings"}
     assert set(data) <= allowed
     assert data["name"] == names[2]
     assert data["description"]["urdf"] == names[1]

@@ -67,7 +67,6 @@ __all__ = [
     "drive_rule",
     "gripper_question",
     "srdf_carries",
-    "tool_frame_question",
     "tool_frame_verdict",
 ]
 
@@ -141,21 +140,6 @@ def tool_frame_verdict(
     if world.is_ancestor(tip, tool) and not tree.moves_below(tip):
         return None, TOOL_AT_END
     return f"the tool frame '{tool.name}' is named as a TCP but is not at the chain's end", None
-
-
-def tool_frame_question(
-    world: World,
-    tool: Body,
-    *,
-    hand: Body | None,
-    tip: Body,
-    srdf_parent: Body | None,
-    tree: Tree,
-) -> str | None:
-    """Why a tool frame the URDF has is a question, or ``None`` when the files state it."""
-    return tool_frame_verdict(world, tool, hand=hand, tip=tip, srdf_parent=srdf_parent, tree=tree)[
-        0
-    ]
 
 
 def gripper_question(coupled: bool, one_driven: bool) -> str | None:

@@ -112,7 +112,8 @@ class Drafter:
         self.tree = Tree(world, root)
         self.facts = self.tree.memo["facts"] = facts or FileFacts()  # read before any guess
         # Found once, on the tree's poses (one forward kinematics for the whole draft).
-        self.wheels = stated_wheels(self.tree, self.facts, wheel_joints(world, self.tree.poses))
+        self.wheel_shaped = wheel_joints(world, self.tree.poses)
+        self.wheels = stated_wheels(self.tree, self.facts, self.wheel_shaped)
         if own is not None:
             drive = own_drive(world, own, self.wheels)
         self.limbs = find_limbs(self.tree, frozenset(c.name for c in self.wheels))

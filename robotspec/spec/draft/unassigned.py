@@ -26,7 +26,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robotspec.model.entities import Body, Connection
-from robotspec.spec.draft.base import wheel_joints
 from robotspec.spec.draft.model import DraftQuestion
 from robotspec.spec.draft.sensors import CAMERA_WORDS, NOT_CAMERA_WORDS
 from robotspec.spec.draft.tree import words
@@ -66,7 +65,7 @@ def _covered(d: Drafter) -> set[int]:
         names |= set(base.joints or ()) | ({base.planar} if base.planar else set())
     out = {world.get_connection_by_name(n).index for n in names if world.has_connection(n)}
     out |= {c.index for c in d.wheels}
-    out |= {c.index for c in wheel_joints(world, d.tree.poses)}
+    out |= {c.index for c in d.wheel_shaped}
     for m in draft.manipulators:
         if world.has_body(m.root):
             for b in world.subtree(world.get_body_by_name(m.root)):

@@ -85,6 +85,41 @@ class Group:
 
 
 @dataclass(frozen=True)
+class Layout:
+    """Where a step's poses go among the bodies (body order, the result's).
+
+    ``runs``: per node with extra poses, (node, its extra poses, their bodies) for each stretch
+    of consecutive bodies; ``node_out`` and ``node_at``: the bodies that are a node's pose, and
+    that node's slot. Why: the extra poses (49 of the PR2's 83 bodies) are written straight into
+    the bodies' order instead of into the store and gathered from it, one pass over the
+    memory fewer (a batch's step moves megabytes: it is bound by memory, not arithmetic).
+    """
+
+    runs: tuple[tuple[int, slice, slice], ...]
+    node_out: Any
+    node_at: Any
+
+
+def _layout(
+    n_nodes: int, n_extra: int, at: I64, extra_runs: tuple[tuple[int, slice], ...]
+) -> Layout:
+    """The :class:`Layout` of a tree's parts (made once, with the tree)."""
+    body_of = np.zeros(n_nodes + n_extra, dtype=np.int64)
+    body_of[at] = np.arange(len(at))  # slot -> body (read for the extra slots: one body each)
+    runs: list[tuple[int, slice, slice]] = []
+    for node, run in extra_runs:
+        bodies = body_of[n_nodes + np.arange(run.start, run.stop)].tolist()
+        first = 0
+        for k in range(1, len(bodies) + 1):
+            if k == len(bodies) or bodies[k] != bodies[k - 1] + 1:
+                extras = slice(run.start + first, run.start + k)
+                runs.append((node, extras, slice(bodies[first], bodies[k - 1] + 1)))
+                first = k
+    node_out = np.flatnonzero(at < n_nodes)
+    return Layout(tuple(runs), node_out, at[node_out])
+
+
+@dataclass(frozen=True)
 class Tree:
     """A tree program (see ``_kincore.c``), rearranged for numpy (module docstring).
 
@@ -108,6 +143,7 @@ class Tree:
     extra_node: I64
     extra_pose: F64
     extra_runs: tuple[tuple[int, slice], ...]  # (node, its extra poses): sorted by node
+    layout: Layout  # a batch's steps: where the extra poses go among the bodies
 
 
 def tree(
@@ -224,6 +260,9 @@ def _program(n_slots: int, n_out: int, n_dof: int, rows: tuple[Any, ...], row_de
     extra_node = new_id[on_node[extra]]
     starts = np.flatnonzero(np.diff(extra_node, prepend=-1))
     ends = np.append(starts[1:], len(extra))[: len(starts)]
+    runs = tuple(
+        (int(extra_node[i]), slice(int(i), int(j))) for i, j in zip(starts, ends, strict=True)
+    )
     return Tree(
         n_slots,
         n_out,
@@ -237,9 +276,8 @@ def _program(n_slots: int, n_out: int, n_dof: int, rows: tuple[Any, ...], row_de
         at,
         extra_node,
         np.ascontiguousarray(times[extra]),
-        tuple(
-            (int(extra_node[i]), slice(int(i), int(j))) for i, j in zip(starts, ends, strict=True)
-        ),
+        runs,
+        _layout(len(nodes) + 1, len(extra), at, runs),
     )
 
 

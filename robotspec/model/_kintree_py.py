@@ -30,7 +30,6 @@ see tests/test_fallback_batch.py), the products being summed in another order.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -43,6 +42,7 @@ from robotspec.model._kintree_build import (
     KIND_PRISMATIC,
     KIND_REVOLUTE,
     TURN,
+    Layout,
     Tree,
     config,
     copy_f64,
@@ -93,40 +93,6 @@ def _buffers(t: Tree, n: int) -> tuple[F64, F64, Any]:
     store = np.empty((t.n_nodes + len(t.extra_node), n, 4, 4))
     store[0] = np.eye(4)
     return store, np.empty((len(t.extra_node), n, 4, 4)), np.empty((t.n_out, n), dtype="V128")
-
-
-@dataclass(frozen=True)
-class Layout:
-    """Where a step's poses go among the bodies (body order, the result's).
-
-    ``runs``: per node with extra poses, (node, its extra poses, their bodies) for each stretch
-    of consecutive bodies; ``node_out`` and ``node_at``: the bodies that are a node's pose, and
-    that node's slot. Why: the extra poses (49 of the PR2's 83 bodies) are written straight into
-    the bodies' order instead of into the store and gathered from it, one pass over the
-    memory fewer (a batch's step moves megabytes: it is bound by memory, not arithmetic).
-    """
-
-    runs: tuple[tuple[int, slice, slice], ...]
-    node_out: Any
-    node_at: Any
-
-
-def _layout(t: Tree) -> Layout:
-    """The :class:`Layout` of ``t`` (a few microseconds: made once per batch)."""
-    at = np.asarray(t.at)
-    body_of = np.zeros(t.n_nodes + len(t.extra_node), dtype=np.int64)
-    body_of[at] = np.arange(len(at))  # slot -> body (read for the extra slots: one body each)
-    runs: list[tuple[int, slice, slice]] = []
-    for node, run in t.extra_runs:
-        bodies = body_of[t.n_nodes + np.arange(run.start, run.stop)].tolist()
-        first = 0
-        for k in range(1, len(bodies) + 1):
-            if k == len(bodies) or bodies[k] != bodies[k - 1] + 1:
-                extras = slice(run.start + first, run.start + k)
-                runs.append((node, extras, slice(bodies[first], bodies[k - 1] + 1)))
-                first = k
-    node_out = np.flatnonzero(at < t.n_nodes)
-    return Layout(tuple(runs), node_out, at[node_out])
 
 
 def _cos_sin(v: F64, cos: F64, sin: F64) -> None:
@@ -243,12 +209,11 @@ def fk_batch(tree: object, q: object, out: Any = None, stream: bool = False) -> 
         check_out(out, shape)
     bufs = _buffers(t, min(n, _CHUNK))  # one set for every full step, reused
     v, turns = _motions(t, qa)
-    layout = None if n < _GATHER_BELOW else _layout(t)
     for lo in range(0, n, _CHUNK):
         hi = min(n, lo + _CHUNK)
         fits = hi - lo == bufs[0].shape[1]
         step = v[:, lo:hi], turns[:, lo:hi]
-        where = None if hi - lo < _GATHER_BELOW else layout
+        where = None if hi - lo < _GATHER_BELOW else t.layout
         _run(t, *step, out[lo:hi], bufs if fits else _buffers(t, hi - lo), where)
     result: F64 = out
     return result

@@ -58,6 +58,7 @@ OLD_PYTHON_WHEELS: Mapping[tuple[str, str], tuple[str, str | None]] = MappingPro
         ("physicalai-rebot-b601-plugin", "0.8.0"): ("312", None),
         ("physicalai-trossen-plugin", "0.2.0"): ("312", None),
         ("arx5-interface", "0.1.5"): ("312", "manylinux_2_28_x86_64"),
+        ("physicalai-bimanual-so101-plugin", "0.5.0"): ("312", None),
     }
 )
 

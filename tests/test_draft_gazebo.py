@@ -260,8 +260,10 @@ def test_a_gazebo_drive_plugin_states_the_drive(tmp_path: Path) -> None:
     )
     body = _wheel("drive_l", 0.2) + _wheel("drive_r", -0.2) + plugin
     d = _draft(_urdf(tmp_path, body), tmp_path)
-    # The first plugin moving the base: planar_move (omni), stated, no question left.
-    assert d.drive is not None and (d.drive.type, d.drive.decide) == ("omni", None)
+    # The first plugin moving the base: planar_move (omni); the second says differential, and
+    # a planar move is a simulator's shortcut for any base: asked (``whole``).
+    assert d.drive is not None and d.drive.type == "omni" and d.drive.stated is None
+    assert "plugins disagree" in (d.drive.decide or "")
     assert d.drive.source == "the Gazebo drive plugin 'libgazebo_ros_planar_move.so'"
 
 

@@ -39,6 +39,7 @@ from robotspec.spec.draft.srdf_groups import (
 )
 from robotspec.spec.draft.tree import Tree, words
 from robotspec.spec.draft.unassigned import find_questions
+from robotspec.spec.draft.whole import keep_marks
 
 __all__ = ["Drafter", "draft_spec"]
 
@@ -360,5 +361,6 @@ def draft_spec(
     add_torso(d)
     add_drive(d)
     add_states(d)
+    keep_marks(d)  # a rule's files state only part of an item: its mark stays
     d.draft.questions = find_questions(d)  # after every part: what none of them covers
     return d.draft

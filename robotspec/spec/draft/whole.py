@@ -1,0 +1,294 @@
+"""Whether the files state a drafted item WHOLE: the checks that keep a ``DECIDE`` mark.
+
+Why a pass of its own (issue 30, item 3): a rule of ``confidence`` drops an item's mark because
+a file states it, but a file often states only part of the item. A Gazebo sensor states that a
+camera exists and where it sees from, not which of the device's frames the spec wants; a mimic
+tag states that two fingers are coupled, not where their tips are; a TCP name states a frame,
+not that it is the only one; a drive plugin states a drive in simulation, which a planar-move
+plugin fakes for any base. Drafts of robots seen for the first time showed wrong items left
+unmarked exactly there. This pass runs after every part is drafted and only ever ADDS a mark
+(and clears the rule that had dropped it), where the files leave part of the item to inference:
+
+============  ==========================================================================
+item          keeps (gets back) its mark when
+============  ==========================================================================
+camera        the sensor's type is no plain image camera (thermal, segmentation, a logical
+              camera); the frame is the sensor's own link while another frame fixed to it
+              looks along its view (an optical child elsewhere); the frame is a device's by
+              its name; several sensors sit on the device (which channel: by names)
+tool frame    the hand (or the chain's end) holds another frame named as a TCP; a gripper's
+              TCP lies behind the hand's root, away from its finger tips
+gripper       a finger's tip carries links of its own (a pad, a frame: which is the tip?)
+chain         the SRDF group's joints include a prismatic one (a lift: torso or arm?)
+drive         a fixed virtual joint on a robot with wheels on fixed joints, wheel-shaped
+              joints, casters or a drive plugin; a floating one on a robot with wheels; a
+              drive plugin that moves the base in the plane (``planar_move``), names no
+              wheels, leaves driven wheels out, or sits on a robot with legs
+============  ==========================================================================
+"""
+
+from __future__ import annotations
+
+import re
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robotspec.model.entities import Body
+from robotspec.spec.draft.base import fixed_wheels
+from robotspec.spec.draft.confidence import (
+    CAMERA_GAZEBO,
+    CHAIN_SRDF,
+    DRIVE_FIXED,
+    DRIVE_FLOATING,
+    DRIVE_PLUGIN,
+    GRIPPER_MIMIC,
+    TOOL_AT_END,
+    TOOL_ON_HAND,
+    TOOL_SRDF,
+)
+from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftManipulator
+from robotspec.spec.draft.stated_cameras import MAX_SENSORS, stated_cameras
+from robotspec.spec.draft.tool_frames import is_named_tcp, own_geometry
+from robotspec.spec.draft.tree import words
+
+if TYPE_CHECKING:
+    from robotspec.spec.draft.build import Drafter
+
+__all__ = ["keep_marks"]
+
+#: Gazebo sensor types whose images a person uses as a camera's (the rest: thermal, labels...).
+_PLAIN = frozenset(
+    {"camera", "depth", "rgbd", "multicamera", "wideanglecamera", "depth_camera", "rgbd_camera"}
+)
+#: How far apart (m) the frames of one device may be (a RealSense's channels: 1.5 to 5 cm).
+_DEVICE_SPAN = 0.1
+#: How near (m) a frame must be to a sensor to be where it sees from.
+_SPOT = 0.01
+#: The cosine within which a frame's z axis is a view direction (8 degrees).
+_ALONG = 0.99
+#: Fixed joints walked above and below a camera's frame for the frames fixed to it.
+_RIGID_DEPTH = 3
+#: Words naming a device's colour channel.
+_COLOUR = frozenset({"color", "colour", "rgb"})
+_TOOLS = (TOOL_SRDF, TOOL_ON_HAND, TOOL_AT_END)
+
+
+def _rigid_root(d: Drafter, body: Body) -> Body:
+    world = d.world
+    while (c := world.parent_connection(body)) is not None and c.is_fixed:
+        if body is d.tree.root:
+            break
+        body = world.bodies[c.parent]
+    return body
+
+
+def _fixed_to(d: Drafter, body: Body) -> list[Body]:
+    """The frames fixed to ``body`` (a few fixed joints above it, and below those)."""
+    world = d.world
+    top = body
+    for _ in range(_RIGID_DEPTH):
+        c = world.parent_connection(top)
+        if c is None or not c.is_fixed or top is d.tree.root:
+            break
+        top = world.bodies[c.parent]
+    out, level = [top], [top]
+    for _ in range(2 * _RIGID_DEPTH):
+        level = [
+            k
+            for b in level
+            for k in world.child_bodies(b)
+            if (c := world.parent_connection(k)) is not None and c.is_fixed
+        ]
+        out += level
+    return out
+
+
+# ------------------------------------------------------------------------------ cameras
+def _camera_doubt(d: Drafter, cam: DraftCamera) -> str | None:
+    """What of a Gazebo-stated camera the sensor leaves to inference, if anything."""
+    world, tree, facts = d.world, d.tree, d.facts
+    body = world.get_body_by_name(cam.body)
+    root = _rigid_root(d, body)
+    at = tree.poses[body.index][:3, 3]
+    sensors = [
+        g
+        for g in facts.cameras[:MAX_SENSORS]
+        if world.has_body(g.link)
+        and world.get_body_by_name(g.link).index in tree.inside
+        and _rigid_root(d, world.get_body_by_name(g.link)) is root
+        and float(np.linalg.norm(tree.poses[world.get_body_by_name(g.link).index][:3, 3] - at))
+        <= _DEVICE_SPAN
+    ]
+    odd = sorted({g.type for g in sensors} - _PLAIN)
+    if odd:
+        return f"a Gazebo '{odd[0]}' sensor: a camera whose images a person uses?"
+    # The frames the device's other sensors resolve to, not drafted: the colour channel was
+    # chosen among them by its name.
+    drafted = {c.body for c in d.draft.cameras}
+    taken = [tree.poses[world.get_body_by_name(c).index][:3, 3] for c in drafted]
+    others = [
+        b.name
+        for b in (world.bodies[i] for i in _resolved(d))
+        if b.name not in drafted
+        and _rigid_root(d, b) is root
+        and float(np.linalg.norm(tree.poses[b.index][:3, 3] - at)) <= _DEVICE_SPAN
+        # a frame where a drafted camera is (a stereo pair's frame on its left eye): the same
+        and all(float(np.linalg.norm(tree.poses[b.index][:3, 3] - t)) > _SPOT for t in taken)
+    ]
+    if others and not _only_colour(cam.body, others):
+        return f"the device's sensors see from '{others[0]}' too: which channel is the camera?"
+    spots = [
+        tree.poses[world.get_body_by_name(g.link).index] @ np.array([*g.pose[:3], 1.0])
+        for g in sensors
+    ]
+    stated = {g.frame for g in sensors if g.frame} | {g.link for g in sensors}
+    if cam.body not in stated and all(float(np.linalg.norm(s[:3] - at)) > _SPOT for s in spots):
+        return f"'{cam.body}' is neither where the sensor sees from nor a frame it names"
+    # Another frame of the device looking the same way (a colour optical frame beside the
+    # depth one the sensor sits on; the second eye of a stereo pair): the sensor states a
+    # device, not which of its frames a spec names, nor whether a pair is one camera or two.
+    view = _view(d, cam, body)
+    for k in _fixed_to(d, body):
+        if k is body or float(np.linalg.norm(tree.poses[k.index][:3, 3] - at)) > _DEVICE_SPAN:
+            continue
+        # A frame the draft did not take (a drafted neighbour is a camera of its own).
+        frame = k.name not in drafted and not world.child_bodies(k) and not own_geometry(k)
+        here = tree.poses[k.index][:3, 3]
+        frame = frame and all(float(np.linalg.norm(here - t)) > _SPOT for t in taken)
+        if frame and _only_colour(cam.body, [k.name]):
+            continue  # the colour channel beside the device's others, each named so
+        if frame and float(tree.poses[k.index][:3, 2] @ view) > _ALONG:
+            return f"'{k.name}', fixed beside it, looks the same way: which frame is the camera?"
+    return None
+
+
+def _only_colour(chosen: str, others: list[str]) -> bool:
+    """Whether ``chosen`` alone is named as a colour channel (its device's others are not).
+
+    Why: a device's channels are told apart only by their names; when the chosen frame says
+    colour and no other frame of the device does, the names agree with the spec's convention
+    (the colour image is the camera). Anything less (no channel words, two colour frames, the
+    chosen one named depth) is a guess, and keeps its mark.
+    """
+    return _colour(chosen) and not any(_colour(o) for o in others)
+
+
+def _colour(name: str) -> bool:
+    tokens = words(name) | set(re.split(r"[^a-z0-9]+", name.lower()))
+    return bool({t.rstrip("0123456789") for t in tokens} & _COLOUR)
+
+
+def _view(d: Drafter, cam: DraftCamera, body: Body) -> np.ndarray:
+    """The way a drafted camera looks, in the root's frame."""
+    if cam.optical or cam.looks_along_z:
+        axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    else:
+        axis = cam.axis or (1.0, 0.0, 0.0)
+    return np.asarray(d.tree.poses[body.index][:3, :3] @ np.array(axis))
+
+
+def _resolved(d: Drafter) -> set[int]:
+    """The bodies every Gazebo camera sensor resolves to (or its plugin names), found once."""
+    memo = d.tree.memo
+    if "whole.resolved" not in memo:
+        memo["whole.resolved"] = stated_cameras(d.tree, d.facts)[1]
+    found: set[int] = memo["whole.resolved"]
+    return found
+
+
+# -------------------------------------------------------------------------- manipulators
+def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str | None:
+    """Why a manipulator's stated tool frame or fingers are not the files' whole answer."""
+    world, tree = d.world, d.tree
+    if not world.has_body(m.root) or not world.has_body(m.tool_frame):
+        return None
+    root, tool = world.get_body_by_name(m.root), world.get_body_by_name(m.tool_frame)
+    if any(r in _TOOLS for r in rules):
+        other = [b.name for b in world.subtree(root) if b is not tool and is_named_tcp(world, b)]
+        if other:
+            return f"'{other[0]}' is named as a TCP too: which is the tool frame?"
+        if m.is_gripper and m.thumb is not None and m.finger is not None:
+            tips = [world.get_body_by_name(f.tip) for f in (m.thumb, m.finger)]
+            base = tree.poses[root.index][:3, 3]
+            reach = sum(tree.poses[t.index][:3, 3] for t in tips) / 2 - base
+            if float((tree.poses[tool.index][:3, 3] - base) @ reach) < 0:
+                return f"the tool frame '{tool.name}' lies behind the hand, away from its tips"
+    if GRIPPER_MIMIC in rules and m.thumb is not None and m.finger is not None:
+        for f in (m.thumb, m.finger):
+            tip = world.get_body_by_name(f.tip) if world.has_body(f.tip) else None
+            pads = [] if tip is None else [k for k in world.subtree(tip) if k is not tip]
+            if any(own_geometry(k) for k in pads):
+                return f"a shape hangs below the finger tip '{f.tip}': which is the tip?"
+    return None
+
+
+def _chain_doubt(d: Drafter, c: DraftChain) -> str | None:
+    world = d.world
+    lifts = [
+        j
+        for j in sorted(c.joints)
+        if world.has_connection(j) and world.get_connection_by_name(j).type.value == "prismatic"
+    ]
+    if lifts:
+        return f"the SRDF group moves '{lifts[0]}', a prismatic joint: a torso's lift or the arm's?"
+    return None
+
+
+# -------------------------------------------------------------------------------- drive
+def _drive_doubt(d: Drafter, rule: str) -> str | None:
+    world, facts, draft = d.world, d.facts, d.draft
+    legs = [c for c in draft.chains if c.role == "leg"]
+    if rule == DRIVE_FIXED:
+        casters = [c for c in world.connections if words(c.name) & {"caster", "castor"}]
+        if d.wheel_shaped or d.wheels or fixed_wheels(world) or casters or facts.actuation.drives:
+            return "the SRDF's virtual joint is fixed, but the files model wheels or a drive"
+    elif rule == DRIVE_FLOATING:
+        if d.wheels or d.wheel_shaped:
+            return "the SRDF's virtual joint is floating, but the robot has wheels: their drive?"
+    elif rule == DRIVE_PLUGIN:
+        drives = facts.actuation.drives
+        plugins = [p for p in drives if all(world.has_connection(w) for w in p.wheels)]
+        if not plugins:
+            return None
+        plugin = plugins[0]  # the one the drive was taken from (``driven.stated_drive``)
+        if len({p.kind for p in plugins}) > 1:
+            return f"the Gazebo drive plugins disagree: {', '.join(p.plugin for p in plugins)}"
+        name = plugin.plugin.lower()
+        if "planar" in name:
+            return f"the Gazebo plugin '{plugin.plugin}' moves the base in the plane: its wheels?"
+        if not plugin.wheels:
+            return f"the Gazebo plugin '{plugin.plugin}' names no wheels"
+        named = set(plugin.wheels)
+        driven = [
+            c.name
+            for c in d.wheels
+            if c.name not in named and facts.actuation.velocity_only(c.name)
+        ]
+        if driven:
+            return f"wheel '{driven[0]}' is driven too, but the drive plugin leaves it out"
+        if len(legs) >= 2:
+            return "wheels at the ends of legs: rolling, or walking?"
+    return None
+
+
+def keep_marks(d: Drafter) -> None:
+    """Give back the mark of every item whose rule's files state only part of it."""
+    draft = d.draft
+    for cam in draft.cameras:
+        if cam.stated == CAMERA_GAZEBO and not cam.decide and d.world.has_body(cam.body):
+            if (why := _camera_doubt(d, cam)) is not None:
+                cam.decide.append(why)
+                cam.stated = None
+    for m in draft.manipulators:
+        if m.stated and not m.decide and (why := _tcp_doubt(d, m, m.stated)) is not None:
+            m.decide.append(why)
+            m.stated = ()
+    for c in draft.chains:
+        if c.stated == CHAIN_SRDF and not c.decide and (why := _chain_doubt(d, c)) is not None:
+            c.decide.append(why)
+            c.stated = None
+    dr = draft.drive
+    if dr is not None and dr.stated and not dr.decide:
+        if (why := _drive_doubt(d, dr.stated)) is not None:
+            dr.decide, dr.stated = why, None

@@ -192,7 +192,10 @@ def _limb(
     if hand is None and len(actuated) <= 3 and _pan_tilt(tree, seg):
         return None  # a pan/tilt unit pointing cameras: a neck (see sensors.find_neck)
     joints = frozenset(c.name for c in actuated)
-    z_tip, z_root = tree.position(tip)[2], tree.position(root)[2]
+    # Where the limb ends up: the lowest frame it carries (a foot fixed past the knee, a wheel),
+    # not the last moving link's origin (a knee, 20 cm above the ground it stands on).
+    z_tip = min(float(tree.position(b)[2]) for b in world.subtree(tip))
+    z_root = float(tree.position(root)[2])
     legs_named = footed or _count(bodies, LEG_WORDS) > _count(bodies, ARM_WORDS)
     grounded = hand is None and z_tip - low < FOOT_CLEARANCE and z_root - z_tip > LEG_DROP
     if legs_named or grounded:

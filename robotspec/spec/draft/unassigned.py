@@ -9,9 +9,14 @@ told nothing. After every part is drafted, this module looks at what is left:
   or more is "an arm? a leg? a head?", several branches hanging together are "a hand?", a short
   run is "a tool? a passive joint?", a run carrying drafted chains "a torso?";
 * frames that look like cameras and are no drafted camera's device: a Gazebo sensor of an
-  image kind the draft did not take, or a link named as a camera (with or without a shape: on
-  the tune half and example-robot-data, shaped ones all sit beside a drafted camera); one
-  question per device (frames fixed to one link within 10 cm).
+  image kind the draft did not take, a link named as a camera (with or without a shape: on
+  the tune half and example-robot-data, shaped ones all sit beside a drafted camera), or a bare
+  frame with a generic name turned as optical frames are (x level, y down: a rear camera, a
+  depth camera tilted down; not at a limb's end or on a finger, where tool frames and tips
+  are); one question per device (frames fixed to one link within 10 cm).
+
+A wheel-shaped joint counts as covered (the drive's) only when nothing moves below it: a leg's
+hip modelled as a continuous joint with a round motor is asked about like any other joint.
 
 A robot whose every moving joint is covered gets no question. Each question carries its subject
 (the joints and links it names) for the corpus measure, which counts a missed item as asked
@@ -44,6 +49,9 @@ _IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
 _LIMB_JOINTS = 3
 #: How far apart (m) the frames of one camera device may be.
 _DEVICE_SPAN = 0.1
+#: An optical frame's x axis is level (|z component| below this), its y points down (below
+#: minus this): a camera's image rows run level and its columns downwards.
+_LEVEL, _DOWN = 0.2, 0.5
 #: Joints named at most this many in a question; longer lists are written first .. last.
 _SHOWN = 4
 #: Words naming a rotor's joint (a drone's): it moves the robot, it is no part.
@@ -64,8 +72,12 @@ def _covered(d: Drafter) -> set[int]:
     if base is not None:
         names |= set(base.joints or ()) | ({base.planar} if base.planar else set())
     out = {world.get_connection_by_name(n).index for n in names if world.has_connection(n)}
-    out |= {c.index for c in d.wheels}
-    out |= {c.index for c in d.wheel_shaped}
+    # A wheel carries nothing that moves: a wheel-shaped joint with joints below it (a leg's
+    # hip modelled continuous, with a round motor) is asked about like any other joint.
+    tree = d.tree
+    out |= {
+        c.index for c in (*d.wheels, *d.wheel_shaped) if not tree.moves_below(world.bodies[c.child])
+    }
     for m in draft.manipulators:
         if world.has_body(m.root):
             for b in world.subtree(world.get_body_by_name(m.root)):
@@ -237,10 +249,43 @@ def _near(d: Drafter, a: Body, b: Body) -> bool:
     return gap <= _DEVICE_SPAN
 
 
+def _limb_ends(d: Drafter) -> set[int]:
+    """The links (rigid roots) at the drafted limbs' ends and below the hands' moving joints."""
+    world, draft = d.world, d.draft
+    names = {c.tip for c in draft.chains} | {m.tool_frame for m in draft.manipulators}
+    names |= {f.parent for f in draft.frames}
+    out = {_rigid_root(d, world.get_body_by_name(n)).index for n in names if world.has_body(n)}
+    for m in draft.manipulators:
+        for j in m.joints:
+            if world.has_connection(j):
+                child = world.bodies[world.get_connection_by_name(j).child]
+                out |= {b.index for b in world.subtree(child)}
+    return out
+
+
+def _turned_optical(d: Drafter, b: Body, taken: set[int]) -> bool:
+    """A bare frame (a leaf without shape on a fixed joint) turned as optical frames are.
+
+    Why: a camera whose frame has a generic name and no Gazebo sensor (a rear camera turned
+    180 degrees, a depth camera tilted down) is known only by its axes in the default pose:
+    x level, y pointing down, z ahead (REP 103). A frame named after nothing but turned so is
+    asked about, never drafted: a tool frame or a marker may be turned so too.
+    """
+    world = d.world
+    c = world.parent_connection(b)
+    if c is None or not c.is_fixed or world.child_bodies(b) or b.visuals or b.collisions:
+        return False
+    if _rigid_root(d, b).index in taken:
+        return False  # on a limb's end or a finger: a tool frame, a finger's tip
+    rot = d.tree.poses[b.index][:3, :3]
+    return abs(float(rot[2, 0])) < _LEVEL and float(rot[2, 1]) < -_DOWN
+
+
 def _camera_questions(d: Drafter) -> list[DraftQuestion]:
     """One question per camera-like device no drafted camera is on."""
     world, tree, draft = d.world, d.tree, d.draft
     drafted = [world.get_body_by_name(c.body) for c in draft.cameras if world.has_body(c.body)]
+    taken = _limb_ends(d)
     why: dict[int, str] = {}
     for link, kind in d.facts.sensor_links.items():
         if world.has_body(link) and any(k in kind for k in _IMAGE_KINDS):
@@ -249,9 +294,12 @@ def _camera_questions(d: Drafter) -> list[DraftQuestion]:
         if b.index in why or b is tree.root:
             continue
         w = words(b.name) | set(_TOKENS.split(b.name.lower()))
-        if w & NOT_CAMERA_WORDS or not (w & CAMERA_WORDS):
+        if w & NOT_CAMERA_WORDS:
             continue
-        why[b.index] = "a frame named as a camera"
+        if w & CAMERA_WORDS:
+            why[b.index] = "a frame named as a camera"
+        elif _turned_optical(d, b, taken):
+            why[b.index] = "a bare frame turned as a camera's optical frame (z ahead, y down)"
     devices: list[list[Body]] = []
     for i in sorted(why):
         b = world.bodies[i]

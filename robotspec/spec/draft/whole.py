@@ -18,7 +18,7 @@ camera        the sensor's type is no plain image camera (thermal, segmentation,
               its name; several sensors sit on the device (which channel: by names)
 tool frame    the hand (or the chain's end) holds another frame named as a TCP; a gripper's
               TCP lies behind the hand's root, away from its finger tips
-gripper       a finger's tip carries links of its own (a pad, a frame: which is the tip?)
+gripper       the two tips end differently (one on its jaw, one on a pad fixed past its jaw)
 chain         the SRDF group's joints include a prismatic one (a lift: torso or arm?)
 drive         a fixed virtual joint on a robot with wheels on fixed joints, wheel-shaped
               joints, casters or a drive plugin; a floating one on a robot with wheels; a
@@ -215,11 +215,16 @@ def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str |
             if float((tree.poses[tool.index][:3, 3] - base) @ reach) < 0:
                 return f"the tool frame '{tool.name}' lies behind the hand, away from its tips"
     if GRIPPER_MIMIC in rules and m.thumb is not None and m.finger is not None:
-        for f in (m.thumb, m.finger):
-            tip = world.get_body_by_name(f.tip) if world.has_body(f.tip) else None
-            pads = [] if tip is None else [k for k in world.subtree(tip) if k is not tip]
-            if any(own_geometry(k) for k in pads):
-                return f"a shape hangs below the finger tip '{f.tip}': which is the tip?"
+        # The mimic tag couples the fingers; where their tips are it does not say. Two alike
+        # fingers end alike: one ending on its jaw and the other on a pad fixed past its jaw
+        # is a file that models the sides differently (which link is each tip?).
+        ends = [
+            world.parent_connection(f.tip) for f in (m.thumb, m.finger) if world.has_body(f.tip)
+        ]
+        if len(ends) == 2 and len({c is not None and c.is_fixed for c in ends}) == 2:
+            return (
+                f"the finger tips '{m.thumb.tip}' and '{m.finger.tip}' end differently: the tips?"
+            )
     return None
 
 

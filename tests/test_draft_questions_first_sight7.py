@@ -1,0 +1,68 @@
+"""Questions about what a draft leaves out, for shapes first-sight robots showed (issue 30).
+
+Small layouts built here: a camera frame with a generic name and no Gazebo sensor, turned as
+optical frames are (a rear camera looking backwards), is asked about by name; a frame that is
+not turned so is not. Whichever part finds such a frame (the camera detector drafts some,
+marked), none is left out unasked.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from robotspec.spec.draft.unassigned import SENSORS
+from tests.test_draft_blind import _draft, _joint, _link
+
+#: REP 103's optical rotation for a camera looking backwards (-x), and one looking forwards.
+_BACKWARDS = "-1.5707963 0 1.5707963"
+_TILTED_DOWN = "-2.3562 0 -1.5707963"
+
+
+def _base(frames: list[tuple[str, str, str]]) -> list[str]:
+    """A box on four fixed feet (nothing moves) with bare frames (name, xyz, rpy) on it."""
+    parts = [_link("body", size=0.3)]
+    for name, xyz, rpy in frames:
+        parts += [
+            f'<link name="{name}"/>',
+            _joint(f"{name}_joint", "body", name, kind="fixed", xyz=xyz, rpy=rpy),
+        ]
+    return parts
+
+
+def test_a_bare_frame_turned_as_an_optical_frame_is_asked_about(tmp_path: Path) -> None:
+    d = _draft(
+        tmp_path,
+        "box",
+        _base([("rear_a", "-0.4 0 0.05", _BACKWARDS), ("front_b", "0.4 0 0.06", _TILTED_DOWN)]),
+    )
+    # Drafted as a camera (marked), or asked about: never left out unasked.
+    sensors = [q for q in d.questions if q.section == SENSORS]
+    asked = {name for q in sensors for name in q.links}
+    drafted = {c.body for c in d.cameras if c.decide}
+    assert asked | drafted >= {"rear_a", "front_b"}
+    assert all("turned as a camera's optical frame" in q.text for q in sensors)
+
+
+def test_frames_not_turned_as_optical_frames_are_not_asked_about(tmp_path: Path) -> None:
+    d = _draft(
+        tmp_path,
+        "box",
+        _base([("marker", "0.4 0 0.05", "0 0 0"), ("imu", "0 0 0.1", "3.1415926 0 0")]),
+    )
+    assert not [q for q in d.questions if q.section == SENSORS]
+
+
+def test_the_question_names_the_frame_when_no_camera_is_drafted_there(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The camera detector set aside (it may draft such frames itself): the question alone.
+    monkeypatch.setattr("robotspec.spec.draft.parts.find_cameras", lambda tree: [])
+    d = _draft(tmp_path, "box", _base([("rear_a", "-0.4 0 0.05", _BACKWARDS)]))
+    (q,) = d.questions
+    assert q.section == SENSORS and q.links == frozenset({"rear_a"})
+    assert q.text == (
+        "rear_a (a bare frame turned as a camera's optical frame (z ahead, y down)) is no "
+        "drafted camera: a camera? which frame?"
+    )

@@ -29,7 +29,7 @@ from lxml import etree
 
 from robotspec.files.xmlsafe import line_of
 
-__all__ = ["CAMERA_TYPES", "GazeboCamera", "gazebo_cameras", "sensor_links"]
+__all__ = ["CAMERA_TYPES", "GazeboCamera", "channel_frames", "gazebo_cameras", "sensor_links"]
 
 #: Sensor types that are image cameras (classic, gz-sim spellings).
 CAMERA_TYPES = frozenset(
@@ -47,6 +47,14 @@ _FRAME_TAGS = (
     "colorOpticalframeName",  # realsense_gazebo_plugin
     "gz_frame_id",  # gz-sim sensor
     "ignition_frame_id",  # ignition-gazebo sensor
+)
+#: A RealSense plugin's channels: the suffix of each sensor's name after the plugin's
+#: ``<prefix>``, and the element naming the frame that channel's images are published in.
+_CHANNEL_TAGS = (
+    ("color", "colorOpticalframeName"),
+    ("depth", "depthOpticalframeName"),
+    ("ired1", "infrared1OpticalframeName"),
+    ("ired2", "infrared2OpticalframeName"),
 )
 #: Most sensors read from one robot file (a file is bounded; this bounds the records kept).
 _MAX_SENSORS = 10_000
@@ -141,18 +149,52 @@ def _first(sensor: etree._Element, tag: str) -> etree._Element | None:
     return None
 
 
-def _frame(sensor: etree._Element, block: etree._Element) -> str | None:
-    """The frame the sensor's images are published in: the sensor's, else its block's plugin."""
+def _frame_name(text: str | None) -> str | None:
+    if text is None or text in ("world", "map", "odom"):
+        return None
+    return text.lstrip("/") or None
+
+
+def _frame(sensor: etree._Element, block: etree._Element, channels: dict[str, str]) -> str | None:
+    """The frame the sensor's images are published in: the sensor's, else its block's plugin.
+
+    ``channels``: the frames a RealSense plugin names per sensor (``channel_frames``); they
+    come before the block's plugins, whose first frame element may be another channel's.
+    """
+    name = None
+    for tag in _FRAME_TAGS:
+        name = name or _frame_name(_text(_first(sensor, tag)))
+    name = name or channels.get((sensor.get("name") or "").strip())
     # The block's own plugins (realsense_gazebo_plugin's), never another sensor's.
-    for scope in (sensor, *_children(block, "plugin")):
+    for scope in _children(block, "plugin"):
         for tag in _FRAME_TAGS:
-            name = _text(_first(scope, tag))
-            if name is not None and name not in ("world", "map", "odom"):
-                return name.lstrip("/")
-    return None
+            name = name or _frame_name(_text(_first(scope, tag)))
+    return name
 
 
-def _camera(block: etree._Element, sensor: etree._Element, link: str) -> GazeboCamera | None:
+def channel_frames(root: etree._Element) -> dict[str, str]:
+    """The frame each sensor of a RealSense plugin publishes in, by the sensor's name.
+
+    Why: realsense_gazebo_plugin is a model plugin (often in a ``<gazebo>`` block of its own)
+    that finds its sensors by name, ``<prefix>`` + ``color``, ``depth``, ``ired1``, ``ired2``,
+    and names one frame per channel; the colour channel's is the camera a person writes.
+    """
+    out: dict[str, str] = {}
+    for block in _children(root, "gazebo"):
+        for plugin in _children(block, "plugin"):
+            prefix = _text(_first(plugin, "prefix"))
+            if prefix is None:
+                continue
+            for suffix, tag in _CHANNEL_TAGS:
+                frame = _frame_name(_text(_first(plugin, tag)))
+                if frame is not None:
+                    out.setdefault(prefix + suffix, frame)
+    return out
+
+
+def _camera(
+    block: etree._Element, sensor: etree._Element, link: str, channels: dict[str, str]
+) -> GazeboCamera | None:
     kind = (sensor.get("type") or "").strip().lower()
     if kind not in CAMERA_TYPES:
         return None
@@ -174,7 +216,7 @@ def _camera(block: etree._Element, sensor: etree._Element, link: str) -> GazeboC
         link=link,
         line=line_of(sensor),
         pose=pose,
-        frame=_frame(sensor, block),
+        frame=_frame(sensor, block, channels),
         horizontal_fov=_positive(_text(_first(scope, "horizontal_fov"))),
         width=_pixels(_text(_first(scope, "width"))),
         height=_pixels(_text(_first(scope, "height"))),
@@ -194,9 +236,10 @@ def _blocks(root: etree._Element) -> list[tuple[etree._Element, str]]:
 def gazebo_cameras(root: etree._Element) -> tuple[GazeboCamera, ...]:
     """The camera sensors of a URDF element tree's ``<gazebo>`` blocks, in file order."""
     out: list[GazeboCamera] = []
+    channels = channel_frames(root)
     for block, link in _blocks(root):
         for sensor in _children(block, "sensor"):
-            cam = _camera(block, sensor, link)
+            cam = _camera(block, sensor, link, channels)
             if cam is not None:
                 out.append(cam)
             if len(out) >= _MAX_SENSORS:

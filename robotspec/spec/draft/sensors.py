@@ -1,7 +1,8 @@
 """Cameras and the neck that points them.
 
 A frame is an *optical* frame when its rotation from its parent is REP 103's (z forward, x
-right, y down), or that rotation tilted up or down (x still right), whatever its name; a frame
+right, y down), or that rotation tilted up or down (x still right), or turned round to look
+back (a rear camera), whatever its name; a frame
 named as a camera without that rotation is a camera looking along its x axis. IMUs, lasers,
 range finders and force sensors are never cameras, whatever their rotation. One device often
 has several frames (PR2's ``wide_stereo`` with its simulated left and right cameras, an Xtion's
@@ -82,7 +83,11 @@ def is_optical(tree: Tree, body: Body) -> bool:
         return True
     # An optical frame tilted down or up (a camera looking at the floor ahead): x still points
     # right (-y of the parent), z ahead within 60 degrees of the parent's x.
-    return bool(np.allclose(rot[:, 0], _OPTICAL[:, 0], atol=1e-3) and rot[0, 2] > _TILT)
+    if np.allclose(rot[:, 0], _OPTICAL[:, 0], atol=1e-3) and rot[0, 2] > _TILT:
+        return True
+    # The same turned round (a rear camera, B2W's 'r_dc_link'): x right of a camera looking
+    # back is the parent's +y, z behind within 60 degrees of the parent's -x.
+    return bool(np.allclose(rot[:, 0], -_OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -_TILT)
 
 
 def _stem(name: str) -> str:

@@ -28,8 +28,10 @@ __all__ = ["StatedCamera", "fill_stated", "stated_cameras"]
 
 #: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
 _OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
-#: Words naming a channel of an RGB-D device.
-_CHANNELS = frozenset({"color", "colour", "rgb", "depth", "ir", "infra", "infrared", "ired"})
+#: Words naming a channel of an RGB-D device (a tracking camera's fisheye pair: one device).
+_CHANNELS = frozenset(
+    {"color", "colour", "rgb", "depth", "ir", "infra", "infrared", "ired", "fisheye"}
+)
 _COLOUR = frozenset({"color", "colour", "rgb"})
 #: How far apart (m) the channels of one device may be (a RealSense's are 1.5 to 5 cm).
 DEVICE_SPAN = 0.1
@@ -145,7 +147,25 @@ def _device_frame(tree: Tree, body: Body, view: np.ndarray) -> Body | None:
     return other if far <= DEVICE_SPAN and float(pose[:3, 2] @ view) > _ALONG else None
 
 
-def _resolve(tree: Tree, g: GazeboCamera) -> StatedCamera | None:
+def _own_frame(
+    tree: Tree, link: Body, named: Body | None, view: np.ndarray, at: np.ndarray
+) -> bool:
+    """Whether the plugin's frame is this sensor's own channel, a little beside where it is.
+
+    Why: a RealSense plugin simulates its colour, depth and infrared images at the device's
+    link and publishes them in the colour optical frame 1.5 cm beside it; that frame is the
+    camera a person writes. Only a frame rigid with the link, within a device's span, looking
+    the sensor's way, and named by sensors at this one spot (``_resolve``'s caller checks).
+    """
+    if named is None or _rigid_root(tree, named) is not _rigid_root(tree, link):
+        return False
+    pose = tree.poses[named.index]
+    near = float(np.linalg.norm(pose[:3, 3] - at)) <= DEVICE_SPAN
+    return near and float(pose[:3, 2] @ view) > _ALONG
+
+
+def _resolve(tree: Tree, g: GazeboCamera, shared: frozenset[str]) -> StatedCamera | None:
+    """The frame a Gazebo camera ``g`` sees from (``shared``: frames named from several spots)."""
     world = tree.world
     if not world.has_body(g.link):
         return None
@@ -161,7 +181,9 @@ def _resolve(tree: Tree, g: GazeboCamera) -> StatedCamera | None:
         named = named if named.index in tree.inside else None
     # Where the sensor is, an optical frame looking its way is the camera; the plugin's frame
     # elsewhere (PR2's 'wide_stereo_optical_frame', between the pair) names the device's.
-    body = _optical_at(tree, link, view, at, named)
+    # A frame the plugin names for sensors at this one spot only, just beside it, is its own.
+    own = g.frame not in shared and _own_frame(tree, link, named, view, at)
+    body = named if own else _optical_at(tree, link, view, at, named)
     how = f"the optical frame where it is on '{g.link}'"
     if body is not None and body is named:
         how = f"its plugin's frame '{named.name}'"
@@ -207,7 +229,18 @@ def _one_device(tree: Tree, a: StatedCamera, b: StatedCamera) -> bool:
     if _rigid_root(tree, a.body) is not _rigid_root(tree, b.body):
         return False
     far = tree.poses[a.body.index][:3, 3] - tree.poses[b.body.index][:3, 3]
-    return float(np.linalg.norm(far)) <= DEVICE_SPAN
+    # One device's channels look one way: a tracking camera beside an RGB-D one (CENTAURO's
+    # T265 4 cm from its D435i, tilted otherwise) is another device.
+    same_way = float(_view(tree, a) @ _view(tree, b)) > _ALONG
+    return float(np.linalg.norm(far)) <= DEVICE_SPAN and same_way
+
+
+def _view(tree: Tree, c: StatedCamera) -> np.ndarray:
+    """The way a stated camera looks, in the world (default pose), a unit vector."""
+    local = np.array([0.0, 0.0, 1.0]) if c.optical else np.asarray(c.axis, dtype=np.float64)
+    v: np.ndarray = np.asarray(tree.poses[c.body.index][:3, :3] @ local, dtype=np.float64)
+    n = float(np.linalg.norm(v))
+    return v / n if n > 1e-9 else v
 
 
 def _preference(c: StatedCamera) -> tuple[int, int]:
@@ -224,7 +257,13 @@ def stated_cameras(tree: Tree, facts: FileFacts) -> tuple[list[StatedCamera], se
     out included: none of them is another camera.
     """
     sensors = facts.cameras[:MAX_SENSORS]
-    resolved = [r for g in sensors if (r := _resolve(tree, g)) is not None]
+    # Frames the plugins of sensors at different spots name (PR2's stereo pair's middle).
+    spots: dict[str, set[tuple[str, tuple[float, ...]]]] = {}
+    for g in sensors:
+        if g.frame is not None:
+            spots.setdefault(g.frame, set()).add((g.link, tuple(round(v, 4) for v in g.pose[:3])))
+    shared = frozenset(f for f, at in spots.items() if len(at) > 1)
+    resolved = [r for g in sensors if (r := _resolve(tree, g, shared)) is not None]
     devices: list[list[StatedCamera]] = []
     for r in resolved:
         home = next((d for d in devices if any(_one_device(tree, r, o) for o in d)), None)

@@ -2,9 +2,10 @@
 
 Why its own module: a tool frame is read from the files before anything is guessed. A bare
 frame named as a TCP (``tool0``, ``*_tcp``, ``grasp_frame``...) is the files' answer; a bare
-frame on the joint a hand's fingers mimic is the hand's TCP (NAO's ``l_gripper``); names
-weaker than these are questions; a hand with none gets a frame proposed between its tips,
-at the far ends of their geometry (``tips.between_tips``).
+frame on the joint a hand's fingers mimic is the hand's TCP (NAO's ``l_gripper``); a bare frame
+at the far end of a rigid tool is its tip, whatever its name; names weaker than these are
+questions; a hand with none gets a frame proposed between its tips, at the far ends of their
+geometry (``tips.between_tips``).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ __all__ = [
     "TCP_NAMES",
     "TOOL_HINTS",
     "bare_fixed_leaf",
+    "end_frame",
     "find_tool_frame",
     "fixed_jaw",
     "frame_at_tips",
@@ -164,7 +166,52 @@ def find_tool_frame(
     ]
     if bare:
         return min(bare, key=lambda b: (world.depth(b), b.index))
-    return fixed_jaw(world, top) if top.index not in exclude else None
+    jaw = fixed_jaw(world, top) if top.index not in exclude else None
+    return jaw if jaw is not None or leaf else end_frame(tree, top, candidates)
+
+
+#: Words of frames that are a sensor's, not a tool's (an F/T sensor's frame, an IMU's...).
+SENSOR_WORDS = frozenset(
+    {"ft", "imu", "force", "torque", "sensor", "camera", "cam", "optical", "laser", "lidar"}
+    | {"led", "light", "gyro", "accel", "accelerometer", "mic", "microphone", "com", "mass"}
+)
+#: How far (m) a frame may lie from the far end of the geometry it ends, to be at that end.
+AT_END = 0.01
+#: ... or this fraction of the way out, for large tools.
+AT_END_SHARE = 0.1
+
+
+def end_frame(tree: Tree, top: Body, candidates: list[Body]) -> Body | None:
+    """The one bare frame at the far end of a rigid end effector, whatever its name.
+
+    Why structure: an arm's tool with nothing that moves (a ball, a probe, a welding torch)
+    often carries a frame where it touches the work, named as nothing this module knows
+    (CENTAURO's 'ball1_tip'); it is a bare leaf placed out at the far end of the tool's
+    geometry, the way it points from the last joint. Frames at the mount (an F/T sensor's, a
+    legacy link's) sit at its origin, frames named as sensors are the sensors'. ``None`` when
+    anything moves below ``top``, or when not exactly one frame is at the end.
+    """
+    world = tree.world
+    if tree.moves_below(top):
+        return None
+    facts = tree.memo.get("facts")
+    sensed = set(getattr(facts, "sensor_links", {}) or {})
+    here = np.asarray(tree.poses[top.index][:3, 3], dtype=np.float64)
+    solid = [b for b in world.subtree(top) if own_geometry(b)]
+    found = []
+    for b in candidates:
+        if b is top or not bare_fixed_leaf(world, b) or b.name in sensed:
+            continue
+        if words(b.name) & SENSOR_WORDS:
+            continue
+        d = np.asarray(tree.poses[b.index][:3, 3], dtype=np.float64) - here
+        along = float(np.linalg.norm(d))
+        if along < AT_END or not solid:
+            continue
+        reach = max(float((far_end(tree, s, d) - here) @ d) / along for s in solid)
+        if abs(along - reach) <= max(AT_END, AT_END_SHARE * reach):
+            found.append(b)
+    return found[0] if len(found) == 1 else None
 
 
 def fixed_jaw(world: World, hand: Body) -> Body | None:

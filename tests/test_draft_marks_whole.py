@@ -12,6 +12,7 @@ from robotspec.spec.draft.confidence import (
     CAMERA_GAZEBO,
     DRIVE_FIXED,
     GRIPPER_MIMIC,
+    TOOL_AT_END,
     TOOL_ON_HAND,
 )
 from robotspec.spec.draft.model import Draft
@@ -173,3 +174,21 @@ def test_a_planar_move_plugin_is_no_drive_stated(tmp_path: Path) -> None:
     kind, why, rule = _drive(d)
     assert (kind, rule) == ("omni", None)
     assert why is not None and "moves the base in the plane" in why
+
+
+def test_a_tcp_name_past_a_bolted_on_tool_keeps_the_mark(tmp_path: Path) -> None:
+    # No hand (nothing moves past the arm), but a shape is bolted on past its last joint: the
+    # frame named 'tool0' may be the flange, not the tool's point.
+    bare = [
+        '<link name="tool0"/>',
+        _joint("tool0_joint", "l4", "tool0", kind="fixed", xyz="0 0 0.05"),
+    ]
+    (m,) = _draft(tmp_path, "arm", [*_arm_on([]), *bare]).manipulators
+    assert (m.tool_frame, m.stated) == ("tool0", (TOOL_AT_END,))
+    torch = [
+        _link("torch", size=0.03),
+        _joint("torch_mount", "l4", "torch", kind="fixed", xyz="0 0 0.05"),
+    ]
+    (m,) = _draft(tmp_path, "arm", [*_arm_on([]), *bare, *torch]).manipulators
+    assert m.tool_frame == "tool0" and m.stated == ()
+    assert "'torch' hangs past the arm's last joint: a tool, whose TCP?" in m.decide

@@ -13,17 +13,22 @@ unmarked exactly there. This pass runs after every part is drafted and only ever
 item          keeps (gets back) its mark when
 ============  ==========================================================================
 camera        the sensor's type is no plain image camera (thermal, segmentation, a logical
-              camera); the frame is the sensor's own link while another frame fixed to it
-              looks along its view (an optical child elsewhere); the frame is a device's by
-              its name; several sensors sit on the device (which channel: by names)
+              camera); another sensor of the device sees from a frame the draft did not
+              take, or a bare frame fixed beside the camera (within 10 cm, not where a
+              drafted camera is) looks the same way (a colour optical frame beside the depth
+              one the sensor sits on), unless the chosen frame alone is named as the colour
+              channel; the frame is neither where the sensor sees from, nor its link, nor a
+              frame its plugin names
 tool frame    the hand (or the chain's end) holds another frame named as a TCP; a gripper's
-              TCP lies behind the hand's root, away from its finger tips
+              TCP lies behind the hand's root, away from its finger tips; without a hand, a
+              shape hangs past the arm's last joint (a tool bolted on)
 gripper       the two tips end differently (one on its jaw, one on a pad fixed past its jaw)
 chain         the SRDF group's joints include a prismatic one (a lift: torso or arm?)
-drive         a fixed virtual joint on a robot with wheels on fixed joints, wheel-shaped
-              joints, casters or a drive plugin; a floating one on a robot with wheels; a
-              drive plugin that moves the base in the plane (``planar_move``), names no
-              wheels, leaves driven wheels out, or sits on a robot with legs
+drive         a fixed virtual joint on a robot with wheels (turning, wheel-shaped or on
+              fixed joints), casters, a drive plugin, or more than two limbs (legs drafted
+              as arms); a floating one on a robot with wheels; drive plugins that disagree,
+              one moving the base in the plane (``planar_move``), naming no wheels, leaving
+              driven wheels out, or on a robot with legs
 ============  ==========================================================================
 """
 
@@ -208,6 +213,13 @@ def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str |
         other = [b.name for b in world.subtree(root) if b is not tool and is_named_tcp(world, b)]
         if other:
             return f"'{other[0]}' is named as a TCP too: which is the tool frame?"
+        if TOOL_AT_END in rules:
+            # No hand found, but a shape hangs past the arm's last joint: a tool bolted on
+            # (a torch, a suction cup, fingers on fixed joints) whose TCP the name may not be.
+            last = _rigid_root(d, root)  # the link the arm's last joint moves
+            shaped = [b.name for b in world.subtree(last) if b is not last and own_geometry(b)]
+            if shaped:
+                return f"'{shaped[0]}' hangs past the arm's last joint: a tool, whose TCP?"
         if m.is_gripper and m.thumb is not None and m.finger is not None:
             tips = [world.get_body_by_name(f.tip) for f in (m.thumb, m.finger)]
             base = tree.poses[root.index][:3, 3]
@@ -244,6 +256,9 @@ def _chain_doubt(d: Drafter, c: DraftChain) -> str | None:
 def _drive_doubt(d: Drafter, rule: str) -> str | None:
     world, facts, draft = d.world, d.facts, d.draft
     legs = [c for c in draft.chains if c.role == "leg"]
+    limbs = [c for c in draft.chains if c.role in ("arm", "leg")]
+    if rule == DRIVE_FIXED and len(limbs) > 2:
+        return f"the SRDF's virtual joint is fixed, but the tree has {len(limbs)} limbs: legs?"
     if rule == DRIVE_FIXED:
         casters = [c for c in world.connections if words(c.name) & {"caster", "castor"}]
         if d.wheel_shaped or d.wheels or fixed_wheels(world) or casters or facts.actuation.drives:
@@ -286,7 +301,7 @@ def keep_marks(d: Drafter) -> None:
                 cam.decide.append(why)
                 cam.stated = None
     for m in draft.manipulators:
-        if m.stated and not m.decide and (why := _tcp_doubt(d, m, m.stated)) is not None:
+        if m.stated and (why := _tcp_doubt(d, m, m.stated)) is not None:
             m.decide.append(why)
             m.stated = ()
     for c in draft.chains:

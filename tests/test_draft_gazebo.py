@@ -185,7 +185,11 @@ def test_pr2_cameras_are_where_its_gazebo_sensors_are(tmp_path: Path) -> None:
         "l_forearm_cam_optical_frame",
         "r_forearm_cam_optical_frame",
     }
-    assert all(c.optical and not c.decide and c.source for c in cams.values())
+    assert all(c.optical and c.source for c in cams.values())
+    # Each stereo pair's two eyes: one camera in a spec, or both, the files do not say (whole).
+    pairs = {b for b, c in cams.items() if c.decide}
+    assert pairs == {b for b in cams if "stereo" in b}
+    assert all(cams[b].decide[0].startswith("two eyes of one device") for b in pairs)
     assert cams["wide_stereo_l_stereo_camera_optical_frame"].field_of_view == (1.5708, 1.287)
     assert "its plugin's frame" in (cams["high_def_optical_frame"].source or "")
 
@@ -204,7 +208,12 @@ def test_hsrb_cameras_are_the_optical_links_above_their_gazebo_frames(tmp_path: 
         "head_rgbd_sensor_link",
         "hand_camera_frame",
     }
-    assert all(c.optical and not c.decide and c.source for c in d.cameras)
+    assert all(c.optical and c.source for c in d.cameras)
+    # The head's stereo pair is asked (one camera or both); the others are stated.
+    assert {c.body for c in d.cameras if c.decide} == {
+        "head_l_stereo_camera_link",
+        "head_r_stereo_camera_link",
+    }
     # Two wheels driven in velocity on a turntable (base_roll_joint): omnidirectional.
     assert d.drive is not None and (d.drive.type, d.drive.source) == (
         "omni",

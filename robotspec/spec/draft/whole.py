@@ -12,13 +12,14 @@ unmarked exactly there. This pass runs after every part is drafted and only ever
 ============  ==========================================================================
 item          keeps (gets back) its mark when
 ============  ==========================================================================
-camera        the sensor's type is no plain image camera (thermal, segmentation, a logical
-              camera); another sensor of the device sees from a frame the draft did not
-              take, or a bare frame fixed beside the camera (within 10 cm, not where a
-              drafted camera is) looks the same way (a colour optical frame beside the depth
-              one the sensor sits on), unless the chosen frame alone is named as the colour
-              channel; the frame is neither where the sensor sees from, nor its link, nor a
-              frame its plugin names
+camera        it is one eye of a stereo pair (two identical imagers on one mount, side by
+              side: one camera or two?); the sensor's type is no plain image camera
+              (thermal, segmentation, a logical camera); another sensor of the device sees
+              from a frame the draft did not take, or a bare frame fixed beside the camera
+              (within 10 cm, not where a drafted camera is) looks the same way (a colour
+              optical frame beside the depth one the sensor sits on), unless the chosen
+              frame alone is named as the colour channel; the frame is neither where the
+              sensor sees from, nor its link, nor a frame its plugin names
 tool frame    the hand (or the chain's end) holds another frame named as a TCP; a gripper's
               TCP lies behind the hand's root, away from its finger tips; without a hand, a
               shape hangs past the arm's last joint (a tool bolted on)
@@ -68,6 +69,9 @@ _PLAIN = frozenset(
 )
 #: How far apart (m) the frames of one device may be (a RealSense's channels: 1.5 to 5 cm).
 _DEVICE_SPAN = 0.1
+#: The widest stereo baseline (m) two identical imagers of one device have (a MultiSense S21's
+#: 21 cm; a ZED's 12 cm, HSR-B's head pair 14 cm).
+_STEREO_BASE = 0.25
 #: How near (m) a frame must be to a sensor to be where it sees from.
 _SPOT = 0.01
 #: The cosine within which a frame's z axis is a view direction (8 degrees).
@@ -193,6 +197,34 @@ def _view(d: Drafter, cam: DraftCamera, body: Body) -> np.ndarray:
     return np.asarray(d.tree.poses[body.index][:3, :3] @ np.array(axis))
 
 
+def _pairs(d: Drafter) -> dict[str, str]:
+    """Gazebo-stated cameras that are two eyes of one device, each with the question.
+
+    Two identical imagers (the same field of view) on one rigid mount, within a stereo rig's
+    baseline of each other and looking the same way are a stereo pair: whether a spec lists
+    one camera or both is a convention the files do not settle (a tracking camera's two
+    fisheyes, a head's pair).
+    """
+    world, tree = d.world, d.tree
+    cams = [
+        (c, world.get_body_by_name(c.body))
+        for c in d.draft.cameras
+        if c.stated == CAMERA_GAZEBO and c.field_of_view is not None and world.has_body(c.body)
+    ]
+    out: dict[str, str] = {}
+    for i, (a, ab) in enumerate(cams):
+        for b, bb in cams[i + 1 :]:
+            if a.field_of_view != b.field_of_view or _rigid_root(d, ab) is not _rigid_root(d, bb):
+                continue
+            gap = float(np.linalg.norm(tree.poses[ab.index][:3, 3] - tree.poses[bb.index][:3, 3]))
+            if gap > _STEREO_BASE or float(_view(d, a, ab) @ _view(d, b, bb)) < _ALONG:
+                continue
+            why = "two eyes of one device ('{}', '{}'): one camera in the spec, or both?"
+            out.setdefault(a.body, why.format(a.body, b.body))
+            out.setdefault(b.body, why.format(a.body, b.body))
+    return out
+
+
 def _resolved(d: Drafter) -> set[int]:
     """The bodies every Gazebo camera sensor resolves to (or its plugin names), found once."""
     memo = d.tree.memo
@@ -295,9 +327,10 @@ def _drive_doubt(d: Drafter, rule: str) -> str | None:
 def keep_marks(d: Drafter) -> None:
     """Give back the mark of every item whose rule's files state only part of it."""
     draft = d.draft
+    pairs = _pairs(d)
     for cam in draft.cameras:
         if cam.stated == CAMERA_GAZEBO and not cam.decide and d.world.has_body(cam.body):
-            if (why := _camera_doubt(d, cam)) is not None:
+            if (why := pairs.get(cam.body) or _camera_doubt(d, cam)) is not None:
                 cam.decide.append(why)
                 cam.stated = None
     for m in draft.manipulators:

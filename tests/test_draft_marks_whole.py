@@ -192,3 +192,25 @@ def test_a_tcp_name_past_a_bolted_on_tool_keeps_the_mark(tmp_path: Path) -> None
     (m,) = _draft(tmp_path, "arm", [*_arm_on([]), *bare, *torch]).manipulators
     assert m.tool_frame == "tool0" and m.stated == ()
     assert "'torch' hangs past the arm's last joint: a tool, whose TCP?" in m.decide
+
+
+def test_the_two_eyes_of_a_stereo_pair_keep_their_marks(tmp_path: Path) -> None:
+    # Two identical Gazebo cameras side by side on one mount, looking the same way: one camera
+    # in a spec, or both? A third, different imager beside them is a camera of its own.
+    parts = [_link("base", size=0.2), _link("mount", size=0.02)]
+    parts.append(_joint("mount_joint", "base", "mount", kind="fixed", xyz="0.1 0 0.5"))
+    for eye, y in (("left", "0.03"), ("right", "-0.03")):
+        parts += [
+            f'<link name="{eye}_eye"/>',
+            _joint(f"{eye}_joint", "mount", f"{eye}_eye", kind="fixed", xyz=f"0 {y} 0"),
+            f'<link name="{eye}_optical"/>',
+            _joint(f"{eye}_opt", f"{eye}_eye", f"{eye}_optical", kind="fixed", rpy=_OPTICAL_RPY),
+            _sensor(f"{eye}_eye"),
+        ]
+    d = _draft(tmp_path, "stereo", parts)
+    assert len(d.cameras) == 2
+    assert all(c.stated is None for c in d.cameras)
+    left, right = sorted(c.body for c in d.cameras)
+    assert [c.decide for c in d.cameras] == 2 * [
+        [f"two eyes of one device ('{left}', '{right}'): one camera in the spec, or both?"]
+    ]

@@ -53,6 +53,7 @@ if str(REPO) not in sys.path:  # ``python tools/corpus/measure.py`` as well as `
     sys.path.insert(0, str(REPO))
 
 from tools.draft_score import (  # noqa: E402
+    ASKED,
     CATEGORIES,
     MARKED,
     RobotScore,
@@ -265,6 +266,12 @@ def rule_lines(scores: Sequence[RobotScore]) -> list[str]:
     lines = ["| rule (what left the item unmarked) | items | wrong |", "| --- | --- | --- |"]
     for rule in sorted(per, key=lambda r: (r == MARKED, r)):
         lines.append(f"| {rule} | {per[rule][0]} | {per[rule][1]} |")
+    # The rows of items a draft states without a mark (a rule's, or none's): how many a user
+    # is told nothing about. Marked items and missed ones a question names are not among them.
+    bare = [r for r in per if r not in (MARKED, ASKED)]
+    items, wrong = sum(per[r][0] for r in bare), sum(per[r][1] for r in bare)
+    total = sum(n for n, _ in per.values())
+    lines += ["", f"Items without a mark: {items} of {total} ({wrong} wrong)."]
     return lines
 
 

@@ -180,3 +180,17 @@ def test_optical_frames_turned_round_are_rear_cameras(tmp_path: Path) -> None:
     cams = {c.body: c for c in d.cameras}
     assert sorted(cams) == ["front_cam", "front_depth", "rear_cam", "rear_depth"]
     assert cams["rear_depth"].optical and cams["rear_depth"].decide  # by rotation: asked
+
+
+def test_the_frame_an_imu_sensor_publishes_in_is_no_camera(tmp_path: Path) -> None:
+    # A device's IMU publishes in a frame turned as optical frames are, named as nothing a
+    # camera or an IMU is named: the Gazebo IMU sensor's plugin says whose frame it is.
+    parts = [_link("base_link", size=0.2), *_realsense("dev", "base_link", "0.2 0 0.3")]
+    parts += _frame("dev_m", "dev_link", "0 -0.02 0")
+    parts += _frame("dev_m_optical", "dev_m", rpy=_OPTICAL_RPY)
+    parts.append(
+        '<gazebo reference="dev_m"><sensor name="m" type="imu"><plugin filename="x.so">'
+        "<frameName>dev_m_optical</frameName></plugin></sensor></gazebo>"
+    )
+    d = _draft(tmp_path, "imu_frame", parts)
+    assert [c.body for c in d.cameras] == ["dev_color_optical_frame"]

@@ -248,15 +248,24 @@ def gazebo_cameras(root: etree._Element) -> tuple[GazeboCamera, ...]:
 
 
 def sensor_links(root: etree._Element) -> dict[str, str]:
-    """Every link a Gazebo sensor block is on, with the type of its first sensor.
+    """Every link a Gazebo sensor block is on, and every frame a sensor that is no camera names.
 
-    Why: a link carrying a laser, an IMU or a contact sensor is no camera whatever its name; and
-    a camera's reference link is its mount, not a second camera.
+    Each with the type of its (first) sensor: the frame an IMU's own plugin publishes in too.
+    Why: a link carrying a laser, an IMU or a contact sensor is no camera whatever its name; a
+    camera's reference link is its mount, not a second camera; and the frame a RealSense's IMU
+    publishes in is turned as an optical frame but is the IMU's, whatever its name.
     """
     out: dict[str, str] = {}
+    frames: dict[str, str] = {}
     for block, link in _blocks(root):
         for sensor in _children(block, "sensor"):
-            out.setdefault(link, (sensor.get("type") or "").strip().lower())
-            if len(out) >= _MAX_SENSORS:
-                return out
-    return out
+            kind = (sensor.get("type") or "").strip().lower()
+            out.setdefault(link, kind)
+            if kind not in CAMERA_TYPES:  # the sensor's own plugin, never its block's
+                for tag in _FRAME_TAGS:
+                    if (frame := _frame_name(_text(_first(sensor, tag)))) is not None:
+                        frames.setdefault(frame, kind)
+                        break
+            if len(out) + len(frames) >= _MAX_SENSORS:
+                return {**frames, **out}
+    return {**frames, **out}

@@ -106,7 +106,10 @@ class Drafter:
         elif vj is not None:
             root = world.get_body_by_name(vj.child_link)
             kind = {"planar": "omni", "floating": "floating", "fixed": "fixed"}.get(vj.type)
-            if kind is not None and (kind == "fixed" or root is world.root):
+            # A parent frame that is a link of the URDF cannot be declared (the compiler
+            # refuses it): the SRDF's joint is a setup assistant's, the tree decides the drive.
+            declarable = not world.has_body(vj.parent_frame)
+            if kind is not None and declarable and (kind == "fixed" or root is world.root):
                 drive = DraftDrive(
                     kind, vj.name, vj.parent_frame, f"the SRDF's virtual joint '{vj.name}'"
                 )
@@ -118,6 +121,9 @@ class Drafter:
         if own is not None:
             drive = own_drive(world, own, self.wheels)
         self.limbs = find_limbs(self.tree, frozenset(c.name for c in self.wheels))
+        # Wheels at legs' ends, known by the leg they end (a wheel-legged robot's): the drive's.
+        known = {c.name for c in self.wheels}
+        self.wheels += [lb.wheel for lb in self.limbs if lb.wheel and lb.wheel.name not in known]
         self.forward, forward_why = facing(self.tree, self.limbs)
         self.draft = Draft(
             name=name,

@@ -97,7 +97,11 @@ def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
         thumb_i = max(range(len(at)), key=apart)
         decide = "the thumb is the finger whose base lies off the row of the others'"
         alone = _alone_on_a_side(tree, body, branches)
-        if alone is not None and _no_clear_row(at):
+        unspread = _without_spread(world, branches)
+        if unspread is not None:
+            thumb_i = unspread
+            decide = "the thumb is the finger with no spread joint, opposing the two that turn"
+        elif alone is not None and _no_clear_row(at):
             # Bases on a circle (D'Claw's three fingers): no row; the one opposing the others
             # across the palm is the thumb.
             thumb_i = alone
@@ -119,6 +123,24 @@ def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
     if any(f.root == f.tip for f in (out.thumb, *out.fingers.values())):
         return None
     return out
+
+
+def _without_spread(world: World, branches: list[Body]) -> int | None:
+    """Of three fingers, the one with a joint fewer than the two others (which have as many).
+
+    Why: a three-finger hand turns two fingers about the palm on spread joints to face the
+    third, fixed to the palm (BarrettHand's finger 3, Robotiq's middle finger, DH-3's finger
+    2): that one opposes them, as a thumb; its joints say so whatever the fingers are named.
+    """
+    if len(branches) != 3:
+        return None
+    counts = [sum(1 for b in world.subtree(k) if _moves(world, b)) for k in branches]
+    low = min(counts)
+    if counts.count(low) != 1 or len({c for c in counts if c != low}) != 1:
+        return None
+    if max(counts) - low != 1:
+        return None
+    return counts.index(low)
 
 
 #: Branches from one palm that make a hand whose one-link branches are fingers too.

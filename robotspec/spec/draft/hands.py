@@ -134,6 +134,9 @@ def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | N
         if (c := world.parent_connection(b)) is not None
         for d in c.dofs
     }
+    by_dof = _sides_by_dof(tree, branches)
+    if by_dof is not None:
+        return by_dof
     if len(dofs) != 1:
         return None  # a linkage moves with one actuator; several make a hand of fingers
     if any("thumb" in b.name.lower() for k in branches for b in world.subtree(k)):
@@ -161,6 +164,30 @@ def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | N
         )
         sides[0 if near_a else 1].append(k)
     return sides if all(len(side) == 2 for side in sides) else None
+
+
+def _reach(tree: Tree, root: Body, b: Body) -> float:
+    """How far ``b``'s frame lies from ``root``'s in the default pose (mm, rounded: ties stay)."""
+    d = tree.poses[b.index][:3, 3] - tree.poses[root.index][:3, 3]
+    return round(float(np.linalg.norm(d)) * 1000.0)
+
+
+def _sides_by_dof(tree: Tree, branches: list[Body]) -> list[list[Body]] | None:
+    """Four branches two actuators move, two each: each actuator's pair is one side, or None.
+
+    Why: a linkage gripper whose jaws have a motor each (the BCN3D Moveo's servo gear and idler
+    gear, each with its pivot arm on a mimic) is two sides of a finger and a linkage link; the
+    mimic tags say which links move together, wherever they start on the hand.
+    """
+    moved = [frozenset(_dofs(tree, k)) for k in branches]
+    if any(len(m) != 1 for m in moved):
+        return None
+    sides: dict[frozenset[int], list[Body]] = {}
+    for k, m in zip(branches, moved, strict=True):
+        sides.setdefault(m, []).append(k)
+    if len(sides) != 2 or any(len(side) != 2 for side in sides.values()):
+        return None
+    return list(sides.values())
 
 
 def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | None, str]:
@@ -193,8 +220,15 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
     for side in sides:
         ends = [finger_tip(tree, k) for k in side]
         # Of a linkage's two ends at one depth, the one a joint moves (Robotiq's finger tip on
-        # its mimic joint) is the tip, not the link fixed on the knuckle beside it.
-        tips.append(max(ends, key=lambda b: (world.depth(b), _moved(world, b), -b.index)))
+        # its mimic joint) is the tip, not the link fixed on the knuckle beside it; of two
+        # moved ones (AG-95's outer finger and pad, both on mimics), the one reaching farther
+        # out from the hand's root in the default pose, where the pad closes on the object.
+        tips.append(
+            max(
+                ends,
+                key=lambda b: (world.depth(b), _moved(world, b), _reach(tree, body, b), -b.index),
+            )
+        )
         leaders.append(
             any(
                 c.is_active

@@ -10,17 +10,37 @@ run splits into fingers; the joint turning it is the arm's last, the joints belo
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-import numpy as np
-
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
 from robotspec.spec.draft.ends import chain_end
 from robotspec.spec.draft.jaws import one_jaw
+from robotspec.spec.draft.limb_kinds import (
+    ARM_WORDS,
+    FINGER_WORDS,
+    HAND_WORDS,
+    HEAD_WORDS,
+    INNER_WORDS,
+    LEG_WORDS,
+    MAX_HAND_SPAN,
+    WORLD_WORDS,
+    Limb,
+    count,
+    hand_span,
+    is_named,
+    named,
+    paired_arms,
+    without_digits,
+)
 from robotspec.spec.draft.tree import Segment, Tree, words
 
 __all__ = [
+    "ARM_WORDS",
+    "FINGER_WORDS",
+    "HAND_WORDS",
+    "HEAD_WORDS",
+    "INNER_WORDS",
+    "LEG_WORDS",
+    "MAX_HAND_SPAN",
     "Limb",
     "beside_branch",
     "chain_end",
@@ -32,66 +52,14 @@ __all__ = [
     "is_named",
 ]
 
-HAND_WORDS = frozenset({"gripper", "hand", "palm", "eef", "jaw", "claw", "effector"})
-FINGER_WORDS = frozenset(
-    {"finger", "thumb", "knuckle", "phalanx", "index", "middle", "ring", "pinky", "little"}
-    | {"fingertip", "digit", "jaw", "claw"}
-)
-LEG_WORDS = frozenset(
-    {"leg", "foot", "feet", "knee", "ankle", "thigh", "calf", "shank", "shin", "sole", "toe"}
-    | {"haa", "hfe", "kfe"}  # ANYmal's hip abduction / hip flexion / knee flexion
-)
-#: Words also recognised inside longer words (``upperleg``, ``lowerleg``).
-INNER_WORDS = frozenset({"leg", "foot", "knee", "ankle", "thigh", "calf", "shank"})
-ARM_WORDS = frozenset({"arm", "shoulder", "elbow", "wrist", "forearm"})
-WORLD_WORDS = frozenset({"world", "map", "odom"})
-HEAD_WORDS = frozenset({"head", "neck", "eye", "eyes", "gaze"})
 #: Fewest actuated joints of a limb.
 MIN_LIMB_JOINTS = 3
 #: Shortest limb (sum of joint offsets, m): fingers are shorter.
 MIN_LIMB_LENGTH = 0.2
-#: A hand reaches no farther than this from where it splits into fingers (m).
-MAX_HAND_SPAN = 0.3
 #: A leg's end is this close to the lowest point of the robot (m) ...
 FOOT_CLEARANCE = 0.1
 #: ... and this far below where the leg starts (m).
 LEG_DROP = 0.15
-
-
-@dataclass(frozen=True)
-class Limb:
-    """An arm or a leg: ``root`` (above its first joint) to ``tip`` (below its last)."""
-
-    kind: str  # "arm" | "leg"
-    root: Body
-    tip: Body
-    hand: Body | None
-    joints: frozenset[str]
-    segment: Segment
-    why: str
-
-
-def hand_span(tree: Tree, body: Body) -> float:
-    """How far the subtree of ``body`` reaches from it in the default pose (m)."""
-    here = tree.position(body)
-    return max(
-        (float(np.linalg.norm(tree.position(b) - here)) for b in tree.world.subtree(body)),
-        default=0.0,
-    )
-
-
-def _named(bodies: tuple[Body, ...], vocabulary: frozenset[str]) -> bool:
-    return any(words(b.name) & vocabulary for b in bodies)
-
-
-def _count(bodies: tuple[Body, ...], vocabulary: frozenset[str]) -> int:
-    return sum(1 for b in bodies if is_named(b.name, vocabulary))
-
-
-def is_named(name: str, vocabulary: frozenset[str]) -> bool:
-    """Whether a name holds one of the words (long words also inside others: ``upperleg``)."""
-    low = name.lower()
-    return bool(words(name) & vocabulary) or any(w in low for w in vocabulary & INNER_WORDS)
 
 
 def hand_cut(tree: Tree, seg: Segment) -> int | None:
@@ -129,8 +97,15 @@ def _hand_joint(tree: Tree, c: Connection) -> bool:
 
 
 def _limb(
-    tree: Tree, seg: Segment, low: float, base: Body | None, wheels: frozenset[str]
+    tree: Tree,
+    seg: Segment,
+    low: float,
+    base: Body | None,
+    wheels: frozenset[str],
+    paired: bool = False,
+    rolling: bool = True,
 ) -> Limb | None:
+    """The arm or leg a run is, or None (``paired``: one of a mirrored pair beside legs)."""
     world = tree.world
     cut = hand_cut(tree, seg)
     jaw = cut is not None and one_jaw(tree, seg, cut)
@@ -152,18 +127,18 @@ def _limb(
         actuated.pop()  # a wheel at a leg's end rolls the robot: the leg ends at its axle
     # Two joints make a leg when its links say so (Solo-8's hip and knee: 'FL_upperleg'), and
     # an arm (Quori's shoulder pitch and roll: 'l_arm_upper', 'l_arm_lower').
-    named_limb = _count(bodies, LEG_WORDS) >= 2 or _count(bodies, ARM_WORDS) >= 2
-    fewest = MIN_LIMB_JOINTS - int(named_limb)
+    named_limb = count(bodies, LEG_WORDS) >= 2 or count(bodies, ARM_WORDS) >= 2
+    fewest = MIN_LIMB_JOINTS - int(named_limb or paired)
     # The link where the run splits into fingers is a palm whatever its name (xArm7's Ability
     # hand: 'thumb_base' carries every finger); only the links above it must not be fingers'.
     palm = cut is None and bodies[-1] is seg.end and len(tree.moving_children(seg.end)) >= 2
-    if len(actuated) < fewest or _named(bodies[:-1] if palm else bodies, FINGER_WORDS):
+    if len(actuated) < fewest or named(bodies[:-1] if palm else bodies, FINGER_WORDS):
         return None
     reach = tree.length(seg, None if jaw else upto)  # with its jaw, as far as it reaches
     # Shorter is a finger, unless named as a leg and reaching the ground (Mini Pupper's legs).
     below = tuple(world.subtree(seg.end))  # with the foot fixed at its end ('lffoot')
-    footed = _count(below, LEG_WORDS) > 0 and tree.position(seg.end)[2] - low < FOOT_CLEARANCE
-    if reach < MIN_LIMB_LENGTH and not footed:
+    footed = count(below, LEG_WORDS) > 0 and tree.position(seg.end)[2] - low < FOOT_CLEARANCE
+    if reach < MIN_LIMB_LENGTH and not (footed or paired):
         return None
     # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.
     root = seg.start if base is None else base
@@ -187,7 +162,7 @@ def _limb(
         hand = seg.end
     if hand is not None and eyes(tree, hand):
         return None  # a head whose cameras turn on their own (eyes): not a hand's fingers
-    if hand is None and _named(bodies, HEAD_WORDS) and not _named(bodies, ARM_WORDS):
+    if hand is None and named(bodies, HEAD_WORDS) and not named(bodies, ARM_WORDS):
         return None  # a head (see sensors.find_neck)
     if hand is None and len(actuated) <= 3 and _pan_tilt(tree, seg):
         return None  # a pan/tilt unit pointing cameras: a neck (see sensors.find_neck)
@@ -196,16 +171,39 @@ def _limb(
     # not the last moving link's origin (a knee, 20 cm above the ground it stands on).
     z_tip = min(float(tree.position(b)[2]) for b in world.subtree(tip))
     z_root = float(tree.position(root)[2])
-    legs_named = footed or _count(bodies, LEG_WORDS) > _count(bodies, ARM_WORDS)
+    legs_named = footed or count(bodies, LEG_WORDS) > count(bodies, ARM_WORDS)
     grounded = hand is None and z_tip - low < FOOT_CLEARANCE and z_root - z_tip > LEG_DROP
     if legs_named or grounded:
         why = "its links are named as a leg's" if legs_named else "it ends on the ground"
+        wheel = None
+        if rolling and len(actuated) > MIN_LIMB_JOINTS and _rolls(tree, actuated[-1]):
+            # A leg ending on a wheel (a wheel-legged robot's, whatever its joint's name): the
+            # leg ends at the link carrying the axle, the wheel rolls the robot.
+            wheel = actuated.pop()
+            tip, joints = world.bodies[actuated[-1].child], joints - {wheel.name}
+            why += f"; '{wheel.name}' turns its wheel"
         tip = chain_end(tree, tip, None)
-        return Limb("leg", root, tip, None, joints, seg, f"{len(actuated)} joints; {why}")
+        return Limb("leg", root, tip, None, joints, seg, f"{len(actuated)} joints; {why}", wheel)
     ends = f"a hand at '{hand.name}'" if hand is not None else "the end of the branch"
     why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"
     tip = chain_end(tree, tip, hand)
     return Limb("arm", root, tip, hand, joints, seg, why)
+
+
+def _rolls(tree: Tree, c: Connection) -> bool:
+    """Whether ``c`` turns without end about a level axis and nothing moves below it (a wheel).
+
+    Why not a knee or an ankle: those turn within limits; a continuous joint at a leg's end
+    turns a wheel (Unitree B2W's 'FL_foot_joint'), whatever it is named or its mesh.
+    """
+    wheel = tree.world.bodies[c.child]
+    if c.type.value != "continuous" or tree.world.child_bodies(wheel):
+        return False  # a knee carrying its foot frame (Mini Cheetah's) is no wheel
+    return abs(float(tree.axis_in_root(c)[2])) < LEVEL
+
+
+#: How level (the cosine of its angle to z, at most) a wheel's axis is in the default pose.
+LEVEL = 0.3
 
 
 def _lifts(tree: Tree, actuated: list[Connection]) -> int:
@@ -258,7 +256,22 @@ def _pan_tilt(tree: Tree, seg: Segment) -> bool:
 
 
 def find_limbs(tree: Tree, wheels: frozenset[str] = frozenset()) -> list[Limb]:
-    """Every arm and leg of the tree, top-down; runs inside a found hand are fingers, not limbs."""
+    """Every arm and leg of the tree, top-down; runs inside a found hand are fingers, not limbs.
+
+    Legs end on wheels (a continuous joint past the leg's last link) only when at least
+    ``MIN_ROLLING_LEGS`` of them do: a biped's continuous toes (Cassie's) are its feet.
+    """
+    limbs = _find_limbs(tree, wheels, rolling=True)
+    if 0 < sum(1 for lb in limbs if lb.wheel is not None) < MIN_ROLLING_LEGS:
+        limbs = _find_limbs(tree, wheels, rolling=False)
+    return limbs
+
+
+#: The fewest legs ending on wheels that make a wheel-legged robot (B2W's four).
+MIN_ROLLING_LEGS = 3
+
+
+def _find_limbs(tree: Tree, wheels: frozenset[str], rolling: bool) -> list[Limb]:
     world = tree.world
     low = tree.lowest_z()
     limbs: list[Limb] = []
@@ -274,38 +287,11 @@ def find_limbs(tree: Tree, wheels: frozenset[str] = frozenset()) -> list[Limb]:
             seg = Segment(above.start, above.bodies + seg.bodies, above.joints + seg.joints)
         # Joined, it starts at its own base: the link above its first joint, not above mounts.
         base = world.bodies[seg.joints[0].parent] if joined else None
-        limb = _limb(tree, seg, low, base, wheels)
+        limb = _limb(tree, seg, low, base, wheels, rolling=rolling)
         if limb is not None:
             limbs.append(limb)
-    return _without_digits(tree, limbs)
-
-
-#: Arms from one link that, each within a hand's span, are a hand's digits (a five-finger hand).
-MIN_DIGIT_ARMS = 4
-
-
-def _without_digits(tree: Tree, limbs: list[Limb]) -> list[Limb]:
-    """``limbs`` less the arms that are a hand's fingers: four or more from one link, each short.
-
-    Why: a hand whose fingers have four joints each (Tesollo's DG-5F) looks like a star of
-    arms; no robot carries four arms or more from one link that each stay within a hand's
-    span and none of whose links is named as an arm's.
-    """
-    world = tree.world
-    by_start: dict[int, list[Limb]] = {}
-    for lb in limbs:
-        if lb.kind == "arm":
-            by_start.setdefault(lb.segment.start.index, []).append(lb)
-    drop: set[int] = set()
-    for group in by_start.values():
-        if len(group) < MIN_DIGIT_ARMS:
-            continue
-        firsts = [world.bodies[lb.segment.joints[0].child] for lb in group]
-        if all(hand_span(tree, b) <= MAX_HAND_SPAN for b in firsts) and not any(
-            _named(lb.segment.bodies, ARM_WORDS) for lb in group
-        ):
-            drop |= {id(lb) for lb in group}
-    return [lb for lb in limbs if id(lb) not in drop]
+    limbs += paired_arms(tree, limbs, lambda s: _limb(tree, s, low, None, wheels, paired=True))
+    return without_digits(tree, limbs)
 
 
 #: Most joints of a run above a branch that still make an arm's shoulder (a camera head beside).

@@ -37,6 +37,7 @@ from robotspec.spec.draft.limbs import (
 )
 from robotspec.spec.draft.model import DraftChain, DraftFrame, DraftManipulator
 from robotspec.spec.draft.naming import unique
+from robotspec.spec.draft.srdf_groups import rigidly_beside
 from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset, rigid_end
 from robotspec.spec.draft.tool_frames import (
     fixed_jaw,
@@ -113,8 +114,16 @@ def manipulator(
             top = tip
     if gripper is not None and not world.is_ancestor(top, gripper.root):
         gripper = None
-    if stated is not None and world.is_ancestor(top, stated) and is_bare_frame(world, stated):
+    if (
+        stated is not None
+        and (world.is_ancestor(top, stated) or rigidly_beside(world, stated, top))
+        and is_bare_frame(world, stated)
+    ):
         tool, decide = stated, []  # the SRDF end effector's parent link: a fact
+        if not world.is_ancestor(top, stated):  # beside the gripper: rooted where both hang
+            top = world.bodies[world.parent_connection(stated).parent]  # type: ignore[union-attr]
+            if not world.is_ancestor(tip, top):  # the chain ran on into the gripper's mount
+                chain.tip, chain.group, tip = top.name, None, top
     frame: DraftFrame | None = None
     if tool is not None:
         tool_name = tool.name

@@ -24,6 +24,7 @@ from robotspec.model.entities import Body
 from robotspec.model.world import World
 
 __all__ = [
+    "rigidly_beside",
     "GroupChain",
     "GroupJoints",
     "end_effector_root",
@@ -227,7 +228,32 @@ def end_effector_root(
     top = min(tops, key=lambda b: world.depth(b)) if tops else None
     if top is not None and (parent is None or world.is_ancestor(parent, top)):
         return top
+    if top is not None and parent is not None:
+        # Where the group hangs (its tops' common link: two jaws' carrier); the parent link a
+        # TCP frame fixed beside it (HIWIN's 'tool0'): the group is the end effector's.
+        hang = top
+        for b in tops:
+            hang = world.common_ancestor(hang, b)
+        if rigidly_beside(world, parent, hang):
+            return hang
     return parent
+
+
+def rigidly_beside(world: World, frame: Body, top: Body) -> bool:
+    """Whether ``frame`` is a leaf fixed on a link that carries ``top`` through fixed joints.
+
+    Why: an SRDF end effector's parent link is often the arm's TCP frame, hung on the last
+    link beside the flange the gripper is bolted to (HIWIN's 'tool0' on 'link_6', the gripper
+    on 'flange'): the frame and the gripper move as one, so the gripper is the end effector's
+    and the frame its tool frame, whatever either is named.
+    """
+    up = world.parent_connection(frame)
+    if up is None or not up.is_fixed or world.child_bodies(frame) or world.is_ancestor(frame, top):
+        return False
+    carrier = world.bodies[up.parent]
+    if not world.is_ancestor(carrier, top):
+        return False
+    return all(c.is_fixed for c in world.compute_chain_of_connections(carrier, top))
 
 
 def state_values(srdf: Srdf) -> list[tuple[str, str | None, dict[str, float]]]:

@@ -1,0 +1,169 @@
+"""What a limb is: its record, the words that name limbs' links, and checks on the set found.
+
+Split from ``limbs`` (which finds each run's limb): the checks here look at the limbs found
+together: four or more short arms from one link are a hand's digits, and a mirrored pair of
+short runs beside two legs is a small humanoid's arms.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from robotspec.model.entities import Body, Connection
+from robotspec.spec.draft.tree import Segment, Tree, words
+
+__all__ = [
+    "ARM_WORDS",
+    "FINGER_WORDS",
+    "HAND_WORDS",
+    "HEAD_WORDS",
+    "INNER_WORDS",
+    "LEG_WORDS",
+    "MAX_HAND_SPAN",
+    "WORLD_WORDS",
+    "Limb",
+    "count",
+    "hand_span",
+    "is_named",
+    "named",
+    "paired_arms",
+    "without_digits",
+]
+
+HAND_WORDS = frozenset({"gripper", "hand", "palm", "eef", "jaw", "claw", "effector"})
+FINGER_WORDS = frozenset(
+    {"finger", "thumb", "knuckle", "phalanx", "index", "middle", "ring", "pinky", "little"}
+    | {"fingertip", "digit", "jaw", "claw"}
+)
+LEG_WORDS = frozenset(
+    {"leg", "foot", "feet", "knee", "ankle", "thigh", "calf", "shank", "shin", "sole", "toe"}
+    | {"haa", "hfe", "kfe"}  # ANYmal's hip abduction / hip flexion / knee flexion
+)
+#: Words also recognised inside longer words (``upperleg``, ``lowerleg``).
+INNER_WORDS = frozenset({"leg", "foot", "knee", "ankle", "thigh", "calf", "shank"})
+ARM_WORDS = frozenset({"arm", "shoulder", "elbow", "wrist", "forearm"})
+WORLD_WORDS = frozenset({"world", "map", "odom"})
+HEAD_WORDS = frozenset({"head", "neck", "eye", "eyes", "gaze"})
+#: A hand reaches no farther than this from where it splits into fingers (m).
+MAX_HAND_SPAN = 0.3
+
+
+@dataclass(frozen=True)
+class Limb:
+    """An arm or a leg: ``root`` (above its first joint) to ``tip`` (below its last)."""
+
+    kind: str  # "arm" | "leg"
+    root: Body
+    tip: Body
+    hand: Body | None
+    joints: frozenset[str]
+    segment: Segment
+    why: str
+    #: The wheel a leg ends on (a continuous joint past its last link), not one of its joints.
+    wheel: Connection | None = None
+
+
+def hand_span(tree: Tree, body: Body) -> float:
+    """How far the subtree of ``body`` reaches from it in the default pose (m)."""
+    here = tree.position(body)
+    return max(
+        (float(np.linalg.norm(tree.position(b) - here)) for b in tree.world.subtree(body)),
+        default=0.0,
+    )
+
+
+def named(bodies: tuple[Body, ...], vocabulary: frozenset[str]) -> bool:
+    """Whether a link of ``bodies`` has a word of ``vocabulary``."""
+    return any(words(b.name) & vocabulary for b in bodies)
+
+
+def count(bodies: tuple[Body, ...], vocabulary: frozenset[str]) -> int:
+    """How many of ``bodies`` are named with a word of ``vocabulary``."""
+    return sum(1 for b in bodies if is_named(b.name, vocabulary))
+
+
+def is_named(name: str, vocabulary: frozenset[str]) -> bool:
+    """Whether a name holds one of the words (long words also inside others: ``upperleg``)."""
+    low = name.lower()
+    return bool(words(name) & vocabulary) or any(w in low for w in vocabulary & INNER_WORDS)
+
+
+#: Arms from one link that, each within a hand's span, are a hand's digits (a five-finger hand).
+MIN_DIGIT_ARMS = 4
+
+
+def without_digits(tree: Tree, limbs: list[Limb]) -> list[Limb]:
+    """``limbs`` less the arms that are a hand's fingers: four or more from one link, each short.
+
+    Why: a hand whose fingers have four joints each (Tesollo's DG-5F) looks like a star of
+    arms; no robot carries four arms or more from one link that each stay within a hand's
+    span and none of whose links is named as an arm's.
+    """
+    world = tree.world
+    by_start: dict[int, list[Limb]] = {}
+    for lb in limbs:
+        if lb.kind == "arm":
+            by_start.setdefault(lb.segment.start.index, []).append(lb)
+    drop: set[int] = set()
+    for group in by_start.values():
+        if len(group) < MIN_DIGIT_ARMS:
+            continue
+        firsts = [world.bodies[lb.segment.joints[0].child] for lb in group]
+        if all(hand_span(tree, b) <= MAX_HAND_SPAN for b in firsts) and not any(
+            named(lb.segment.bodies, ARM_WORDS) for lb in group
+        ):
+            drop |= {id(lb) for lb in group}
+    return [lb for lb in limbs if id(lb) not in drop]
+
+
+#: How far (m) a mirrored run's first joint may lie from its twin's mirror image.
+MIRROR = 0.01
+
+
+def paired_arms(
+    tree: Tree, limbs: list[Limb], make: Callable[[Segment], Limb | None]
+) -> list[Limb]:
+    """Short arms of a legged robot: two-joint runs from the legs' trunk, mirrored left-right.
+
+    Why: a small humanoid's arms (a shoulder and an elbow, 15 cm: a kid-size soccer robot's)
+    are shorter and have fewer joints than an arm is asked to have, and may be named after
+    muscles ('bicep'); beside two legs, a mirrored pair of such runs from the trunk they hang
+    from is its arms, whatever the names (a head is one run, not a mirrored pair). ``make``:
+    the limb a run is, asked as one of such a pair.
+    """
+    legs = [lb for lb in limbs if lb.kind == "leg"]
+    if len(legs) < 2 or any(lb.kind == "arm" for lb in limbs):
+        return []
+    trunks = {lb.root.index for lb in legs}
+    used = {lb.segment.bodies[0].index for lb in limbs}
+    runs = [
+        s
+        for s in tree.segments
+        if s.start.index in trunks
+        and s.bodies[0].index not in used
+        and len(s.actuated) == 2
+        and not tree.moving_children(s.end)
+        and all(c.type.value == "revolute" for c in s.joints)
+    ]
+    out: list[Limb] = []
+    for i, a in enumerate(runs):
+        for b in runs[i + 1 :]:
+            if a.start is not b.start or not _mirrored(tree, a, b):
+                continue
+            pair = [make(s) for s in (a, b)]
+            if all(lb is not None and lb.kind == "arm" and lb.hand is None for lb in pair):
+                out += [lb for lb in pair if lb is not None]
+    return out
+
+
+def _mirrored(tree: Tree, a: Segment, b: Segment) -> bool:
+    """Whether two runs' first joints lie mirrored across their start's x-z plane."""
+    inv = np.linalg.inv(tree.poses[a.start.index])
+    pa = (inv @ tree.poses[a.bodies[0].index])[:3, 3]
+    pb = (inv @ tree.poses[b.bodies[0].index])[:3, 3]
+    if abs(float(pa[1])) < MIRROR:
+        return False
+    return float(np.linalg.norm(pa - pb * np.array([1.0, -1.0, 1.0]))) < MIRROR

@@ -31,6 +31,14 @@ drive              a Gazebo drive plugin names it (an Ackermann one is asked: no
 forward            never
 =================  ===========================================================================
 
+Each row is narrowed to what its evidence proves: after every part is drafted, ``whole`` gives
+an item its mark back wherever the rule's files state only part of it (a Gazebo sensor states a
+device, not which of its frames or eyes a spec names; a mimic tag states coupled fingers, not
+where their tips are; a TCP name states a frame, not that it is the only one or that nothing is
+bolted past it; a fixed virtual joint states what a planner assumes, not that the base has no
+wheels; a ``planar_move`` plugin fakes any drive). Drafts of robots seen for the first time
+left wrong items unmarked exactly there.
+
 Each row that leaves an item unmarked has a code (``CHAIN_SRDF``, ``TOOL_SRDF``...): the draft
 item records it (``stated``, never written into the spec), so that the corpus measure counts,
 per rule, how many items it left unmarked and how many of those were wrong. A rule that leaves

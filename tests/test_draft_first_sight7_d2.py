@@ -194,3 +194,20 @@ def test_the_frame_an_imu_sensor_publishes_in_is_no_camera(tmp_path: Path) -> No
     )
     d = _draft(tmp_path, "imu_frame", parts)
     assert [c.body for c in d.cameras] == ["dev_color_optical_frame"]
+
+
+def test_an_rgbd_device_without_sensors_is_one_camera_on_its_colour_frame(
+    tmp_path: Path,
+) -> None:
+    # An OpenNI-style device with no Gazebo sensor: 'cam_ir' is shorter than 'cam_rgb', but
+    # the colour channel is the camera; the device's own optical frame would come first.
+    parts = [_link("base_link", size=0.2), _link("cam_link", size=0.02)]
+    parts.append(_joint("cam_joint", "base_link", "cam_link", "fixed", "0.2 0 0.3"))
+    for channel, y in (("ir", 0.0), ("depth", 0.0), ("rgb", -0.025)):
+        parts += _frame(f"cam_{channel}_frame", "cam_link", f"0 {y} 0")
+        parts += _frame(f"cam_{channel}_optical_frame", f"cam_{channel}_frame", rpy=_OPTICAL_RPY)
+    d = _draft(tmp_path, "openni", parts)
+    assert [c.body for c in d.cameras] == ["cam_rgb_optical_frame"]
+    own = _frame("cam_optical_frame", "cam_link", rpy=_OPTICAL_RPY)
+    d = _draft(tmp_path, "openni_own", [*parts, *own])
+    assert [c.body for c in d.cameras] == ["cam_optical_frame"]

@@ -131,12 +131,11 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             found.append(CameraFound(_stem(b.name) or b.name, b, optical))
     # One per device: drop a camera whose name extends another's on the same rigid body, or
     # is extended by it. Optical frames first: 'camera_link' and its child
-    # 'camera_color_optical_frame' are one camera, on the optical frame; of a device's
-    # channels, the colour one.
+    # 'camera_color_optical_frame' are one camera, on the optical frame; the device's own frame
+    # (TIAGo's 'xtion_optical_frame'), else of its channels the colour one.
     kept: list[CameraFound] = list(stated)
     order = sorted(
-        found,
-        key=lambda c: (not c.optical, len(c.name), not words(c.name) & _COLOUR, c.body.index),
+        found, key=lambda c: (not c.optical, _channel_rank(c.name), len(c.name), c.body.index)
     )
     for cam in order:
         carrier = _rigid_root(tree, cam.body)
@@ -173,6 +172,15 @@ _CHANNELS = frozenset({"color", "colour", "rgb", "depth", "ir", "infra", "infra1
 _COLOUR = frozenset({"color", "colour", "rgb"})
 #: Words naming one of a stereo pair; with a channel word, both are one device's.
 _SIDES = frozenset({"left", "right", "l", "r", "1", "2"})
+
+
+def _channel_rank(name: str) -> int:
+    """Which of a device's frames is its camera first: its own (no channel named), colour, the rest.
+
+    Why not the shortest name: an OpenNI device's 'camera_ir' is shorter than its 'camera_rgb'.
+    """
+    parts = set(re.split(r"[^a-z0-9]+", name.lower())) | words(name)
+    return 0 if not parts & _CHANNELS else 1 if parts & _COLOUR else 2
 
 
 def _device(name: str) -> str:

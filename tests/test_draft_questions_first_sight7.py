@@ -66,3 +66,34 @@ def test_the_question_names_the_frame_when_no_camera_is_drafted_there(
         "rear_a (a bare frame turned as a camera's optical frame (z ahead, y down)) is no "
         "drafted camera: a camera? which frame?"
     )
+
+
+def test_a_neck_of_more_joints_than_a_head_turns_on_is_asked_about(tmp_path: Path) -> None:
+    # An arm carrying a camera, taken for a neck, covers its joints: nothing else would ask.
+    from types import SimpleNamespace
+
+    from robotspec.description.load import load_description
+    from robotspec.spec.draft.model import Draft, DraftChain
+    from robotspec.spec.draft.unassigned import CHAINS, _long_part_questions
+
+    parts = [_link("base", size=0.1)]
+    for i in range(1, 6):
+        above = "base" if i == 1 else f"l{i - 1}"
+        parts += [_link(f"l{i}", size=0.03), _joint(f"q{i}", above, f"l{i}", xyz="0 0 0.1")]
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text('<robot name="arm">' + "".join(parts) + "</robot>")
+    world = load_description(str(urdf)).world
+    draft = Draft("arm", "arm.urdf", None, "base", None, [], [], [])
+    for n in (3, 5):
+        joints = frozenset(f"q{i}" for i in range(1, n + 1))
+        draft.neck = DraftChain("neck", "base", f"l{n}", "the URDF tree", "neck", joints=joints)
+        asked = _long_part_questions(SimpleNamespace(draft=draft, world=world))  # type: ignore[arg-type]
+        if n == 3:
+            assert asked == []  # a head's pan, tilt and roll
+        else:
+            (q,) = asked
+            assert q.section == CHAINS and q.joints == joints
+            assert q.text == (
+                "the neck moves 5 joints (q1 .. q5 (5 joints)), more than a head turns on: "
+                "an arm carrying a camera?"
+            )

@@ -15,8 +15,10 @@ told nothing. After every part is drafted, this module looks at what is left:
   depth camera tilted down; not at a limb's end or on a finger, where tool frames and tips
   are); one question per device (frames fixed to one link within 10 cm).
 
-A wheel-shaped joint counts as covered (the drive's) only when nothing moves below it: a leg's
-hip modelled as a continuous joint with a round motor is asked about like any other joint.
+A drafted neck of more than three joints, or torso of more than four, is asked about too (an
+arm carrying a camera taken for a neck leaves no joint uncovered). A wheel-shaped joint counts
+as covered (the drive's) only when nothing moves below it: a leg's hip modelled as a continuous
+joint with a round motor is asked about like any other joint.
 
 A robot whose every moving joint is covered gets no question. Each question carries its subject
 (the joints and links it names) for the corpus measure, which counts a missed item as asked
@@ -52,6 +54,9 @@ _DEVICE_SPAN = 0.1
 #: An optical frame's x axis is level (|z component| below this), its y points down (below
 #: minus this): a camera's image rows run level and its columns downwards.
 _LEVEL, _DOWN = 0.2, 0.5
+#: The most joints a drafted neck and torso turn on before they are asked about (a head's pan,
+#: tilt and roll; a mobile manipulator's lift and waist, four on Galaxea's R1).
+_LONGEST = {"neck": 3, "torso": 4}
 #: Joints named at most this many in a question; longer lists are written first .. last.
 _SHOWN = 4
 #: Words naming a rotor's joint (a drone's): it moves the robot, it is no part.
@@ -320,9 +325,29 @@ def _camera_questions(d: Drafter) -> list[DraftQuestion]:
     return out
 
 
+def _long_part_questions(d: Drafter) -> list[DraftQuestion]:
+    """A drafted neck or torso of more joints than a head or a waist turns on: what is it?
+
+    Why: a limb the draft took for a neck (an arm carrying a camera) or a torso leaves its
+    joints covered, and nothing would ask about the arm or leg they make.
+    """
+    out = []
+    for part in (d.draft.neck, d.draft.torso):
+        if part is None or len(part.joints) <= _LONGEST.get(part.role, 4):
+            continue
+        names = sorted(part.joints, key=lambda j: d.world.get_connection_by_name(j).index)
+        kind = "an arm carrying a camera" if part.role == "neck" else "an arm? a leg"
+        text = (
+            f"the {part.role} moves {len(names)} joints ({_span(names)}), more than a "
+            f"{'head' if part.role == 'neck' else 'waist'} turns on: {kind}?"
+        )
+        out.append(DraftQuestion(CHAINS, text, frozenset(names), frozenset()))
+    return out
+
+
 def find_questions(d: Drafter) -> list[DraftQuestion]:
     """Questions about what no drafted part covers (see the module docstring)."""
-    return _joint_questions(d) + _camera_questions(d)
+    return _joint_questions(d) + _long_part_questions(d) + _camera_questions(d)
 
 
 def asked(draft: Draft) -> tuple[frozenset[str], frozenset[str]]:

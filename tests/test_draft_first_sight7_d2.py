@@ -165,7 +165,8 @@ def test_a_fisheye_pair_is_one_device_and_another_device_beside_it_stays_one(
 def test_optical_frames_turned_round_are_rear_cameras(tmp_path: Path) -> None:
     # A legged base's bare frames rotated as REP 103 says but looking back, level and tilted
     # 45 degrees down (B2W's rear cameras), beside the same looking ahead: four cameras. A
-    # frame turned to look sideways is left alone (a joint's frame is often turned so).
+    # frame turned to look sideways is left alone (a joint's frame is often turned so), and
+    # so is one turned round on a moving link.
     back, back_down = "-1.5708 0 1.5708", "-2.3562 0 1.5708"
     parts = [_link("base_link", size=0.3)]
     for name, xyz, rpy in (
@@ -176,6 +177,9 @@ def test_optical_frames_turned_round_are_rear_cameras(tmp_path: Path) -> None:
         ("side_frame", "0 0.2 0", "-1.5708 0 0"),
     ):
         parts += _frame(name, "base_link", xyz, rpy)
+    # The same turned-round frame on a moving link (an arm's button panel): no camera.
+    parts += [_link("arm", size=0.05), _joint("arm_j", "base_link", "arm", xyz="0 0 0.3")]
+    parts += _frame("arm_panel", "arm", "0 0 0.1", back)
     d = _draft(tmp_path, "rear", parts)
     cams = {c.body: c for c in d.cameras}
     assert sorted(cams) == ["front_cam", "front_depth", "rear_cam", "rear_depth"]

@@ -1,14 +1,14 @@
 """Cameras and the neck that points them.
 
 A frame is an *optical* frame when its rotation from its parent is REP 103's (z forward, x
-right, y down), or that rotation tilted up or down (x still right), or turned round to look
-back (a rear camera), whatever its name; a frame
-named as a camera without that rotation is a camera looking along its x axis. IMUs, lasers,
-range finders and force sensors are never cameras, whatever their rotation. One device often
-has several frames (PR2's ``wide_stereo`` with its simulated left and right cameras, an Xtion's
-``rgb`` and ``depth`` channels): one camera per device, its shortest-named optical frame. The
-neck is the run of one to three revolute joints that carries cameras and ends the branch it is
-on (four for a run whose links are named as a head's).
+right, y down), or that rotation tilted up or down (x still right), or, on the body the robot
+faces with, turned round to look back (a rear camera), whatever its name; a frame named as a
+camera without that rotation is a camera looking along its x axis. IMUs, lasers, range
+finders and force sensors are never cameras, whatever their rotation. One device often has
+several frames (PR2's ``wide_stereo`` with its simulated left and right cameras, an Xtion's
+``rgb`` and ``depth`` channels): one camera per device, the device's own optical frame, else its
+colour channel's. The neck is the run of one to three revolute joints that carries cameras and
+ends the branch it is on (four for a run whose links are named as a head's).
 """
 
 from __future__ import annotations
@@ -86,8 +86,11 @@ def is_optical(tree: Tree, body: Body) -> bool:
     if np.allclose(rot[:, 0], _OPTICAL[:, 0], atol=1e-3) and rot[0, 2] > _TILT:
         return True
     # The same turned round (a rear camera, B2W's 'r_dc_link'): x right of a camera looking
-    # back is the parent's +y, z behind within 60 degrees of the parent's -x.
-    return bool(np.allclose(rot[:, 0], -_OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -_TILT)
+    # back is the parent's +y, z behind within 60 degrees of the parent's -x. Only on the
+    # body the robot faces with: on a limb or a torso, "behind" says nothing (Baxter's arm
+    # buttons, TIAGo Pro's arm mounts are turned so).
+    behind = np.allclose(rot[:, 0], -_OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -_TILT
+    return bool(behind) and _rigid_root(tree, body) is tree.root
 
 
 def _stem(name: str) -> str:

@@ -17,8 +17,9 @@ told nothing. After every part is drafted, this module looks at what is left:
 
 A drafted neck of more than three joints, or torso of more than four, is asked about too (an
 arm carrying a camera taken for a neck leaves no joint uncovered). A wheel-shaped joint counts
-as covered (the drive's) only when nothing moves below it: a leg's hip modelled as a continuous
-joint with a round motor is asked about like any other joint.
+as covered (the drive's) only when nothing but free turning joints moves below it (a ball
+caster's axes): a leg's hip modelled as a continuous joint with a round motor is asked about
+like any other joint.
 
 A robot whose every moving joint is covered gets no question. Each question carries its subject
 (the joints and links it names) for the corpus measure, which counts a missed item as asked
@@ -32,7 +33,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robotspec.model.entities import Body, Connection
+from robotspec.model.entities import Body, Connection, ConnectionType
 from robotspec.spec.draft.model import DraftQuestion
 from robotspec.spec.draft.sensors import CAMERA_WORDS, NOT_CAMERA_WORDS
 from robotspec.spec.draft.tree import words
@@ -77,12 +78,10 @@ def _covered(d: Drafter) -> set[int]:
     if base is not None:
         names |= set(base.joints or ()) | ({base.planar} if base.planar else set())
     out = {world.get_connection_by_name(n).index for n in names if world.has_connection(n)}
-    # A wheel carries nothing that moves: a wheel-shaped joint with joints below it (a leg's
-    # hip modelled continuous, with a round motor) is asked about like any other joint.
-    tree = d.tree
-    out |= {
-        c.index for c in (*d.wheels, *d.wheel_shaped) if not tree.moves_below(world.bodies[c.child])
-    }
+    # A wheel carries nothing that moves but free turning joints (a ball caster's axes): a
+    # wheel-shaped joint with a limited joint below it (a leg's hip modelled continuous, with
+    # a round motor) is asked about like any other joint.
+    out |= {c.index for c in (*d.wheels, *d.wheel_shaped) if _rolls_freely(d, c)}
     for m in draft.manipulators:
         if world.has_body(m.root):
             for b in world.subtree(world.get_body_by_name(m.root)):
@@ -90,6 +89,16 @@ def _covered(d: Drafter) -> set[int]:
                 if up is not None and b.name != m.root:
                     out.add(up.index)
     return out
+
+
+def _rolls_freely(d: Drafter, c: Connection) -> bool:
+    """Whether only continuous joints move below ``c`` (a wheel, a ball caster's axes)."""
+    world = d.world
+    return all(
+        k.type is ConnectionType.CONTINUOUS or k.is_fixed or k.is_mimic
+        for b in world.subtree(world.bodies[c.child])
+        if (k := world.parent_connection(b)) is not None and b.index != c.child
+    )
 
 
 def _caster(d: Drafter, c: Connection) -> bool:

@@ -97,3 +97,33 @@ def test_a_neck_of_more_joints_than_a_head_turns_on_is_asked_about(tmp_path: Pat
                 "the neck moves 5 joints (q1 .. q5 (5 joints)), more than a head turns on: "
                 "an arm carrying a camera?"
             )
+
+
+def test_a_round_hip_carrying_a_knee_is_asked_about_not_taken_for_a_wheel(
+    tmp_path: Path,
+) -> None:
+    # Four legs whose hips are continuous joints turning a round motor about a level axis
+    # (wheel-shaped), each carrying a limited knee: whatever the draft makes of them, no hip is
+    # left as a wheel nobody asks about.
+    from tests.test_draft_blind import _WHEEL
+
+    parts = [_link("body", size=0.3)]
+    for leg, (x, y) in {
+        "fl": (0.3, 0.2),
+        "fr": (0.3, -0.2),
+        "hl": (-0.3, 0.2),
+        "hr": (-0.3, -0.2),
+    }.items():
+        parts += [
+            _link(f"{leg}_hip", _WHEEL),
+            _joint(f"{leg}_hip_j", "body", f"{leg}_hip", "continuous", f"{x} {y} 0", "0 1 0"),
+            _link(f"{leg}_shin", size=0.03),
+            _joint(f"{leg}_knee_j", f"{leg}_hip", f"{leg}_shin", xyz="0 0 -0.2"),
+        ]
+    d = _draft(tmp_path, "quad", parts)
+    covered = {j for c in d.chains for j in c.joints} | {
+        j for m in d.manipulators for j in m.joints
+    }
+    asked = {j for q in d.questions for j in q.joints}
+    hips = {f"{leg}_hip_j" for leg in ("fl", "fr", "hl", "hr")}
+    assert hips <= covered | asked

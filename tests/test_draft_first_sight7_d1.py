@@ -228,3 +228,14 @@ def test_a_mirrored_pair_of_two_joint_runs_beside_two_legs_are_arms(tmp_path: Pa
     roles = sorted((c.role, c.tip) for c in d.chains)
     assert [r for r in roles if r[0] == "arm"] == [("arm", "a12"), ("arm", "a22")]
     assert [r for r in roles if r[0] == "leg"] == [("leg", "l14"), ("leg", "l24")]
+
+
+def test_a_leg_ends_at_its_lowest_fixed_frame_among_several(tmp_path: Path) -> None:
+    # Each knee link carries its foot frame 25 cm down and a sensor's frame 6 cm down and 3 cm
+    # aside (neither on the knee's axis, neither named): the leg ends at the foot, the lowest.
+    parts = list(_quadruped(0.25))
+    for n in (1, 2, 3, 4):
+        parts.append(_link(f"s{n}", size=0.01))
+        parts.append(_joint(f"s{n}_fix", f"c{n}", f"s{n}", "fixed", xyz="0.03 0 -0.06"))
+    d = _draft(tmp_path, "foot_and_sensor", parts)
+    assert sorted(c.tip for c in d.chains) == ["e1", "e2", "e3", "e4"]

@@ -21,14 +21,15 @@ END_WORDS = frozenset({"flange", "tool", "tool0", "ee", "eef", "tcp", "foot", "s
 ON_AXIS = 1e-3
 
 
-def chain_end(tree: Tree, tip: Body, hand: Body | None) -> Body:
+def chain_end(tree: Tree, tip: Body, hand: Body | None, leg: bool = False) -> Body:
     """Where a chain ends: the flange, tool or foot link one fixed joint past its last joint.
 
     Why: a chain ends at the link a tool or the ground is met on (``docs/getting-started.md``:
     Panda's ``panda_link8``), not one fixed joint short at the last moving link. One step:
     toward the hand when there is one (never the hand itself), else to the fixed child below
     which nothing moves (never into a finger); of several, the only one on the last joint's
-    axis, else the only one named as an end. Otherwise the last moving link.
+    axis, else the only one named as an end, else (a leg's) the one clearly lowest. Otherwise
+    the last moving link.
     """
     world = tree.world
     up = world.parent_connection(tip)
@@ -38,7 +39,23 @@ def chain_end(tree: Tree, tip: Body, hand: Body | None) -> Body:
         nxt = next((k for k in kids if world.is_ancestor(k, hand)), None)
         return tip if nxt is None or nxt is hand else nxt
     kids = [k for k in kids if not tree.moves_below(k)]
-    return _pick_end(tree, kids, axis) or tip
+    return _pick_end(tree, kids, axis) or (_lowest(tree, kids) if leg else None) or tip
+
+
+#: How much lower (m) than the other fixed children a leg's foot frame must sit.
+BELOW = 0.01
+
+
+def _lowest(tree: Tree, kids: list[Body]) -> Body | None:
+    """A leg's foot among several fixed children: the one clearly lowest in the default pose.
+
+    Why: the foot is where the leg meets the ground, whatever the frames beside it (a contact
+    sensor's, a shell's) are named; only when it is lower than each of them.
+    """
+    if len(kids) < 2:
+        return None
+    by_z = sorted(kids, key=lambda k: float(tree.position(k)[2]))
+    return by_z[0] if tree.position(by_z[1])[2] - tree.position(by_z[0])[2] > BELOW else None
 
 
 def _pick_end(tree: Tree, kids: list[Body], axis: np.ndarray | None) -> Body | None:

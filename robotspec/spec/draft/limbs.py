@@ -182,7 +182,7 @@ def _limb(
             wheel = actuated.pop()
             tip, joints = world.bodies[actuated[-1].child], joints - {wheel.name}
             why += f"; '{wheel.name}' turns its wheel"
-        tip = chain_end(tree, tip, None)
+        tip = chain_end(tree, tip, None, leg=True)
         return Limb("leg", root, tip, None, joints, seg, f"{len(actuated)} joints; {why}", wheel)
     ends = f"a hand at '{hand.name}'" if hand is not None else "the end of the branch"
     why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"

@@ -239,3 +239,29 @@ def test_a_leg_ends_at_its_lowest_fixed_frame_among_several(tmp_path: Path) -> N
         parts.append(_joint(f"s{n}_fix", f"c{n}", f"s{n}", "fixed", xyz="0.03 0 -0.06"))
     d = _draft(tmp_path, "foot_and_sensor", parts)
     assert sorted(c.tip for c in d.chains) == ["e1", "e2", "e3", "e4"]
+
+
+def test_two_continuous_joints_on_one_axle_are_wheels_whatever_their_names(
+    tmp_path: Path,
+) -> None:
+    # A base whose two wheels are boxes (meshes the drafter cannot measure) on continuous
+    # joints named by numbers, on one axle (the line between them along their axes): a
+    # differential drive, and no gripper of two "fingers".
+    parts = [_link("b0", size=0.3)]
+    for n, y in ((1, 0.2), (2, -0.2)):
+        parts.append(_link(f"r{n}", size=0.1))
+        parts.append(_joint(f"q{n}", "b0", f"r{n}", "continuous", xyz=f"0 {y} -0.1"))
+    d = _draft(tmp_path, "unnamed_wheels", parts)
+    assert not d.manipulators
+    assert d.drive is not None and d.drive.type == "differential"
+
+
+def test_two_continuous_jaws_side_by_side_across_their_axes_are_no_wheels(tmp_path: Path) -> None:
+    # Two one-link jaws on continuous joints about parallel axes, 4 cm apart across them:
+    # a gripper's jaws, not an axle.
+    parts = [_link("h0", size=0.05)]
+    for n, x in ((1, 0.02), (2, -0.02)):
+        parts.append(_link(f"j{n}", size=0.01))
+        parts.append(_joint(f"q{n}", "h0", f"j{n}", "continuous", xyz=f"{x} 0 0.06"))
+    d = _draft(tmp_path, "continuous_jaws", parts)
+    assert d.drive is not None and d.drive.type == "fixed"

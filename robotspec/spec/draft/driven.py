@@ -47,7 +47,54 @@ def stated_wheels(tree: Tree, facts: FileFacts, found: list[Connection]) -> list
         said = c.name in plugin_wheels or facts.actuation.velocity_only(c.name)
         if said and _driven_wheel(tree, c):
             extra.append(c)
-    return [*found, *extra]
+    return [*found, *extra] or _axle_pairs(tree)
+
+
+#: How closely (cosine) two wheels' axes, and the line between them, must agree to be one axle.
+_AXLE = 0.95
+
+
+def _axle_pairs(tree: Tree) -> list[Connection]:
+    """Unnamed wheels on the chassis: continuous joints about level axes, paired on an axle.
+
+    Why: when neither a name, a shape nor a control block says which joints are wheels (a
+    mesh named by a part number), the axle still does: two continuous joints on the chassis
+    (only fixed joints above them), nothing moving below, turning about parallel level axes
+    with the line between them along those axes. A gripper's jaws turn about parallel axes
+    too, but lie apart across them, not along them.
+    """
+    world = tree.world
+    cands = [c for c in world.connections if _on_chassis(tree, c)]
+    paired: set[str] = set()
+    for i, a in enumerate(cands):
+        for b in cands[i + 1 :]:
+            if _one_axle(tree, a, b):
+                paired |= {a.name, b.name}
+    return [c for c in cands if c.name in paired]
+
+
+def _on_chassis(tree: Tree, c: Connection) -> bool:
+    """A continuous joint about a level axis, fixed to the root, nothing moving below it."""
+    world = tree.world
+    above = world.bodies[c.parent]
+    if c.type is not ConnectionType.CONTINUOUS or not c.is_active:
+        return False
+    if tree.moves_below(world.bodies[c.child]) or words(c.name) & {"caster", "castor"}:
+        return False
+    if abs(float(tree.axis_in_root(c)[2])) >= _LEVEL or not world.is_ancestor(tree.root, above):
+        return False
+    return all(k.is_fixed for k in world.compute_chain_of_connections(tree.root, above))
+
+
+def _one_axle(tree: Tree, a: Connection, b: Connection) -> bool:
+    """Whether two joints turn about one axle: parallel axes, the line between them along it."""
+    ax, bx = tree.axis_in_root(a), tree.axis_in_root(b)
+    ax = ax / (np.linalg.norm(ax) or 1.0)
+    if abs(float(ax @ bx)) / (np.linalg.norm(bx) or 1.0) < _AXLE:
+        return False
+    apart = tree.position(tree.world.bodies[b.child]) - tree.position(tree.world.bodies[a.child])
+    n = float(np.linalg.norm(apart))
+    return n > 1e-3 and abs(float(apart @ ax)) / n > _AXLE
 
 
 def _steered(tree: Tree, c: Connection) -> bool:

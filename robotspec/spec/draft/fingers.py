@@ -15,7 +15,7 @@ from robotspec.model.entities import Body
 from robotspec.model.world import World
 from robotspec.spec.draft.model import DraftFinger
 from robotspec.spec.draft.tool_frames import bare_fixed_leaf
-from robotspec.spec.draft.tree import Tree, words
+from robotspec.spec.draft.tree import Tree, solid, words
 
 __all__ = ["FINGER_NAMES", "Fingers", "find_fingers", "finger_tip", "hand_branches"]
 
@@ -32,7 +32,7 @@ def hand_branches(tree: Tree, hand: Body) -> tuple[Body, list[Body]]:
 
 
 def _has_geometry(tree: Tree, body: Body) -> bool:
-    return any(b.collisions or b.visuals for b in tree.world.subtree(body))
+    return any(solid(tree.world, b) for b in tree.world.subtree(body))
 
 
 def finger_tip(tree: Tree, branch: Body) -> Body:
@@ -45,8 +45,12 @@ def finger_tip(tree: Tree, branch: Body) -> Body:
     moved = [b for b in inside if (c := world.parent_connection(b)) is not None and not c.is_fixed]
     # A fixed tip link with geometry is the finger's tip (Baxter's 'r_gripper_l_finger_tip');
     # collision geometry first: a leaf with a look only is a decoration (HSR-B's vacuum pad).
-    solid = [b for b in inside if b.collisions] or [b for b in inside if b.visuals]
-    tip = max(solid or moved or [branch], key=lambda b: (world.depth(b), -b.index))
+    parts = (
+        [b for b in inside if b.collisions]
+        or [b for b in inside if b.visuals]
+        or [b for b in inside if solid(world, b)]  # a file without shapes: links with a mass
+    )
+    tip = max(parts or moved or [branch], key=lambda b: (world.depth(b), -b.index))
     # A bare frame the URDF fixes at the end of the last phalanx is the tip it names (Ability's
     # 'index_tip', D'Claw's 'link_f1_head'): the only bare leaf hanging there.
     bare = [k for k in world.child_bodies(tip) if bare_fixed_leaf(world, k)]

@@ -30,9 +30,8 @@ from robotspec.spec.draft.tool_frames import (
     find_tool_frame,
     hand_center,
     is_named_tcp,
-    own_geometry,
 )
-from robotspec.spec.draft.tree import Tree
+from robotspec.spec.draft.tree import Tree, solid
 
 __all__ = [
     "Gripper",
@@ -93,7 +92,7 @@ def _jaws(tree: Tree, hand: Body) -> Gripper | None:
         return None
     j1, j2 = passed
     jaw1, jaw2 = world.bodies[j1.child], world.bodies[j2.child]
-    if j1.type != j2.type or not (own_geometry(jaw1) and own_geometry(jaw2)):
+    if j1.type != j2.type or not (solid(world, jaw1) and solid(world, jaw2)):
         return None
     named = any(is_named(b.name, FINGER_WORDS | HAND_WORDS) for b in (jaw1, jaw2))
     if j1.type.value != "prismatic" and not named:
@@ -246,7 +245,7 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
     ]
     if decide is None and max(leaves) > 1:
         decide = "a finger with several end links: its tip is the deepest one a joint moves"
-    bare = [t.name for t in tips if not own_geometry(t)]
+    bare = [t.name for t in tips if not solid(world, t)]
     if decide is None and bare:  # a frame at the pad's end, named by whoever wrote it (PR2's)
         decide = f"the finger tip '{bare[0]}' is a bare frame at the finger's end, not its pad"
     if leaders[0] != leaders[1]:

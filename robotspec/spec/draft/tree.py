@@ -18,7 +18,7 @@ from robotspec.model.entities import Body, Connection
 from robotspec.model.kinematics import Kinematics
 from robotspec.model.world import World
 
-__all__ = ["Segment", "Tree", "words"]
+__all__ = ["Segment", "Tree", "solid", "words"]
 
 _SPLIT = re.compile(r"[^a-z0-9]+|(?<=[a-z])(?=[0-9])|(?<=[0-9])(?=[a-z])")
 
@@ -32,6 +32,21 @@ def words(name: str) -> set[str]:
         if w:
             out.add(w)
     return out
+
+
+def solid(world: World, body: Body) -> bool:
+    """Whether ``body`` is a part of the robot rather than a bare frame.
+
+    A part has a shape (visual or collision). Why a mass too: a file written for kinematics or
+    dynamics only (no shape anywhere, as when meshes were stripped or never made) still tells
+    parts from frames by their inertia; there a link with a mass is a part. Only in such a file:
+    elsewhere a massive link without a shape is a linkage helper (PR2's parallel links).
+    """
+    if body.collisions or body.visuals:
+        return True
+    if not body.mass:
+        return False
+    return not any(b.collisions or b.visuals for b in world.bodies)
 
 
 @dataclass(frozen=True)

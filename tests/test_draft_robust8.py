@@ -1,0 +1,85 @@
+"""Rules that hold when another maker's files say less (issue 30, round 8: robustness).
+
+Why: ``tools/corpus/robustness.py`` drafts the tune half under perturbations another maker's
+files show (names blinded, neutral ids, the root moved, no meshes); a rule that falls there is
+made structural. Each test is a small layout of the rule's shape whose links are only numbered
+(``n0``, ``n1``...), so no name can decide it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robotspec.compiler import check_spec
+from robotspec.spec.draft import Draft, render_draft
+from robotspec.spec.draft.run import draft_from_files
+
+_MASS = (
+    '<inertial><mass value="{m}"/>'
+    '<inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial>'
+)
+_BOX = '<collision><geometry><box size="0.04 0.04 0.04"/></geometry></collision>'
+
+
+def _link(name: str, mass: float | None = 0.3, box: bool = False) -> str:
+    inner = ("" if mass is None else _MASS.format(m=mass)) + (_BOX if box else "")
+    return f'<link name="{name}">{inner}</link>'
+
+
+def _joint(
+    name: str,
+    parent: str,
+    child: str,
+    kind: str = "revolute",
+    xyz: str = "0 0 0.15",
+    axis: str = "0 1 0",
+    mimic: str | None = None,
+) -> str:
+    limit = '<limit lower="-0.04" upper="0.04" effort="1" velocity="1"/>'
+    moving = "" if kind == "fixed" else f'<axis xyz="{axis}"/>{limit}'
+    tag = "" if mimic is None else f'<mimic joint="{mimic}"/>'
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}"/>{moving}{tag}</joint>'
+    )
+
+
+def _arm_with_jaws(box_on_base: bool = False) -> list[str]:
+    """Six revolute joints, a hand, two prismatic jaws (one mimics the other): no shape at all."""
+    parts = [_link("n0", box=box_on_base)]
+    for i in range(1, 7):
+        axis = "0 0 1" if i % 2 else "0 1 0"
+        parts += [_link(f"n{i}"), _joint(f"q{i}", f"n{i - 1}", f"n{i}", axis=axis)]
+    parts += [_link("n7"), _joint("q7", "n6", "n7", kind="fixed", xyz="0 0 0.08")]
+    parts += [_link("n8"), _joint("q8", "n7", "n8", "prismatic", "0 0.02 0.06", "0 1 0")]
+    parts += [_link("n9"), _joint("q9", "n7", "n9", "prismatic", "0 -0.02 0.06", "0 -1 0", "q8")]
+    parts += [_link("n10", None), _joint("q10", "n7", "n10", kind="fixed", xyz="0 0 0.1")]
+    return parts
+
+
+def _draft(tmp_path: Path, name: str, parts: list[str]) -> Draft:
+    urdf = tmp_path / f"{name}.urdf"
+    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
+    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
+    spec = tmp_path / f"{name}.yaml"
+    spec.write_text(render_draft(draft))
+    assert check_spec(spec).robot is not None  # valid as written
+    return draft
+
+
+def test_a_file_without_shapes_still_has_a_gripper(tmp_path: Path) -> None:
+    """No shape anywhere (a kinematics-only file, meshes stripped): links with a mass are parts.
+
+    The two jaws are found as fingers by their inertia, where a file with shapes finds them by
+    their geometry; the massless leaf on the hand stays a bare frame.
+    """
+    draft = _draft(tmp_path, "shapeless", _arm_with_jaws())
+    [m] = draft.manipulators
+    assert m.thumb is not None and m.finger is not None
+    assert {m.thumb.tip, m.finger.tip} == {"n8", "n9"}
+
+
+def test_massive_shapeless_links_beside_shapes_are_not_fingers(tmp_path: Path) -> None:
+    """Where the file has shapes, a massive link without one is a helper (a linkage), not a jaw."""
+    draft = _draft(tmp_path, "helpers", _arm_with_jaws(box_on_base=True))
+    assert all(m.thumb is None for m in draft.manipulators)

@@ -83,3 +83,42 @@ def test_massive_shapeless_links_beside_shapes_are_not_fingers(tmp_path: Path) -
     """Where the file has shapes, a massive link without one is a helper (a linkage), not a jaw."""
     draft = _draft(tmp_path, "helpers", _arm_with_jaws(box_on_base=True))
     assert all(m.thumb is None for m in draft.manipulators)
+
+
+def _arm(root_xyz: str) -> list[str]:
+    """Six revolute joints in series on a boxed base whose first joint sits at ``root_xyz``."""
+    parts = [_link("n0", box=True)]
+    for i in range(1, 7):
+        axis = "0 0 1" if i % 2 else "0 1 0"
+        xyz = root_xyz if i == 1 else "0.15 0 0"  # stretched out level, as UR arms are drawn
+        parts += [
+            _link(f"n{i}", box=True),
+            _joint(f"q{i}", f"n{i - 1}", f"n{i}", xyz=xyz, axis=axis),
+        ]
+    return parts
+
+
+def test_a_lone_run_reaching_below_its_base_frame_is_an_arm(tmp_path: Path) -> None:
+    """A base frame placed 45 cm above the arm (another maker's ``base_link``) makes no leg.
+
+    The run ends lowest, as a leg on the ground does; but a robot stands on two legs or more,
+    and nothing names this one a leg: it is the arm, as with the frame placed at its foot.
+    """
+    for name, xyz in (("low", "0 0 0.1"), ("high", "0.3 -0.2 -0.45")):
+        draft = _draft(tmp_path, name, _arm(xyz))
+        assert [c.role for c in draft.chains] == ["arm"], name
+        assert draft.chains[0].joints == frozenset(f"q{i}" for i in range(1, 7))
+
+
+def test_two_runs_reaching_the_ground_stay_legs(tmp_path: Path) -> None:
+    """Two mirrored runs from a trunk down to the ground stay legs (the rule is the lone run)."""
+    parts = [_link("n0", box=True)]
+    for side, y in (("a", "0.1"), ("b", "-0.1")):
+        above = "n0"
+        for i in range(1, 4):
+            link = f"n{side}{i}"
+            xyz = f"0 {y} -0.05" if i == 1 else "0 0 -0.2"
+            parts += [_link(link, box=True), _joint(f"q{side}{i}", above, link, xyz=xyz)]
+            above = link
+    draft = _draft(tmp_path, "biped", parts)
+    assert sorted(c.role for c in draft.chains) == ["leg", "leg"]

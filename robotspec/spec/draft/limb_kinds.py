@@ -64,6 +64,8 @@ class Limb:
     why: str
     #: The wheel a leg ends on (a continuous joint past its last link), not one of its joints.
     wheel: Connection | None = None
+    #: A leg only because it ends on the ground (no name says so): see ``limbs.find_limbs``.
+    grounded: bool = False
 
 
 def hand_span(tree: Tree, body: Body) -> float:

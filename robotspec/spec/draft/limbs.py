@@ -104,8 +104,13 @@ def _limb(
     wheels: frozenset[str],
     paired: bool = False,
     rolling: bool = True,
+    stands: bool = True,
 ) -> Limb | None:
-    """The arm or leg a run is, or None (``paired``: one of a mirrored pair beside legs)."""
+    """The arm or leg a run is, or None (``paired``: one of a mirrored pair beside legs).
+
+    ``stands=False``: reaching the ground does not make the run a leg (a lone one, see
+    ``_find_limbs``).
+    """
     world = tree.world
     cut = hand_cut(tree, seg)
     jaw = cut is not None and one_jaw(tree, seg, cut)
@@ -172,7 +177,9 @@ def _limb(
     z_tip = min(float(tree.position(b)[2]) for b in world.subtree(tip))
     z_root = float(tree.position(root)[2])
     legs_named = footed or count(bodies, LEG_WORDS) > count(bodies, ARM_WORDS)
-    grounded = hand is None and z_tip - low < FOOT_CLEARANCE and z_root - z_tip > LEG_DROP
+    grounded = (
+        stands and hand is None and z_tip - low < FOOT_CLEARANCE and z_root - z_tip > LEG_DROP
+    )
     if legs_named or grounded:
         why = "its links are named as a leg's" if legs_named else "it ends on the ground"
         wheel = None
@@ -183,7 +190,8 @@ def _limb(
             tip, joints = world.bodies[actuated[-1].child], joints - {wheel.name}
             why += f"; '{wheel.name}' turns its wheel"
         tip = chain_end(tree, tip, None, leg=True)
-        return Limb("leg", root, tip, None, joints, seg, f"{len(actuated)} joints; {why}", wheel)
+        why = f"{len(actuated)} joints; {why}"
+        return Limb("leg", root, tip, None, joints, seg, why, wheel, not legs_named)
     ends = f"a hand at '{hand.name}'" if hand is not None else "the end of the branch"
     why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"
     tip = chain_end(tree, tip, hand)
@@ -275,6 +283,7 @@ def _find_limbs(tree: Tree, wheels: frozenset[str], rolling: bool) -> list[Limb]
     world = tree.world
     low = tree.lowest_z()
     limbs: list[Limb] = []
+    bases: list[Body | None] = []
     ending = {s.end.index: s for s in tree.segments}
     for seg in tree.segments:
         if any(world.is_ancestor(lb.tip, seg.start) for lb in limbs):
@@ -290,6 +299,15 @@ def _find_limbs(tree: Tree, wheels: frozenset[str], rolling: bool) -> list[Limb]
         limb = _limb(tree, seg, low, base, wheels, rolling=rolling)
         if limb is not None:
             limbs.append(limb)
+            bases.append(base)
+    legs = [i for i, lb in enumerate(limbs) if lb.kind == "leg"]
+    if len(legs) == 1 and limbs[legs[0]].grounded:
+        # A robot stands on two legs or more: one run alone reaching the ground, no name
+        # calling it a leg, hangs from a base whose frame sits above it (a UR arm whose
+        # 'base_link' a maker placed higher): an arm, whatever the ground says.
+        i = legs[0]
+        arm = _limb(tree, limbs[i].segment, low, bases[i], wheels, rolling=rolling, stands=False)
+        limbs[i : i + 1] = [] if arm is None else [arm]
     limbs += paired_arms(tree, limbs, lambda s: _limb(tree, s, low, None, wheels, paired=True))
     return without_digits(tree, limbs)
 

@@ -122,3 +122,16 @@ def test_two_runs_reaching_the_ground_stay_legs(tmp_path: Path) -> None:
             above = link
     draft = _draft(tmp_path, "biped", parts)
     assert sorted(c.role for c in draft.chains) == ["leg", "leg"]
+
+
+def test_a_run_of_frames_past_the_last_joint_ends_at_the_tool_frame(tmp_path: Path) -> None:
+    """A frame fixed on a frame past the arm (a UR's flange, then tool0): the run's end is the TCP.
+
+    Nothing is bolted to the run but where it ends; with the names gone (numbered links), the
+    tool frame is still the last frame, not the flange it hangs on.
+    """
+    parts = [*_arm("0 0 0.1"), _link("n7", None), _joint("q7", "n6", "n7", "fixed", "0.05 0 0")]
+    parts += [_link("n8", None), _joint("q8", "n7", "n8", "fixed", "0 0 0")]
+    draft = _draft(tmp_path, "frames", parts)
+    [m] = draft.manipulators
+    assert m.tool_frame == "n8"

@@ -40,6 +40,7 @@ from robotspec.spec.draft.naming import unique
 from robotspec.spec.draft.srdf_groups import rigidly_beside
 from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset, rigid_end
 from robotspec.spec.draft.tool_frames import (
+    bare_run_end,
     fixed_jaw,
     frame_at_tips,
     is_bare_frame,
@@ -195,7 +196,7 @@ def manipulator(
             tool_name, top.name, end, "the URDF has no tool frame: the far end of the last link"
         )
     elif hand is None and (up := world.parent_connection(top)) is not None and up.is_fixed:
-        tool_name = top.name  # the flange link the chain ends at, past its last joint
+        tool_name = bare_run_end(world, top).name  # the flange, or its frames' end (tool0)
         decide.append(f"the tool frame '{tool_name}': the link past the arm's last joint")
     elif hand is None and not tree.moves_below(top) and _shape_unknown(top):
         # A bare arm's last link whose shape is not loaded (its meshes missing): where the

@@ -21,6 +21,7 @@ __all__ = [
     "TCP_NAMES",
     "TOOL_HINTS",
     "bare_fixed_leaf",
+    "bare_run_end",
     "end_frame",
     "find_tool_frame",
     "fixed_jaw",
@@ -66,6 +67,23 @@ def bare_fixed_leaf(world: World, body: Body) -> bool:
 def own_geometry(body: Body) -> bool:
     """Whether ``body`` itself has a shape (visual or collision)."""
     return bool(body.collisions or body.visuals)
+
+
+def bare_run_end(world: World, top: Body) -> Body:
+    """The last of a run of bare frames fixed one below the other from ``top``, else ``top``.
+
+    Why: past an arm's last joint a maker often fixes a frame on a frame (a UR's ``flange``,
+    then ``tool0`` turned to the tool's convention): nothing is bolted to the run but where it
+    ends, so its end is the tool frame whatever either is named. Only a single line of frames
+    (each the one child of the one above, no shape): a branch says nothing about which end.
+    """
+    body = top
+    while len(kids := world.child_bodies(body)) == 1:
+        c = world.parent_connection(kids[0])
+        if c is None or not c.is_fixed or kids[0].collisions or kids[0].visuals:
+            return top
+        body = kids[0]
+    return top if kids else body
 
 
 def _carries_moving(world: World, body: Body) -> bool:

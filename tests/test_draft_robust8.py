@@ -135,3 +135,41 @@ def test_a_run_of_frames_past_the_last_joint_ends_at_the_tool_frame(tmp_path: Pa
     draft = _draft(tmp_path, "frames", parts)
     [m] = draft.manipulators
     assert m.tool_frame == "n8"
+
+
+def _short_runs(feet: list[tuple[float, float]]) -> list[str]:
+    """A boxed trunk with a 3-joint run of 12 cm hanging down from each (x, y) given."""
+    parts = [_link("n0", box=True)]
+    for i, (x, y) in enumerate(feet):
+        above = "n0"
+        for k, (xyz, axis) in enumerate(
+            ((f"{x} {y} 0", "1 0 0"), ("0 0 -0.02", "0 1 0"), ("0 0 -0.05", "0 1 0"))
+        ):
+            link = f"n{i + 1}{k}"
+            parts += [
+                _link(link, box=True),
+                _joint(f"q{i + 1}{k}", above, link, xyz=xyz, axis=axis),
+            ]
+            above = link
+        parts += [
+            _link(f"n{i + 1}9", None),
+            _joint(f"q{i + 1}9", above, f"n{i + 1}9", "fixed", "0 0 -0.05"),
+        ]
+    return parts
+
+
+def test_short_mirrored_runs_standing_on_the_ground_are_legs(tmp_path: Path) -> None:
+    """Four 12 cm runs from the trunk, feet on the ground in mirrored pairs: a small quadruped.
+
+    Shorter than an arm must be, and no name says "leg": where they stand decides.
+    """
+    feet = [(0.1, 0.05), (0.1, -0.05), (-0.1, 0.05), (-0.1, -0.05)]
+    draft = _draft(tmp_path, "quadruped", _short_runs(feet))
+    assert sorted(c.role for c in draft.chains) == ["leg"] * 4
+
+
+def test_short_runs_side_by_side_are_no_legs(tmp_path: Path) -> None:
+    """Four such runs side by side (a hand's fingers hanging down), not mirrored: no legs."""
+    feet = [(0.0, 0.045), (0.0, 0.015), (0.0, -0.015), (0.03, -0.04)]
+    draft = _draft(tmp_path, "fingers", _short_runs(feet))
+    assert all(c.role != "leg" for c in draft.chains)

@@ -30,6 +30,7 @@ __all__ = [
     "is_named",
     "named",
     "paired_arms",
+    "standing_runs",
     "without_digits",
 ]
 
@@ -169,3 +170,49 @@ def _mirrored(tree: Tree, a: Segment, b: Segment) -> bool:
     if abs(float(pa[1])) < MIRROR:
         return False
     return float(np.linalg.norm(pa - pb * np.array([1.0, -1.0, 1.0]))) < MIRROR
+
+
+def standing_runs(tree: Tree, low: float, clearance: float) -> set[int]:
+    """The runs that are legs by where they end (by their first link's index).
+
+    Four or more runs from one trunk, each of at least ``MIN_STANDING_JOINTS`` joints, ending
+    within ``clearance`` of the ground in mirrored pairs: each foot has a partner across the
+    trunk's x-z plane (the same x and height, the opposite y, both well off the middle).
+
+    Why: a small quadruped's legs are shorter than an arm must be (Mini Pupper's, 12 cm) and
+    only their names said so; a robot stands on mirrored runs from its trunk that reach the
+    ground, which no maker's naming changes. A hand's fingers hanging down are side by side
+    or turned about the palm (three, or a thumb against four), never all in mirrored pairs.
+    """
+    by_start: dict[int, list[Segment]] = {}
+    for seg in tree.segments:
+        low_end = min(float(tree.position(b)[2]) for b in tree.world.subtree(seg.end))
+        if len(seg.actuated) >= MIN_STANDING_JOINTS and low_end - low < clearance:
+            by_start.setdefault(seg.start.index, []).append(seg)
+    out: set[int] = set()
+    for runs in by_start.values():
+        if len(runs) < MIN_STANDING_RUNS:
+            continue
+        inv = np.linalg.inv(tree.poses[runs[0].start.index])
+        feet = [(inv @ tree.poses[s.end.index])[:3, 3] for s in runs]
+        mirrored = all(
+            abs(float(f[1])) > MIRROR_OFF
+            and any(
+                float(np.linalg.norm(g - f * np.array([1.0, -1.0, 1.0]))) < MIRROR_TOLERANCE
+                for g in feet
+            )
+            for f in feet
+        )
+        if mirrored:
+            out |= {s.bodies[0].index for s in runs}
+    return out
+
+
+#: The fewest joints of a leg found by where it stands.
+MIN_STANDING_JOINTS = 3
+#: The fewest runs from one trunk that stand a robot up by their shape alone (a quadruped).
+MIN_STANDING_RUNS = 4
+#: How far off the trunk's middle (m) a foot of a mirrored pair is, at least.
+MIRROR_OFF = 0.03
+#: How far (m) a foot may lie from its partner's mirror image.
+MIRROR_TOLERANCE = 0.01

@@ -29,6 +29,7 @@ from robotspec.spec.draft.limb_kinds import (
     is_named,
     named,
     paired_arms,
+    standing_runs,
     without_digits,
 )
 from robotspec.spec.draft.tree import Segment, Tree, words
@@ -105,11 +106,13 @@ def _limb(
     paired: bool = False,
     rolling: bool = True,
     stands: bool = True,
+    afoot: bool = False,
 ) -> Limb | None:
     """The arm or leg a run is, or None (``paired``: one of a mirrored pair beside legs).
 
     ``stands=False``: reaching the ground does not make the run a leg (a lone one, see
-    ``_find_limbs``).
+    ``_find_limbs``). ``afoot``: one of several runs from one trunk whose ends are on the
+    ground (a small quadruped's short legs, whatever their names).
     """
     world = tree.world
     cut = hand_cut(tree, seg)
@@ -142,7 +145,8 @@ def _limb(
     reach = tree.length(seg, None if jaw else upto)  # with its jaw, as far as it reaches
     # Shorter is a finger, unless named as a leg and reaching the ground (Mini Pupper's legs).
     below = tuple(world.subtree(seg.end))  # with the foot fixed at its end ('lffoot')
-    footed = count(below, LEG_WORDS) > 0 and tree.position(seg.end)[2] - low < FOOT_CLEARANCE
+    on_ground = tree.position(seg.end)[2] - low < FOOT_CLEARANCE
+    footed = (afoot or count(below, LEG_WORDS) > 0) and on_ground
     if reach < MIN_LIMB_LENGTH and not (footed or paired):
         return None
     # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.
@@ -285,6 +289,7 @@ def _find_limbs(tree: Tree, wheels: frozenset[str], rolling: bool) -> list[Limb]
     limbs: list[Limb] = []
     bases: list[Body | None] = []
     ending = {s.end.index: s for s in tree.segments}
+    afoot = standing_runs(tree, low, FOOT_CLEARANCE)
     for seg in tree.segments:
         if any(world.is_ancestor(lb.tip, seg.start) for lb in limbs):
             continue  # inside a hand (fingers) or hanging below a limb's end
@@ -296,7 +301,8 @@ def _find_limbs(tree: Tree, wheels: frozenset[str], rolling: bool) -> list[Limb]
             seg = Segment(above.start, above.bodies + seg.bodies, above.joints + seg.joints)
         # Joined, it starts at its own base: the link above its first joint, not above mounts.
         base = world.bodies[seg.joints[0].parent] if joined else None
-        limb = _limb(tree, seg, low, base, wheels, rolling=rolling)
+        on_foot = seg.bodies[0].index in afoot
+        limb = _limb(tree, seg, low, base, wheels, rolling=rolling, afoot=on_foot)
         if limb is not None:
             limbs.append(limb)
             bases.append(base)

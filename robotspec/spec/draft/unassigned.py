@@ -35,6 +35,7 @@ import numpy as np
 
 from robotspec.model.entities import Body, Connection, ConnectionType
 from robotspec.spec.draft.model import DraftQuestion
+from robotspec.spec.draft.open_ends import open_end_questions
 from robotspec.spec.draft.sensors import CAMERA_WORDS, NOT_CAMERA_WORDS
 from robotspec.spec.draft.tree import words
 
@@ -356,7 +357,9 @@ def _long_part_questions(d: Drafter) -> list[DraftQuestion]:
 
 def find_questions(d: Drafter) -> list[DraftQuestion]:
     """Questions about what no drafted part covers (see the module docstring)."""
-    return _joint_questions(d) + _long_part_questions(d) + _camera_questions(d)
+    return (
+        _joint_questions(d) + _long_part_questions(d) + open_end_questions(d) + _camera_questions(d)
+    )
 
 
 def asked(draft: Draft) -> tuple[frozenset[str], frozenset[str]]:

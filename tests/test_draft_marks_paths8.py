@@ -114,3 +114,35 @@ def test_a_frame_of_the_stated_cameras_device_is_not_asked_again(tmp_path: Path)
     ]
     draft, _ = _draft(tmp_path, _head(extra), {})
     assert not [q for q in draft.questions if "link_4" in q.links]
+
+
+def _two_arms(along: str) -> list[str]:
+    """A base and two 6-joint arms of numbered names, their shoulders apart along ``along``."""
+    parts = [_link("link_0", size=0.2)]
+    for k, sign in (("a", 1), ("b", -1)):
+        above = "link_0"
+        for i in range(1, 7):
+            at = f"{0.2 * sign} 0 0.3" if along == "x" else f"0 {0.2 * sign} 0.3"
+            parts += [
+                _link(f"link_{k}{i}", size=0.03),
+                _joint(f"joint_{k}{i}", above, f"link_{k}{i}", xyz=at if i == 1 else "0 0 0.1"),
+            ]
+            above = f"link_{k}{i}"
+    return parts
+
+
+def test_a_default_facing_across_a_pair_of_arms_is_marked(tmp_path: Path) -> None:
+    # No side names: the facing is +x by default. The arms lie apart along x, so the robot
+    # faces +y or -y; without the mark, a wrong facing was stated as if the files said it.
+    draft, s = _draft(tmp_path, _two_arms("x"), {"forward": [0.0, 1.0, 0.0]})
+    assert draft.forward == (1.0, 0.0, 0.0)
+    assert draft.forward_decide == "its two arms lie apart along x: it faces +y or -y, not +x?"
+    assert "forward: [1, 0, 0]  # DECIDE: its two arms" in render_draft(draft)
+    assert "torso/neck/drive: forward: [1.0, 0.0, 0.0]" in s.wrong and s.unmarked == []
+
+
+def test_a_default_facing_between_a_pair_of_arms_apart_along_y_stays_unwritten(
+    tmp_path: Path,
+) -> None:
+    draft, _ = _draft(tmp_path, _two_arms("y"), {})
+    assert draft.forward_decide is None

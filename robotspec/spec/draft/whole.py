@@ -324,6 +324,34 @@ def _drive_doubt(d: Drafter, rule: str) -> str | None:
     return None
 
 
+# ------------------------------------------------------------------------------ facing
+def _facing_doubt(d: Drafter) -> str | None:
+    """Why a facing drafted +x by default (no names said otherwise) is a question.
+
+    A pair of arms (or legs) lies across the way the robot faces. When a pair's first links
+    lie apart along x, the robot faces +y or -y, and +x (REP 103's default, kept when no side
+    names say otherwise) is a guess the files contradict: which side is left only names say.
+    """
+    world, tree, draft = d.world, d.tree, d.draft
+    for role in ("arm", "leg"):
+        pair = [c for c in draft.chains if c.role == role]
+        if len(pair) != 2:
+            continue
+        spots = []
+        for c in pair:
+            moving = [world.get_connection_by_name(j) for j in c.joints if world.has_connection(j)]
+            if not moving:
+                break
+            first = min(moving, key=lambda j: world.depth(world.bodies[j.child]))
+            spots.append(tree.position(world.bodies[first.child]))
+        if len(spots) != 2:
+            continue
+        gap = spots[0] - spots[1]
+        if abs(float(gap[0])) > max(2 * abs(float(gap[1])), _SPOT * 2):
+            return f"its two {role}s lie apart along x: it faces +y or -y, not +x?"
+    return None
+
+
 def keep_marks(d: Drafter) -> None:
     """Give back the mark of every item whose rule's files state only part of it."""
     draft = d.draft
@@ -341,6 +369,9 @@ def keep_marks(d: Drafter) -> None:
         if c.stated == CHAIN_SRDF and not c.decide and (why := _chain_doubt(d, c)) is not None:
             c.decide.append(why)
             c.stated = None
+    if draft.forward_decide is None and draft.forward in (None, (1.0, 0.0, 0.0)):
+        if (why := _facing_doubt(d)) is not None:
+            draft.forward, draft.forward_decide = (1.0, 0.0, 0.0), why
     dr = draft.drive
     if dr is not None and dr.stated and not dr.decide:
         if (why := _drive_doubt(d, dr.stated)) is not None:

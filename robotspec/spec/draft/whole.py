@@ -30,6 +30,7 @@ drive         a fixed virtual joint on a robot with wheels (turning, wheel-shape
               as arms); a floating one on a robot with wheels; drive plugins that disagree,
               one moving the base in the plane (``planar_move``), naming no wheels, leaving
               driven wheels out, or on a robot with legs
+facing        (+x by default, no names said) the robot's two arms or legs lie apart along x
 ============  ==========================================================================
 """
 

@@ -31,9 +31,9 @@ Each row counts right/counted per category over the robots, like ``measure``'s t
 perturbation that breaks loading counts the robot as missed. ``--wrong`` lists each wrong
 item per robot and perturbation (tune half only).
 
-Protocol: the tune half only, never the held-out half; robots listed in a manifest after a
-``# round 8a`` or ``# round 8b`` comment (robots kept blind for a first-sight measurement) are
-skipped too.
+Protocol: the tune half only, never the held-out half. ``--blind-round 9a`` (repeatable) also
+skips the robots a manifest lists after a ``# round 9a`` comment: a round's new robots, kept
+blind to whoever changes the drafter until the lead has measured them at first sight.
 """
 
 from __future__ import annotations
@@ -66,18 +66,24 @@ __all__ = ["PERTURBATIONS", "blind_ids", "main", "rename_map", "score_robot"]
 ROOT_OFFSET = (0.3, -0.2, -0.45)
 #: The words a blinded name keeps.
 SIDE_WORDS = frozenset({"left", "right", "l", "r"})
-_BLIND_ROUND = re.compile(r"^\s*#\s*round\s+8[ab]\b", re.IGNORECASE)
 _ID = re.compile(r"^\s*-?\s*id:\s*(\S+)")
 
 
-def blind_ids(manifests: Sequence[Path]) -> frozenset[str]:
-    """Robot ids a manifest lists after a ``# round 8a``/``# round 8b`` comment (kept blind)."""
+def blind_ids(manifests: Sequence[Path], rounds: Sequence[str]) -> frozenset[str]:
+    """Robot ids a manifest lists after a ``# round R`` comment, for R in ``rounds`` (kept blind).
+
+    A block runs to the next ``# round`` comment.
+    """
     out: set[str] = set()
+    if not rounds:
+        return frozenset()
+    marker = re.compile(r"^\s*#\s*round\s+([^\s:(]+)", re.IGNORECASE)
+    wanted = {r.lower() for r in rounds}
     for path in manifests:
         blind = False
         for line in path.read_text(encoding="utf-8").splitlines():
-            if _BLIND_ROUND.match(line):
-                blind = True
+            if m := marker.match(line):
+                blind = m.group(1).lower() in wanted
             elif blind and (m := _ID.match(line)):
                 out.add(m.group(1))
     return frozenset(out)
@@ -287,9 +293,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--only", action="append", choices=list(PERTURBATIONS))
     ap.add_argument("--robots", nargs="*", default=None, help="tune-half robot ids")
     ap.add_argument("--wrong", action="store_true", help="list the wrong items per robot")
+    ap.add_argument(
+        "--blind-round", action="append", default=[], help="skip a round's robots (e.g. 9a)"
+    )
     args = ap.parse_args(argv)
     kinds = args.only or list(PERTURBATIONS)
-    hidden = blind_ids([fetch.MANIFEST, extract_github.MANIFEST])
+    hidden = blind_ids([fetch.MANIFEST, extract_github.MANIFEST], args.blind_round)
     robots, skipped = corpus_robots()
     tune = [r for r in robots if r.half == "tune" and r.id not in hidden]
     if args.robots is not None:

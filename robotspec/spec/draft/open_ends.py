@@ -44,16 +44,6 @@ _IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
 _SHOWN = 3
 
 
-def _moved_by_last_joint(d: Drafter, body: Body) -> Body:
-    """The link the chain's last moving joint moves (``body`` or one it is fixed below)."""
-    world = d.world
-    while (c := world.parent_connection(body)) is not None and c.is_fixed:
-        if body is d.tree.root:
-            break
-        body = world.bodies[c.parent]
-    return body
-
-
 def _fixed_below(d: Drafter, end: Body) -> list[Body]:
     """The bodies fixed below ``end`` (fixed or mimic joints), but another sensor's frames.
 
@@ -89,7 +79,7 @@ def open_end_questions(d: Drafter) -> list[DraftQuestion]:
     for chain in draft.chains:
         if chain.role not in _ROLES or not world.has_body(chain.tip):
             continue
-        end = _moved_by_last_joint(d, world.get_body_by_name(chain.tip))
+        end = d.tree.rigid_root(world.get_body_by_name(chain.tip))
         if any(world.is_ancestor(end, r) or world.is_ancestor(r, end) for r in roots):
             continue  # a manipulator at (or around) its end: its own marks ask
         if any(world.is_ancestor(end, k) for k in cams):
@@ -118,7 +108,7 @@ def _head_questions(d: Drafter, cams: list[Body]) -> list[DraftQuestion]:
     world, tree, neck = d.world, d.tree, d.draft.neck
     if neck is None or not world.has_body(neck.tip):
         return []
-    head = _moved_by_last_joint(d, world.get_body_by_name(neck.tip))
+    head = d.tree.rigid_root(world.get_body_by_name(neck.tip))
     seen = [tree.position(k) for k in cams]
     bare = [
         b

@@ -90,7 +90,7 @@ def is_optical(tree: Tree, body: Body) -> bool:
     # body the robot faces with: on a limb or a torso, "behind" says nothing (Baxter's arm
     # buttons, TIAGo Pro's arm mounts are turned so).
     behind = np.allclose(rot[:, 0], -_OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -_TILT
-    return bool(behind) and _rigid_root(tree, body) is tree.root
+    return bool(behind) and tree.rigid_root(body) is tree.root
 
 
 def _stem(name: str) -> str:
@@ -141,10 +141,10 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
         found, key=lambda c: (not c.optical, _channel_rank(c.name), len(c.name), c.body.index)
     )
     for cam in order:
-        carrier = _rigid_root(tree, cam.body)
+        carrier = tree.rigid_root(cam.body)
         device = _device(cam.name)
         dup = any(
-            _rigid_root(tree, k.body) is carrier
+            tree.rigid_root(k.body) is carrier
             and (
                 cam.name == k.name
                 or cam.name.startswith(k.name + "_")
@@ -155,7 +155,7 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             for k in kept
         )
         # A body frame named as a camera, rigid with an optical frame, is that camera's link.
-        optical_here = any(k.optical and _rigid_root(tree, k.body) is carrier for k in kept)
+        optical_here = any(k.optical and tree.rigid_root(k.body) is carrier for k in kept)
         dup = dup or (not cam.optical and optical_here)
         if not dup and stated:
             cam = CameraFound(
@@ -212,17 +212,6 @@ def _pair(tree: Tree, a: CameraFound, b: CameraFound) -> bool:
         return False
     gap = float(np.linalg.norm(tree.position(a.body) - tree.position(b.body)))
     return gap <= DEVICE_SPAN
-
-
-def _rigid_root(tree: Tree, body: Body) -> Body:
-    """The body a frame is rigidly fixed to: up through fixed joints to a moving one."""
-    world = tree.world
-    b = body
-    while True:
-        c = world.parent_connection(b)
-        if c is None or not c.is_fixed or b is tree.root:
-            return b
-        b = world.bodies[c.parent]
 
 
 def find_neck(tree: Tree, cameras: list[CameraFound], limb_tops: list[Body]) -> NeckFound | None:

@@ -140,7 +140,7 @@ def _device_frame(tree: Tree, body: Body, view: np.ndarray) -> Body | None:
     if name == body.name or not world.has_body(name):
         return None
     other = world.get_body_by_name(name)
-    if other.index not in tree.inside or _rigid_root(tree, other) is not _rigid_root(tree, body):
+    if other.index not in tree.inside or tree.rigid_root(other) is not tree.rigid_root(body):
         return None
     pose = tree.poses[other.index]
     far = float(np.linalg.norm(pose[:3, 3] - tree.poses[body.index][:3, 3]))
@@ -157,7 +157,7 @@ def _own_frame(
     camera a person writes. Only a frame rigid with the link, within a device's span, looking
     the sensor's way, and named by sensors at this one spot (``_resolve``'s caller checks).
     """
-    if named is None or _rigid_root(tree, named) is not _rigid_root(tree, link):
+    if named is None or tree.rigid_root(named) is not tree.rigid_root(link):
         return False
     pose = tree.poses[named.index]
     near = float(np.linalg.norm(pose[:3, 3] - at)) <= DEVICE_SPAN
@@ -209,16 +209,6 @@ def _resolve(tree: Tree, g: GazeboCamera, shared: frozenset[str]) -> StatedCamer
     return StatedCamera(name, body, g, optical, axis, f"the Gazebo sensor '{g.name}': {how}", doubt)
 
 
-def _rigid_root(tree: Tree, body: Body) -> Body:
-    world = tree.world
-    b = body
-    while True:
-        c = world.parent_connection(b)
-        if c is None or not c.is_fixed or b is tree.root:
-            return b
-        b = world.bodies[c.parent]
-
-
 def _one_device(tree: Tree, a: StatedCamera, b: StatedCamera) -> bool:
     """Whether two sensors are channels of one device (or one camera named twice)."""
     if a.body is b.body or a.fact.link == b.fact.link:
@@ -226,7 +216,7 @@ def _one_device(tree: Tree, a: StatedCamera, b: StatedCamera) -> bool:
     # Channels by their frames' names: a stereo depth camera (Go1's five) is a device alone.
     if not (_channel_words(a.body.name) and _channel_words(b.body.name)):
         return False
-    if _rigid_root(tree, a.body) is not _rigid_root(tree, b.body):
+    if tree.rigid_root(a.body) is not tree.rigid_root(b.body):
         return False
     far = tree.poses[a.body.index][:3, 3] - tree.poses[b.body.index][:3, 3]
     # One device's channels look one way: a tracking camera beside an RGB-D one (CENTAURO's

@@ -97,6 +97,19 @@ class Tree:
         """The connection above ``body`` (``None`` at the world's root)."""
         return self.world.parent_connection(body)
 
+    def rigid_root(self, body: Body) -> Body:
+        """The link a frame is rigidly fixed to: up through fixed joints to a moving one.
+
+        Why one place: cameras, devices, tool frames and the questions all ask "which link does
+        this frame move with", and each answer must be the same.
+        """
+        b = body
+        while (c := self.world.parent_connection(b)) is not None and c.is_fixed:
+            if b is self.root:
+                break
+            b = self.world.bodies[c.parent]
+        return b
+
     def moving_children(self, body: Body) -> list[Body]:
         """Children whose branch moves: a moving joint to them, or one somewhere below them."""
         out = []

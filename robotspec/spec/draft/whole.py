@@ -84,15 +84,6 @@ _COLOUR = frozenset({"color", "colour", "rgb"})
 _TOOLS = (TOOL_SRDF, TOOL_ON_HAND, TOOL_AT_END)
 
 
-def _rigid_root(d: Drafter, body: Body) -> Body:
-    world = d.world
-    while (c := world.parent_connection(body)) is not None and c.is_fixed:
-        if body is d.tree.root:
-            break
-        body = world.bodies[c.parent]
-    return body
-
-
 def _fixed_to(d: Drafter, body: Body) -> list[Body]:
     """The frames fixed to ``body`` (a few fixed joints above it, and below those)."""
     world = d.world
@@ -119,14 +110,14 @@ def _camera_doubt(d: Drafter, cam: DraftCamera) -> str | None:
     """What of a Gazebo-stated camera the sensor leaves to inference, if anything."""
     world, tree, facts = d.world, d.tree, d.facts
     body = world.get_body_by_name(cam.body)
-    root = _rigid_root(d, body)
+    root = d.tree.rigid_root(body)
     at = tree.poses[body.index][:3, 3]
     sensors = [
         g
         for g in facts.cameras[:MAX_SENSORS]
         if world.has_body(g.link)
         and world.get_body_by_name(g.link).index in tree.inside
-        and _rigid_root(d, world.get_body_by_name(g.link)) is root
+        and d.tree.rigid_root(world.get_body_by_name(g.link)) is root
         and float(np.linalg.norm(tree.poses[world.get_body_by_name(g.link).index][:3, 3] - at))
         <= _DEVICE_SPAN
     ]
@@ -141,7 +132,7 @@ def _camera_doubt(d: Drafter, cam: DraftCamera) -> str | None:
         b.name
         for b in (world.bodies[i] for i in _resolved(d))
         if b.name not in drafted
-        and _rigid_root(d, b) is root
+        and d.tree.rigid_root(b) is root
         and float(np.linalg.norm(tree.poses[b.index][:3, 3] - at)) <= _DEVICE_SPAN
         # a frame where a drafted camera is (a stereo pair's frame on its left eye): the same
         and all(float(np.linalg.norm(tree.poses[b.index][:3, 3] - t)) > _SPOT for t in taken)
@@ -215,7 +206,7 @@ def _pairs(d: Drafter) -> dict[str, str]:
     out: dict[str, str] = {}
     for i, (a, ab) in enumerate(cams):
         for b, bb in cams[i + 1 :]:
-            if a.field_of_view != b.field_of_view or _rigid_root(d, ab) is not _rigid_root(d, bb):
+            if a.field_of_view != b.field_of_view or tree.rigid_root(ab) is not tree.rigid_root(bb):
                 continue
             gap = float(np.linalg.norm(tree.poses[ab.index][:3, 3] - tree.poses[bb.index][:3, 3]))
             if gap > _STEREO_BASE or float(_view(d, a, ab) @ _view(d, b, bb)) < _ALONG:
@@ -249,7 +240,7 @@ def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str |
         if TOOL_AT_END in rules:
             # No hand found, but a shape hangs past the arm's last joint: a tool bolted on
             # (a torch, a suction cup, fingers on fixed joints) whose TCP the name may not be.
-            last = _rigid_root(d, root)  # the link the arm's last joint moves
+            last = d.tree.rigid_root(root)  # the link the arm's last joint moves
             shaped = [b.name for b in world.subtree(last) if b is not last and own_geometry(b)]
             if shaped:
                 return f"'{shaped[0]}' hangs past the arm's last joint: a tool, whose TCP?"

@@ -15,9 +15,11 @@ the drafts come is measured against hand-written ground truth by ``tools/draft_s
 
 One module per job: ``tree`` (segments and the default pose), ``limbs`` (arms, legs), ``hands``
 (grippers), ``fingers`` (hands of three or more fingers), ``tool_frames``, ``manipulators`` (what
-hangs at a chain's end), ``sensors`` (cameras, neck), ``srdf_groups`` (what the SRDF says),
-``confidence`` (when a part carries a DECIDE mark: only where no file states it), ``build``
-(joining them), ``render`` (YAML that survives any name), ``paths`` (portable file references).
+hangs at a chain's end), ``lone_hand`` (a hand without an arm), ``sensors`` (cameras, neck),
+``parts`` (cameras and the neck placed on the chains, named states), ``torso_drive`` (torso,
+drive), ``srdf_groups`` (what the SRDF says), ``confidence`` (when a part carries a DECIDE mark:
+only where no file states it), ``build`` (joining them), ``render`` (YAML that survives any
+name), ``paths`` (portable file references).
 """
 
 from __future__ import annotations

@@ -17,7 +17,8 @@ from robotspec.spec.draft.driven import stated_wheels
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.hands import find_fingers, find_gripper
 from robotspec.spec.draft.limbs import Limb, find_limbs, group_end
-from robotspec.spec.draft.manipulators import lone_hand, manipulator
+from robotspec.spec.draft.lone_hand import lone_hand
+from robotspec.spec.draft.manipulators import manipulator
 from robotspec.spec.draft.model import Draft, DraftChain, DraftDrive, DraftManipulator
 from robotspec.spec.draft.naming import (
     facing,
@@ -30,13 +31,14 @@ from robotspec.spec.draft.naming import (
     side_of,
     unique,
 )
-from robotspec.spec.draft.parts import add_drive, add_sensors, add_states, add_torso
+from robotspec.spec.draft.parts import add_sensors, add_states
 from robotspec.spec.draft.srdf_groups import (
     GroupJoints,
     end_effector_root,
     group_chains,
     group_notes,
 )
+from robotspec.spec.draft.torso_drive import add_drive, add_torso
 from robotspec.spec.draft.tree import Tree, words
 from robotspec.spec.draft.unassigned import find_questions
 from robotspec.spec.draft.whole import keep_marks
@@ -249,7 +251,7 @@ class Drafter:
         return manipulator(self, chain, limb, name, start, stated)
 
     def lone_hand(self) -> DraftManipulator | None:
-        """A hand or a gripper alone (``manipulators.lone_hand``)."""
+        """A hand or a gripper alone (``lone_hand.lone_hand``)."""
         return lone_hand(self)
 
     def end_effectors(self, chains: list[tuple[DraftChain, Limb | None]]) -> None:

@@ -8,7 +8,6 @@ Whether each decision is stated by the files or a question is ``confidence``'s r
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -16,7 +15,6 @@ import numpy as np
 from robotspec.model.entities import Body
 from robotspec.model.world import World
 from robotspec.spec.draft.confidence import GRIPPER_MIMIC, TOOL_SRDF, tool_frame_verdict
-from robotspec.spec.draft.fingers import MIN_DIGITS
 from robotspec.spec.draft.hands import (
     Gripper,
     facing_quaternion,
@@ -26,15 +24,7 @@ from robotspec.spec.draft.hands import (
     hand_center,
     hand_joints,
 )
-from robotspec.spec.draft.limbs import (
-    FINGER_WORDS,
-    HAND_WORDS,
-    MAX_HAND_SPAN,
-    Limb,
-    eyes,
-    hand_span,
-    is_named,
-)
+from robotspec.spec.draft.limbs import Limb
 from robotspec.spec.draft.model import DraftChain, DraftFrame, DraftManipulator
 from robotspec.spec.draft.naming import unique
 from robotspec.spec.draft.srdf_groups import rigidly_beside
@@ -50,7 +40,7 @@ from robotspec.spec.draft.tool_frames import (
 if TYPE_CHECKING:
     from robotspec.spec.draft.build import Drafter
 
-__all__ = ["MAX_WRIST", "ON_ROOT", "lone_hand", "manipulator"]
+__all__ = ["ON_ROOT", "manipulator"]
 
 
 def manipulator(
@@ -281,76 +271,8 @@ def _facing(
         m.facing = "grasping along the hand's reach"  # follows the tool frame: no question
 
 
-def lone_hand(self: Drafter) -> DraftManipulator | None:
-    """A hand or a gripper alone (no arm): one manipulator rooted at the robot's root.
-
-    Why not nothing: a hand's URDF (Allegro's, a WSG-50's) is a part that specs compose onto
-    an arm; its spec is its manipulator, fingers and tool frame. It is a hand when its
-    fingers make a parallel gripper, or when two or more short moving branches leave its
-    root, or when its links are named as a hand's.
-    """
-    tree, world = self.tree, self.world
-    root = tree.root
-    # Where the fingers split: down the single moving branch from the root, through a mount
-    # (fixed joints) and a wrist (at most MAX_WRIST joints, drafted as a chain of its own).
-    split, wrist = root, []
-    while len(kids := tree.moving_children(split)) == 1:
-        c = world.parent_connection(kids[0])
-        if c is not None and c.is_active:
-            wrist.append(c.name)
-        split = kids[0]
-    if len(wrist) > MAX_WRIST:
-        split, wrist = root, []
-    if eyes(tree, split):
-        return None  # a head's eyes, each carrying a camera: no hand
-    gripper, _ = find_gripper(tree, split)
-    # Wheels (continuous joints about a level axis turning a wheel's shape) are never fingers.
-    wheels = {c.child for c in self.wheels}
-
-    def rolls(body: Body) -> bool:
-        return any(a.index in wheels for a in (*world.ancestors(body), body))
-
-    if gripper is not None and (rolls(gripper.thumb_tip) or rolls(gripper.finger_tip)):
-        gripper = None
-    # Fingers have phalanges: a branch of one joint (a rotor, a wheel) is not one, unless the
-    # palm has MIN_DIGITS of them on limited joints (a five-finger hand's one-joint digits).
-    kids = [
-        k
-        for k in tree.moving_children(split)
-        if not any(b.index in wheels for b in world.subtree(k))
-    ]
-    branches = [
-        k for k in kids if sum(1 for b in world.subtree(k) if not _fixed_above(world, b)) >= 2
-    ]
-    if len(kids) >= MIN_DIGITS and all(_limited(world, k) for k in kids):
-        branches = kids
-    named = any(is_named(b.name, HAND_WORDS | FINGER_WORDS) for b in world.subtree(split))
-    small = hand_span(tree, split) <= MAX_HAND_SPAN
-    if gripper is None and not (len(branches) >= 2 and (small or named)):
-        return None
-    if wrist:
-        holder = DraftChain(
-            unique("wrist", self.names),
-            root.name,
-            split.name,
-            "the URDF tree",
-            joints=frozenset(wrist),
-            decide=[f"a wrist: {len(wrist)} joint(s) from the root to where the fingers split"],
-        )
-        self.draft.chains.append(holder)
-    else:
-        holder = DraftChain("hand", root.name, root.name, "the URDF tree")
-    m = manipulator(self, holder, None, "gripper" if gripper else "hand", start=split)
-    if m is not None and not wrist:
-        m.decide.insert(0, "a hand alone (no arm): rooted at the robot's root")
-        self.draft.lone_hand = m.name
-    return m
-
-
 #: A point between the finger tips this close to the gripper's link (m) is that link.
 ON_ROOT = 0.01
-#: Most joints between a lone hand's root and where its fingers split (a wrist, not an arm).
-MAX_WRIST = 3
 
 
 def _bare_frames(world: World, body: Body) -> list[Body]:
@@ -378,21 +300,3 @@ def _shape_unknown(body: Body) -> bool:
     """Whether ``body``'s shape is not loaded: none, or only meshes whose files were not found."""
     shapes = (*body.visuals, *body.collisions)
     return all(getattr(s.geometry, "path", "") is None for s in shapes)
-
-
-#: The widest range (rad or m) of a digit's joint; a rotor's (Iris's 'revolute' +-1e16) is wider.
-MAX_DIGIT_RANGE = 2 * math.pi
-
-
-def _limited(world: World, body: Body) -> bool:
-    """Whether ``body`` moves on a joint whose range a digit's could be (never a rotor's)."""
-    c = world.parent_connection(body)
-    if c is None or c.type.value not in ("revolute", "prismatic") or not c.dofs:
-        return False
-    dof = world.degrees_of_freedom[c.dofs[0]]
-    return dof.is_bounded and dof.upper - dof.lower <= MAX_DIGIT_RANGE
-
-
-def _fixed_above(world: World, body: Body) -> bool:
-    c = world.parent_connection(body)
-    return c is None or c.is_fixed

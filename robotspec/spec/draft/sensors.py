@@ -24,7 +24,7 @@ from robotspec.spec.draft.limbs import HEAD_WORDS, eyes
 from robotspec.spec.draft.stated_cameras import StatedCamera, stated_cameras
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["CameraFound", "NeckFound", "find_cameras", "find_neck"]
+__all__ = ["CameraFound", "NeckFound", "find_cameras", "find_neck", "stated_channels"]
 
 CAMERA_WORDS = frozenset(
     {"camera", "cam", "optical", "rgb", "rgbd", "xtion", "kinect", "realsense", "stereo"}
@@ -104,12 +104,24 @@ def find_cameras(tree: Tree) -> list[CameraFound]:
     return list(tree.memo["cameras"])
 
 
+def stated_channels(tree: Tree) -> set[int]:
+    """The bodies each Gazebo camera sensor resolves to or its plugin names, found once.
+
+    None of them is another camera. Kept with :func:`find_cameras`'s result so that the marks
+    (``whole``) read them instead of resolving every sensor a second time.
+    """
+    find_cameras(tree)
+    channels: set[int] = tree.memo["stated_channels"]
+    return channels
+
+
 def _find_cameras(tree: Tree) -> list[CameraFound]:
     world = tree.world
     facts = tree.memo.get("facts")
     facts = facts if isinstance(facts, FileFacts) else FileFacts()
     # What the files state first: each Gazebo camera device, on the frame it publishes in.
     devices, channels = stated_cameras(tree, facts)
+    tree.memo["stated_channels"] = channels
     stated = [CameraFound(s.name, s.body, s.optical, s) for s in devices]
     # A link a Gazebo sensor is on is that sensor's (a laser, an IMU, a camera's mount).
     taken = channels | {

@@ -55,7 +55,8 @@ from robotspec.spec.draft.confidence import (
     TOOL_SRDF,
 )
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftManipulator
-from robotspec.spec.draft.stated_cameras import MAX_SENSORS, stated_cameras
+from robotspec.spec.draft.sensors import stated_channels
+from robotspec.spec.draft.stated_cameras import MAX_SENSORS
 from robotspec.spec.draft.tool_frames import is_named_tcp, own_geometry
 from robotspec.spec.draft.tree import words
 
@@ -130,7 +131,7 @@ def _camera_doubt(d: Drafter, cam: DraftCamera) -> str | None:
     taken = [tree.poses[world.get_body_by_name(c).index][:3, 3] for c in drafted]
     others = [
         b.name
-        for b in (world.bodies[i] for i in _resolved(d))
+        for b in (world.bodies[i] for i in stated_channels(d.tree))
         if b.name not in drafted
         and d.tree.rigid_root(b) is root
         and float(np.linalg.norm(tree.poses[b.index][:3, 3] - at)) <= _DEVICE_SPAN
@@ -215,15 +216,6 @@ def _pairs(d: Drafter) -> dict[str, str]:
             out.setdefault(a.body, why.format(a.body, b.body))
             out.setdefault(b.body, why.format(a.body, b.body))
     return out
-
-
-def _resolved(d: Drafter) -> set[int]:
-    """The bodies every Gazebo camera sensor resolves to (or its plugin names), found once."""
-    memo = d.tree.memo
-    if "whole.resolved" not in memo:
-        memo["whole.resolved"] = stated_cameras(d.tree, d.facts)[1]
-    found: set[int] = memo["whole.resolved"]
-    return found
 
 
 # -------------------------------------------------------------------------- manipulators

@@ -11,6 +11,7 @@ from pathlib import Path
 from robotspec.compiler import check_spec
 from robotspec.spec.draft import Draft, render_draft
 from robotspec.spec.draft.run import draft_from_files
+from tests.draft_support import draft_layout as _draft
 
 _BOX = '<visual><geometry><box size="{s} {s} {s}"/></geometry></visual>'
 #: A wheel's shape: a flat cylinder about the link's y axis.
@@ -44,16 +45,6 @@ def _joint(
         f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
         f'<origin xyz="{xyz}" rpy="{rpy}"/>{moving}</joint>'
     )
-
-
-def _draft(tmp_path: Path, name: str, parts: list[str]) -> Draft:
-    urdf = tmp_path / f"{name}.urdf"
-    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
-    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
-    spec = tmp_path / f"{name}.yaml"
-    spec.write_text(render_draft(draft))
-    assert check_spec(spec).robot is not None  # valid as written
-    return draft
 
 
 def _finger(prefix: str, parent: str, xyz: str, tip: str) -> list[str]:

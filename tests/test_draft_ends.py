@@ -7,9 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from robotspec.compiler import check_spec
-from robotspec.spec.draft import Draft, render_draft
 from robotspec.spec.draft.run import draft_from_files
+from tests.draft_support import draft_layout as _draft
 
 from .conftest import erd_robots, shared_path
 
@@ -48,16 +47,6 @@ def _arm(prefix: str, parent: str, n: int = 6, first_xyz: str = "0 0 0.1") -> li
         parts += [_link(link), _joint(f"{prefix}joint{i}", above, link, xyz=xyz, axis=axis)]
         above = link
     return parts
-
-
-def _draft(tmp_path: Path, name: str, parts: list[str]) -> Draft:
-    urdf = tmp_path / f"{name}.urdf"
-    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
-    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
-    spec = tmp_path / f"{name}.yaml"
-    spec.write_text(render_draft(draft))
-    assert check_spec(spec).robot is not None  # valid as written
-    return draft
 
 
 def test_an_arm_ends_at_the_flange_past_its_last_joint(tmp_path: Path) -> None:

@@ -5,8 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from robotspec.compiler import check_spec
-from robotspec.spec.draft import Draft, render_draft
+from robotspec.spec.draft import render_draft
 from robotspec.spec.draft.run import draft_from_files
+from tests.draft_support import draft_layout as _draft
 
 _BOX = '<collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision>'
 
@@ -31,16 +32,6 @@ def _limb(side: str, parent: str, names: list[str], start: str, step: str) -> li
         parts += [_link(link), _joint(f"{side}_{n}", above, link, start if i == 0 else step, axis)]
         above = link
     return parts
-
-
-def _draft(tmp_path: Path, name: str, parts: list[str]) -> Draft:
-    urdf = tmp_path / f"{name}.urdf"
-    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
-    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
-    spec = tmp_path / f"{name}.yaml"
-    spec.write_text(render_draft(draft))
-    assert check_spec(spec).robot is not None  # valid as written
-    return draft
 
 
 def test_a_humanoid_rooted_at_its_trunk_has_its_waist_as_torso(tmp_path: Path) -> None:

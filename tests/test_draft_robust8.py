@@ -10,9 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from robotspec.compiler import check_spec
-from robotspec.spec.draft import Draft, render_draft
-from robotspec.spec.draft.run import draft_from_files
+from tests.draft_support import draft_layout as _draft
 
 _MASS = (
     '<inertial><mass value="{m}"/>'
@@ -55,16 +53,6 @@ def _arm_with_jaws(box_on_base: bool = False) -> list[str]:
     parts += [_link("n9"), _joint("q9", "n7", "n9", "prismatic", "0 -0.02 0.06", "0 -1 0", "q8")]
     parts += [_link("n10", None), _joint("q10", "n7", "n10", kind="fixed", xyz="0 0 0.1")]
     return parts
-
-
-def _draft(tmp_path: Path, name: str, parts: list[str]) -> Draft:
-    urdf = tmp_path / f"{name}.urdf"
-    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
-    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
-    spec = tmp_path / f"{name}.yaml"
-    spec.write_text(render_draft(draft))
-    assert check_spec(spec).robot is not None  # valid as written
-    return draft
 
 
 def test_a_file_without_shapes_still_has_a_gripper(tmp_path: Path) -> None:

@@ -10,12 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robotspec.compiler import check_spec
 from robotspec.description.load import load_description
-from robotspec.spec.draft import Draft, render_draft
-from robotspec.spec.draft.run import draft_from_files
 from robotspec.spec.draft.tips import far_end, flange_offset
 from robotspec.spec.draft.tree import Tree
+from tests.draft_support import draft_layout as _draft
 
 from .conftest import erd_robots
 
@@ -58,16 +56,6 @@ def _arm(n: int = 6) -> list[str]:
         parts += [_link(f"link{i}"), _joint(f"joint{i}", above, f"link{i}", axis=axis)]
         above = f"link{i}"
     return parts
-
-
-def _draft(tmp_path: Path, name: str, parts: list[str]) -> Draft:
-    urdf = tmp_path / f"{name}.urdf"
-    urdf.write_text(f'<robot name="{name}">' + "".join(parts) + "</robot>")
-    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
-    spec = tmp_path / f"{name}.yaml"
-    spec.write_text(render_draft(draft))
-    assert check_spec(spec).robot is not None  # valid as written
-    return draft
 
 
 def test_a_bare_arm_gets_a_flange_frame_at_the_far_end_of_its_last_link(

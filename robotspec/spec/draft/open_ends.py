@@ -26,7 +26,8 @@ import numpy as np
 
 from robotspec.model.entities import Body
 from robotspec.spec.draft.model import DraftQuestion
-from robotspec.spec.draft.sensors import NOT_CAMERA_WORDS
+from robotspec.spec.draft.sensors import IMAGE_KINDS, NOT_CAMERA_WORDS
+from robotspec.spec.draft.stated_cameras import DEVICE_SPAN
 from robotspec.spec.draft.tree import words
 
 if TYPE_CHECKING:
@@ -36,10 +37,6 @@ __all__ = ["open_end_questions"]
 
 #: The chain roles whose end may carry a tool or a camera nothing drafted covers.
 _ROLES = frozenset({"arm", "chain"})
-#: How far apart (m) the frames of one camera device may be (as ``unassigned``'s).
-_DEVICE_SPAN = 0.1
-#: Gazebo sensor types that take images (as ``unassigned``'s): other sensors' frames are theirs.
-_IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
 #: Frames named in a question's text at most (all are in its subject).
 _SHOWN = 3
 
@@ -64,7 +61,7 @@ def _fixed_below(d: Drafter, end: Body) -> list[Body]:
             b
             for b in level
             if not (words(b.name) | set(re.split(r"[^a-z0-9]+", b.name.lower()))) & NOT_CAMERA_WORDS
-            and (b.name not in kinds or any(k in kinds[b.name] for k in _IMAGE_KINDS))
+            and (b.name not in kinds or any(k in kinds[b.name] for k in IMAGE_KINDS))
         ]
     return out
 
@@ -116,7 +113,7 @@ def _head_questions(d: Drafter, cams: list[Body]) -> list[DraftQuestion]:
         if not world.child_bodies(b)
         and not b.visuals
         and not b.collisions
-        and all(float(np.linalg.norm(tree.position(b) - p)) > _DEVICE_SPAN for p in seen)
+        and all(float(np.linalg.norm(tree.position(b) - p)) > DEVICE_SPAN for p in seen)
     ]
     if not bare:
         return []

@@ -21,11 +21,13 @@ import numpy as np
 from robotspec.model.entities import Body, Connection
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.limbs import HEAD_WORDS, eyes
-from robotspec.spec.draft.stated_cameras import StatedCamera, stated_cameras
+from robotspec.spec.draft.stated_cameras import DEVICE_SPAN, StatedCamera, stated_cameras
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = ["CameraFound", "NeckFound", "find_cameras", "find_neck", "stated_channels"]
 
+#: Gazebo sensor types that take images: the frames of other sensors are theirs, never cameras.
+IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
 CAMERA_WORDS = frozenset(
     {"camera", "cam", "optical", "rgb", "rgbd", "xtion", "kinect", "realsense", "stereo"}
     | {"webcam", "zed", "eye", "vision", "d435", "d415", "asus"}
@@ -203,10 +205,6 @@ def _device(name: str) -> str:
     parts = [p for p in re.split(r"[^A-Za-z0-9]+", name.lower()) if p]
     kept = [p for p in parts if p not in _CHANNELS]
     return "_".join(kept) or name
-
-
-#: How far apart (m) the frames of one RGB-D device may be (a RealSense's are 1.5 to 5 cm).
-DEVICE_SPAN = 0.1
 
 
 def _pair(tree: Tree, a: CameraFound, b: CameraFound) -> bool:

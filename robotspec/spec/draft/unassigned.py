@@ -36,7 +36,8 @@ import numpy as np
 from robotspec.model.entities import Body, Connection, ConnectionType
 from robotspec.spec.draft.model import DraftQuestion
 from robotspec.spec.draft.open_ends import open_end_questions
-from robotspec.spec.draft.sensors import CAMERA_WORDS, NOT_CAMERA_WORDS
+from robotspec.spec.draft.sensors import CAMERA_WORDS, IMAGE_KINDS, NOT_CAMERA_WORDS
+from robotspec.spec.draft.stated_cameras import DEVICE_SPAN
 from robotspec.spec.draft.tree import words
 
 if TYPE_CHECKING:
@@ -47,12 +48,8 @@ __all__ = ["CHAINS", "MANIPULATORS", "SENSORS", "asked", "find_questions"]
 
 #: The spec sections a question is written in (where the part it asks about would go).
 CHAINS, MANIPULATORS, SENSORS = "chains", "manipulators", "sensors"
-#: Gazebo sensor types that take images (a sensor of such a type not drafted is asked).
-_IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
 #: A run of at least this many joints is a limb's (an arm, a leg, a head); fewer, a tool's.
 _LIMB_JOINTS = 3
-#: How far apart (m) the frames of one camera device may be.
-_DEVICE_SPAN = 0.1
 #: An optical frame's x axis is level (|z component| below this), its y points down (below
 #: minus this): a camera's image rows run level and its columns downwards.
 _LEVEL, _DOWN = 0.2, 0.5
@@ -261,7 +258,7 @@ def _near(d: Drafter, a: Body, b: Body) -> bool:
     if _rigid_root(d, a) is not _rigid_root(d, b):
         return False
     gap = float(np.linalg.norm(d.tree.position(a) - d.tree.position(b)))
-    return gap <= _DEVICE_SPAN
+    return gap <= DEVICE_SPAN
 
 
 def _limb_ends(d: Drafter) -> set[int]:
@@ -303,7 +300,7 @@ def _camera_questions(d: Drafter) -> list[DraftQuestion]:
     taken = _limb_ends(d)
     why: dict[int, str] = {}
     for link, kind in d.facts.sensor_links.items():
-        if world.has_body(link) and any(k in kind for k in _IMAGE_KINDS):
+        if world.has_body(link) and any(k in kind for k in IMAGE_KINDS):
             why[world.get_body_by_name(link).index] = f"a Gazebo '{kind}' sensor"
     for b in world.bodies:
         if b.index in why or b is tree.root:

@@ -56,7 +56,7 @@ from robotspec.spec.draft.confidence import (
 )
 from robotspec.spec.draft.model import DraftCamera, DraftChain, DraftManipulator
 from robotspec.spec.draft.sensors import stated_channels
-from robotspec.spec.draft.stated_cameras import MAX_SENSORS
+from robotspec.spec.draft.stated_cameras import DEVICE_SPAN, MAX_SENSORS
 from robotspec.spec.draft.tool_frames import is_named_tcp, own_geometry
 from robotspec.spec.draft.tree import words
 
@@ -69,8 +69,6 @@ __all__ = ["keep_marks"]
 _PLAIN = frozenset(
     {"camera", "depth", "rgbd", "multicamera", "wideanglecamera", "depth_camera", "rgbd_camera"}
 )
-#: How far apart (m) the frames of one device may be (a RealSense's channels: 1.5 to 5 cm).
-_DEVICE_SPAN = 0.1
 #: The widest stereo baseline (m) two identical imagers of one device have (a MultiSense S21's
 #: 21 cm; a ZED's 12 cm, HSR-B's head pair 14 cm).
 _STEREO_BASE = 0.25
@@ -120,7 +118,7 @@ def _camera_doubt(d: Drafter, cam: DraftCamera) -> str | None:
         and world.get_body_by_name(g.link).index in tree.inside
         and d.tree.rigid_root(world.get_body_by_name(g.link)) is root
         and float(np.linalg.norm(tree.poses[world.get_body_by_name(g.link).index][:3, 3] - at))
-        <= _DEVICE_SPAN
+        <= DEVICE_SPAN
     ]
     odd = sorted({g.type for g in sensors} - _PLAIN)
     if odd:
@@ -134,7 +132,7 @@ def _camera_doubt(d: Drafter, cam: DraftCamera) -> str | None:
         for b in (world.bodies[i] for i in stated_channels(d.tree))
         if b.name not in drafted
         and d.tree.rigid_root(b) is root
-        and float(np.linalg.norm(tree.poses[b.index][:3, 3] - at)) <= _DEVICE_SPAN
+        and float(np.linalg.norm(tree.poses[b.index][:3, 3] - at)) <= DEVICE_SPAN
         # a frame where a drafted camera is (a stereo pair's frame on its left eye): the same
         and all(float(np.linalg.norm(tree.poses[b.index][:3, 3] - t)) > _SPOT for t in taken)
     ]
@@ -152,7 +150,7 @@ def _camera_doubt(d: Drafter, cam: DraftCamera) -> str | None:
     # device, not which of its frames a spec names, nor whether a pair is one camera or two.
     view = _view(d, cam, body)
     for k in _fixed_to(d, body):
-        if k is body or float(np.linalg.norm(tree.poses[k.index][:3, 3] - at)) > _DEVICE_SPAN:
+        if k is body or float(np.linalg.norm(tree.poses[k.index][:3, 3] - at)) > DEVICE_SPAN:
             continue
         # A frame the draft did not take (a drafted neighbour is a camera of its own).
         frame = k.name not in drafted and not world.child_bodies(k) and not own_geometry(k)

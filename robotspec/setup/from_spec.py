@@ -10,7 +10,7 @@ import copy
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from robotspec.files.yamlio import LocatedYaml
 from robotspec.model.world import World
@@ -25,6 +25,10 @@ from robotspec.spec.draft.model import (
 )
 from robotspec.spec.draft.render import PLACEHOLDER_FOV
 from robotspec.spec.load import LoadedSpec
+from robotspec.spec.models import RobotSpec
+
+if TYPE_CHECKING:
+    from robotspec.compose.assembly import Composition
 
 __all__ = ["ReadSpec", "draft_of_spec"]
 
@@ -112,7 +116,6 @@ def draft_of_spec(
     parts' chains, hands and sensors, each still written in its own file.
     """
     from robotspec.compiler import resolve_spec
-    from robotspec.description.load import load_description
     from robotspec.setup.source import KEPT_KEYS
     from robotspec.spec.load import check_package_paths, load_spec
 
@@ -129,27 +132,7 @@ def draft_of_spec(
     spec = loaded.spec
     marks = _Marks(top)
     files = spec.files
-    if composition is not None:
-        from robotspec.description.urdf import world_from_urdf_xml
-
-        world = world_from_urdf_xml(
-            copy.deepcopy(composition.urdf),
-            composition.source,
-            resolver=composition.resolver,
-            meshes="keep",
-            issues=[],
-            checked=True,
-        )
-    else:
-        paths = [*(_rebase(p, loaded, None) for p in files.package_paths), *map(str, package_paths)]
-        absolute = [p if Path(p).is_absolute() else str(loaded.folder / p) for p in paths]
-        world = load_description(
-            files.urdf,
-            package_paths=absolute,
-            xacro_args=files.xacro_args or None,
-            meshes="keep",
-            base_folder=loaded.folder,
-        ).world
+    world = _world(loaded, composition, package_paths)
     draft = Draft(
         name=spec.name,
         urdf=_rebase(files.urdf, loaded, folder),
@@ -164,6 +147,50 @@ def draft_of_spec(
         states={k: dict(v) for k, v in spec.states.items()},
         notes=marks.notes(),
     )
+    _add_base(draft, spec, marks)
+    _add_chains(draft, spec, marks)
+    _add_manipulators(draft, spec, marks)
+    _add_cameras(draft, spec, marks)
+    raw = top.documents[0].data
+    kept = {k: raw[k] for k in KEPT_KEYS if isinstance(raw, dict) and k in raw}
+    # The draft as the file states it (paths as written): saving elsewhere rewrites them.
+    as_read = copy.copy(draft)
+    as_read.urdf, as_read.srdf = files.urdf, files.srdf
+    as_read.package_paths = [*files.package_paths]
+    return ReadSpec(draft, world, kept, tuple(loaded.documents[1:]), as_read)
+
+
+def _world(
+    loaded: LoadedSpec, composition: Composition | None, package_paths: Sequence[str | Path]
+) -> World:
+    """The robot's tree as the spec reads it: the composed URDF, or the spec's own files."""
+    if composition is not None:
+        from robotspec.description.urdf import world_from_urdf_xml
+
+        return world_from_urdf_xml(
+            copy.deepcopy(composition.urdf),
+            composition.source,
+            resolver=composition.resolver,
+            meshes="keep",
+            issues=[],
+            checked=True,
+        )
+    from robotspec.description.load import load_description
+
+    files = loaded.spec.files
+    paths = [*(_rebase(p, loaded, None) for p in files.package_paths), *map(str, package_paths)]
+    absolute = [p if Path(p).is_absolute() else str(loaded.folder / p) for p in paths]
+    return load_description(
+        files.urdf,
+        package_paths=absolute,
+        xacro_args=files.xacro_args or None,
+        meshes="keep",
+        base_folder=loaded.folder,
+    ).world
+
+
+def _add_base(draft: Draft, spec: RobotSpec, marks: _Marks) -> None:
+    """The facing, the drive, the spec's own frames, the torso and the neck."""
     forward = getattr(spec, "forward", None)
     if forward is not None:
         draft.forward = (float(forward[0]), float(forward[1]), float(forward[2]))
@@ -177,7 +204,7 @@ def draft_of_spec(
             source=marks.source(("drive",)),
             decide=next(iter(marks.decide(("drive",))), None),
         )
-    for name, f in files.frames.items():
+    for name, f in spec.files.frames.items():
         loc: tuple[str | int, ...] = ("description", "frames", name)
         draft.frames.append(DraftFrame(name, f.parent, f.xyz, (marks.decide(loc) or [""])[0]))
     for key in ("torso", "neck"):
@@ -196,6 +223,9 @@ def draft_of_spec(
         if key == "neck":
             c.yaw_body, c.pitch_body, c.sensors = part.yaw_body, part.pitch_body, [*part.sensors]
         setattr(draft, key, c)
+
+
+def _add_chains(draft: Draft, spec: RobotSpec, marks: _Marks) -> None:
     for name, ch in spec.chains.items():
         ends = marks.ends(("chains", name, "group")) if ch.group else ("", "")
         draft.chains.append(
@@ -213,6 +243,9 @@ def draft_of_spec(
                 side=ch.side,
             )
         )
+
+
+def _add_manipulators(draft: Draft, spec: RobotSpec, marks: _Marks) -> None:
     for name, m in spec.manipulators.items():
         dm = DraftManipulator(
             name=name,
@@ -230,9 +263,13 @@ def draft_of_spec(
             dm.thumb = DraftFinger(m.thumb.root, m.thumb.tip)
             dm.fingers = {k: DraftFinger(f.root, f.tip) for k, f in m.fingers.items()}
         draft.manipulators.append(dm)
+
+
+def _add_cameras(draft: Draft, spec: RobotSpec, marks: _Marks) -> None:
+    """The spec's cameras; a generic sensor is edited as text (setup/edits_more.py), kept as is."""
     for name, s in spec.sensors.items():
         if s.type != "camera":
-            continue  # a generic sensor: edited as text (setup/edits_more.py), kept as written
+            continue
         axis = s.forward_facing_axis
         fov = s.field_of_view
         angles = None if fov is None else (fov.horizontal, fov.vertical)
@@ -251,10 +288,3 @@ def draft_of_spec(
                 default=s.default,
             )
         )
-    raw = top.documents[0].data
-    kept = {k: raw[k] for k in KEPT_KEYS if isinstance(raw, dict) and k in raw}
-    # The draft as the file states it (paths as written): saving elsewhere rewrites them.
-    as_read = copy.copy(draft)
-    as_read.urdf, as_read.srdf = files.urdf, files.srdf
-    as_read.package_paths = [*files.package_paths]
-    return ReadSpec(draft, world, kept, tuple(loaded.documents[1:]), as_read)

@@ -157,30 +157,9 @@ class HPChain:
                     r11, r12 = c * r11 + s_ * r12, c * r12 - s_ * r11
                     r21, r22 = c * r21 + s_ * r22, c * r22 - s_ * r21
             else:
-                hx, hy, hz = self._h_list[i]
-                c = cos(qi)
-                s_ = sin(qi)
-                v = 1.0 - c
-                # Rodrigues: rot(h, q) = c I + s [h]x + (1 - c) h h^T
-                a00 = c + v * hx * hx
-                a01 = v * hx * hy - s_ * hz
-                a02 = v * hx * hz + s_ * hy
-                a10 = v * hx * hy + s_ * hz
-                a11 = c + v * hy * hy
-                a12 = v * hy * hz - s_ * hx
-                a20 = v * hx * hz - s_ * hy
-                a21 = v * hy * hz + s_ * hx
-                a22 = c + v * hz * hz
-                r00, r01, r02, r10, r11, r12, r20, r21, r22 = (
-                    r00 * a00 + r01 * a10 + r02 * a20,
-                    r00 * a01 + r01 * a11 + r02 * a21,
-                    r00 * a02 + r01 * a12 + r02 * a22,
-                    r10 * a00 + r11 * a10 + r12 * a20,
-                    r10 * a01 + r11 * a11 + r12 * a21,
-                    r10 * a02 + r11 * a12 + r12 * a22,
-                    r20 * a00 + r21 * a10 + r22 * a20,
-                    r20 * a01 + r21 * a11 + r22 * a21,
-                    r20 * a02 + r21 * a12 + r22 * a22,
+                r00, r01, r02, r10, r11, r12, r20, r21, r22 = _times(
+                    (r00, r01, r02, r10, r11, r12, r20, r21, r22),
+                    _rodrigues(self._h_list[i], cos(qi), sin(qi)),
                 )
             if not self._p_zero[i + 1]:
                 bx, by, bz = self._p_list[i + 1]
@@ -192,27 +171,16 @@ class HPChain:
         )
         if tool_rotation is not None and tool_position is not None:
             frames += ((tool_rotation, tool_position),)
+        rot = (r00, r01, r02, r10, r11, r12, r20, r21, r22)
         for fr, fp in frames:
             bx, by, bz = fp
-            px += r00 * bx + r01 * by + r02 * bz
-            py += r10 * bx + r11 * by + r12 * bz
-            pz += r20 * bx + r21 * by + r22 * bz
-            a00, a01, a02, a10, a11, a12, a20, a21, a22 = fr
-            r00, r01, r02, r10, r11, r12, r20, r21, r22 = (
-                r00 * a00 + r01 * a10 + r02 * a20,
-                r00 * a01 + r01 * a11 + r02 * a21,
-                r00 * a02 + r01 * a12 + r02 * a22,
-                r10 * a00 + r11 * a10 + r12 * a20,
-                r10 * a01 + r11 * a11 + r12 * a21,
-                r10 * a02 + r11 * a12 + r12 * a22,
-                r20 * a00 + r21 * a10 + r22 * a20,
-                r20 * a01 + r21 * a11 + r22 * a21,
-                r20 * a02 + r21 * a12 + r22 * a22,
-            )
+            px += rot[0] * bx + rot[1] * by + rot[2] * bz
+            py += rot[3] * bx + rot[4] * by + rot[5] * bz
+            pz += rot[6] * bx + rot[7] * by + rot[8] * bz
+            rot = _times(rot, fr)
         vx = wy * pz - wz * py - cx + lx
         vy = wz * px - wx * pz - cy + ly
         vz = wx * py - wy * px - cz + lz
-        rot = (r00, r01, r02, r10, r11, r12, r20, r21, r22)
         return rot, (px, py, pz), (wx, wy, wz, vx, vy, vz)
 
     def fk(
@@ -272,3 +240,40 @@ class HPChain:
             jac[:3, :] = np.where(self._rev[None, :], axes.T, 0.0)
             jac[3:, :] = np.where(self._rev[None, :], lin.T, axes.T)
         return r, p, jac.copy() if with_jacobian else jac
+
+
+_Rot = tuple[float, float, float, float, float, float, float, float, float]
+
+
+def _times(r: Sequence[float], a: Sequence[float]) -> _Rot:
+    """The product of two rotations, each row-major in nine plain floats."""
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = r
+    a00, a01, a02, a10, a11, a12, a20, a21, a22 = a
+    return (
+        r00 * a00 + r01 * a10 + r02 * a20,
+        r00 * a01 + r01 * a11 + r02 * a21,
+        r00 * a02 + r01 * a12 + r02 * a22,
+        r10 * a00 + r11 * a10 + r12 * a20,
+        r10 * a01 + r11 * a11 + r12 * a21,
+        r10 * a02 + r11 * a12 + r12 * a22,
+        r20 * a00 + r21 * a10 + r22 * a20,
+        r20 * a01 + r21 * a11 + r22 * a21,
+        r20 * a02 + r21 * a12 + r22 * a22,
+    )
+
+
+def _rodrigues(h: Sequence[float], c: float, s: float) -> _Rot:
+    """rot(h, q) = c I + s [h]x + (1 - c) h h^T, from c = cos q and s = sin q."""
+    hx, hy, hz = h
+    v = 1.0 - c
+    return (
+        c + v * hx * hx,
+        v * hx * hy - s * hz,
+        v * hx * hz + s * hy,
+        v * hx * hy + s * hz,
+        c + v * hy * hy,
+        v * hy * hz - s * hx,
+        v * hx * hz - s * hy,
+        v * hy * hz + s * hx,
+        c + v * hz * hz,
+    )

@@ -15,7 +15,7 @@ import unicodedata
 
 import yaml
 
-from robotspec.spec.draft.model import Draft, DraftChain, DraftManipulator, JointState
+from robotspec.spec.draft.model import Draft, DraftCamera, DraftChain, DraftManipulator, JointState
 
 __all__ = ["SCHEMA_FILE", "camera_presets", "comment", "render_draft", "scalar"]
 
@@ -164,6 +164,49 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
     ]
     out += [f"# Note: {comment(n)}." for n in d.notes]
     out += ["robotspec: 1", f"name: {scalar(d.name)}", "description:"]
+    _description(out, d)
+    out.append(f"root: {scalar(d.root)}")
+    _base(out, d)
+    if d.chains:
+        out.append("chains:")
+        for c in d.chains:
+            out.append(f"  {scalar(c.name)}:  # from {comment(c.source)}{_decide(c.decide)}")
+            _chain_body(out, c, "    ")
+    elif d.lone_hand is not None:
+        out.append(f"chains: {{}}  # a hand alone: {comment(d.lone_hand)} is on no chain")
+    else:
+        out.append("chains: {}  # DECIDE: no arm or leg found; add root/tip pairs")
+    _questions(out, d, "chains", written=True)
+    if d.manipulators:
+        out.append("manipulators:")
+        for m in d.manipulators:
+            _manipulator(out, m)
+    _questions(out, d, "manipulators", written=bool(d.manipulators))
+    if d.cameras:
+        out.append("sensors:")
+        # A preset replaces the whole line (``preset: NAME``); it is not a field_of_view value.
+        offer = (
+            f"; or replace this line with 'preset: NAME' ({', '.join(presets)})"
+            if presets
+            else "; or replace this line with 'preset: NAME'"
+        )
+        for cam in d.cameras:
+            _camera(out, cam, offer)
+    _questions(out, d, "sensors", written=bool(d.cameras))
+    if d.states:
+        out.append("states:")
+        for name, values in d.states.items():
+            out.append(f"  {scalar(name)}: {_flow(values)}")
+    if d.lone_hand is not None:
+        out.append("accept_warnings:")
+        out.append(f"  - at: {scalar('manipulators.' + d.lone_hand)}")
+        out.append("    says: is on no chain")
+        out.append("    because: a hand alone; the arm it is mounted on carries it")
+    return "\n".join(out) + "\n"
+
+
+def _description(out: list[str], d: Draft) -> None:
+    """The ``description:`` block's fields: the files, their packages, the proposed frames."""
     out.append(f"  urdf: {scalar(d.urdf)}")
     if d.srdf:
         out.append(f"  srdf: {scalar(d.srdf)}")
@@ -181,7 +224,10 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
                 f"    {scalar(f.name)}: {{parent: {scalar(f.parent)}, xyz: [{xyz}]}}"
                 + (f"  # DECIDE: {comment(f.reason)}" if f.reason else "")
             )
-    out.append(f"root: {scalar(d.root)}")
+
+
+def _base(out: list[str], d: Draft) -> None:
+    """The facing, the drive, the torso and the neck."""
     if d.forward is not None:
         fwd = ", ".join(_num(v) for v in d.forward)
         # forward_decide "" is a facing a person decided (robotspec setup): no mark.
@@ -202,70 +248,39 @@ def render_draft(d: Draft, *, presets: tuple[str, ...] = ()) -> str:
         if part is not None:
             out.append(f"{key}:  # from {comment(part.source)}{_decide(part.decide)}")
             _chain_body(out, part, "  ")
-    if d.chains:
-        out.append("chains:")
-        for c in d.chains:
-            out.append(f"  {scalar(c.name)}:  # from {comment(c.source)}{_decide(c.decide)}")
-            _chain_body(out, c, "    ")
-    elif d.lone_hand is not None:
-        out.append(f"chains: {{}}  # a hand alone: {comment(d.lone_hand)} is on no chain")
+
+
+def _camera(out: list[str], cam: DraftCamera, offer: str) -> None:
+    """One camera's entry under ``sensors:`` (``offer``: the presets a user may name)."""
+    source = f"  # from {comment(cam.source)}" if cam.source else ""
+    out.append(f"  {scalar(cam.name)}:{source}{_decide(cam.decide)}")
+    out.append("    type: camera")
+    if cam.optical:
+        out.append(f"    body: {scalar(cam.body)}  # an optical frame: looks along +z")
+    elif cam.axis is not None:
+        out.append(f"    body: {scalar(cam.body)}")
+        axis = ", ".join(_num(a) for a in cam.axis)
+        out.append(f"    forward_facing_axis: [{axis}]  # the view axis the URDF states")
+    elif cam.looks_along_z:
+        out.append(f"    body: {scalar(cam.body)}")
+        out.append("    forward_facing_axis: [0, 0, 1]  # a body frame looking along +z")
     else:
-        out.append("chains: {}  # DECIDE: no arm or leg found; add root/tip pairs")
-    _questions(out, d, "chains", written=True)
-    if d.manipulators:
-        out.append("manipulators:")
-        for m in d.manipulators:
-            _manipulator(out, m)
-    _questions(out, d, "manipulators", written=bool(d.manipulators))
-    if d.cameras:
-        out.append("sensors:")
+        out.append(f"    body: {scalar(cam.body)}")
+        out.append("    forward_facing_axis: [1, 0, 0]  # a body frame: looks along +x")
+    if cam.preset is not None:
+        out.append(f"    preset: {scalar(cam.preset)}")
+    elif cam.field_of_view is not None:
+        fh, fv = (_num(a) for a in cam.field_of_view)
+        out.append(f"    field_of_view: {{horizontal: {fh}, vertical: {fv}}}")
+    else:
         h, v = PLACEHOLDER_FOV
-        # A preset replaces the whole line (``preset: NAME``); it is not a field_of_view value.
-        offer = (
-            f"; or replace this line with 'preset: NAME' ({', '.join(presets)})"
-            if presets
-            else "; or replace this line with 'preset: NAME'"
+        out.append(
+            f"    field_of_view: {{horizontal: {h}, vertical: {v}}}"
+            f"  # DECIDE: the camera's angles{offer}"
         )
-        for cam in d.cameras:
-            source = f"  # from {comment(cam.source)}" if cam.source else ""
-            out.append(f"  {scalar(cam.name)}:{source}{_decide(cam.decide)}")
-            out.append("    type: camera")
-            if cam.optical:
-                out.append(f"    body: {scalar(cam.body)}  # an optical frame: looks along +z")
-            elif cam.axis is not None:
-                out.append(f"    body: {scalar(cam.body)}")
-                axis = ", ".join(_num(a) for a in cam.axis)
-                out.append(f"    forward_facing_axis: [{axis}]  # the view axis the URDF states")
-            elif cam.looks_along_z:
-                out.append(f"    body: {scalar(cam.body)}")
-                out.append("    forward_facing_axis: [0, 0, 1]  # a body frame looking along +z")
-            else:
-                out.append(f"    body: {scalar(cam.body)}")
-                out.append("    forward_facing_axis: [1, 0, 0]  # a body frame: looks along +x")
-            if cam.preset is not None:
-                out.append(f"    preset: {scalar(cam.preset)}")
-            elif cam.field_of_view is not None:
-                fh, fv = (_num(a) for a in cam.field_of_view)
-                out.append(f"    field_of_view: {{horizontal: {fh}, vertical: {fv}}}")
-            else:
-                out.append(
-                    f"    field_of_view: {{horizontal: {h}, vertical: {v}}}"
-                    f"  # DECIDE: the camera's angles{offer}"
-                )
-            if cam.minimal_height is not None:
-                out.append(f"    minimal_height: {_num(cam.minimal_height)}")
-            if cam.maximal_height is not None:
-                out.append(f"    maximal_height: {_num(cam.maximal_height)}")
-            if cam.default:
-                out.append("    default: true")
-    _questions(out, d, "sensors", written=bool(d.cameras))
-    if d.states:
-        out.append("states:")
-        for name, values in d.states.items():
-            out.append(f"  {scalar(name)}: {_flow(values)}")
-    if d.lone_hand is not None:
-        out.append("accept_warnings:")
-        out.append(f"  - at: {scalar('manipulators.' + d.lone_hand)}")
-        out.append("    says: is on no chain")
-        out.append("    because: a hand alone; the arm it is mounted on carries it")
-    return "\n".join(out) + "\n"
+    if cam.minimal_height is not None:
+        out.append(f"    minimal_height: {_num(cam.minimal_height)}")
+    if cam.maximal_height is not None:
+        out.append(f"    maximal_height: {_num(cam.maximal_height)}")
+    if cam.default:
+        out.append("    default: true")

@@ -143,73 +143,83 @@ class Drafter:
     # ------------------------------------------------------------------------------ chains
     def chains(self) -> list[tuple[DraftChain, Limb | None]]:
         """SRDF groups that are chains (matched to the tree's limbs), then the other limbs."""
+        used: set[int] = set()
+        out = self._group_chains(used) if self.srdf is not None else []
+        rest = [lb for i, lb in enumerate(self.limbs) if i not in used]
+        return out + self._tree_chains(rest)
+
+    def _group_chains(self, used: set[int]) -> list[tuple[DraftChain, Limb | None]]:
+        """The SRDF's groups that are chains; ``used`` gets the limbs they were matched to."""
+        assert self.srdf is not None
         limbs = self.limbs
         out: list[tuple[DraftChain, Limb | None]] = []
-        used: set[int] = set()
-        if self.srdf is not None:
-            self.groups = GroupJoints.of(self.world, self.srdf)
-            self.draft.notes.extend(group_notes(self.groups))
-            found = group_chains(self.world, self.srdf, self.groups)
-            joins = _SubsetIndex([lb.joints for lb in limbs] + [gc.joints for gc in found])
-            accepted: set[frozenset[str]] = set()
-            hands = [lb.hand for lb in limbs if lb.hand is not None]
-            base = self.own_base
-            base_joints = {c.name for c in self.wheels}
-            if base is not None:
-                base_joints |= set(base.joints or ()) | ({base.planar} if base.planar else set())
-            for gc in found:
-                # A group is evidence of what a planner moves together, not of what the part
-                # is: one joint is a gripper's or a tool's, the base's joints are the drive.
-                if len(gc.joints) == 1:
-                    self.draft.notes.append(
-                        f"SRDF group {gc.group.name!r} moves one joint: not drafted as a chain"
-                    )
-                    continue
-                if gc.joints <= base_joints:
-                    self.draft.notes.append(
-                        f"SRDF group {gc.group.name!r} moves the base: the drive, not a chain"
-                    )
-                    continue
-                if gc.joints in accepted or joins.has_strict_subset(gc.joints):
-                    self.draft.notes.append(
-                        f"SRDF group {gc.group.name!r} joins or repeats other chains; not drafted"
-                    )
-                    continue
-                if any(self.world.is_ancestor(h, gc.root) for h in hands):
-                    continue  # a hand's own joints (Panda's 'hand'): its manipulator has them
-                accepted.add(gc.joints)
-                limb_i = next(
-                    (i for i, lb in enumerate(limbs) if lb.joints & gc.joints and i not in used),
-                    None,
+        self.groups = GroupJoints.of(self.world, self.srdf)
+        self.draft.notes.extend(group_notes(self.groups))
+        found = group_chains(self.world, self.srdf, self.groups)
+        joins = _SubsetIndex([lb.joints for lb in limbs] + [gc.joints for gc in found])
+        accepted: set[frozenset[str]] = set()
+        hands = [lb.hand for lb in limbs if lb.hand is not None]
+        base = self.own_base
+        base_joints = {c.name for c in self.wheels}
+        if base is not None:
+            base_joints |= set(base.joints or ()) | ({base.planar} if base.planar else set())
+        for gc in found:
+            # A group is evidence of what a planner moves together, not of what the part
+            # is: one joint is a gripper's or a tool's, the base's joints are the drive.
+            if len(gc.joints) == 1:
+                self.draft.notes.append(
+                    f"SRDF group {gc.group.name!r} moves one joint: not drafted as a chain"
                 )
-                limb = limbs[limb_i] if limb_i is not None else None
-                if limb_i is not None:
-                    used.add(limb_i)
-                end = group_end(self.world, gc.tip, limb, gc.joints)
-                c = DraftChain(
-                    unique(gc.group.name, self.names),
-                    gc.root.name,
-                    end,
-                    f"the SRDF group '{gc.group.name}'",
-                    role=limb.kind if limb is not None else role_by_name(gc.group.name),
-                    # A group's <chain> ends at its tip: past it, root and tip are written.
-                    group=gc.group.name if gc.single_chain and end == gc.tip.name else None,
-                    srdf_group=gc.group.name,
-                    joints=gc.joints,
+                continue
+            if gc.joints <= base_joints:
+                self.draft.notes.append(
+                    f"SRDF group {gc.group.name!r} moves the base: the drive, not a chain"
                 )
-                agrees = limb is not None and limb.joints == gc.joints
-                if not agrees:
-                    # The tree does not confirm the group as an arm or a leg of these joints.
-                    c.decide.append(
-                        "the SRDF groups these joints; the tree finds "
-                        + ("no arm or leg there" if limb is None else f"a {limb.kind} of others")
-                    )
-                elif q := chain_question(self.srdf, gc.group.name, gc.tip.name, agrees):
-                    c.decide.append(q)  # confirmed, but nothing in the SRDF hangs on it
-                else:
-                    c.stated = CHAIN_SRDF
-                out.append((c, limb))
-        rest = [lb for i, lb in enumerate(limbs) if i not in used]
+                continue
+            if gc.joints in accepted or joins.has_strict_subset(gc.joints):
+                self.draft.notes.append(
+                    f"SRDF group {gc.group.name!r} joins or repeats other chains; not drafted"
+                )
+                continue
+            if any(self.world.is_ancestor(h, gc.root) for h in hands):
+                continue  # a hand's own joints (Panda's 'hand'): its manipulator has them
+            accepted.add(gc.joints)
+            limb_i = next(
+                (i for i, lb in enumerate(limbs) if lb.joints & gc.joints and i not in used),
+                None,
+            )
+            limb = limbs[limb_i] if limb_i is not None else None
+            if limb_i is not None:
+                used.add(limb_i)
+            end = group_end(self.world, gc.tip, limb, gc.joints)
+            c = DraftChain(
+                unique(gc.group.name, self.names),
+                gc.root.name,
+                end,
+                f"the SRDF group '{gc.group.name}'",
+                role=limb.kind if limb is not None else role_by_name(gc.group.name),
+                # A group's <chain> ends at its tip: past it, root and tip are written.
+                group=gc.group.name if gc.single_chain and end == gc.tip.name else None,
+                srdf_group=gc.group.name,
+                joints=gc.joints,
+            )
+            agrees = limb is not None and limb.joints == gc.joints
+            if not agrees:
+                # The tree does not confirm the group as an arm or a leg of these joints.
+                c.decide.append(
+                    "the SRDF groups these joints; the tree finds "
+                    + ("no arm or leg there" if limb is None else f"a {limb.kind} of others")
+                )
+            elif q := chain_question(self.srdf, gc.group.name, gc.tip.name, agrees):
+                c.decide.append(q)  # confirmed, but nothing in the SRDF hangs on it
+            else:
+                c.stated = CHAIN_SRDF
+            out.append((c, limb))
+        return out
+
+    def _tree_chains(self, rest: list[Limb]) -> list[tuple[DraftChain, Limb | None]]:
+        """The arms and legs the tree finds that no SRDF group took, named by side."""
+        out: list[tuple[DraftChain, Limb | None]] = []
         for kind in ("arm", "leg"):
             group = [lb for lb in rest if lb.kind == kind]
             if not group:

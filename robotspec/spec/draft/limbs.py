@@ -115,12 +115,7 @@ def _limb(
     ground (a small quadruped's short legs, whatever their names).
     """
     world = tree.world
-    cut = hand_cut(tree, seg)
-    jaw = cut is not None and one_jaw(tree, seg, cut)
-    if cut is None and len(seg.bodies) >= 2 and one_jaw(tree, seg, len(seg.bodies) - 1, False):
-        cut, jaw = len(seg.bodies) - 1, True  # a jaw by its shape and swing (Spot's 'fngr')
-    if cut is not None and jaw:
-        cut -= 1  # the moving jaw is the hand's; the link carrying both jaws is the hand
+    cut, jaw = _hand_cut(tree, seg)
     # The joint that moves the hand is the arm's last (a wrist roll turning 'gripper_link').
     into_hand = None if cut is None else world.parent_connection(seg.bodies[cut])
     upto = None if cut is None else cut + int(into_hand is not None and not into_hand.is_fixed)
@@ -149,26 +144,15 @@ def _limb(
     footed = (afoot or count(below, LEG_WORDS) > 0) and on_ground
     if reach < MIN_LIMB_LENGTH and not (footed or paired):
         return None
-    # The limb starts where it branches off (PR2's torso_lift_link), or below a world frame.
-    root = seg.start if base is None else base
-    top = world.parent_connection(seg.bodies[0])
-    if root.index == tree.root.index and words(root.name) & WORLD_WORDS and top and top.is_fixed:
-        root = seg.bodies[0]
+    root = _root(tree, seg, base)
     lifts = _lifts(tree, actuated)
     if lifts and len(actuated) - lifts >= MIN_LIMB_JOINTS:
         # A lift under the arm (HSR-B's arm lift) is a torso: the arm starts on top of it.
         root, actuated = world.bodies[actuated[lifts - 1].child], actuated[lifts:]
     tip = world.bodies[actuated[-1].child]
-    hand: Body | None = None
-    if cut is not None:
-        hand = seg.bodies[cut]
-    elif len(tree.moving_children(seg.end)) >= 2:
-        # How far the branches reach from where each starts, not from the end's frame: a link
-        # frame may lie far from its geometry (Alicia-M's 'grasp_base', 70 cm out of the wrist).
-        branches = tree.moving_children(seg.end)
-        if max(hand_span(tree, k) for k in branches) > MAX_HAND_SPAN:
-            return None  # limbs branch off here: a trunk (simple_humanoid's waist), not an arm
-        hand = seg.end
+    hand, trunk = (seg.bodies[cut], False) if cut is not None else _end_hand(tree, seg)
+    if trunk:
+        return None  # limbs branch off here: a trunk (simple_humanoid's waist), not an arm
     if hand is not None and eyes(tree, hand):
         return None  # a head whose cameras turn on their own (eyes): not a hand's fingers
     if hand is None and named(bodies, HEAD_WORDS) and not named(bodies, ARM_WORDS):
@@ -200,6 +184,38 @@ def _limb(
     why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"
     tip = chain_end(tree, tip, hand)
     return Limb("arm", root, tip, hand, joints, seg, why)
+
+
+def _hand_cut(tree: Tree, seg: Segment) -> tuple[int | None, bool]:
+    """Where a run's hand starts (an index into its bodies, or None) and whether it is a jaw."""
+    cut = hand_cut(tree, seg)
+    jaw = cut is not None and one_jaw(tree, seg, cut)
+    if cut is None and len(seg.bodies) >= 2 and one_jaw(tree, seg, len(seg.bodies) - 1, False):
+        cut, jaw = len(seg.bodies) - 1, True  # a jaw by its shape and swing (Spot's 'fngr')
+    if cut is not None and jaw:
+        cut -= 1  # the moving jaw is the hand's; the link carrying both jaws is the hand
+    return cut, jaw
+
+
+def _root(tree: Tree, seg: Segment, base: Body | None) -> Body:
+    """The limb starts where it branches off (PR2's torso_lift_link), or below a world frame."""
+    root = seg.start if base is None else base
+    top = tree.world.parent_connection(seg.bodies[0])
+    if root.index == tree.root.index and words(root.name) & WORLD_WORDS and top and top.is_fixed:
+        root = seg.bodies[0]
+    return root
+
+
+def _end_hand(tree: Tree, seg: Segment) -> tuple[Body | None, bool]:
+    """The hand at a run's end where branches split (else None), and whether it is a trunk."""
+    if len(tree.moving_children(seg.end)) < 2:
+        return None, False
+    # How far the branches reach from where each starts, not from the end's frame: a link
+    # frame may lie far from its geometry (Alicia-M's 'grasp_base', 70 cm out of the wrist).
+    branches = tree.moving_children(seg.end)
+    if max(hand_span(tree, k) for k in branches) > MAX_HAND_SPAN:
+        return None, True
+    return seg.end, False
 
 
 def _rolls(tree: Tree, c: Connection) -> bool:

@@ -26,6 +26,11 @@ questions each draft asks (the robots that ask none are counted, not listed). A 
 unmarked items turn out wrong on robots seen for the first time (``--only`` the robots a round
 added, before any change) is too broad and must be narrowed.
 
+``--truth DIR`` scores the same drafts against another folder of truths of the same format (a
+second expert's, ``tests/data/blind_truth_second/``), only on the robots it has a truth for; a
+file holding only a comment is skipped. ``python -m tools.corpus.agreement`` compares two such
+folders with each other, and ``--drafter`` puts the drafter's totals against both side by side.
+
 The protocol is enforced here: for the ``holdout`` half nothing per robot is printed (no rows,
 no wrong items, no drafts, no error messages), only the totals by category. Never change the
 drafter because of a holdout result.
@@ -67,6 +72,7 @@ __all__ = [
     "BLIND_TRUTH",
     "CorpusRobot",
     "corpus_robots",
+    "load_truth_folder",
     "main",
     "measure_robot",
     "noted_package_paths",
@@ -294,6 +300,27 @@ def _truths() -> dict[str, Truth]:
     return {t.robot: t for t in load_truths(BLIND_TRUTH)}
 
 
+def load_truth_folder(folder: Path) -> tuple[dict[str, Truth], list[str]]:
+    """The truths of ``folder`` by robot id, and messages about the files skipped.
+
+    A file holding only a comment (``# could not load: ...``: its writer could not load the
+    robot) is skipped with a message, and so is one without ``robot: <id>``.
+    """
+    import yaml
+
+    out: dict[str, Truth] = {}
+    skipped: list[str] = []
+    for path in sorted(folder.glob("*.yaml")):
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        if data is None:
+            skipped.append(f"{path.name}: no truth (a comment only)")
+        elif not isinstance(data, dict) or not isinstance(data.get("robot"), str):
+            skipped.append(f"{path.name}: a truth needs 'robot: <id>'")
+        else:
+            out[data["robot"]] = Truth(path.stem, data["robot"], data)
+    return out, skipped
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m tools.corpus.measure [--half tune|holdout]``."""
     parser = argparse.ArgumentParser(prog="python -m tools.corpus.measure", description=__doc__)
@@ -305,6 +332,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="robots to measure (ids); on the holdout half a group of at least "
         f"{MIN_HOLDOUT_GROUP}, totals only (e.g. the robots a round added, never seen drafted)",
     )
+    parser.add_argument(
+        "--truth",
+        type=Path,
+        default=None,
+        help="score against the truths of this folder (default: tests/data/blind_truth); "
+        "robots without a truth there are left out",
+    )
     args = parser.parse_args(argv)
     if args.half == "holdout" and args.only is not None and len(set(args.only)) < MIN_HOLDOUT_GROUP:
         parser.error(
@@ -314,8 +348,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     robots, skipped = corpus_robots()
     for msg in skipped:
         sys.stderr.write(f"skipped: {msg}\n")
-    truths = _truths()
     chosen = [r for r in robots if r.half == args.half]
+    if args.truth is None:
+        truths = _truths()
+    else:  # another expert's truths: only the robots it has
+        truths, unread = load_truth_folder(args.truth)
+        for msg in unread:
+            sys.stderr.write(f"skipped: {msg}\n")
+        chosen = [r for r in chosen if r.id in truths]
     if args.only:
         chosen = [r for r in chosen if r.id in args.only]
     scores: list[RobotScore] = []

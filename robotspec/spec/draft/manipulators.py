@@ -64,6 +64,42 @@ def manipulator(
     decide: list[str] = []
     rules: list[str] = []  # confidence's rules that state what is drafted without a question
     gripper, why = find_gripper(tree, hand) if hand is not None else (None, "no hand")
+    tool, top, gripper, tip = _tool_and_top(self, chain, limb, tip, hand, gripper, stated, decide)
+    tool_name, frame = _tool_name(self, name, tool, top, tip, gripper, hand, stated, decide, rules)
+    if any(m.tool_frame == tool_name for m in self.draft.manipulators):
+        self.draft.notes.append(
+            f"chain {chain.name!r}: its tool frame {tool_name!r} has a manipulator already"
+        )
+        return None
+    if frame is not None:
+        self.draft.frames.append(frame)
+        decide.append(f"its tool frame '{tool_name}' is proposed (description.frames)")
+    m = DraftManipulator(unique(name, self.names), top.name, tool_name, "", decide)
+    _fingers(self, m, chain, top, gripper, hand, why, rules)
+    m.joints = hand_joints(tree, top)
+    m.stated = tuple(rules)
+    _facing(self, m, gripper, tip, frame)
+    self.draft.manipulators.append(m)
+    chain.manipulator = m.name
+    return m
+
+
+def _tool_and_top(
+    self: Drafter,
+    chain: DraftChain,
+    limb: Limb | None,
+    tip: Body,
+    hand: Body | None,
+    gripper: Gripper | None,
+    stated: Body | None,
+    decide: list[str],
+) -> tuple[Body | None, Body, Gripper | None, Body]:
+    """The tool frame the URDF or SRDF names (or None) and the manipulator's root.
+
+    Also the gripper (None when the root ended above it) and the chain's tip, which an SRDF
+    end effector beside the gripper moves back to where both hang (``chain`` follows).
+    """
+    tree, world = self.tree, self.world
     top = gripper.root if gripper is not None else (hand or tip)
     others = frozenset(
         b.index
@@ -110,11 +146,29 @@ def manipulator(
         and (world.is_ancestor(top, stated) or rigidly_beside(world, stated, top))
         and is_bare_frame(world, stated)
     ):
-        tool, decide = stated, []  # the SRDF end effector's parent link: a fact
+        tool = stated  # the SRDF end effector's parent link: a fact
+        decide.clear()
         if not world.is_ancestor(top, stated):  # beside the gripper: rooted where both hang
             top = world.bodies[world.parent_connection(stated).parent]  # type: ignore[union-attr]
             if not world.is_ancestor(tip, top):  # the chain ran on into the gripper's mount
                 chain.tip, chain.group, tip = top.name, None, top
+    return tool, top, gripper, tip
+
+
+def _tool_name(
+    self: Drafter,
+    name: str,
+    tool: Body | None,
+    top: Body,
+    tip: Body,
+    gripper: Gripper | None,
+    hand: Body | None,
+    stated: Body | None,
+    decide: list[str],
+    rules: list[str],
+) -> tuple[str, DraftFrame | None]:
+    """The tool frame's name, and the frame proposed when the URDF has none."""
+    tree, world = self.tree, self.world
     frame: DraftFrame | None = None
     if tool is not None:
         tool_name = tool.name
@@ -129,31 +183,7 @@ def manipulator(
             jaw = tool is fixed_jaw(world, top)  # a one-jaw gripper's: by where it is
             decide.append(f"the tool frame '{tool.name}' at the fixed jaw's end" if jaw else q)
     elif gripper is not None:
-        tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))
-        mid = (tree.poses[gripper.thumb_tip.index] + tree.poses[gripper.finger_tip.index])[
-            :3, 3
-        ] / 2
-        local = np.linalg.inv(tree.poses[gripper.root.index]) @ np.append(mid, 1.0)
-        apart = (
-            tree.poses[gripper.thumb_tip.index][:3, 3] - tree.poses[gripper.finger_tip.index][:3, 3]
-        )
-        if float(np.linalg.norm(local[:3])) < ON_ROOT and float(np.linalg.norm(apart)) >= ON_ROOT:
-            # The gripper's own link sits between its finger tips (Fetch's 'gripper_link'):
-            # it is the tool frame the URDF has, not a new one at the same place. Not when the
-            # fingers are hinged at its origin too (myCobot's jaws): the URDF says nothing there.
-            tool_name = gripper.root.name
-            decide.append(f"the tool frame '{tool_name}': between the finger tips")
-        elif at := frame_at_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip)):
-            tool_name = at.name  # a bare frame the URDF puts between the tips
-            decide.append(f"the tool frame '{tool_name}': a frame between the finger tips")
-        else:
-            xyz = between_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip))
-            why = "between the finger tips in the default pose"
-            if xyz == (0.0, 0.0, 0.0):
-                why = "the fingers hinge at the gripper's origin: move it out between their tips"
-            frame = DraftFrame(
-                tool_name, gripper.root.name, xyz, f"the URDF has no tool frame: {why}"
-            )
+        tool_name, frame = _gripper_tool(self, name, gripper, decide)
     elif hand is not None and (center := hand_center(tree, top)) is not None:
         tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))
         frame = DraftFrame(
@@ -204,15 +234,50 @@ def manipulator(
     else:
         tool_name = top.name
         decide.append("no tool frame link found; add one under description.frames")
-    if any(m.tool_frame == tool_name for m in self.draft.manipulators):
-        self.draft.notes.append(
-            f"chain {chain.name!r}: its tool frame {tool_name!r} has a manipulator already"
-        )
-        return None
-    if frame is not None:
-        self.draft.frames.append(frame)
-        decide.append(f"its tool frame '{tool_name}' is proposed (description.frames)")
-    m = DraftManipulator(unique(name, self.names), top.name, tool_name, "", decide)
+    return tool_name, frame
+
+
+def _gripper_tool(
+    self: Drafter, name: str, gripper: Gripper, decide: list[str]
+) -> tuple[str, DraftFrame | None]:
+    """A parallel gripper's tool frame where the URDF names none: between its finger tips."""
+    tree, world = self.tree, self.world
+    frame: DraftFrame | None = None
+    tool_name = unique(f"{name}_tool_frame", self.names | set(world.body_names))
+    mid = (tree.poses[gripper.thumb_tip.index] + tree.poses[gripper.finger_tip.index])[:3, 3] / 2
+    local = np.linalg.inv(tree.poses[gripper.root.index]) @ np.append(mid, 1.0)
+    apart = tree.poses[gripper.thumb_tip.index][:3, 3] - tree.poses[gripper.finger_tip.index][:3, 3]
+    if float(np.linalg.norm(local[:3])) < ON_ROOT and float(np.linalg.norm(apart)) >= ON_ROOT:
+        # The gripper's own link sits between its finger tips (Fetch's 'gripper_link'):
+        # it is the tool frame the URDF has, not a new one at the same place. Not when the
+        # fingers are hinged at its origin too (myCobot's jaws): the URDF says nothing there.
+        tool_name = gripper.root.name
+        decide.append(f"the tool frame '{tool_name}': between the finger tips")
+    elif at := frame_at_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip)):
+        tool_name = at.name  # a bare frame the URDF puts between the tips
+        decide.append(f"the tool frame '{tool_name}': a frame between the finger tips")
+    else:
+        xyz = between_tips(tree, gripper.root, (gripper.thumb_tip, gripper.finger_tip))
+        why = "between the finger tips in the default pose"
+        if xyz == (0.0, 0.0, 0.0):
+            why = "the fingers hinge at the gripper's origin: move it out between their tips"
+        frame = DraftFrame(tool_name, gripper.root.name, xyz, f"the URDF has no tool frame: {why}")
+    return tool_name, frame
+
+
+def _fingers(
+    self: Drafter,
+    m: DraftManipulator,
+    chain: DraftChain,
+    top: Body,
+    gripper: Gripper | None,
+    hand: Body | None,
+    why: str,
+    rules: list[str],
+) -> None:
+    """The gripper's two fingers, a hand's fingers, or a generic tool's question."""
+    tree, world = self.tree, self.world
+    decide = m.decide
     if gripper is not None:
         m.thumb, m.finger = gripper.thumb, gripper.finger
         m.source = f"{gripper.found} below '{gripper.root.name}'"
@@ -237,12 +302,6 @@ def manipulator(
             decide.append("a foot")
         elif hand is not None:
             decide.append(f"a generic hand: {why}")
-    m.joints = hand_joints(tree, top)
-    m.stated = tuple(rules)
-    _facing(self, m, gripper, tip, frame)
-    self.draft.manipulators.append(m)
-    chain.manipulator = m.name
-    return m
 
 
 def _facing(

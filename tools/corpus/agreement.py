@@ -215,6 +215,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     skipped += not_on_disk
     found: list[Agreement] = []
     pairs: list[tuple[RobotScore, RobotScore]] = []
+    problems: list[str] = []
     with tempfile.TemporaryDirectory(prefix="robotspec-agree-") as tmp:
         for i, rid in enumerate(ids):
             robot = by_id.get(rid)
@@ -224,14 +225,20 @@ def main(argv: Sequence[str] | None = None) -> int:
             folder = Path(tmp) / str(i)
             folder.mkdir()
             if args.drafter:
-                pairs.append(_drafted(robot, first[rid], second[rid], folder))
+                f, s, problem = _drafted(robot, first[rid], second[rid], folder)
+                pairs.append((f, s))
+                problems += [f"- {rid}: {problem}"] if problem else []
                 continue
             found_one = _agreement(robot, first[rid], second[rid], folder, skipped)
             if found_one is not None:
                 found.append(found_one)
     for msg in skipped:
         sys.stderr.write(f"skipped: {msg}\n")
-    lines = drafter_lines(pairs, args.wrong) if args.drafter else agreement_lines(found, args.wrong)
+    if args.drafter:
+        lines = drafter_lines(pairs, args.wrong)
+        lines += ["", "Problems:", "", *problems] if problems else []
+    else:
+        lines = agreement_lines(found, args.wrong)
     sys.stdout.write("\n".join(lines) + "\n")
     return 0
 
@@ -251,15 +258,21 @@ def _agreement(
 
 def _drafted(
     robot: CorpusRobot, first: Truth, second: Truth, tmp: Path
-) -> tuple[RobotScore, RobotScore]:
-    """The draft of ``robot`` (as ``measure`` makes it) scored against each truth."""
-    scores = []
+) -> tuple[RobotScore, RobotScore, str]:
+    """The draft of ``robot`` (as ``measure`` makes it) scored against each truth.
+
+    ``measure_robot`` drafts and scores in one call, so the robot is drafted once per truth:
+    the same files in a fresh folder each time give the same draft (the drafter is
+    deterministic). Returns both scores and what went wrong drafting (``measure``'s problem).
+    """
+    scores, problems = [], []
     for name, truth in (("a", first), ("b", second)):
         (tmp / name).mkdir()
-        score, _ = measure_robot(robot, truth, tmp / name)
+        score, problem = measure_robot(robot, truth, tmp / name)
         score.robot = robot.id
         scores.append(score)
-    return scores[0], scores[1]
+        problems += [problem] if problem and problem not in problems else []
+    return scores[0], scores[1], "; ".join(problems)
 
 
 if __name__ == "__main__":

@@ -312,3 +312,31 @@ def test_drafter_mode_scores_one_draft_against_each_truth(
     assert len(seen) == 2 * len(REAL) and len(set(seen)) == 2 * len(REAL)
     assert f"| first truths | {len(REAL)} | {len(REAL)}/{len(REAL)} (100 %) |" in out
     assert f"| second truths | {len(REAL)} |" in out
+
+
+def test_measure_scores_against_another_truth_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # ``measure --truth DIR``: only the robots DIR has a truth for; a comment-only file skipped.
+    from tools.corpus import measure
+    from tools.draft_score import RobotScore
+
+    robots = [measure.CorpusRobot(f"x/r{i}", "tune", Path("a.urdf"), None, (), {}) for i in (1, 2)]
+    (tmp_path / "x__r1.yaml").write_text("robot: x/r1\ndrive: {type: omni}\n")
+    (tmp_path / "x__r2.yaml").write_text("# could not load: no such package\n")
+    scored: list[dict[str, Any]] = []
+
+    def fake(robot: measure.CorpusRobot, truth: Truth, tmp: Path) -> tuple[RobotScore, str]:
+        scored.append(truth.data)
+        s = RobotScore(robot.id)
+        s.add("valid", True, "")
+        return s, ""
+
+    monkeypatch.setattr(measure, "corpus_robots", lambda: (robots, []))
+    monkeypatch.setattr(measure, "measure_robot", fake)
+    assert measure.main(["--truth", str(tmp_path)]) == 0
+    out = capsys.readouterr()
+    assert scored == [{"robot": "x/r1", "drive": {"type": "omni"}}]
+    assert "| x/r1 |" in out.out and "x/r2" not in out.out
+    assert "x__r2.yaml: no truth (a comment only)" in out.err
+    assert "left out: 1 robots without a truth" in out.err

@@ -355,6 +355,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         truths, unread = load_truth_folder(args.truth)
         for msg in unread:
             sys.stderr.write(f"skipped: {msg}\n")
+        left_out = [r for r in chosen if r.id not in truths]
+        if left_out:
+            sys.stderr.write(f"left out: {len(left_out)} robots without a truth in {args.truth}\n")
         chosen = [r for r in chosen if r.id in truths]
     if args.only:
         chosen = [r for r in chosen if r.id in args.only]

@@ -340,3 +340,19 @@ def test_measure_scores_against_another_truth_folder(
     assert "| x/r1 |" in out.out and "x/r2" not in out.out
     assert "x__r2.yaml: no truth (a comment only)" in out.err
     assert "left out: 1 robots without a truth" in out.err
+
+
+def test_a_truth_missing_a_key_the_counting_reads_is_skipped_with_its_file(tmp_path: Path) -> None:
+    from tools.corpus.measure import load_truth_folder
+
+    (tmp_path / "a.yaml").write_text("robot: x/a\nchains: {arm: {root: base}}\n")
+    (tmp_path / "b.yaml").write_text(
+        "robot: x/b\nmanipulators: {g: {type: parallel_gripper, tool_frame: t}}\n"
+    )
+    (tmp_path / "c.yaml").write_text("robot: x/c\n")
+    truths, skipped = load_truth_folder(tmp_path)
+    assert list(truths) == ["x/c"]
+    assert skipped == [
+        "a.yaml: chain arm needs root and tip",
+        "b.yaml: manipulator g (parallel_gripper) needs fingers",
+    ]

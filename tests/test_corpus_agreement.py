@@ -356,3 +356,11 @@ def test_a_truth_missing_a_key_the_counting_reads_is_skipped_with_its_file(tmp_p
         "a.yaml: chain arm needs root and tip",
         "b.yaml: manipulator g (parallel_gripper) needs fingers",
     ]
+
+
+def test_cohens_kappa_of_the_drive_types() -> None:
+    labels = [("fixed", "fixed"), ("omni", "omni"), ("fixed", "omni"), ("omni", "omni")]
+    # Observed 3/4; by chance 1/2 * 1/4 + 1/2 * 3/4 = 1/2; kappa (3/4 - 1/2) / (1 - 1/2).
+    line = agreement._kappa_line(labels)
+    assert line.endswith("agree on 3 of 4, chance 0.50, Cohen's kappa 0.50.")
+    assert "undefined" in agreement._kappa_line([("fixed", "fixed")] * 3)

@@ -37,7 +37,8 @@ items. Matching is one to one, so the totals with the second as the reference mu
 with the first as the reference; both are printed as a check. The agreement table gives, per
 category, how many items each expert states and on how many both agree, and the positive
 agreement ``2 * both / (first + second)``: Cohen's kappa needs the items neither states (every
-link that is no camera), which have no count here, so it is not given.
+link that is no camera), which have no count here, so it is given only for the drive type, where
+each expert gives every robot exactly one label.
 
 ``--drafter`` drafts each of the same robots exactly as ``tools.corpus.measure`` does (its
 ``measure_robot``: ``robotspec init``, ``validate``, the in-process draft) and scores it against
@@ -138,12 +139,32 @@ def agreement_lines(found: Sequence[Agreement], wrong: bool = False) -> list[str
         both = sum(a.stated.get(c, (0, 0, 0))[2] for a in found)
         pa = f"{round(100 * 2 * both / (first + second))} %" if first + second else "-"
         lines.append(f"| {c} | {first} | {second} | {both} | {pa} |")
+    lines += ["", _kappa_line([a.drives for a in found])]
     named = sum(NAMED_VS_NEW in w for a in found for w in a.first.wrong)
     lines += ["", f"Tool frames of the first that disagree only as {NAMED_VS_NEW}: {named}."]
     if wrong:
         lines += ["", "Disagreements (the first as the reference; 'the other' is the second):", ""]
         lines += [f"- {a.robot}: {w}" for a in found for w in a.first.wrong]
     return lines
+
+
+def _kappa_line(labels: Sequence[tuple[str, str]]) -> str:
+    """Cohen's kappa of the drive types: agreement beyond what the two experts' rates give."""
+    n = len(labels)
+    if not n:
+        return "Drive type: no robots."
+    observed = sum(a == b for a, b in labels) / n
+    kinds = {k for pair in labels for k in pair}
+    chance = sum(
+        (sum(a == k for a, _ in labels) / n) * (sum(b == k for _, b in labels) / n) for k in kinds
+    )
+    kappa = (
+        "undefined (one type only)" if chance == 1 else f"{(observed - chance) / (1 - chance):.2f}"
+    )
+    return (
+        f"Drive type, one label per robot from each: agree on {sum(a == b for a, b in labels)} "
+        f"of {n}, chance {chance:.2f}, Cohen's kappa {kappa}."
+    )
 
 
 def drafter_lines(pairs: Sequence[tuple[RobotScore, RobotScore]], wrong: bool = False) -> list[str]:

@@ -42,13 +42,15 @@ class Agreement:
 
     ``first``: the second scored with the first as the reference (its rows, its ``wrong``);
     ``second``: the other way round. ``stated``: per category, (items the first states, items
-    the second states, items both agree on).
+    the second states, items both agree on). ``drives``: each truth's drive type (the one
+    category with exactly one label per robot from each expert, for Cohen's kappa).
     """
 
     robot: str
     first: RobotScore
     second: RobotScore
     stated: dict[str, tuple[int, int, int]]
+    drives: tuple[str, str]
 
 
 def _chain_joints(world: Any, root: str, tip: str) -> frozenset[str]:
@@ -226,4 +228,8 @@ def compare(first: Truth, second: Truth, world: object) -> Agreement:
     """The two truths of one robot compared both ways round."""
     a, b = _compare_one(first, second, world), _compare_one(second, first, world)
     stated = {c: (v[0], v[1], v[2]) for c, v in a.stated.items()}
-    return Agreement(first.robot, a.score, b.score, stated)
+    drives = (
+        (first.data.get("drive") or {}).get("type", "fixed"),
+        (second.data.get("drive") or {}).get("type", "fixed"),
+    )
+    return Agreement(first.robot, a.score, b.score, stated, (str(drives[0]), str(drives[1])))

@@ -125,7 +125,7 @@ def test_a_changed_tip_an_extra_camera_and_another_drive(world: object) -> None:
     assert found.first.counts == found.second.counts  # one-to-one: the same both ways round
     assert found.stated["grippers/hands"] == (1, 1, 0)
     assert found.stated["cameras"] == (1, 2, 1)
-    assert "torso/neck/drive: drive: the other's differential" in found.first.wrong
+    assert "torso/neck/drive: drive: fixed vs the other's differential" in found.first.wrong
 
 
 def test_chains_by_kind_and_joints_and_a_neck_without_camera_is_a_chain(world: object) -> None:

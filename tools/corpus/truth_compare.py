@@ -197,7 +197,11 @@ def _parts(side: _Side, t: dict[str, Any], o: dict[str, Any], world: Any) -> Non
             continue
         want_j = None if want is None else _chain_joints(world, want["root"], want["tip"])
         have_j = None if have is None else _chain_joints(world, have["root"], have["tip"])
-        s.add("torso/neck/drive", want_j == have_j, f"{key}: the other's {sorted(have_j or [])}")
+        s.add(
+            "torso/neck/drive",
+            want_j == have_j,
+            f"{key}: {sorted(want_j or [])} vs the other's {sorted(have_j or [])}",
+        )
         side.state(
             "torso/neck/drive",
             int(want is not None),
@@ -207,15 +211,22 @@ def _parts(side: _Side, t: dict[str, Any], o: dict[str, Any], world: Any) -> Non
     want_fwd = tuple(float(v) for v in t.get("forward") or (1.0, 0.0, 0.0))
     have_fwd = tuple(float(v) for v in o.get("forward") or (1.0, 0.0, 0.0))
     if want_fwd != (1.0, 0.0, 0.0) or have_fwd != (1.0, 0.0, 0.0):
-        s.add("torso/neck/drive", want_fwd == have_fwd, f"forward: the other's {list(have_fwd)}")
+        s.add(
+            "torso/neck/drive",
+            want_fwd == have_fwd,
+            f"forward: {list(want_fwd)} vs the other's {list(have_fwd)}",
+        )
         side.state("torso/neck/drive", 1, 1, int(want_fwd == have_fwd))
     want_d = t.get("drive") or {"type": "fixed"}
     have_d = o.get("drive") or {"type": "fixed"}
     ok = want_d["type"] == have_d["type"]
     if ok and "joints" in want_d and "joints" in have_d:
         ok = list(want_d["joints"]) == list(have_d["joints"])
-    shown = have_d["type"] + (f" {list(have_d['joints'])}" if "joints" in have_d else "")
-    s.add("torso/neck/drive", ok, f"drive: the other's {shown}")
+
+    def shown(d: dict[str, Any]) -> str:
+        return str(d["type"]) + (f" {list(d['joints'])}" if "joints" in d else "")
+
+    s.add("torso/neck/drive", ok, f"drive: {shown(want_d)} vs the other's {shown(have_d)}")
     side.state("torso/neck/drive", 1, 1, int(ok))
 
 

@@ -70,6 +70,8 @@ class Scratch:
         self.margin = math.nan
         self.request = coal.CollisionRequest()
         self.result = coal.CollisionResult()
+        #: The fallback's free balls (:mod:`.free_balls`), made on their first use.
+        self.free_balls: Any = None
 
     def collision(self, margin: float) -> tuple[Any, Any]:
         """Coal's collision request for ``margin`` and the result to reuse."""

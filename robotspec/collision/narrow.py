@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robotspec.arrays import F64, I64
-from robotspec.collision import meshcore
+from robotspec.collision import free_balls, meshcore
 from robotspec.collision.compiled import Compiled, Scratch
 
 __all__ = [
@@ -308,6 +308,11 @@ def narrow_block(
         return first_hits(c, scratch, req, poses, rows, ks, eps)
     drop = mode == WALK_DROP_FOUND
     seen = found.astype(np.bool_).tolist()
+    if drop and c.meshes is not None and batch_proofs and len(ks):
+        # Pairs never seen colliding are asked at every sample: free balls prove most of the
+        # nearly touching ones free from a few coal distances (see free_balls).
+        keep = free_balls.sift(c, scratch, poses, rows, ks, eps)
+        rows, ks = rows[keep], ks[keep]
     cand = (rows.tolist(), ks.tolist(), [UNTRIED] * len(ks))
     if c.meshes is not None and batch_proofs and len(ks) >= _BATCH_PROOFS:
         # Every candidate is tested, so the mesh proofs run in one call (no Python per

@@ -39,8 +39,9 @@ CELLS = 4096
 #: How far (m) a cell marked inside is at least from the surface (so a query's ``eps`` beyond it
 #: proves nothing inside: coal decides).
 CLEARANCE = 1e-4
-#: Connected pieces of a mesh's surface told apart (bits of an int64); smaller ones unsampled.
-PIECES = 62
+#: Connected pieces of a mesh's surface told apart (31 bits inside, 31 outside, of an int64);
+#: smaller ones unsampled.
+PIECES = 31
 #: The mesh core's code of a candidate proven crossing (robotspec.collision.narrow.CROSS).
 CROSS = 2
 #: Cell codes: wholly inside the surface, wholly outside the box (both by CLEARANCE at least).
@@ -80,11 +81,14 @@ class Proofs:
     strides: I64  # (G, 3) of the flat codes
     codes: NDArray[np.uint8]  # (G, C)
     closed: NDArray[np.bool_]  # (G,): some cell is inside
+    lut: I64  # (G, K, 3) per point and cell code: 0, its piece's bit, that bit << 31
     inside_lo: F64  # (G, 3) the inside cells' bounding box, in cells
     inside_hi: F64  # (G, 3)
     ball: F64  # (G, 4) a ball around the points: centre (homogeneous, mesh frame)
     radius: F64  # (G,) its radius (m)
     cell: F64  # (G,) the cell's side (m)
+    core: F64  # (G, 4) a ball around the inside cells: centre (homogeneous, mesh frame)
+    core_radius: F64  # (G,) its radius (m); -inf where no cell is inside
 
 
 def _merged(vertices: F64, faces: I64) -> tuple[F64, I64]:
@@ -281,28 +285,50 @@ def stack(proofs: list[MeshProof | None]) -> Proofs:
     inside_lo = np.full((g, 3), np.inf)
     inside_hi = np.full((g, 3), -np.inf)
     cell = np.ones(g)
+    core = np.ones((g, 4))
+    core_radius = np.full(g, -np.inf)
     for x, p in enumerate(proofs):
         if p is None:
             continue
         cells = np.argwhere(p.codes.reshape(tuple(p.dims)) == INSIDE)
         if len(cells):
             inside_lo[x], inside_hi[x] = cells.min(axis=0), cells.max(axis=0) + 1
-            cell[x] = 1.0 / float(np.linalg.norm(p.to_grid[0, :3]))
+            side = 1.0 / float(np.linalg.norm(p.to_grid[0, :3]))
+            cell[x] = side
+            # The inside cells' box, back in the mesh frame: its centre and half diagonal.
+            mid = (inside_lo[x] + inside_hi[x]) / 2.0
+            rot, shift = p.to_grid[:3, :3] * side, p.to_grid[:3, 3]  # rot is orthonormal
+            core[x, :3] = rot.T @ ((mid - shift) * side)
+            core_radius[x] = float(np.linalg.norm(inside_hi[x] - inside_lo[x])) * side / 2.0
     pts = points[:, :, :3]
     ball = np.ones((g, 4))
     ball[:, :3] = (pts.max(axis=1) + pts.min(axis=1)) / 2.0
     radius = np.sqrt(((pts - ball[:, None, :3]) ** 2).sum(axis=2).max(axis=1))
     closed = np.isfinite(inside_lo[:, 0])
+    lut = np.stack([np.zeros_like(bits), bits, bits << 31], axis=2)
     return Proofs(
-        points, bits, to_grid, top, strides, codes, closed, inside_lo, inside_hi, ball, radius, cell
+        points,
+        bits,
+        to_grid,
+        top,
+        strides,
+        codes,
+        closed,
+        lut,
+        inside_lo,
+        inside_hi,
+        ball,
+        radius,
+        cell,
+        core,
+        core_radius * (1.0 + _SLACK),
     )
 
 
 def _one_way(s: Proofs, pa: F64, pb: F64, a: I64, b: I64) -> NDArray[np.bool_]:
     """Per candidate: a piece of B's surface reaches a cell inside A and one outside A's box.
 
-    ``pa``, ``pb`` (n, 4, 4) are the poses of A and B. Only the candidates whose ball around
-    B's points reaches A's inside cells and A's outer layer test the points.
+    ``pa``, ``pb`` (n, 4, 4) are the poses of A and B.
     """
     rt = pa[:, :3, :3].transpose(0, 2, 1)
     rel = np.matmul(rt, pb[:, :3, :])  # B's frame -> A's (3, 4)
@@ -310,27 +336,14 @@ def _one_way(s: Proofs, pa: F64, pb: F64, a: I64, b: I64) -> NDArray[np.bool_]:
     g = s.to_grid[a]
     m = np.matmul(g[:, :, :3], rel)  # B's frame -> A's grid
     m[:, :, 3] += g[:, :, 3]
-    mid = np.matmul(m, s.ball[b][..., None])[..., 0]
-    reach = s.radius[b] / s.cell[a]  # cells
-    gap = np.maximum(np.maximum(s.inside_lo[a] - mid, mid - s.inside_hi[a]), 0.0)
-    near = (gap * gap).sum(axis=1) < reach * reach
-    top = s.top[a]
-    near &= ((mid - reach[:, None] < 1.0) | (mid + reach[:, None] > top)).any(axis=1)
-    at = np.flatnonzero(near)
-    proven = np.zeros(len(a), dtype=np.bool_)
-    if not len(at):
-        return proven
-    a, b = a[at], b[at]
-    u = np.matmul(s.points[b], m[at].transpose(0, 2, 1))  # (n, K, 3) in cells
+    u = np.matmul(s.points[b], m.transpose(0, 2, 1))  # (n, K, 3) in cells
     np.maximum(u, 0.0, out=u)  # beyond the grid: its outer layer
-    np.minimum(u, top[at][:, None, :], out=u)
+    np.minimum(u, s.top[a][:, None, :], out=u)
     flat = np.matmul(u.astype(np.int64), s.strides[a][:, :, None])[..., 0]
     code = s.codes[a[:, None], flat]
-    bits = s.bits[b]
-    ins = np.bitwise_or.reduce(np.where(code == INSIDE, bits, 0), axis=1)
-    outs = np.bitwise_or.reduce(np.where(code == OUTSIDE, bits, 0), axis=1)
-    proven[at] = (ins & outs) != 0
-    return proven
+    seen = np.bitwise_or.reduce(s.lut[b[:, None], np.arange(code.shape[1]), code], axis=1)
+    out: NDArray[np.bool_] = (seen & (seen >> 31)) != 0
+    return out
 
 
 def crossing(s: Proofs, poses: F64, rows: I64, g1: I64, g2: I64, eps: float) -> NDArray[np.bool_]:
@@ -349,6 +362,18 @@ def crossing(s: Proofs, poses: F64, rows: I64, g1: I64, g2: I64, eps: float) -> 
     a = np.concatenate([g1[one], g2[two]])
     b = np.concatenate([g2[one], g1[two]])
     r = rows[at]
+    # Where B's ball cannot reach A's inside cells, nothing is proven: B's ball centre taken
+    # into A's grid alone (elementwise, no stacked matrix products), the rest only after.
+    pa, pb = poses[r, a, :3], poses[r, b, :3]
+    d = (pb * s.ball[b][:, None, :]).sum(axis=2) - pa[:, :, 3]
+    local = (pa[:, :, :3] * d[:, :, None]).sum(axis=1)  # A's frame
+    g = s.to_grid[a]
+    mid = (g[:, :, :3] * local[:, None, :]).sum(axis=2) + g[:, :, 3]
+    gap = np.maximum(np.maximum(s.inside_lo[a] - mid, mid - s.inside_hi[a]), 0.0)
+    reach = s.radius[b] / s.cell[a]  # cells
+    near = np.flatnonzero((gap * gap).sum(axis=1) < reach * reach)
     proven = np.zeros(n, dtype=np.bool_)
-    proven[at[_one_way(s, poses[r, a], poses[r, b], a, b)]] = True
+    if len(near):
+        a, b, r = a[near], b[near], r[near]
+        proven[at[near[_one_way(s, poses[r, a], poses[r, b], a, b)]]] = True
     return proven

@@ -1,13 +1,20 @@
-"""The mesh core's entry points in numpy: crossing proofs only, everything else left to coal.
+"""The mesh core's entry points without its proofs: every candidate is left to coal.
 
 Why this is enough: ``_meshcore.c`` only accelerates. A pair it proves apart or crossing is one
 coal answers the same way (that is what its proofs are checked against), and a hull's closest
 point it finds on the mesh only lets the checker skip coal's exact mesh distance. So a fallback
-that proves less and finds no point on a surface gives every answer, from coal, the same to
-coal's tolerance, only slower (see benchmarks/bench_fallback.py). What it does prove:
-:func:`apart` proves, for a whole block of candidates in one numpy pass, the pairs whose
-surfaces must cross (:mod:`._crossing_py`), the colliding candidates that cost coal most;
-:func:`apart_one` (one candidate, where numpy's fixed cost exceeds coal's answer) proves nothing.
+that proves nothing and finds no point on a surface gives every answer, from coal, the same to
+coal's tolerance, only slower on nearly touching meshes (see benchmarks/bench_fallback.py).
+
+Crossing proofs in numpy were measured here and not kept (issue 34, commits f9e2470 and 5678a2a:
+``_crossing_py.py`` and its tests against coal). By continuity, a piece of one mesh's surface
+with a vertex in a grid cell inside the other, closed and oriented mesh and a vertex outside its
+box must meet its surface, so coal reports a collision: never wrong on PR2, Talos and random
+poses, they prove a third of the PR2's colliding candidates of a batch of 64 (27-33 of 80-93;
+Talos 127 of 286), but half the PR2's meshes are open, the deep crossings they catch are not the
+ones coal is slowest on, and one vectorised pass over a block costs numpy about as much as the
+coal calls it spares (PR2: 1.1 ms for 0.6 ms of coal; Talos: 5.2 ms for 2.1 ms). Interleaved,
+the fallback's ``collisions_batch`` of 64 ran at 0.97x, ``in_collision_batch`` 0.78x.
 
 The arguments are read and checked as the C core reads and checks them, in its order (see
 ``_meshcore.pyi`` and :mod:`robotspec.model._core_args`), so a caller's mistake raises the same
@@ -22,7 +29,6 @@ from typing import Any
 
 import numpy as np
 
-from robotspec.collision import _crossing_py
 from robotspec.model._core_args import from_any, index, real, table
 
 _INT32_MAX = 2**31 - 1
@@ -30,14 +36,13 @@ _INT32_MAX = 2**31 - 1
 
 @dataclass(frozen=True)
 class MeshSet:
-    """How many geometries a checker has, which are meshes, and their crossing proofs' data."""
+    """How many geometries a checker has, and which are meshes."""
 
     n: int
     is_mesh: tuple[bool, ...]
-    proofs: _crossing_py.Proofs
 
 
-def _mesh(item: object) -> tuple[np.ndarray[Any, Any], np.ndarray[Any, Any]]:
+def _mesh(item: object) -> None:
     """Check one (vertices (V, 3), triangles (T >= 1, 3)) mesh as the C core's ``tree_new`` does."""
     if not isinstance(item, tuple) or len(item) != 2:
         raise TypeError("mesh_set: each mesh is (vertices, triangles) or None")
@@ -56,7 +61,6 @@ def _mesh(item: object) -> tuple[np.ndarray[Any, Any], np.ndarray[Any, Any]]:
         if out[bad[0]]:
             raise ValueError("a triangle refers to a vertex out of range")
         raise ValueError("a mesh vertex is not finite")
-    return v, f
 
 
 def mesh_set(meshes: Any) -> object:
@@ -64,9 +68,10 @@ def mesh_set(meshes: Any) -> object:
         items = list(meshes)
     except TypeError:
         raise TypeError("mesh_set needs a sequence") from None
-    checked = [None if item is None else _mesh(item) for item in items]
-    proofs = _crossing_py.stack([None if m is None else _crossing_py.prepare(*m) for m in checked])
-    return MeshSet(len(items), tuple(item is not None for item in items), proofs)
+    for item in items:
+        if item is not None:
+            _mesh(item)
+    return MeshSet(len(items), tuple(item is not None for item in items))
 
 
 def _set_of(obj: object) -> MeshSet:
@@ -95,10 +100,7 @@ def apart(meshes: object, poses: Any, rows: Any, pairs: Any, g1: Any, g2: Any, e
             bad = (i < 0) | (i >= ng) | (j < 0) | (j >= ng)
         if bad.any():
             raise ValueError("apart: a candidate is out of range")
-    codes = np.zeros(len(r), dtype=np.uint8)  # unknown: coal decides
-    if len(r):
-        codes[_crossing_py.crossing(s.proofs, p, r, a[k], b[k], eps)] = _crossing_py.CROSS
-    return codes
+    return np.zeros(len(r), dtype=np.uint8)  # nothing proven: coal decides every candidate
 
 
 def _borrowable(obj: object, who: str, what: str) -> np.ndarray[Any, Any]:

@@ -21,21 +21,27 @@ import numpy as np
 from robotspec.model.entities import Body, Connection
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.limbs import HEAD_WORDS, eyes
+from robotspec.spec.draft.optical import (
+    CAMERA_WORDS,
+    device_groups,
+    names_silent,
+    optical_from_body,
+    pick_channel,
+)
 from robotspec.spec.draft.stated_cameras import DEVICE_SPAN, StatedCamera, stated_cameras
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["CameraFound", "NeckFound", "find_cameras", "find_neck", "stated_channels"]
+__all__ = [
+    "CAMERA_WORDS",
+    "CameraFound",
+    "NeckFound",
+    "find_cameras",
+    "find_neck",
+    "stated_channels",
+]
 
 #: Gazebo sensor types that take images: the frames of other sensors are theirs, never cameras.
 IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
-CAMERA_WORDS = frozenset(
-    {"camera", "cam", "optical", "rgb", "rgbd", "xtion", "kinect", "realsense", "stereo"}
-    | {"webcam", "zed", "eye", "vision", "d435", "d415", "asus"}
-    # Device models a frame is often named after.
-    | {"d405", "d435i", "d455", "d457", "l515", "zed2", "zed2i", "zedm", "kinect2", "azure"}
-    | {"astra", "orbbec", "femto", "gemini", "primesense", "carmine", "oak", "mynteye"}
-    | {"flir", "basler", "ximea", "pointgrey", "bumblebee"}
-)
 NOT_CAMERA_WORDS = frozenset(
     {"imu", "laser", "lidar", "scan", "hokuyo", "accelerometer", "accel", "gyro", "range"}
     | {"sonar", "ft", "force", "torque", "contact", "velodyne", "ultrasound", "projector"}
@@ -92,7 +98,10 @@ def is_optical(tree: Tree, body: Body) -> bool:
     # body the robot faces with: on a limb or a torso, "behind" says nothing (Baxter's arm
     # buttons, TIAGo Pro's arm mounts are turned so).
     behind = np.allclose(rot[:, 0], -_OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -_TILT
-    return bool(behind) and tree.rigid_root(body) is tree.root
+    if behind:
+        return tree.rigid_root(body) is tree.root
+    # Turned so from a body frame higher up its fixed joints or beside it (optical.py).
+    return optical_from_body(tree, body)
 
 
 def _stem(name: str) -> str:
@@ -146,6 +155,7 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             continue  # a link turned as optical frames are, carrying others (iCub's 'neck_2')
         if optical or (w & CAMERA_WORDS and not world.child_bodies(b)):
             found.append(CameraFound(_stem(b.name) or b.name, b, optical))
+    found = _one_per_nameless_device(tree, found)
     # One per device: drop a camera whose name extends another's on the same rigid body, or
     # is extended by it. Optical frames first: 'camera_link' and its child
     # 'camera_color_optical_frame' are one camera, on the optical frame; the device's own frame
@@ -171,6 +181,12 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
         # A body frame named as a camera, rigid with an optical frame, is that camera's link.
         optical_here = any(k.optical and tree.rigid_root(k.body) is carrier for k in kept)
         dup = dup or (not cam.optical and optical_here)
+        # A frame named as nothing, beside a Gazebo camera and looking its way: a channel of
+        # the device the sensor simulates (its depth frame beside the colour one it sees from).
+        dup = dup or (
+            names_silent(cam.name)
+            and any(k.stated is not None and _beside(tree, cam.body, k.body) for k in stated)
+        )
         if not dup and stated:
             cam = CameraFound(
                 cam.name,
@@ -182,6 +198,26 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             kept.append(cam)
     kept.sort(key=lambda c: c.body.index)
     return kept
+
+
+def _beside(tree: Tree, a: Body, b: Body) -> bool:
+    """Whether two frames are one device's: rigid on one link, near, looking one way."""
+    return bool(device_groups(tree, [a, b]) == [[a, b]])
+
+
+def _one_per_nameless_device(tree: Tree, found: list[CameraFound]) -> list[CameraFound]:
+    """Optical frames whose names say nothing of cameras or channels: one per device.
+
+    Why: names tell a device's channels apart below (``_device``, ``_pair``); frames named as
+    nothing (a maker's ids, numbered links) are grouped by where they are and which way they
+    look, and the device's camera is chosen by their spots (``optical.pick_channel``).
+    """
+    nameless = [c for c in found if c.optical and names_silent(c.body.name)]
+    if len(nameless) < 2:
+        return found
+    keep = {pick_channel(tree, g).index for g in device_groups(tree, [c.body for c in nameless])}
+    drop = {c.body.index for c in nameless} - keep
+    return [c for c in found if c.body.index not in drop]
 
 
 #: Words naming a channel of a camera device (one device: one camera, on its colour channel).

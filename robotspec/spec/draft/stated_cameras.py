@@ -22,6 +22,7 @@ from robotspec.model.entities import Body
 from robotspec.model.rotations import rpy_to_matrix
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.model import DraftCamera
+from robotspec.spec.draft.optical import device_groups, names_silent, pick_channel
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = ["StatedCamera", "fill_stated", "stated_cameras"]
@@ -213,6 +214,12 @@ def _one_device(tree: Tree, a: StatedCamera, b: StatedCamera) -> bool:
     """Whether two sensors are channels of one device (or one camera named twice)."""
     if a.body is b.body or a.fact.link == b.fact.link:
         return True
+    # Frames named as nothing (a maker's ids): a depth sensor and a camera beside it, rigid
+    # on one link and looking one way, are one RGB-D device. Two plain cameras so placed may
+    # be a stereo pair a spec lists eye by eye (PR2's): apart.
+    if names_silent(a.body.name) and names_silent(b.body.name):
+        rgbd = a.fact.has_depth or b.fact.has_depth
+        return rgbd and device_groups(tree, [a.body, b.body]) == [[a.body, b.body]]
     # Channels by their frames' names: a stereo depth camera (Go1's five) is a device alone.
     if not (_channel_words(a.body.name) and _channel_words(b.body.name)):
         return False
@@ -263,6 +270,11 @@ def stated_cameras(tree: Tree, facts: FileFacts) -> tuple[list[StatedCamera], se
             home.append(r)
     out = []
     for device in devices:
+        if len(device) > 1 and all(names_silent(c.body.name) for c in device):
+            # Nothing named: the channel by the frames' spots (optical.pick_channel).
+            chosen = pick_channel(tree, list(dict.fromkeys(c.body for c in device)))
+            out.append(next(c for c in device if c.body is chosen))
+            continue
         order = sorted(range(len(device)), key=lambda i: (*_preference(device[i]), i))
         out.append(device[order[0]])
     world = tree.world

@@ -122,6 +122,30 @@ def test_random_programs_equal_the_c_core(
         np.testing.assert_array_equal(kin_py.fk(tree_py, qs[i]), got[i])
 
 
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n_out=st.integers(1, 14),
+    n_scratch=st.integers(0, 3),
+    n_extra=st.integers(0, 4),
+    n=st.integers(32, 700),
+)
+def test_random_programs_in_steps_equal_the_c_core_and_the_single_call(
+    seed: int, n_out: int, n_scratch: int, n_extra: int, n: int
+) -> None:
+    """A batch's steps (a plan: bodies' rows in body order, groups as strided views, a short
+    last step) on random programs: the C core's poses, and every row the single call's bits."""
+    kin_c = _c_core()
+    args = _program(seed, n_out, n_scratch, n_extra, 3)
+    tree_c, tree_py = kin_c.tree(*args), kin_py.tree(*args)
+    qs = np.random.default_rng(seed + 2).uniform(-4.0, 4.0, (n, 3))
+    got = kin_py.fk_batch(tree_py, qs)
+    np.testing.assert_allclose(got, kin_c.fk_batch(tree_c, qs, None, False), rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(got[:, :, 3], np.tile([0.0, 0.0, 0.0, 1.0], (n, n_out, 1)))
+    for i in range(n):
+        np.testing.assert_array_equal(kin_py.fk(tree_py, qs[i]), got[i])
+
+
 def test_a_long_batch_across_the_steps_equals_the_c_core() -> None:
     kin_c = _c_core()
     args = _program(7, 12, 2, 3, 4)

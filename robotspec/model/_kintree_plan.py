@@ -108,9 +108,11 @@ class Plan:
         samples' poses are copied out.
         """
         m = min(self.v.shape[1], len(out))
-        if m < self.v.shape[1]:
+        if m == self.v.shape[1]:
+            np.take(q_t[:, :m], self.dof, axis=0, out=self.v, mode="clip")
+        else:
             self.v[:, m:] = 0.0
-        self.v[:, :m] = np.take(q_t[:, :m], self.dof, axis=0, mode="clip")
+            self.v[:, :m] = np.take(q_t[:, :m], self.dof, axis=0, mode="clip")
         for call in self.calls:
             call()
         # Whole poses (128 bytes) moved at once into the result's layout.
@@ -179,7 +181,7 @@ def _group_calls(
 ) -> list[Callable[[], object]]:
     """A group's products and motions, one of each per run of evenly spaced rows (see _runs)."""
     dst_rows = [row[i] for i in range(g.nodes.start, g.nodes.stop)]
-    parent_rows = [row[int(p)] for p in g.parents]
+    parent_rows = [row[p] for p in g.parents.tolist()]
     if g.how == GENERAL:
         return [partial(_general_rows, g, rows, parent_rows, dst_rows, v)]
     n = rows.shape[1]
@@ -227,8 +229,9 @@ def _span(r: list[int]) -> slice:
 
 def _view(a: F64, shape: tuple[int, ...]) -> F64:
     """``a`` reshaped without a copy (an error if that needs one: the calls write through it)."""
-    b = a.view()
-    b.shape = shape
+    b = a.reshape(shape)
+    if not np.may_share_memory(a, b):
+        raise ValueError(f"a plan's view {a.shape} -> {shape} would be a copy")
     return b
 
 

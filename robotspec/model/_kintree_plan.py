@@ -62,7 +62,7 @@ def _motion_calls(
     c = g.column
     if g.how == TURN:
         cols = dst[..., c : c + 2].view(np.complex128)[..., 0]
-        return [partial(np.multiply, cols, turns[motion][:, :, None], out=cols)]
+        return [partial(np.multiply, cols, turns[motion], out=cols)]
     col3, moved = dst[..., 3], np.empty(dst.shape[:3])
     return [
         partial(np.multiply, dst[..., c], v[motion][:, :, None], out=moved),
@@ -126,7 +126,7 @@ def plan(t: Tree, n: int) -> Plan:
     rows = np.empty((n_rows, n, 4, 4))
     rows[row[0]] = np.eye(4)
     v = np.empty((len(t.dof), n))
-    turns = np.empty((t.n_turn, n), dtype=np.complex128)
+    turns = np.empty((t.n_turn, n, 4), dtype=np.complex128)  # per row of a pose (see below)
     calls = _motion_value_calls(t, v, turns)
     for g in t.groups:
         calls += _group_calls(g, rows, row, v, turns)
@@ -141,7 +141,7 @@ def plan(t: Tree, n: int) -> Plan:
     ]
     if pairs:
         seconds, firsts = (np.array(side, dtype=np.int64) for side in zip(*pairs, strict=True))
-        calls.append(partial(_copy_rows, whole, seconds, firsts))
+        calls.append(partial(_copy_rows, _view(rows, (n_rows, 16 * n)), seconds, firsts))
     bodies = whole[: t.n_out]
     return Plan(t.dof, v, tuple(calls), bodies)
 
@@ -158,8 +158,8 @@ def _motion_value_calls(t: Tree, v: F64, turns: Any) -> list[Callable[[], object
         partial(np.multiply, v, t.mul[:, None], out=v),
         partial(np.add, v, t.off[:, None], out=v),
         partial(cos_sin, v[: t.n_turn], cos, sin, half, square),
-        partial(np.copyto, turns.real, cos),
-        partial(np.copyto, turns.imag, sin),
+        partial(np.copyto, turns.real, cos[:, :, None]),
+        partial(np.copyto, turns.imag, sin[:, :, None]),
     ]
 
 
@@ -242,8 +242,9 @@ def _product(lhs: F64, weights: F64, out: F64) -> Callable[[], object]:
     return partial(np.matmul, lhs, weights, out)
 
 
-def _copy_rows(whole: Any, dst: I64, src: I64) -> None:
-    whole[dst] = whole[src]
+def _copy_rows(flat: F64, dst: I64, src: I64) -> None:
+    """Rows ``src`` of ``flat`` (R, 16 n) copied to rows ``dst``: whole rows, one block each."""
+    flat[dst] = flat[src]
 
 
 def _general_rows(g: Group, rows: F64, parents: list[int], dst: list[int], v: F64) -> None:

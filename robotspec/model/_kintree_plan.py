@@ -56,8 +56,8 @@ def _motion_calls(
     """A group's motion on its nodes' poses ``dst`` (k, n, 4, 4), as numpy calls to make.
 
     The walk's operations (``_kintree_py._run_few``), bound: a turn multiplies two columns,
-    seen as one complex number, by ``exp(-i angle)``; a slide adds ``v`` times column k to
-    column 3.
+    seen as one complex number, by ``exp(-i angle)`` (``turns``: (turns, n, 4), a factor per
+    row of a pose); a slide adds ``v`` times column k to column 3.
     """
     c = g.column
     if g.how == TURN:
@@ -126,7 +126,7 @@ def plan(t: Tree, n: int) -> Plan:
     rows = np.empty((n_rows, n, 4, 4))
     rows[row[0]] = np.eye(4)
     v = np.empty((len(t.dof), n))
-    turns = np.empty((t.n_turn, n, 4), dtype=np.complex128)  # per row of a pose (see below)
+    turns = np.empty((t.n_turn, n, 4), dtype=np.complex128)  # a factor per row of a pose
     calls = _motion_value_calls(t, v, turns)
     for g in t.groups:
         calls += _group_calls(g, rows, row, v, turns)
@@ -149,9 +149,11 @@ def plan(t: Tree, n: int) -> Plan:
 def _motion_value_calls(t: Tree, v: F64, turns: Any) -> list[Callable[[], object]]:
     """A step's motion values and turns from its configuration values, as the walk's.
 
-    The quotients in whole rows, then one copy each into the complex parts (their views
-    interleave; computing in them costs twice as much): the same operations, so the same bits
-    as a single configuration's.
+    The quotients in whole rows, as the walk computes them (the same bits), then copied into
+    the complex parts of ``turns`` (turns, n, 4), once per row of a pose. Why four copies: a
+    turn's multiplication then runs over a node's rows and samples as one long loop, where a
+    factor broadcast over the rows makes numpy loop four values at a time (PR2, 250 samples:
+    the turns 120 -> 50 us a step, the copies 10 -> 50 us).
     """
     cos, sin, half, square = np.empty((4, t.n_turn, v.shape[1]))
     return [

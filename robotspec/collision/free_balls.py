@@ -61,12 +61,17 @@ _CHEAP = 30e-6
 #: costs more than this many collision calls (Talos' arms: 40; the PR2's nesting pairs 1-5).
 _EXPLORE = 4
 _DEAREST = 8.0
+#: How many times its cost a new ball must be expected to save (the estimate is rough: a
+#: distance asked for nothing costs up to 40 collision calls).
+_MARGIN = 2.0
 #: Collision calls between two looks at whether a distance would pay (the estimate moves slowly).
 _RECONSIDER = 16
 #: Recent balls whose covering rate estimates what the next ball would cover.
 _RECENT = 16
 #: Candidates assumed still to come for a pair, at least (then: as many as were seen).
 _HORIZON = 256
+#: Fewest candidates per candidate seen that a pair's balls must cover to be tested at all.
+_USEFUL = 0.05
 #: Balls kept per pair and in a whole store (bounds its memory: 49 floats a ball).
 _MAX_PER_PAIR = 1024
 _MAX_TOTAL = 16384
@@ -93,8 +98,12 @@ def relative_corners(pose_a: F64, pose_b: F64, corners_a: F64, corners_b: F64) -
 
 
 def box_centres(corners: F64) -> F64:
-    """(n, 2, 3): the centres of the two boxes of corner sets (n, 16, 3)."""
-    out: F64 = corners.reshape(-1, 2, 8, 3).mean(axis=2)
+    """(n, 2, 3): the centres of the two boxes of corner sets (n, 16, 3).
+
+    A centre is the midpoint of two opposite corners (the first and the last of each eight:
+    the low and the high one of :func:`box_corners`).
+    """
+    out: F64 = (corners[:, [0, 8]] + corners[:, [7, 15]]) * 0.5
     return out
 
 
@@ -105,7 +114,7 @@ def ball_covers(
 
     ``points`` (n, 16, 3) are the candidates' corners and ``centres`` (n, 2, 3) their boxes'
     centres; ``corners``, ``ball_centres`` and ``radii`` (B,) the balls' and coal's distances.
-    The centres first: a centre is a mean of corners, so it moves no more than the farthest
+    The centres first: a centre is a midpoint of corners, so it moves no more than the farthest
     corner, and a ball whose centres are too far off cannot cover (most are: 2 points, not 16).
     """
     room = radii - eps
@@ -144,6 +153,14 @@ class _Pair:
         self.born.append(self.seen)
         self.credit.append(0)
 
+    def useless(self) -> bool:
+        """Whether the balls covered too few candidates to pay for testing them.
+
+        The PR2's forearm against its palm: a relative pose of two joints, the meshes 1 mm
+        apart, so a ball covers almost nothing of the next samples.
+        """
+        return self.seen >= _HORIZON and sum(self.credit) < _USEFUL * self.seen
+
     def worth_asking(self) -> bool:
         """Whether a coal distance (a new ball) is expected to save more than it costs.
 
@@ -158,7 +175,7 @@ class _Pair:
         recent = slice(-_RECENT, None)
         tests = sum(self.seen - b for b in self.born[recent])
         rate = sum(self.credit[recent]) / max(tests, 1)
-        return rate * max(self.seen, _HORIZON) * collide > distance
+        return rate * max(self.seen, _HORIZON) * collide > _MARGIN * distance
 
 
 class FreeBalls:
@@ -217,6 +234,39 @@ class FreeBalls:
         test: its answer, whatever the balls).
         """
         i, j = c.pair_geom1_list[k], c.pair_geom2_list[k]
+        n = len(rows)
+        keep = np.ones(n, dtype=np.bool_)
+        start = 0
+        while p.collided < _PROBES and start < n:  # probes: no ball yet, no numpy
+            p.seen += 1
+            self._place(scratch, poses, int(rows[start]), i, j)
+            if not self._collision_free(c, scratch, k, p):
+                return keep  # a hit: this and the rest of the block go to the walk
+            keep[start] = False
+            start += 1
+        if p.collided == _PROBES and p.collide_time < _CHEAP * _PROBES:
+            p.cheap = True  # the walk asks its calls from now on
+        if start == n or p.cheap:
+            return keep
+        rows = rows[start:]
+        kept = self._sift_rows(c, scratch, poses, rows, k, p, eps)
+        keep[start:] = kept
+        return keep
+
+    def _place(self, scratch: Scratch, poses: F64, r: int, i: int, j: int) -> None:
+        """Geometries ``i`` and ``j`` where row ``r`` puts them, in this thread's transforms."""
+        tf = scratch.transforms
+        pose_i, pose_j = poses[r, i], poses[r, j]
+        tf[i].setRotation(pose_i[:3, :3])
+        tf[i].setTranslation(pose_i[:3, 3])
+        tf[j].setRotation(pose_j[:3, :3])
+        tf[j].setTranslation(pose_j[:3, 3])
+
+    def _sift_rows(
+        self, c: Compiled, scratch: Scratch, poses: F64, rows: I64, k: int, p: _Pair, eps: float
+    ) -> Bools:
+        """:meth:`_sift_pair` once the pair's probes are done."""
+        i, j = c.pair_geom1_list[k], c.pair_geom2_list[k]
         ca, cb = self._corners[i], self._corners[j]
         assert ca is not None and cb is not None  # two meshes: sift passes no other
         pts = relative_corners(poses[rows, i], poses[rows, j], ca, cb)
@@ -238,21 +288,16 @@ class FreeBalls:
             p.seen += 1
             if not keep[pos]:  # covered by a ball made at an earlier row of this block
                 continue
-            r = int(rows[pos])
-            pose_i, pose_j = poses[r, i], poses[r, j]
-            tf[i].setRotation(pose_i[:3, :3])
-            tf[i].setTranslation(pose_i[:3, 3])
-            tf[j].setRotation(pose_j[:3, :3])
-            tf[j].setTranslation(pose_j[:3, 3])
+            self._place(scratch, poses, int(rows[pos]), i, j)
             if not ask:
                 if not self._collision_free(c, scratch, k, p):
                     return keep  # a hit: this and the rest of the block go to the walk
                 keep[pos] = False
-                if p.collided == _PROBES and p.collide_time < _CHEAP * _PROBES:
-                    p.cheap = True  # the walk asks its calls from now on
-                    return keep
-                if p.collided % _RECONSIDER == 0 or p.collided == _PROBES:
+                if p.collided % _RECONSIDER == 0:
                     ask = self._may_ask(p)
+                    if not ask and p.useless():
+                        p.cheap = True  # the walk asks coal, without the balls' numpy
+                        return keep
                 continue
             d = self._distance_of(c, k, tf[i], tf[j], p)
             if not d > eps:

@@ -343,7 +343,7 @@ def test_measure_scores_against_another_truth_folder(
 
 
 def test_a_truth_missing_a_key_the_counting_reads_is_skipped_with_its_file(tmp_path: Path) -> None:
-    from tools.corpus.measure import load_truth_folder
+    from tools.corpus.truths import load_truth_folder
 
     (tmp_path / "a.yaml").write_text("robot: x/a\nchains: {arm: {root: base}}\n")
     (tmp_path / "b.yaml").write_text(

@@ -64,12 +64,12 @@ from tools.corpus.measure import (  # noqa: E402
     BLIND_TRUTH,
     CorpusRobot,
     corpus_robots,
-    load_truth_folder,
     measure_robot,
     totals_lines,
 )
 from tools.corpus.split import half  # noqa: E402
 from tools.corpus.truth_compare import AGREEMENT, NAMED_VS_NEW, Agreement, compare  # noqa: E402
+from tools.corpus.truths import load_truth_folder  # noqa: E402
 from tools.draft_score import CATEGORIES, RobotScore, Truth  # noqa: E402
 
 __all__ = ["SECOND_TRUTH", "agreement_lines", "drafter_lines", "load_world", "main"]

@@ -196,3 +196,16 @@ def test_the_ball_covers_its_own_pose_and_not_a_far_one(meshes: _Meshes) -> None
     both = np.concatenate([at, far])
     covered = free_balls.ball_covers(both, centres(both), at, centres(at), np.array([d]), 1e-5)
     assert covered[:, 0].tolist() == [True, False]
+
+
+def test_a_pairs_balls_grow_without_losing_one() -> None:
+    pair = free_balls._Pair()
+    rng = np.random.default_rng(0)
+    corners = rng.normal(size=(40, 16, 3))
+    for n in range(40):
+        pair.add(corners[n], free_balls.box_centres(corners[n : n + 1])[0], 0.001 * (n + 1))
+    assert pair.n == 40 and len(pair.credit) == 40
+    np.testing.assert_array_equal(pair.corners, corners)
+    np.testing.assert_array_equal(pair.centres, free_balls.box_centres(corners))
+    np.testing.assert_array_equal(pair.radii, 0.001 * np.arange(1, 41))
+    assert pair.drop_balls() == 40 and pair.n == 0 and not len(pair.radii)

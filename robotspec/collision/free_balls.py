@@ -72,7 +72,7 @@ _RECENT = 16
 _HORIZON = 256
 #: Fewest candidates per candidate seen that a pair's balls must cover to be tested at all.
 _USEFUL = 0.05
-#: Balls kept per pair and in a whole store (bounds its memory: 49 floats a ball).
+#: Balls kept per pair and in a whole store (bounds its memory: 57 floats a ball).
 _MAX_PER_PAIR = 1024
 _MAX_TOTAL = 16384
 
@@ -132,11 +132,13 @@ def ball_covers(
 
 @dataclass
 class _Pair:
-    """What a store knows of one geometry pair: its balls and what its coal calls cost."""
+    """What a store knows of one geometry pair: its balls and what its coal calls cost.
 
-    corners: F64 = field(default_factory=lambda: np.zeros((0, 16, 3)))
-    centres: F64 = field(default_factory=lambda: np.zeros((0, 2, 3)))
-    radii: F64 = field(default_factory=lambda: np.zeros(0))
+    Mutable: it is the store's working state, one per pair, written by one thread.
+    """
+
+    n: int = 0  # balls
+    room: F64 = field(default_factory=lambda: np.zeros((0, 19, 3)))  # corners, centres, radius
     born: list[int] = field(default_factory=list)  # candidates seen when each ball was made
     credit: list[int] = field(default_factory=list)  # candidates each ball was first to cover
     seen: int = 0
@@ -146,12 +148,39 @@ class _Pair:
     distance_time: float = 0.0
     cheap: bool = False
 
+    @property
+    def corners(self) -> F64:
+        """(n, 16, 3): each ball's box corners (b's in a's frame, then a's in b's)."""
+        return self.room[: self.n, :16]
+
+    @property
+    def centres(self) -> F64:
+        """(n, 2, 3): the boxes' centres."""
+        return self.room[: self.n, 16:18]
+
+    @property
+    def radii(self) -> F64:
+        """(n,): coal's distance at each ball's pose."""
+        return self.room[: self.n, 18, 0]
+
     def add(self, corners: F64, centres: F64, d: float) -> None:
-        self.corners = np.concatenate([self.corners, corners[None]])
-        self.centres = np.concatenate([self.centres, centres[None]])
-        self.radii = np.append(self.radii, d)
+        if self.n == len(self.room):  # room for twice as many: no copy per ball
+            grown = np.zeros((max(16, 2 * self.n), 19, 3))
+            grown[: self.n] = self.room[: self.n]
+            self.room = grown
+        self.room[self.n, :16] = corners
+        self.room[self.n, 16:18] = centres
+        self.room[self.n, 18, 0] = d
+        self.n += 1
         self.born.append(self.seen)
         self.credit.append(0)
+
+    def drop_balls(self) -> int:
+        """Forget the balls (the pair is left to the walk); how many there were."""
+        n, self.n = self.n, 0
+        self.room = np.zeros((0, 19, 3))
+        self.born, self.credit = [], []
+        return n
 
     def useless(self) -> bool:
         """Whether the balls covered too few candidates to pay for testing them.
@@ -297,6 +326,7 @@ class FreeBalls:
                     ask = self._may_ask(p)
                     if not ask and p.useless():
                         p.cheap = True  # the walk asks coal, without the balls' numpy
+                        self.balls -= p.drop_balls()
                         return keep
                 continue
             d = self._distance_of(c, k, tf[i], tf[j], p)

@@ -24,6 +24,10 @@ answers (:func:`narrow_block` picks one):
   proofs in one C call. The C call releases the GIL, so threads sharing a checker run their
   proofs at once; the waves keep the work near the one-by-one walk's, which stops each sample at
   its first hit (proving every candidate of a block at once costs twice as much on the PR2).
+
+Before either, a "Never" pass (pairs never seen colliding, asked at every sample) lets
+:mod:`.free_balls` drop the mesh candidates it proves free from coal distances asked at nearby
+relative poses (the PR2's shoulder and fingers: tens of distances for thousands of samples).
 """
 
 from __future__ import annotations

@@ -32,7 +32,7 @@ from robotspec.model.world import World
 from .conftest import erd_robots
 
 #: Samples: two blocks of the "Never" pass, so balls made in one serve the next.
-SAMPLES = 1000
+SAMPLES = 700
 
 
 def _world(name: str) -> World:

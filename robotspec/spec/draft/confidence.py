@@ -140,7 +140,7 @@ def tool_frame_verdict(
     if srdf_parent is not None and tool is srdf_parent and is_bare_frame(world, tool):
         return None, TOOL_SRDF
     if not is_named_tcp(world, tool):
-        return f"the tool frame '{tool.name}' by its name", None
+        return f"the tool frame '{tool.name}': by its name or where it lies", None
     if hand is not None:
         if world.is_ancestor(hand, tool):
             return None, TOOL_ON_HAND

@@ -3,9 +3,10 @@
 Why its own module: a tool frame is read from the files before anything is guessed. A bare
 frame named as a TCP (``tool0``, ``*_tcp``, ``grasp_frame``...) is the files' answer; a bare
 frame on the joint a hand's fingers mimic is the hand's TCP (NAO's ``l_gripper``); a bare frame
-at the far end of a rigid tool is its tip, whatever its name; names weaker than these are
-questions; a hand with none gets a frame proposed between its tips, at the far ends of their
-geometry (``tips.between_tips``).
+at the far end of a rigid tool is its tip, and one fixed on a hand out the way its fingers
+reach is its TCP, whatever their names (``tool_places``: the rules by where a frame lies);
+names weaker than these are questions; a hand with none gets a frame proposed between its
+tips, at the far ends of their geometry (``tips.between_tips``).
 """
 
 from __future__ import annotations
@@ -14,7 +15,15 @@ import numpy as np
 
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
-from robotspec.spec.draft.tips import between_tips, far_end
+from robotspec.spec.draft.tips import between_tips
+from robotspec.spec.draft.tool_places import (
+    AT_END,
+    bare_fixed_leaf,
+    end_frame,
+    frame_at_tips,
+    frame_past_fingers,
+    own_geometry,
+)
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = [
@@ -51,22 +60,6 @@ TOOL_HINTS: tuple[str, ...] = (
     "tool",
     "flange",
 )
-
-
-def bare_fixed_leaf(world: World, body: Body) -> bool:
-    """Whether ``body`` is a frame: a leaf on a fixed joint, without geometry."""
-    c = world.parent_connection(body)
-    return (
-        c is not None
-        and c.is_fixed
-        and not world.child_bodies(body)
-        and not (body.collisions or body.visuals)
-    )
-
-
-def own_geometry(body: Body) -> bool:
-    """Whether ``body`` itself has a shape (visual or collision)."""
-    return bool(body.collisions or body.visuals)
 
 
 def bare_run_end(world: World, top: Body) -> Body:
@@ -173,63 +166,28 @@ def find_tool_frame(
             )
     # Last: a bare frame named as the gripper (iCub's 'l_gripper' below 'l_hand'), fixed or
     # turned by the joint the fingers mimic (NAO's 'l_gripper' on 'LHand': the hand's TCP).
+    # The turned one is the hand's TCP by structure alone, named as anything, when it is out
+    # from the hand (at the hand's origin it is the motor's stand-in: HSR-B's, qb SoftHand's).
     bare = [
         b
         for b in candidates
-        if "gripper" in names[b.index][0][1]
-        and not world.child_bodies(b)
+        if not world.child_bodies(b)
         and not own_geometry(b)
         and (c := world.parent_connection(b)) is not None
-        and (c.is_fixed or _leads_fingers(world, c, top))
+        and (
+            (c.is_fixed or _leads_fingers(world, c, top))
+            if "gripper" in names[b.index][0][1]
+            else _leads_fingers(world, c, top, shaped=True)
+            and float(np.linalg.norm(c.origin[:3, 3])) > AT_END
+        )
     ]
     if bare:
         return min(bare, key=lambda b: (world.depth(b), b.index))
+    # A bare frame fixed on the hand, out towards its finger tips: its TCP, whatever its name.
+    if (past := frame_past_fingers(tree, top, candidates)) is not None:
+        return past
     jaw = fixed_jaw(world, top) if top.index not in exclude else None
     return jaw if jaw is not None or leaf else end_frame(tree, top, candidates)
-
-
-#: Words of frames that are a sensor's, not a tool's (an F/T sensor's frame, an IMU's...).
-SENSOR_WORDS = frozenset(
-    {"ft", "imu", "force", "torque", "sensor", "camera", "cam", "optical", "laser", "lidar"}
-    | {"led", "light", "gyro", "accel", "accelerometer", "mic", "microphone", "com", "mass"}
-)
-#: How far (m) a frame may lie from the far end of the geometry it ends, to be at that end.
-AT_END = 0.01
-#: ... or this fraction of the way out, for large tools.
-AT_END_SHARE = 0.1
-
-
-def end_frame(tree: Tree, top: Body, candidates: list[Body]) -> Body | None:
-    """The one bare frame at the far end of a rigid end effector, whatever its name.
-
-    Why structure: an arm's tool with nothing that moves (a ball, a probe, a welding torch)
-    often carries a frame where it touches the work, named as nothing this module knows
-    (CENTAURO's 'ball1_tip'); it is a bare leaf placed out at the far end of the tool's
-    geometry, the way it points from the last joint. Frames at the mount (an F/T sensor's, a
-    legacy link's) sit at its origin, frames named as sensors are the sensors'. ``None`` when
-    anything moves below ``top``, or when not exactly one frame is at the end.
-    """
-    world = tree.world
-    if tree.moves_below(top):
-        return None
-    facts = tree.memo.get("facts")
-    sensed = set(getattr(facts, "sensor_links", {}) or {})
-    here = np.asarray(tree.poses[top.index][:3, 3], dtype=np.float64)
-    solid = [b for b in world.subtree(top) if own_geometry(b)]
-    found = []
-    for b in candidates:
-        if b is top or not bare_fixed_leaf(world, b) or b.name in sensed:
-            continue
-        if words(b.name) & SENSOR_WORDS:
-            continue
-        d = np.asarray(tree.poses[b.index][:3, 3], dtype=np.float64) - here
-        along = float(np.linalg.norm(d))
-        if along < AT_END or not solid:
-            continue
-        reach = max(float((far_end(tree, s, d) - here) @ d) / along for s in solid)
-        if abs(along - reach) <= max(AT_END, AT_END_SHARE * reach):
-            found.append(b)
-    return found[0] if len(found) == 1 else None
 
 
 def fixed_jaw(world: World, hand: Body) -> Body | None:
@@ -260,16 +218,20 @@ def fixed_jaw(world: World, hand: Body) -> Body | None:
     return jaws[0] if len(jaws) == 1 and len(kids) == 2 else None
 
 
-def _leads_fingers(world: World, c: Connection, top: Body) -> bool:
+def _leads_fingers(world: World, c: Connection, top: Body, shaped: bool = False) -> bool:
     """Whether ``c`` is an active joint that joints of other branches below ``top`` mimic.
 
     Why: a hand driven by one motor is often modelled as a bare link on the motor's joint, the
     fingers mimicking it; that link is a frame (no geometry, nothing below), not a finger.
+    ``shaped``: only fingers with a shape count (a file without shapes has bare fingers, one
+    of which leads the other: a finger, not a frame).
     """
     if not c.is_active:
         return False
     return any(
-        o.is_mimic and set(o.dofs) & set(c.dofs)
+        o.is_mimic
+        and set(o.dofs) & set(c.dofs)
+        and (not shaped or any(own_geometry(k) for k in world.subtree(b)))
         for b in world.subtree(top)
         if (o := world.parent_connection(b)) is not None and o is not c
     )
@@ -300,39 +262,3 @@ def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:
     if not tips:
         return None
     return between_tips(tree, top, tips)  # at the far ends of the tips' geometry
-
-
-#: How far off the line from a gripper's root through its tips' far ends a frame may lie (m).
-OFF_AXIS = 0.01
-#: How far beyond the tips' far ends a frame between the fingers may lie (m).
-BEYOND_TIPS = 0.03
-
-
-def frame_at_tips(tree: Tree, root: Body, tips: tuple[Body, Body]) -> Body | None:
-    """A bare frame the URDF puts between a gripper's finger tips, whatever its name.
-
-    Why structure first: a TCP is often named as nothing this module knows (a
-    'pinch_point', a 'grasp_center'); a frame fixed on the gripper (not on a finger) that lies
-    on the gripper's axis between the fingers' bases and just beyond their far ends is one.
-    """
-    world = tree.world
-    on_fingers = {b.index for t in tips for b in world.ancestors(t)} - {
-        b.index for b in world.ancestors(root)
-    }
-    here = np.asarray(tree.poses[root.index][:3, 3], dtype=np.float64)
-    way = np.mean([tree.poses[t.index][:3, 3] for t in tips], axis=0) - here
-    ends = np.mean([far_end(tree, t, way) for t in tips], axis=0)  # the pads, not the joints
-    reach = float(np.linalg.norm(ends - here))
-    if reach < OFF_AXIS:
-        return None
-    axis = (ends - here) / reach
-    found = []
-    for b in world.subtree(root):
-        c = world.parent_connection(b)
-        if b is root or c is None or not bare_fixed_leaf(world, b) or c.parent in on_fingers:
-            continue
-        d = np.asarray(tree.poses[b.index][:3, 3], dtype=np.float64) - here
-        along = float(d @ axis)
-        if float(np.linalg.norm(d - along * axis)) <= OFF_AXIS and 0 < along <= reach + BEYOND_TIPS:
-            found.append(b)
-    return found[0] if len(found) == 1 else None

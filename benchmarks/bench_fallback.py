@@ -18,25 +18,33 @@ side; the CPU time counts the work. Every call compared runs on this one thread 
 ``processes=1``), so nothing is left out. Give the load (``uptime``) with any figure.
 
 What a user without the cores gets (the README's table has the figures): a batch of FKs at about
-half the C speed (it is bound by memory: a batch of 2,000 PR2 configurations is 21 MB of poses,
-written through numpy's buffers in steps that stay in the caches), single configurations at a
-few percent (numpy's fixed cost per operation, paid per call), and collision queries at about a
-third. Why collisions stay there: the fallback's answers come from coal, one Python call per
-broad-phase candidate, and the C core's mesh proofs are what spare those calls. On the PR2 a
-batch of 64 leaves 444 candidates; coal turns a free one away in a few microseconds but takes
-about six times as long on one that collides (93 of them, most of coal's time), and the matrix
-spends nearly all its coal time on pairs that nearly touch and never collide. Numpy proofs were
-measured against the coal calls they remove (issue 34): the meshes' own oriented boxes, tested
-for every candidate at once, prove a third of the free candidates, for what coal's quick
-rejection of those far pairs costs; descending box trees to the triangles, as the C core does,
-proves the touching and crossing pairs but costs ten times the coal calls it removes; convex
-hulls along the centre line prove fewer still. Two more were measured and not kept: triangle
-pairs coal named in earlier collisions, tested again first, prove 4 of the batch's 93 colliding
-candidates on fresh configurations (13 with 16 kept per pair) for more numpy time than coal's
-answers; the hulls of each mesh and of its two halves prove the matrix's fingers and upper arm
-against forearm, but its six costliest pairs nest 0.4-12 mm apart, and no split into up to 8x8
-hulls separates them (PR2 matrix at most 4 % faster, Talos' slower). So the fallback proves
-nothing and asks coal.
+half the C speed or a little more (it is bound by memory: a batch of 2,000 PR2 configurations is
+21 MB of poses; its steps run numpy calls bound once per batch, ``_kintree_plan.py``), single
+configurations at a few percent (numpy's fixed cost per operation, paid per call), the collision
+matrix at 0.4-0.5 and a batch of collision queries at about a third. Why collisions stay there:
+the fallback's answers come from coal, one Python call per broad-phase candidate, and the C
+core's mesh proofs are what spare those calls. On the PR2 a batch of 64 leaves 444 candidates;
+coal turns a free one away in a few microseconds but takes about six times as long on one that
+collides (93 of them), and FK and the broad phase of the 64 take about as long again as coal
+(1.8 and 2.0 ms of 8.3). The matrix spends nearly all its coal time on pairs that nearly touch
+and never collide; there the fallback has proofs of its own (``collision/free_balls.py``): a
+coal distance at one pose proves the pair free at every pose that moves no point of the mesh by
+that much, so a pair whose relative pose turns on one or two joints (the PR2's shoulder against
+its upper arm, its fingers) is settled by some 80 distances for 2,000 samples; the forearm
+against the palm (two joints, 0.3-2.7 mm apart) is left to coal, about 1 s of the 2.5. Measured
+and not kept (issue 34): the meshes' own oriented boxes, tested for every candidate at once,
+prove a third of the free candidates, for what coal's quick rejection of those far pairs costs;
+descending box trees to the triangles, as the C core does, proves the touching and crossing
+pairs but costs ten times the coal calls it removes; convex hulls along the centre line prove
+fewer still; triangle pairs coal named in earlier collisions prove 4 of the batch's 93 colliding
+candidates on fresh configurations; the hulls of each mesh and of its halves (up to 8x8) do not
+separate the matrix's six costliest pairs (they nest 0.4-12 mm apart); crossing proofs (a piece
+of one mesh's surface with a vertex in a cell inside the other, closed mesh and one outside its
+box must cross its surface) prove 27-33 of the batch's 93 colliding candidates, never wrongly,
+but half the PR2's meshes are open and the numpy pass costs what the coal calls it spares
+(collisions_batch 0.97x, in_collision_batch 0.78x, interleaved); coal's distance lower bound
+from collision calls, its ``rel_err``, a security margin as a cheap distance and OBB instead of
+OBBRSS gained nothing. So the batch's fallback proves nothing and asks coal.
 """
 
 from __future__ import annotations

@@ -128,3 +128,33 @@ def _body_times_optical(rpy: str) -> str:
     r, p, y = (float(v) for v in rpy.split())
     out = matrix_to_rpy(rpy_to_matrix(r, p, y) @ OPTICAL)
     return " ".join(repr(float(v)) for v in np.asarray(out))
+
+
+def test_a_bare_frame_turned_as_an_upside_down_camera_on_the_body(tmp_path: Path) -> None:
+    """z ahead, x left, y up (an optical frame turned half round its z) under the body: a camera."""
+    parts = [
+        _link("n0", box=True),
+        _link("n1"),
+        _fixed("q0", "n0", "n1", "0.26 0 0.2", "0 -0.1745 0"),
+        _link("n2"),
+        _fixed("q1", "n1", "n2", rpy="1.5707963 0 1.5707963"),
+    ]
+    draft = _draft(tmp_path, "upside", parts)
+    assert [c.body for c in draft.cameras] == ["n2"]
+
+
+def test_a_flange_frame_turned_so_past_an_arms_joint_is_no_camera(tmp_path: Path) -> None:
+    """The same turn on a bare flange frame past a moving joint is a tool frame's convention."""
+    limit = '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    parts = [
+        _link("n0", box=True),
+        _link("n1", box=True),
+        '<joint name="q0" type="revolute"><parent link="n0"/><child link="n1"/>'
+        f'<origin xyz="0 0 0.2"/>{limit}</joint>',
+        _link("n2"),
+        _fixed("q1", "n1", "n2", "0 0.1 0", "0 -1.5707963 -1.5707963"),
+        _link("n3"),
+        _fixed("q2", "n2", "n3", rpy="1.5707963 0 1.5707963"),
+    ]
+    draft = _draft(tmp_path, "flange", parts)
+    assert "n3" not in [c.body for c in draft.cameras]

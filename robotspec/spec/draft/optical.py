@@ -30,6 +30,7 @@ __all__ = [
     "names_silent",
     "optical_from_body",
     "pick_channel",
+    "upside_down",
 ]
 
 CAMERA_WORDS = frozenset(
@@ -80,6 +81,20 @@ def _optical_rotation(rot: np.ndarray) -> bool:
     return bool(np.allclose(rot[:, 0], OPTICAL[:, 0], atol=1e-3) and rot[0, 2] > TILT)
 
 
+def upside_down(rot: np.ndarray) -> bool:
+    """Whether ``rot`` is an optical frame turned half round its z: a camera mounted upside down.
+
+    z still ahead (within 60 degrees, tilted up or down), x left and y up: the image rotated
+    180 degrees, as a camera hung under its mount writes it (a base camera's, a head's screen
+    camera's). Only a bare leaf is read so (``sensors.is_optical``, ``optical_from_body``).
+    """
+    return bool(np.allclose(rot[:, 0], -OPTICAL[:, 0], atol=1e-3) and rot[0, 2] > TILT)
+
+
+def _bare_leaf(tree: Tree, body: Body) -> bool:
+    return not tree.world.child_bodies(body) and not (body.collisions or body.visuals)
+
+
 def optical_from_body(tree: Tree, body: Body) -> bool:
     """Whether ``body`` is turned as an optical frame from a body frame above or beside it.
 
@@ -88,7 +103,7 @@ def optical_from_body(tree: Tree, body: Body) -> bool:
     """
     world = tree.world
     c = world.parent_connection(body)
-    if c is None or not c.is_fixed or world.child_bodies(body):
+    if c is None or not c.is_fixed or not _bare_leaf(tree, body):
         return False
     pose = tree.poses[body.index]
     up = world.bodies[c.parent]
@@ -97,7 +112,8 @@ def optical_from_body(tree: Tree, body: Body) -> bool:
         if above is None or up is tree.root or not above.is_fixed:
             break
         up = world.bodies[above.parent]
-        if _optical_rotation(tree.poses[up.index][:3, :3].T @ pose[:3, :3]):
+        rot = tree.poses[up.index][:3, :3].T @ pose[:3, :3]
+        if _optical_rotation(rot) or upside_down(rot):
             return True
     for k in world.child_bodies(world.bodies[c.parent]):
         kc = world.parent_connection(k)
@@ -106,7 +122,8 @@ def optical_from_body(tree: Tree, body: Body) -> bool:
         if k.collisions or k.visuals:
             continue
         near = float(np.linalg.norm(tree.poses[k.index][:3, 3] - pose[:3, 3])) <= SAME_SPOT
-        if near and _optical_rotation(tree.poses[k.index][:3, :3].T @ pose[:3, :3]):
+        rot = tree.poses[k.index][:3, :3].T @ pose[:3, :3]
+        if near and (_optical_rotation(rot) or upside_down(rot)):
             return True
     return False
 

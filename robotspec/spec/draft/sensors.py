@@ -27,6 +27,7 @@ from robotspec.spec.draft.optical import (
     names_silent,
     optical_from_body,
     pick_channel,
+    upside_down,
 )
 from robotspec.spec.draft.stated_cameras import DEVICE_SPAN, StatedCamera, stated_cameras
 from robotspec.spec.draft.tree import Tree, words
@@ -97,6 +98,13 @@ def is_optical(tree: Tree, body: Body) -> bool:
     # back is the parent's +y, z behind within 60 degrees of the parent's -x. Only on the
     # body the robot faces with: on a limb or a torso, "behind" says nothing (Baxter's arm
     # buttons, TIAGo Pro's arm mounts are turned so).
+    world = tree.world
+    if upside_down(rot) and not world.child_bodies(body) and not (body.collisions or body.visuals):
+        # A bare frame of a camera mounted upside down (optical.upside_down), on the body or
+        # on a shaped link; on a bare frame past a moving joint it is a flange's tool frame
+        # (a UR's 'tool0' is turned so from its 'flange').
+        parent = world.bodies[c.parent]
+        return tree.rigid_root(body) is tree.root or bool(parent.collisions or parent.visuals)
     behind = np.allclose(rot[:, 0], -_OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -_TILT
     if behind:
         return tree.rigid_root(body) is tree.root

@@ -120,3 +120,19 @@ def test_a_bare_link_the_fingers_follow_out_on_the_hand_is_its_tcp(tmp_path: Pat
     parts[-1] = _joint("q9", "n6", "n9", xyz="0 -0.015 0.05", mimic="q7")
     draft = _draft(tmp_path, "motor", parts)
     assert any(m.tool_frame == "n7" for m in draft.manipulators)
+
+
+def test_the_leaf_farthest_out_on_the_last_joints_axis_is_the_tool_frame(tmp_path: Path) -> None:
+    """Past the last joint: a shaped gripper base, a shaped leaf on it out along the axis (the
+    mount point), and sensors hung off the axis beside them. The leaf on the axis is the tool
+    frame, shape or not; nothing is proposed beside it."""
+    parts = _arm()
+    parts[-1] = _joint("q6", "n5", "n6", axis="0 0 1")
+    parts += [_link("n7"), _joint("q7", "n6", "n7", "fixed", "0 0 0.1")]
+    parts += [_link("n8", "0.02 0.02 0.02"), _joint("q8", "n7", "n8", "fixed", "0.04 0.01 0.02")]
+    parts += [_link("n9", "0.05 0.05 0.02"), _joint("q9", "n7", "n9", "fixed", "0 0 0")]
+    parts += [_link("n10", "0.01 0.01 0.01"), _joint("q10", "n9", "n10", "fixed", "0 0 0.025")]
+    draft = _draft(tmp_path, "axis", parts)
+    [m] = draft.manipulators
+    assert m.tool_frame == "n10"
+    assert m.decide and not draft.frames

@@ -22,6 +22,7 @@ from robotspec.spec.draft.tool_places import (
     end_frame,
     frame_at_tips,
     frame_past_fingers,
+    line_end,
     own_geometry,
 )
 from robotspec.spec.draft.tree import Tree, words
@@ -38,6 +39,7 @@ __all__ = [
     "hand_center",
     "is_bare_frame",
     "is_named_tcp",
+    "line_end",
     "own_geometry",
 ]
 
@@ -187,7 +189,9 @@ def find_tool_frame(
     if (past := frame_past_fingers(tree, top, candidates)) is not None:
         return past
     jaw = fixed_jaw(world, top) if top.index not in exclude else None
-    return jaw if jaw is not None or leaf else end_frame(tree, top, candidates)
+    if jaw is not None or leaf:
+        return jaw
+    return end_frame(tree, top, candidates) or line_end(tree, top)
 
 
 def fixed_jaw(world: World, hand: Body) -> Body | None:

@@ -24,6 +24,7 @@ __all__ = [
     "end_frame",
     "frame_at_tips",
     "frame_past_fingers",
+    "line_end",
     "own_geometry",
 ]
 
@@ -189,3 +190,37 @@ def frame_at_tips(tree: Tree, root: Body, tips: tuple[Body, Body]) -> Body | Non
         if float(np.linalg.norm(d - along * axis)) <= OFF_AXIS and 0 < along <= reach + BEYOND_TIPS:
             found.append(b)
     return found[0] if len(found) == 1 else None
+
+
+def line_end(tree: Tree, top: Body) -> Body | None:
+    """The leaf farthest out along the arm's last joint axis, fixed past that joint.
+
+    Why: past the last joint a maker often bolts parts (a gripper's base, then its mount
+    point) fixed one on the other, the last on the joint's axis, beside sensors hung off it
+    (a wrist camera, a range finder): the tool is met at the end on the axis, whatever the
+    parts are named or whether they have a shape. Only when nothing moves below ``top``, of
+    the leaves fixed to the link the last joint moves, within ``OFF_AXIS`` of its axis and at
+    least ``AT_END`` along it; not a Gazebo sensor's link nor a frame named as a sensor.
+    """
+    world = tree.world
+    moved = tree.rigid_root(top)
+    c = world.parent_connection(moved)
+    if c is None or c.is_fixed or tree.moves_below(top):
+        return None
+    pose = tree.poses[moved.index]
+    axis = pose[:3, :3] @ np.asarray(c.axis, dtype=np.float64)
+    n = float(np.linalg.norm(axis))
+    if n < 1e-9:
+        return None
+    axis = axis / n
+    facts = tree.memo.get("facts")
+    sensed = set(getattr(facts, "sensor_links", {}) or {})
+    found: list[tuple[float, Body]] = []
+    for b in world.subtree(top):
+        if b is top or world.child_bodies(b) or b.name in sensed or words(b.name) & SENSOR_WORDS:
+            continue
+        d = np.asarray(tree.poses[b.index][:3, 3] - pose[:3, 3], dtype=np.float64)
+        along = float(d @ axis)
+        if abs(along) >= AT_END and float(np.linalg.norm(d - along * axis)) <= OFF_AXIS:
+            found.append((abs(along), b))
+    return max(found, key=lambda f: (f[0], -f[1].index))[1] if found else None

@@ -158,3 +158,17 @@ def test_a_flange_frame_turned_so_past_an_arms_joint_is_no_camera(tmp_path: Path
     ]
     draft = _draft(tmp_path, "flange", parts)
     assert "n3" not in [c.body for c in draft.cameras]
+
+
+def test_a_tree_rooted_at_the_optical_frame_of_its_shaped_body(tmp_path: Path) -> None:
+    """A sensor's own file: the root a bare frame, the device's shaped body fixed at its origin
+    turned back to x forward (the root is optical from it). The root is the camera."""
+    parts = [
+        _link("n0"),
+        _link("n1", box=True),
+        _fixed("q0", "n0", "n1", rpy="0 -1.5707963 1.5707963"),
+        _link("n2"),
+        _fixed("q1", "n0", "n2", "0.4 0 -0.04", "-1.5707963 0 0"),
+    ]
+    draft = _draft(tmp_path, "rooted", parts)
+    assert [c.body for c in draft.cameras] == ["n0"]

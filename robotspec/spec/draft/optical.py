@@ -30,6 +30,7 @@ __all__ = [
     "names_silent",
     "optical_from_body",
     "pick_channel",
+    "root_is_optical",
     "upside_down",
 ]
 
@@ -124,6 +125,28 @@ def optical_from_body(tree: Tree, body: Body) -> bool:
         near = float(np.linalg.norm(tree.poses[k.index][:3, 3] - pose[:3, 3])) <= SAME_SPOT
         rot = tree.poses[k.index][:3, :3].T @ pose[:3, :3]
         if near and (_optical_rotation(rot) or upside_down(rot)):
+            return True
+    return False
+
+
+def root_is_optical(tree: Tree) -> bool:
+    """Whether the tree's root is a camera's optical frame, its shaped body turned from it.
+
+    Why: a sensor's own description (a stereo head's) often roots its tree at the camera's
+    optical frame and hangs the device's shaped body below it, turned back to x forward. The
+    root is then a bare frame whose one shaped child, fixed at its origin, sees it turned as
+    an optical frame is from its body frame.
+    """
+    world, root = tree.world, tree.root
+    if root.collisions or root.visuals:
+        return False
+    for k in world.child_bodies(root):
+        c = world.parent_connection(k)
+        if c is None or not c.is_fixed or not (k.collisions or k.visuals):
+            continue
+        if float(np.linalg.norm(c.origin[:3, 3])) <= SAME_SPOT and _optical_rotation(
+            c.origin[:3, :3].T
+        ):
             return True
     return False
 

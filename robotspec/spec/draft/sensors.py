@@ -27,6 +27,7 @@ from robotspec.spec.draft.optical import (
     names_silent,
     optical_from_body,
     pick_channel,
+    root_is_optical,
     upside_down,
 )
 from robotspec.spec.draft.stated_cameras import DEVICE_SPAN, StatedCamera, stated_cameras
@@ -147,6 +148,8 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
         world.get_body_by_name(link).index for link in facts.sensor_links if world.has_body(link)
     }
     found: list[CameraFound] = []
+    if tree.root.index not in taken and root_is_optical(tree):
+        found.append(CameraFound(_stem(tree.root.name) or tree.root.name, tree.root, True))
     for b in world.bodies:
         if b.index not in tree.inside or b is tree.root or b.index in taken:
             continue

@@ -28,6 +28,7 @@ __all__ = [
     "count",
     "hand_span",
     "is_named",
+    "mirrored",
     "named",
     "paired_arms",
     "standing_runs",
@@ -129,32 +130,36 @@ MIRROR = 0.01
 def paired_arms(
     tree: Tree, limbs: list[Limb], make: Callable[[Segment], Limb | None]
 ) -> list[Limb]:
-    """Short arms of a legged robot: two-joint runs from the legs' trunk, mirrored left-right.
+    """Short arms of a legged robot: mirrored runs of one or two turning joints from its trunk.
 
-    Why: a small humanoid's arms (a shoulder and an elbow, 15 cm: a kid-size soccer robot's)
-    are shorter and have fewer joints than an arm is asked to have, and may be named after
-    muscles ('bicep'); beside two legs, a mirrored pair of such runs from the trunk they hang
-    from is its arms, whatever the names (a head is one run, not a mirrored pair). ``make``:
-    the limb a run is, asked as one of such a pair.
+    Why: a small humanoid's arms (a shoulder and an elbow, 15 cm: a kid-size soccer robot's; a
+    single shoulder on a biped's trunk) are shorter and have fewer joints than an arm is asked
+    to have, and may be named after muscles ('bicep'); beside two legs, a mirrored pair of such
+    runs from the trunk they hang from, or from a link a waist turns above it, is its arms,
+    whatever the names (a head is one run, not a mirrored pair). Without legs such a pair is
+    not taken (a social robot's two-joint shoulders and a pair of antennas have one shape:
+    only names tell them, ``limbs._limb``). ``make``: the limb a run is, asked as one of such
+    a pair.
     """
     legs = [lb for lb in limbs if lb.kind == "leg"]
     if len(legs) < 2 or any(lb.kind == "arm" for lb in limbs):
         return []
-    trunks = {lb.root.index for lb in legs}
+    trunks = _trunks(tree, legs)
     used = {lb.segment.bodies[0].index for lb in limbs}
     runs = [
         s
         for s in tree.segments
         if s.start.index in trunks
         and s.bodies[0].index not in used
-        and len(s.actuated) == 2
+        and 1 <= len(s.actuated) <= 2
+        and len(s.actuated) == len(s.joints)
         and not tree.moving_children(s.end)
         and all(c.type.value == "revolute" for c in s.joints)
     ]
     out: list[Limb] = []
     for i, a in enumerate(runs):
         for b in runs[i + 1 :]:
-            if a.start is not b.start or not _mirrored(tree, a, b):
+            if a.start is not b.start or not mirrored(tree, a, b):
                 continue
             pair = [make(s) for s in (a, b)]
             if all(lb is not None and lb.kind == "arm" and lb.hand is None for lb in pair):
@@ -162,22 +167,51 @@ def paired_arms(
     return out
 
 
-def _mirrored(tree: Tree, a: Segment, b: Segment) -> bool:
-    """Whether two runs' first joints lie mirrored across their start's x-z plane."""
-    inv = np.linalg.inv(tree.poses[a.start.index])
-    pa = (inv @ tree.poses[a.bodies[0].index])[:3, 3]
-    pb = (inv @ tree.poses[b.bodies[0].index])[:3, 3]
-    if abs(float(pa[1])) < MIRROR:
+#: Most joints of a waist between the legs' trunk and the link carrying the arms.
+MAX_WAIST_JOINTS = 2
+
+
+def _trunks(tree: Tree, legs: list[Limb]) -> set[int]:
+    """The legs' trunks, and each link a short waist turns above one where runs branch."""
+    trunks = {lb.root.index for lb in legs}
+    for s in tree.segments:
+        if s.start.index in trunks and 1 <= len(s.actuated) <= MAX_WAIST_JOINTS:
+            if len(tree.moving_children(s.end)) >= 2:
+                trunks.add(s.end.index)
+    return trunks
+
+
+def mirrored(tree: Tree, a: Segment, b: Segment) -> bool:
+    """Whether two runs from one link are mirror images across a plane of their start's x-z.
+
+    The plane is the one halfway between the two runs' first joints (a maker's trunk frame need
+    not sit on the robot's middle: a root link placed at a hip); every link of one run lies on
+    the mirror image of its twin's, to ``MIRROR``, and the first joints lie apart.
+    """
+    if len(a.bodies) != len(b.bodies):
         return False
-    return float(np.linalg.norm(pa - pb * np.array([1.0, -1.0, 1.0]))) < MIRROR
+    inv = np.linalg.inv(tree.poses[a.start.index])
+    pas = [(inv @ tree.poses[x.index])[:3, 3] for x in a.bodies]
+    pbs = [(inv @ tree.poses[x.index])[:3, 3] for x in b.bodies]
+    mid = (float(pas[0][1]) + float(pbs[0][1])) / 2
+    if abs(float(pas[0][1]) - mid) < MIRROR:
+        return False
+    flip = np.array([1.0, -1.0, 1.0])
+    shift = np.array([0.0, 2 * mid, 0.0])
+    return all(
+        float(np.linalg.norm(pa - (pb * flip + shift))) < MIRROR
+        for pa, pb in zip(pas, pbs, strict=True)
+    )
 
 
-def standing_runs(tree: Tree, low: float, clearance: float) -> set[int]:
+def standing_runs(tree: Tree, low: float, clearance: float, drop: float) -> set[int]:
     """The runs that are legs by where they end (by their first link's index).
 
-    Four or more runs from one trunk, each of at least ``MIN_STANDING_JOINTS`` joints, ending
-    within ``clearance`` of the ground in mirrored pairs: each foot has a partner across the
-    trunk's x-z plane (the same x and height, the opposite y, both well off the middle).
+    Four or more runs from one trunk, each of at least ``MIN_STANDING_JOINTS`` joints (one
+    more unless it ends at least ``drop`` below the trunk; no wheel's joint counted), ending
+    within ``clearance`` of the ground, in mirrored pairs: each foot has a partner across the
+    feet's middle x-z plane (the same x and height, the opposite side, both well off the
+    middle; the middle is the feet's, not the trunk frame's, which a maker may place at a hip).
 
     Why: a small quadruped's legs are shorter than an arm must be (Mini Pupper's, 12 cm) and
     only their names said so; a robot stands on mirrored runs from its trunk that reach the
@@ -187,7 +221,11 @@ def standing_runs(tree: Tree, low: float, clearance: float) -> set[int]:
     by_start: dict[int, list[Segment]] = {}
     for seg in tree.segments:
         low_end = min(float(tree.position(b)[2]) for b in tree.world.subtree(seg.end))
-        if len(seg.actuated) >= MIN_STANDING_JOINTS and low_end - low < clearance:
+        # A wheel's joint (continuous: a caster's steer and wheel) is no leg's.
+        n = sum(1 for c in seg.actuated if c.type.value != "continuous")
+        # Two joints stand only well below the trunk (a hexapod's longer legs lie flat).
+        dropped = float(tree.position(seg.start)[2]) - low_end > drop
+        if n >= MIN_STANDING_JOINTS + int(not dropped) and low_end - low < clearance:
             by_start.setdefault(seg.start.index, []).append(seg)
     out: set[int] = set()
     for runs in by_start.values():
@@ -195,7 +233,9 @@ def standing_runs(tree: Tree, low: float, clearance: float) -> set[int]:
             continue
         inv = np.linalg.inv(tree.poses[runs[0].start.index])
         feet = [(inv @ tree.poses[s.end.index])[:3, 3] for s in runs]
-        mirrored = all(
+        mid = np.array([0.0, float(np.mean([f[1] for f in feet])), 0.0])
+        feet = [f - mid for f in feet]
+        paired = all(
             abs(float(f[1])) > MIRROR_OFF
             and any(
                 float(np.linalg.norm(g - f * np.array([1.0, -1.0, 1.0]))) < MIRROR_TOLERANCE
@@ -203,13 +243,13 @@ def standing_runs(tree: Tree, low: float, clearance: float) -> set[int]:
             )
             for f in feet
         )
-        if mirrored:
+        if paired:
             out |= {s.bodies[0].index for s in runs}
     return out
 
 
-#: The fewest joints of a leg found by where it stands.
-MIN_STANDING_JOINTS = 3
+#: The fewest joints of a leg found by where it stands (Solo-8's: a hip and a knee).
+MIN_STANDING_JOINTS = 2
 #: The fewest runs from one trunk that stand a robot up by their shape alone (a quadruped).
 MIN_STANDING_RUNS = 4
 #: How far off the trunk's middle (m) a foot of a mirrored pair is, at least.

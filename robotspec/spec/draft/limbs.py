@@ -130,8 +130,10 @@ def _limb(
         actuated.pop()  # a wheel at a leg's end rolls the robot: the leg ends at its axle
     # Two joints make a leg when its links say so (Solo-8's hip and knee: 'FL_upperleg'), and
     # an arm (Quori's shoulder pitch and roll: 'l_arm_upper', 'l_arm_lower').
+    # A mirrored pair of short runs (``paired``) may be a single shoulder each (Bolt's arms), a
+    # quadruped's mirrored runs standing on the ground (``afoot``) a hip and a knee (Solo-8's).
     named_limb = count(bodies, LEG_WORDS) >= 2 or count(bodies, ARM_WORDS) >= 2
-    fewest = MIN_LIMB_JOINTS - int(named_limb or paired)
+    fewest = 1 if paired else MIN_LIMB_JOINTS - int(named_limb or afoot)
     # The link where the run splits into fingers is a palm whatever its name (xArm7's Ability
     # hand: 'thumb_base' carries every finger); only the links above it must not be fingers'.
     palm = cut is None and bodies[-1] is seg.end and len(tree.moving_children(seg.end)) >= 2
@@ -181,7 +183,8 @@ def _limb(
         why = f"{len(actuated)} joints; {why}"
         return Limb("leg", root, tip, None, joints, seg, why, wheel, not legs_named)
     ends = f"a hand at '{hand.name}'" if hand is not None else "the end of the branch"
-    why = f"{len(actuated)} joints in series from '{root.name}' to {ends}"
+    n = len(actuated)
+    why = f"{n} joint{'s' if n > 1 else ''} in series from '{root.name}' to {ends}"
     tip = chain_end(tree, tip, hand)
     return Limb("arm", root, tip, hand, joints, seg, why)
 
@@ -305,7 +308,7 @@ def _find_limbs(tree: Tree, wheels: frozenset[str], rolling: bool) -> list[Limb]
     limbs: list[Limb] = []
     bases: list[Body | None] = []
     ending = {s.end.index: s for s in tree.segments}
-    afoot = standing_runs(tree, low, FOOT_CLEARANCE)
+    afoot = standing_runs(tree, low, FOOT_CLEARANCE, LEG_DROP)
     for seg in tree.segments:
         if any(world.is_ancestor(lb.tip, seg.start) for lb in limbs):
             continue  # inside a hand (fingers) or hanging below a limb's end

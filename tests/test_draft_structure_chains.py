@@ -1,0 +1,122 @@
+"""Chains found from the tree's shape when no name helps (issue 30: arms and legs by structure).
+
+Why: another maker's names match none of the drafter's word lists; a leg is a run standing the
+robot on the ground in mirrored pairs, an arm a mirrored pair of runs on the trunk, whatever
+they are called. Each test is a small layout of one rule's shape whose links and joints are
+only numbered, so no name can decide it; the trunk frame is also placed off the robot's middle
+(a maker's root link at a hip), which a mirror test must not depend on.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from tests.draft_support import draft_layout as _draft
+
+_BOX = '<collision><geometry><box size="{s} {s} {s}"/></geometry></collision>'
+_MASS = (
+    '<inertial><mass value="0.3"/>'
+    '<inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial>'
+)
+
+
+def _link(name: str, size: float = 0.03) -> str:
+    return f'<link name="{name}">{_MASS}{_BOX.format(s=size)}</link>'
+
+
+def _joint(
+    name: str, parent: str, child: str, xyz: str, axis: str = "0 1 0", kind: str = "revolute"
+) -> str:
+    moving = (
+        ""
+        if kind == "fixed"
+        else f'<axis xyz="{axis}"/><limit lower="-1" upper="1" effort="5" velocity="2"/>'
+    )
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}"/>{moving}</joint>'
+    )
+
+
+def _run(prefix: str, parent: str, offsets: list[str], axes: list[str]) -> list[str]:
+    """A serial run of revolute joints below ``parent``: links ``{prefix}1``..."""
+    parts: list[str] = []
+    above = parent
+    for i, (xyz, axis) in enumerate(zip(offsets, axes, strict=True), 1):
+        parts += [_link(f"{prefix}{i}"), _joint(f"{prefix}j{i}", above, f"{prefix}{i}", xyz, axis)]
+        above = f"{prefix}{i}"
+    return parts
+
+
+#: Where the trunk's frame lies off the robot's middle (m): a maker's root at a hip.
+_OFF = 0.07
+
+
+def test_four_mirrored_two_joint_runs_well_below_the_trunk_are_legs(tmp_path: Path) -> None:
+    # A hip and a knee each (a small quadruped's), the feet 32 cm below the trunk on the
+    # ground in mirrored pairs; the trunk's frame sits 7 cm off the middle.
+    parts = [_link("t0", 0.3)]
+    for n, (x, y) in enumerate(((0.2, 0.14), (0.2, -0.14), (-0.2, 0.14), (-0.2, -0.14)), 1):
+        parts += _run(f"r{n}", "t0", [f"{x} {y - _OFF} 0", "0 0 -0.16"], ["0 1 0", "0 1 0"])
+        parts += [
+            _link(f"f{n}", 0.02),
+            _joint(f"fj{n}", f"r{n}2", f"f{n}", "0 0 -0.16", kind="fixed"),
+        ]
+    d = _draft(tmp_path, "two_joint_legs", parts)
+    assert sorted(c.role for c in d.chains) == ["leg"] * 4
+    assert sorted(c.tip for c in d.chains) == ["f1", "f2", "f3", "f4"]
+
+
+def test_four_casters_steering_and_rolling_are_no_legs(tmp_path: Path) -> None:
+    # Four mirrored runs of a steering joint and a wheel (continuous) reaching the ground: a
+    # base's casters; a wheel's joint is no leg's.
+    parts = [_link("t0", 0.3)]
+    for n, (x, y) in enumerate(((0.2, 0.18), (0.2, -0.18), (-0.2, 0.18), (-0.2, -0.18)), 1):
+        parts += [
+            _link(f"s{n}"),
+            _joint(f"sj{n}", "t0", f"s{n}", f"{x} {y} -0.1", "0 0 1"),
+            _link(f"w{n}", 0.1),
+            _joint(f"wj{n}", f"s{n}", f"w{n}", "0 0 -0.15", "0 1 0", "continuous"),
+        ]
+    d = _draft(tmp_path, "casters", parts)
+    assert all(c.role != "leg" for c in d.chains)
+
+
+def _biped(waist: bool, arm_joints: int) -> list[str]:
+    """Two 3-joint legs on a trunk, arms of ``arm_joints`` on it (or on a waist it turns)."""
+    parts = [_link("t0", 0.2)]
+    for n, y in ((1, 0.1), (2, -0.1)):
+        parts += _run(
+            f"g{n}",
+            "t0",
+            [f"0 {y - _OFF} -0.05", "0 0 -0.15", "0 0 -0.15"],
+            ["1 0 0", "0 1 0", "0 1 0"],
+        )
+    carrier = "t0"
+    if waist:
+        parts += [_link("w1", 0.1), _joint("wj1", "t0", "w1", "0 0 0.08", "0 0 1")]
+        carrier = "w1"
+    for n, y in ((1, 0.11), (2, -0.11)):
+        off = -_OFF if carrier == "t0" else 0.0
+        offsets = [f"0 {y + off} 0.12", "0 0 -0.1"][:arm_joints]
+        parts += _run(f"a{n}", carrier, offsets, ["0 1 0", "1 0 0"][:arm_joints])
+    return parts
+
+
+def test_a_mirrored_pair_of_single_shoulders_on_a_waist_above_legs_are_arms(
+    tmp_path: Path,
+) -> None:
+    # A biped whose arms are one shoulder joint each, on a link a waist turns above the legs'
+    # trunk (a small research biped's): the mirrored pair is its arms.
+    d = _draft(tmp_path, "one_joint_arms", _biped(waist=True, arm_joints=1))
+    arms = sorted((c.root, c.tip, tuple(sorted(c.joints))) for c in d.chains if c.role == "arm")
+    assert arms == [("w1", "a11", ("a1j1",)), ("w1", "a21", ("a2j1",))]
+    assert sorted(c.role for c in d.chains if c.role == "leg") == ["leg", "leg"]
+    assert all(c.decide for c in d.chains)  # found by shape: each asks to be checked
+
+
+def test_two_joint_arms_beside_legs_with_the_trunk_frame_off_the_middle(tmp_path: Path) -> None:
+    # The mirror plane is the runs' own middle, not the trunk frame's x-z plane.
+    d = _draft(tmp_path, "off_middle", _biped(waist=False, arm_joints=2))
+    arms = sorted(tuple(sorted(c.joints)) for c in d.chains if c.role == "arm")
+    assert arms == [("a1j1", "a1j2"), ("a2j1", "a2j2")]

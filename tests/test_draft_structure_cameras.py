@@ -172,3 +172,16 @@ def test_a_tree_rooted_at_the_optical_frame_of_its_shaped_body(tmp_path: Path) -
     ]
     draft = _draft(tmp_path, "rooted", parts)
     assert [c.body for c in draft.cameras] == ["n0"]
+
+
+def test_a_frame_on_a_link_carrying_only_an_imu_sensor_is_the_imus(tmp_path: Path) -> None:
+    """A bare frame turned as an optical frame (tilted), fixed on a link whose Gazebo sensor is
+    an IMU, named as nothing: the IMU's axes, no camera."""
+    parts = [
+        _link("n0", box=True),
+        _link("n1"),
+        _fixed("q0", "n0", "n1", "0.08 -0.01 -0.11", "-2.0943952 0 -1.5707963"),
+        '<gazebo reference="n0"><sensor name="s0" type="imu"/></gazebo>',
+    ]
+    draft = _draft(tmp_path, "imu", parts)
+    assert not draft.cameras

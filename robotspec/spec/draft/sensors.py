@@ -162,6 +162,8 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
         parent_words = words(world.bodies[parent.parent].name) if parent is not None else set()
         if optical and parent_words & NOT_CAMERA_WORDS:
             continue
+        if optical and parent is not None and _sensor_frame(tree, facts, b, parent.parent):
+            continue
         if optical and world.child_bodies(b) and not w & CAMERA_WORDS:
             continue  # a link turned as optical frames are, carrying others (iCub's 'neck_2')
         if optical or (w & CAMERA_WORDS and not world.child_bodies(b)):
@@ -209,6 +211,17 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             kept.append(cam)
     kept.sort(key=lambda c: c.body.index)
     return kept
+
+
+def _sensor_frame(tree: Tree, facts: FileFacts, body: Body, parent: int) -> bool:
+    """Whether a bare frame named as nothing is the frame of the sensor on its parent.
+
+    Why: a link carrying only Gazebo sensors that take no images (an IMU, a laser) often has
+    the sensor's frame fixed on it, turned as an optical frame (the IMU's axes); its name, where
+    it says 'imu', is the only other evidence, and a maker's ids say nothing.
+    """
+    kind = facts.sensor_links.get(tree.world.bodies[parent].name)
+    return kind is not None and kind not in IMAGE_KINDS and names_silent(body.name)
 
 
 def _beside(tree: Tree, a: Body, b: Body) -> bool:

@@ -67,10 +67,16 @@ def test_a_file_without_shapes_still_has_a_gripper(tmp_path: Path) -> None:
     assert {m.thumb.tip, m.finger.tip} == {"n8", "n9"}
 
 
-def test_massive_shapeless_links_beside_shapes_are_not_fingers(tmp_path: Path) -> None:
-    """Where the file has shapes, a massive link without one is a helper (a linkage), not a jaw."""
+def test_massive_shapeless_jaws_beside_shapes_elsewhere_are_fingers(tmp_path: Path) -> None:
+    """A shape elsewhere (a box on the base) does not make massive shapeless jaws helpers.
+
+    Where a hand's meshes are missing, its jaws' masses and mimic tag still say what they are;
+    helpers beside them are told by structure (``tests/test_draft_structure_hands.py``).
+    """
     draft = _draft(tmp_path, "helpers", _arm_with_jaws(box_on_base=True))
-    assert all(m.thumb is None for m in draft.manipulators)
+    [m] = draft.manipulators
+    assert m.thumb is not None and m.finger is not None
+    assert {m.thumb.tip, m.finger.tip} == {"n8", "n9"}
 
 
 def _arm(root_xyz: str) -> list[str]:

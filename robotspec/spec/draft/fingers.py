@@ -1,8 +1,11 @@
 """A hand of three or more fingers: which branch is the thumb, and the others by name.
 
 Split from ``hands`` (parallel grippers and tool frames): a thumb is found by its name, else by
-where its base lies against the other fingers' (off their row, or alone across the palm), which
-is a guess the draft marks.
+structure: the one finger that is no copy of the others (``thumbs``), or where its base lies
+against the other fingers' (off their row, or alone across the palm), guesses the draft marks.
+Which branches are fingers at all is read from their shapes, or where those are missing from
+masses, ranges and mimic tags (``bare_fingers``); a linkage's rods and anything turning without
+end never are (``linkages``).
 """
 
 from __future__ import annotations
@@ -13,7 +16,9 @@ import numpy as np
 
 from robotspec.model.entities import Body
 from robotspec.model.world import World
+from robotspec.spec.draft.bare_fingers import bare_branches
 from robotspec.spec.draft.model import DraftFinger
+from robotspec.spec.draft.thumbs import odd_by_shape
 from robotspec.spec.draft.tool_frames import bare_fixed_leaf
 from robotspec.spec.draft.tree import Tree, solid, words
 
@@ -21,18 +26,40 @@ __all__ = ["FINGER_NAMES", "Fingers", "find_fingers", "finger_tip", "hand_branch
 
 
 def hand_branches(tree: Tree, hand: Body) -> tuple[Body, list[Body]]:
-    """Where the hand first splits (below its single links), and the moving branches there."""
+    """Where the hand first splits (below its single links), and the moving branches there.
+
+    The branches with geometry, and those without whose masses, ranges and mimic tags say they
+    are fingers too (``bare_fingers``: a thumb whose meshes are missing beside shaped fingers).
+    Where one branch is left of several, the hand splits below it.
+    """
     body = hand
     while True:
         kids = tree.moving_children(body)
         if len(kids) != 1:
             break
         body = kids[0]
-    return body, [k for k in tree.moving_children(body) if _has_geometry(tree, k)]
+    branches = bare_branches(tree, kids)
+    if len(kids) >= 2 and len(branches) == 1 and _rigid_to_split(tree, branches[0]):
+        # The others were no fingers (a gripper motor's prop turning without end beside the
+        # finger carriage, Interbotix's): the fingers split further down the one left, where
+        # fixed joints carry it (a joint on the way would make it a limb, not a carriage).
+        below, deeper = hand_branches(tree, branches[0])
+        if len(deeper) >= 2:
+            return below, deeper
+    return body, branches
 
 
-def _has_geometry(tree: Tree, body: Body) -> bool:
-    return any(solid(tree.world, b) for b in tree.world.subtree(body))
+def _rigid_to_split(tree: Tree, body: Body) -> bool:
+    """Whether ``body`` hangs on a fixed joint and fixed joints alone lead down to its split."""
+    world = tree.world
+    while True:
+        c = world.parent_connection(body)
+        if c is None or not c.is_fixed:
+            return False
+        kids = tree.moving_children(body)
+        if len(kids) != 1:
+            return True
+        body = kids[0]
 
 
 def finger_tip(tree: Tree, branch: Body) -> Body:
@@ -45,8 +72,19 @@ def finger_tip(tree: Tree, branch: Body) -> Body:
     moved = [b for b in inside if (c := world.parent_connection(b)) is not None and not c.is_fixed]
     # A fixed tip link with geometry is the finger's tip (Baxter's 'r_gripper_l_finger_tip');
     # collision geometry first: a leaf with a look only is a decoration (HSR-B's vacuum pad).
+    collided = [b for b in inside if b.collisions]
+    # A moving link with a mass but no shape is a part whose shape is missing (Shadow's distal
+    # phalanx once its mesh is gone, past the middle one's primitive collision).
+    missing = [b for b in moved if b.mass and not (b.visuals or b.collisions)]
+    if missing and not collided:
+        # No collision shape at all: the finger's parts are its links with a mass, fixed ones
+        # too (Dex1's pads), but not a fixed leaf with a look only (the vacuum pad, the one
+        # visual left once meshes are gone).
+        parts = [b for b in inside if b.mass and not _decoration(world, b)]
+    else:
+        parts = collided + missing
     parts = (
-        [b for b in inside if b.collisions]
+        parts
         or [b for b in inside if b.visuals]
         or [b for b in inside if solid(world, b)]  # a file without shapes: links with a mass
     )
@@ -57,6 +95,13 @@ def finger_tip(tree: Tree, branch: Body) -> Body:
     if len(bare) == 1 and all(not world.child_bodies(k) for k in world.child_bodies(tip)):
         return bare[0]
     return tip
+
+
+def _decoration(world: World, body: Body) -> bool:
+    """Whether ``body`` is a fixed leaf with a look (visual) but no collision shape."""
+    c = world.parent_connection(body)
+    fixed = c is not None and c.is_fixed
+    return fixed and bool(body.visuals) and not body.collisions and not world.child_bodies(body)
 
 
 #: Names of a hand's fingers besides the thumb, as links often carry them.
@@ -102,9 +147,13 @@ def find_fingers(tree: Tree, hand: Body) -> Fingers | None:
         decide = "the thumb is the finger whose base lies off the row of the others'"
         alone = _alone_on_a_side(tree, body, branches)
         unspread = _without_spread(world, branches)
+        odd = odd_by_shape(world, branches)
         if unspread is not None:
             thumb_i = unspread
             decide = "the thumb is the finger with no spread joint, opposing the two that turn"
+        elif odd is not None:
+            thumb_i = odd
+            decide = "the thumb is the one finger unlike the others (copies of one finger)"
         elif alone is not None and _no_clear_row(at):
             # Bases on a circle (D'Claw's three fingers): no row; the one opposing the others
             # across the palm is the thumb.

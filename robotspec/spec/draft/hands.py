@@ -25,6 +25,7 @@ from robotspec.model.world import World
 from robotspec.spec.draft.confidence import gripper_question
 from robotspec.spec.draft.fingers import find_fingers, finger_tip, hand_branches
 from robotspec.spec.draft.limbs import FINGER_WORDS, HAND_WORDS, is_named
+from robotspec.spec.draft.linkages import turns_freely
 from robotspec.spec.draft.model import DraftFinger
 from robotspec.spec.draft.tool_frames import (
     find_tool_frame,
@@ -213,6 +214,10 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
         if not branches:
             return None, "no finger branches below it"
         return None, f"{len(branches)} finger branches below '{body.name}', not two sides"
+    if any(turns_freely(world, k) for side in sides for k in side):
+        # A side driven without end (a car's two front wheels, whatever their names): fingers
+        # close within a range; a mimic follows its leader's, whatever its type says.
+        return None, f"a branch below '{body.name}' turns without end: not a finger"
     # A side's tip is its deepest moving link; it is driven when one of its joints is not a mimic.
     tips: list[Body] = []
     leaders: list[bool] = []

@@ -23,6 +23,7 @@ from robotspec.spec.draft.limbs import (
     hand_span,
     is_named,
 )
+from robotspec.spec.draft.linkages import ball_joint
 from robotspec.spec.draft.manipulators import manipulator
 from robotspec.spec.draft.model import DraftChain, DraftManipulator
 from robotspec.spec.draft.naming import unique
@@ -69,10 +70,11 @@ def lone_hand(self: Drafter) -> DraftManipulator | None:
         gripper = None
     # Fingers have phalanges: a branch of one joint (a rotor, a wheel) is not one, unless the
     # palm has MIN_DIGITS of them on limited joints (a five-finger hand's one-joint digits).
+    # Nor are a parallel mechanism's rods, each ending in a ball joint (a Stewart platform's).
     kids = [
         k
         for k in tree.moving_children(split)
-        if not any(b.index in wheels for b in world.subtree(k))
+        if not any(b.index in wheels for b in world.subtree(k)) and not ball_joint(world, k)
     ]
     branches = [
         k for k in kids if sum(1 for b in world.subtree(k) if not _fixed_above(world, b)) >= 2

@@ -303,3 +303,20 @@ def test_the_thumb_is_the_finger_that_is_no_copy_of_the_others(tmp_path: Path) -
     assert m.thumb is not None and m.thumb.tip == "t3"
     assert sorted(f.tip for f in m.fingers.values()) == ["f03", "f13", "f23"]
     assert any("unlike the others" in d for d in m.decide)
+
+
+def test_a_shapeless_helper_beside_two_shaped_fingers_is_no_finger(tmp_path: Path) -> None:
+    """Two jaws with shapes and a slider with a mass but none, on a prismatic joint of its own.
+
+    Two shaped branches are the gripper's fingers (as before shapes were read as missing); a
+    massive shapeless branch beside them is a helper, whatever its joint.
+    """
+    parts = _arm()
+    parts += [_link("s", 0.01), _joint("qs", "h", "s", "prismatic", "0 0 0.01", limit=(-0.1, 0.1))]
+    for side, y, mimic in (("a", "0.02", None), ("b", "-0.02", "qa")):
+        parts += [
+            _link(side, 0.05, "collision"),
+            _joint(f"q{side}", "h", side, "prismatic", f"0 {y} 0.05", "0 1 0", mimic, -1.0),
+        ]
+    draft = _draft(tmp_path, "helper", parts)
+    assert _gripper(draft) == ("a", "b")

@@ -33,9 +33,10 @@ def massive(world: World, branch: Body) -> bool:
 def bare_branches(tree: Tree, kids: list[Body]) -> list[Body]:
     """The moving branches ``kids`` of a split that are fingers, in their order.
 
-    A branch with a shape is one (``fingers.hand_branches``' rule). A shapeless one is when it
-    has a mass (or when no branch has a mass or a shape: the joints alone say it), turns within
-    a finger's range and is not the actuator's stand-in. None holds a ball joint.
+    A branch with a shape is one (``fingers.hand_branches``' rule); two such are a gripper's
+    fingers, and nothing beside them is. Else a shapeless one is a finger when it has a mass
+    (or when no branch has a mass or a shape: the joints alone say it), turns within a
+    finger's range and is not the actuator's stand-in. None holds a ball joint.
     """
     world = tree.world
     kids = [k for k in kids if not ball_joint(world, k)]  # a linkage's rod (``linkages``)
@@ -44,6 +45,8 @@ def bare_branches(tree: Tree, kids: list[Body]) -> list[Body]:
     if not shaped and not bare:
         bare = list(kids)
     bare = [k for k in bare if not turns_freely(world, k)]
+    if len(shaped) == 2:
+        return shaped  # a gripper's two fingers with their shapes: what lies beside is a helper
     parts = shaped + bare
     stand_ins = {k.index for k in bare if _stand_in(world, k, parts)}
     return [k for k in kids if k in shaped or (k in bare and k.index not in stand_ins)]

@@ -120,3 +120,55 @@ def test_two_joint_arms_beside_legs_with_the_trunk_frame_off_the_middle(tmp_path
     d = _draft(tmp_path, "off_middle", _biped(waist=False, arm_joints=2))
     arms = sorted(tuple(sorted(c.joints)) for c in d.chains if c.role == "arm")
     assert arms == [("a1j1", "a1j2"), ("a2j1", "a2j2")]
+
+
+def test_legs_below_hips_reach_the_ground_when_the_root_frame_sits_on_it(tmp_path: Path) -> None:
+    # The trunk's frame on the ground under the pelvis (a maker's choice): the legs start at
+    # hips 54 cm up and end 9 cm above that frame; they drop from their hips, not from it.
+    parts = [_link("t0", 0.2)]
+    for n, y in ((1, 0.08), (2, -0.08)):
+        parts += _run(
+            f"g{n}",
+            "t0",
+            [f"0 {y} 0.54", "0 0 -0.15", "0 0 -0.15", "0 0 -0.15"],
+            ["1 0 0", "0 1 0", "0 1 0", "0 1 0"],
+        )
+    for n, y in ((1, 0.15), (2, -0.15)):
+        parts += _run(
+            f"a{n}", "t0", [f"0 {y} 0.76", "0 0 -0.1", "0 0 -0.1"], ["0 1 0", "1 0 0", "0 1 0"]
+        )
+    d = _draft(tmp_path, "pelvis_up", parts)
+    legs = sorted(tuple(sorted(c.joints)) for c in d.chains if c.role == "leg")
+    assert legs == [tuple(f"g1j{i}" for i in range(1, 5)), tuple(f"g2j{i}" for i in range(1, 5))]
+    assert sorted(c.root for c in d.chains if c.role == "arm") == ["t0", "t0"]
+
+
+def _humanoid_with_head(head: list[tuple[str, str]]) -> list[str]:
+    """Two legs, two arms and a head of ``head`` (offset, axis) joints on the trunk's top."""
+    parts = [_link("t0", 0.2)]
+    for n, y in ((1, 0.08), (2, -0.08)):
+        parts += _run(f"g{n}", "t0", [f"0 {y} -0.1", "0 0 -0.2", "0 0 -0.2"], ["1 0 0"] * 3)
+        parts += _run(
+            f"a{n}", "t0", [f"0 {2 * y} 0.2", "0 0 -0.1", "0 0 -0.1"], ["0 1 0", "1 0 0", "0 1 0"]
+        )
+    offsets, axes = [o for o, _ in head], [a for _, a in head]
+    return parts + _run("h", "t0", offsets, axes)
+
+
+def test_a_single_yaw_joint_carrying_the_top_of_the_robot_is_its_head(tmp_path: Path) -> None:
+    d = _draft(tmp_path, "yaw_head", _humanoid_with_head([("0 0 0.3", "0 0 1")]))
+    [head] = [c for c in d.chains if c.joints == frozenset({"hj1"})]
+    assert head.role == "chain" and head.decide
+
+
+def test_a_head_that_tilts_then_pans_on_top_is_a_head(tmp_path: Path) -> None:
+    d = _draft(
+        tmp_path, "tilt_pan", _humanoid_with_head([("0 0 0.3", "0 1 0"), ("0 0 0.05", "0 0 1")])
+    )
+    assert [c.role for c in d.chains if c.joints == frozenset({"hj1", "hj2"})] == ["chain"]
+
+
+def test_a_yaw_joint_below_the_top_of_the_robot_is_no_head(tmp_path: Path) -> None:
+    # The same joint on the trunk's front, lower than the shoulders: no head.
+    d = _draft(tmp_path, "low_yaw", _humanoid_with_head([("0.1 0 0.05", "0 0 1")]))
+    assert not [c for c in d.chains if c.joints == frozenset({"hj1"})]

@@ -165,7 +165,10 @@ def _limb(
     # Where the limb ends up: the lowest frame it carries (a foot fixed past the knee, a wheel),
     # not the last moving link's origin (a knee, 20 cm above the ground it stands on).
     z_tip = min(float(tree.position(b)[2]) for b in world.subtree(tip))
-    z_root = float(tree.position(root)[2])
+    # How far it drops from where it starts: its root's frame, or for a run of a leg's joints
+    # its first joint if higher (a maker's root frame may sit on the ground under a pelvis).
+    starts = (root, world.bodies[actuated[0].child])[: 2 if len(actuated) >= MIN_LIMB_JOINTS else 1]
+    z_root = max(float(tree.position(b)[2]) for b in starts)
     legs_named = footed or count(bodies, LEG_WORDS) > count(bodies, ARM_WORDS)
     grounded = (
         stands and hand is None and z_tip - low < FOOT_CLEARANCE and z_root - z_tip > LEG_DROP

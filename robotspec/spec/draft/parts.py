@@ -193,22 +193,37 @@ def _add_head(d: Drafter, limb_tops: list[Body]) -> None:
 
 
 def _pan_tilt(d: Drafter, joints: tuple[Connection, ...] | list[Connection]) -> bool:
-    """Whether 2-3 revolute (limited) joints turn about the vertical, then a level axis, upwards.
+    """Whether 1-3 revolute (limited) joints turn a head: a pan and a tilt, upwards, on top.
 
     Why: a head whose links are named nothing a reader knows (Booster T1's 'H1', 'H2') is
-    still a pan and a tilt on top of the body; its run ends higher than it starts.
+    still a pan and a tilt on top of the body; its run ends higher than it starts. A makers'
+    head may also tilt before it pans, or only pan (one yaw joint); then what makes it the head
+    is where it is: the highest part of the robot is on it.
     """
-    if not 2 <= len(joints) <= 3 or any(c.type.value != "revolute" for c in joints):
+    if not 1 <= len(joints) <= 3 or any(c.type.value != "revolute" for c in joints):
         return False  # a caster's steer and wheel (continuous) are no head
     if any(c.child in {w.child for w in d.wheels} for c in joints):
         return False
     axes = [np.abs(d.tree.axis_in_root(c)) for c in joints]
-    if not (axes[0][2] > 0.9 and any(a[2] < 0.1 for a in axes[1:])):
-        return False
+    if not any(a[2] > 0.9 for a in axes):
+        return False  # a head pans about the vertical
+    if len(joints) > 1 and not any(a[2] < 0.1 for a in axes):
+        return False  # ... and tilts about a level axis
     world = d.world
     start = d.tree.position(world.bodies[joints[0].parent])
     end = d.tree.position(world.bodies[joints[-1].child])
-    return bool(end[2] > start[2] + 1e-3)
+    if not end[2] > start[2] + 1e-3:
+        return False
+    if len(joints) > 1 and axes[0][2] > 0.9:
+        return True  # pan, then tilt: the shape alone says head
+    return _on_top(d, world.bodies[joints[-1].child])
+
+
+def _on_top(d: Drafter, body: Body) -> bool:
+    """Whether the highest frame of the robot (in the default pose) is ``body`` or below it."""
+    tree, world = d.tree, d.world
+    top = max(float(tree.position(b)[2]) for b in world.bodies if b.index in tree.inside)
+    return max(float(tree.position(b)[2]) for b in world.subtree(body)) >= top - 1e-6
 
 
 # ----------------------------------------------------------------------------- states

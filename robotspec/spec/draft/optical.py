@@ -87,7 +87,8 @@ def upside_down(rot: np.ndarray) -> bool:
 
     z still ahead (within 60 degrees, tilted up or down), x left and y up: the image rotated
     180 degrees, as a camera hung under its mount writes it (a base camera's, a head's screen
-    camera's). Only a bare leaf is read so (``sensors.is_optical``, ``optical_from_body``).
+    camera's). Only a bare leaf named as nothing is read so (``sensors.is_optical``,
+    ``optical_from_body``): weaker evidence than a name.
     """
     return bool(np.allclose(rot[:, 0], -OPTICAL[:, 0], atol=1e-3) and rot[0, 2] > TILT)
 
@@ -114,7 +115,7 @@ def optical_from_body(tree: Tree, body: Body) -> bool:
             break
         up = world.bodies[above.parent]
         rot = tree.poses[up.index][:3, :3].T @ pose[:3, :3]
-        if _optical_rotation(rot) or upside_down(rot):
+        if _optical_rotation(rot) or (upside_down(rot) and names_silent(body.name)):
             return True
     for k in world.child_bodies(world.bodies[c.parent]):
         kc = world.parent_connection(k)
@@ -124,7 +125,7 @@ def optical_from_body(tree: Tree, body: Body) -> bool:
             continue
         near = float(np.linalg.norm(tree.poses[k.index][:3, 3] - pose[:3, 3])) <= SAME_SPOT
         rot = tree.poses[k.index][:3, :3].T @ pose[:3, :3]
-        if near and (_optical_rotation(rot) or upside_down(rot)):
+        if near and (_optical_rotation(rot) or (upside_down(rot) and names_silent(body.name))):
             return True
     return False
 

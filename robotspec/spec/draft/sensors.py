@@ -100,10 +100,13 @@ def is_optical(tree: Tree, body: Body) -> bool:
     # body the robot faces with: on a limb or a torso, "behind" says nothing (Baxter's arm
     # buttons, TIAGo Pro's arm mounts are turned so).
     world = tree.world
-    if upside_down(rot) and not world.child_bodies(body) and not (body.collisions or body.visuals):
+    bare = not world.child_bodies(body) and not (body.collisions or body.visuals)
+    if upside_down(rot) and bare and names_silent(body.name):
         # A bare frame of a camera mounted upside down (optical.upside_down), on the body or
         # on a shaped link; on a bare frame past a moving joint it is a flange's tool frame
-        # (a UR's 'tool0' is turned so from its 'flange').
+        # (a UR's 'tool0' is turned so from its 'flange'). Weaker evidence than a name: only
+        # where the name says nothing (Romeo's 'CameraDepth_frame' is turned so beside the
+        # head's named body-frame cameras, which it must not hide).
         parent = world.bodies[c.parent]
         return tree.rigid_root(body) is tree.root or bool(parent.collisions or parent.visuals)
     behind = np.allclose(rot[:, 0], -_OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -_TILT

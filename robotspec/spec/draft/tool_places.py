@@ -193,14 +193,15 @@ def frame_at_tips(tree: Tree, root: Body, tips: tuple[Body, Body]) -> Body | Non
 
 
 def line_end(tree: Tree, top: Body) -> Body | None:
-    """The leaf farthest out along the arm's last joint axis, fixed past that joint.
+    """The shaped leaf farthest out along the arm's last joint axis, fixed past that joint.
 
     Why: past the last joint a maker often bolts parts (a gripper's base, then its mount
     point) fixed one on the other, the last on the joint's axis, beside sensors hung off it
     (a wrist camera, a range finder): the tool is met at the end on the axis, whatever the
-    parts are named or whether they have a shape. Only when nothing moves below ``top``, of
-    the leaves fixed to the link the last joint moves, within ``OFF_AXIS`` of its axis and at
-    least ``AT_END`` along it; not a Gazebo sensor's link nor a frame named as a sensor.
+    parts are named. Only when nothing moves below ``top``, of the leaves with a shape fixed to
+    the link the last joint moves, within ``OFF_AXIS`` of its axis and at least ``AT_END``
+    along it; not a Gazebo sensor's link nor one named as a sensor. A bare frame there is
+    ``end_frame``'s to judge (short of the tool's far end it is a mount's or a centre's).
     """
     world = tree.world
     moved = tree.rigid_root(top)
@@ -217,7 +218,9 @@ def line_end(tree: Tree, top: Body) -> Body | None:
     sensed = set(getattr(facts, "sensor_links", {}) or {})
     found: list[tuple[float, Body]] = []
     for b in world.subtree(top):
-        if b is top or world.child_bodies(b) or b.name in sensed or words(b.name) & SENSOR_WORDS:
+        if b is top or world.child_bodies(b) or not own_geometry(b):
+            continue  # bare frames: end_frame's (at the far end of the shapes, or none)
+        if b.name in sensed or words(b.name) & SENSOR_WORDS:
             continue
         d = np.asarray(tree.poses[b.index][:3, 3] - pose[:3, 3], dtype=np.float64)
         along = float(d @ axis)

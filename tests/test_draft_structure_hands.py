@@ -320,3 +320,43 @@ def test_a_shapeless_helper_beside_two_shaped_fingers_is_no_finger(tmp_path: Pat
         ]
     draft = _draft(tmp_path, "helper", parts)
     assert _gripper(draft) == ("a", "b")
+
+
+def _linkage(transmission: bool) -> list[str]:
+    """A linkage gripper of four branches (outer and inner knuckles) with no mimic tag at all."""
+    parts = _arm()
+    for side, s in (("a", 1), ("b", -1)):
+        parts += [
+            _link(f"{side}o", 0.02, "collision"),
+            _joint(f"q{side}o", "h", f"{side}o", xyz=f"0.055 {0.031 * s} 0"),
+            _link(f"{side}f", 0.03, "collision"),
+            _joint(f"q{side}f", f"{side}o", f"{side}f", kind="fixed", xyz=f"0 {0.03 * s} 0.01"),
+            _link(f"{side}i", 0.03, "collision"),
+            _joint(f"q{side}i", "h", f"{side}i", xyz=f"0.061 {0.013 * s} 0"),
+            _link(f"{side}t", 0.02, "collision"),
+            _joint(f"q{side}t", f"{side}i", f"{side}t", xyz=f"0.043 {0.038 * s} 0"),
+        ]
+    if transmission:
+        parts.append(
+            '<transmission name="tr"><type>transmission_interface/SimpleTransmission</type>'
+            '<joint name="qao"><hardwareInterface>hardware_interface/PositionJointInterface'
+            '</hardwareInterface></joint><actuator name="m"><mechanicalReduction>1'
+            "</mechanicalReduction></actuator></transmission>"
+        )
+    return parts
+
+
+def test_a_linkage_without_mimic_tags_one_transmission_drives(tmp_path: Path) -> None:
+    """Four finger branches, no mimic tag, one joint in a transmission: one motor, a gripper.
+
+    A Robotiq-style linkage whose file couples its links only in a simulator plugin: the
+    control block says one joint is driven, so the four branches are two sides of one
+    gripper (still a question: no mimic tag states the coupling); without the block they are
+    four separately driven branches, no gripper.
+    """
+    draft = _draft(tmp_path, "linkage", _linkage(transmission=True))
+    assert _gripper(draft) == ("at", "bt")
+    [m] = draft.manipulators
+    assert m.decide  # not stated by a mimic tag: still asked
+    plain = _draft(tmp_path, "plain", _linkage(transmission=False))
+    assert _gripper(plain) is None

@@ -20,12 +20,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robotspec.description.actuation import Actuation
 from robotspec.model.entities import Body
 from robotspec.model.world import World
 from robotspec.spec.draft.confidence import gripper_question
 from robotspec.spec.draft.fingers import find_fingers, finger_tip, hand_branches
 from robotspec.spec.draft.limbs import FINGER_WORDS, HAND_WORDS, is_named
-from robotspec.spec.draft.linkages import turns_freely
+from robotspec.spec.draft.linkages import one_actuator, turns_freely
 from robotspec.spec.draft.model import DraftFinger
 from robotspec.spec.draft.tool_frames import (
     find_tool_frame,
@@ -115,12 +116,16 @@ def _jaws(tree: Tree, hand: Body) -> Gripper | None:
     )
 
 
-def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | None:
+def _sides(
+    tree: Tree, root: Body, branches: list[Body], actuation: Actuation | None = None
+) -> list[list[Body]] | None:
     """Finger branches grouped into two sides of the hand, or ``None`` if they are not two sides.
 
     Two branches are two sides. A linkage gripper (Robotiq's, on Tiago Pro) has two branches a
     side, an inner and an outer link: each branch goes to the side of the farther-apart pair of
-    tips it is nearer to, and a side holds at most two.
+    tips it is nearer to, and a side holds at most two. One actuator moves a linkage: its mimic
+    tags say so, or, in a file without them, its control blocks (one joint driven, the others
+    passive or named by no block: ``actuation``).
     """
     if len(branches) == 2:
         return [[branches[0]], [branches[1]]]
@@ -137,7 +142,7 @@ def _sides(tree: Tree, root: Body, branches: list[Body]) -> list[list[Body]] | N
     by_dof = _sides_by_dof(tree, branches)
     if by_dof is not None:
         return by_dof
-    if len(dofs) != 1:
+    if len(dofs) != 1 and not one_actuator(world, branches, actuation):
         return None  # a linkage moves with one actuator; several make a hand of fingers
     if any("thumb" in b.name.lower() for k in branches for b in world.subtree(k)):
         return None  # a one-motor hand with a thumb and three fingers (Romeo's) is a hand
@@ -190,8 +195,12 @@ def _sides_by_dof(tree: Tree, branches: list[Body]) -> list[list[Body]] | None:
     return list(sides.values())
 
 
-def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | None, str]:
+def find_gripper(
+    tree: Tree, hand: Body, _depth: int = 0, actuation: Actuation | None = None
+) -> tuple[Gripper | None, str]:
     """A parallel gripper at or below ``hand``, or ``None`` and why not.
+
+    ``actuation``: what the URDF's control blocks say (which joints are driven), when known.
 
     Two branches that no joint couples, one of which splits again into two coupled fingers
     (Interbotix's: the gripper motor's horn beside the finger carriage), are not the fingers:
@@ -202,14 +211,14 @@ def find_gripper(tree: Tree, hand: Body, _depth: int = 0) -> tuple[Gripper | Non
     uncoupled = len(branches) == 2 and not _dofs(tree, branches[0]) & _dofs(tree, branches[1])
     if uncoupled and _depth < 2:  # a horn beside a carriage is one level; never a deep search
         for k in branches:
-            deeper, _ = find_gripper(tree, k, _depth + 1)
+            deeper, _ = find_gripper(tree, k, _depth + 1, actuation)
             if deeper is not None and deeper.decide is None:
                 return deeper, "two coupled finger branches"
     if not branches:
         jaws = _jaws(tree, hand)
         if jaws is not None:
             return jaws, "two jaws, one hanging on the other"
-    sides = _sides(tree, body, branches)
+    sides = _sides(tree, body, branches, actuation)
     if sides is None:
         if not branches:
             return None, "no finger branches below it"

@@ -13,10 +13,11 @@ import math
 
 import numpy as np
 
+from robotspec.description.actuation import Actuation
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
 
-__all__ = ["MAX_FINGER_RANGE", "ball_joint", "moving_joints", "turns_freely"]
+__all__ = ["MAX_FINGER_RANGE", "ball_joint", "moving_joints", "one_actuator", "turns_freely"]
 
 #: The widest range (rad or m) of a finger's joint; a screw's or a wheel's is unbounded.
 MAX_FINGER_RANGE = 2 * math.pi
@@ -74,3 +75,17 @@ def _run_at_one_point(world: World, body: Body) -> list[Connection]:
             break  # this joint sits away from its parent's: the run starts here
         c = world.parent_connection(world.bodies[c.parent])
     return run[::-1]
+
+
+def one_actuator(world: World, branches: list[Body], actuation: Actuation | None) -> bool:
+    """Whether the control blocks drive exactly one joint of ``branches``, the rest following.
+
+    Why: a linkage gripper's file may leave out the mimic tags (a simulator couples its links
+    by a plugin) while its transmission or ``ros2_control`` block still names the one joint a
+    motor drives; the others are passive (named so, or named by no block).
+    """
+    if actuation is None or not actuation.stated:
+        return False
+    joints = [c for k in branches for c in moving_joints(world, k)]
+    driven = [c for c in joints if c.name in actuation.joints and c.name not in actuation.passive]
+    return len(driven) == 1

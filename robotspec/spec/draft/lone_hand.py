@@ -59,7 +59,7 @@ def lone_hand(self: Drafter) -> DraftManipulator | None:
         split, wrist = root, []
     if eyes(tree, split):
         return None  # a head's eyes, each carrying a camera: no hand
-    gripper, _ = find_gripper(tree, split)
+    gripper, _ = find_gripper(tree, split, actuation=self.facts.actuation)
     # Wheels (continuous joints about a level axis turning a wheel's shape) are never fingers.
     wheels = {c.child for c in self.wheels}
 

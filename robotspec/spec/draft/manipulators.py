@@ -63,7 +63,11 @@ def manipulator(
         hand = None
     decide: list[str] = []
     rules: list[str] = []  # confidence's rules that state what is drafted without a question
-    gripper, why = find_gripper(tree, hand) if hand is not None else (None, "no hand")
+    gripper, why = (
+        find_gripper(tree, hand, actuation=self.facts.actuation)
+        if hand is not None
+        else (None, "no hand")
+    )
     tool, top, gripper, tip = _tool_and_top(self, chain, limb, tip, hand, gripper, stated, decide)
     tool_name, frame = _tool_name(self, name, tool, top, tip, gripper, hand, stated, decide, rules)
     if any(m.tool_frame == tool_name for m in self.draft.manipulators):

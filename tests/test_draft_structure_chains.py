@@ -172,3 +172,13 @@ def test_a_yaw_joint_below_the_top_of_the_robot_is_no_head(tmp_path: Path) -> No
     # The same joint on the trunk's front, lower than the shoulders: no head.
     d = _draft(tmp_path, "low_yaw", _humanoid_with_head([("0.1 0 0.05", "0 0 1")]))
     assert not [c for c in d.chains if c.joints == frozenset({"hj1"})]
+
+
+def test_a_three_joint_neck_carrying_the_top_between_the_arms_is_a_head(tmp_path: Path) -> None:
+    # A neck's pitch, roll and yaw (23 cm: as long as a short arm) on the trunk beside the arms,
+    # numbers only: it carries the robot's top and pans, so a head, not a third arm.
+    offsets = [("0 0 0.2", "0 1 0"), ("0 0 0.03", "1 0 0"), ("0 0 0.2", "0 0 1")]
+    d = _draft(tmp_path, "neck3", _humanoid_with_head(offsets))
+    assert sorted(c.role for c in d.chains) == ["arm", "arm", "chain", "leg", "leg"]
+    [head] = [c for c in d.chains if c.role == "chain"]
+    assert head.joints == frozenset({"hj1", "hj2", "hj3"})

@@ -13,6 +13,7 @@ from __future__ import annotations
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
 from robotspec.spec.draft.ends import chain_end
+from robotspec.spec.draft.head_runs import eyes, head_on_top, pan_tilt
 from robotspec.spec.draft.jaws import one_jaw
 from robotspec.spec.draft.limb_kinds import (
     ARM_WORDS,
@@ -159,8 +160,10 @@ def _limb(
         return None  # a head whose cameras turn on their own (eyes): not a hand's fingers
     if hand is None and named(bodies, HEAD_WORDS) and not named(bodies, ARM_WORDS):
         return None  # a head (see sensors.find_neck)
-    if hand is None and len(actuated) <= 3 and _pan_tilt(tree, seg):
+    if hand is None and len(actuated) <= 3 and pan_tilt(tree, seg):
         return None  # a pan/tilt unit pointing cameras: a neck (see sensors.find_neck)
+    if hand is None and len(actuated) <= 3 and head_on_top(tree, seg):
+        return None  # a head between limbs, on top of the robot (see parts._add_head)
     joints = frozenset(c.name for c in actuated)
     # Where the limb ends up: the lowest frame it carries (a foot fixed past the knee, a wheel),
     # not the last moving link's origin (a knee, 20 cm above the ground it stands on).
@@ -254,41 +257,6 @@ def _lifts(tree: Tree, actuated: list[Connection]) -> int:
 VERTICAL = 0.9
 
 
-#: Words of a camera's frames (a run carrying one and nothing else is a neck, not an arm).
-LOOK_WORDS = frozenset({"camera", "cam", "optical", "rgb", "rgbd", "depth", "stereo", "kinect"})
-
-
-def eyes(tree: Tree, hand: Body) -> bool:
-    """Whether every moving branch below where ``hand`` splits carries a camera and no finger.
-
-    Why: a head whose eyes turn on their own (iCub's, a humanoid's stereo pair) splits into
-    branches like a hand into fingers; the cameras they carry say they are eyes.
-    """
-    world = tree.world
-    body = hand
-    while len(kids := tree.moving_children(body)) == 1:
-        body = kids[0]
-    if len(kids) < 2:
-        return False
-    for k in kids:
-        inside = world.subtree(k)
-        if not any(words(b.name) & LOOK_WORDS for b in inside):
-            return False
-        if any(is_named(b.name, FINGER_WORDS | HAND_WORDS) for b in inside):
-            return False
-    return True
-
-
-def _pan_tilt(tree: Tree, seg: Segment) -> bool:
-    """Whether a run's joints all turn (no lift) and its end carries a camera frame and no limb."""
-    world = tree.world
-    if any(c.type.value not in ("revolute", "continuous") for c in seg.joints):
-        return False
-    if tree.moving_children(seg.end):
-        return False
-    return any(words(b.name) & LOOK_WORDS for b in world.subtree(seg.end))
-
-
 def find_limbs(tree: Tree, wheels: frozenset[str] = frozenset()) -> list[Limb]:
     """Every arm and leg of the tree, top-down; runs inside a found hand are fingers, not limbs.
 
@@ -357,9 +325,9 @@ def _beside_heads(tree: Tree, above: Segment, seg: Segment) -> bool:
     others = [s for s in tree.segments if s.start is seg.start and s is not seg]
     if not others or len(others) + 1 != len(tree.moving_children(seg.start)):
         return False
-    if _pan_tilt(tree, seg):
+    if pan_tilt(tree, seg):
         return False
-    return all(len(s.actuated) <= 3 and _pan_tilt(tree, s) for s in others)
+    return all(len(s.actuated) <= 3 and pan_tilt(tree, s) for s in others)
 
 
 def beside_branch(world: World, body: Body, tip: Body | str) -> bool:

@@ -182,3 +182,28 @@ def test_a_three_joint_neck_carrying_the_top_between_the_arms_is_a_head(tmp_path
     assert sorted(c.role for c in d.chains) == ["arm", "arm", "chain", "leg", "leg"]
     [head] = [c for c in d.chains if c.role == "chain"]
     assert head.joints == frozenset({"hj1", "hj2", "hj3"})
+
+
+def test_a_yaw_joint_on_a_lower_body_without_arms_is_no_head(tmp_path: Path) -> None:
+    # A lower body whose torso stub turns on the hips' link (example-robot-data's Alexander
+    # lower body): the top of the robot, but no arm hangs beside it: a waist, not a head.
+    parts = [_link("t0", 0.2)]
+    for n, y in ((1, 0.08), (2, -0.08)):
+        parts += _run(f"g{n}", "t0", [f"0 {y} -0.1", "0 0 -0.2", "0 0 -0.2"], ["1 0 0"] * 3)
+    d = _draft(tmp_path, "lower_body", parts + _run("h", "t0", ["0 0 0.2"], ["0 0 1"]))
+    assert not [c for c in d.chains if c.joints == frozenset({"hj1"})]
+
+
+def test_spinners_turning_about_parallel_vertical_axes_on_top_are_no_head(tmp_path: Path) -> None:
+    # Four rotors on a multirotor's body, revolute joints without a real range (example-robot-
+    # data's Iris): each pans on top of the robot, but siblings spinning alike are no head.
+    parts = [_link("t0", 0.2)]
+    for n, (x, y) in enumerate(((0.13, -0.22), (-0.13, 0.2), (0.13, 0.22), (-0.13, -0.2)), 1):
+        parts += [
+            _link(f"p{n}", 0.01),
+            f'<joint name="p{n}j1" type="revolute"><parent link="t0"/><child link="p{n}"/>'
+            f'<origin xyz="{x} {y} 0.023"/><axis xyz="0 0 1"/>'
+            '<limit lower="-1e16" upper="1e16" effort="0" velocity="0"/></joint>',
+        ]
+    d = _draft(tmp_path, "rotors", parts)
+    assert not [c for c in d.chains if c.joints & {"p1j1", "p2j1", "p3j1", "p4j1"}]

@@ -216,7 +216,32 @@ def _pan_tilt(d: Drafter, joints: tuple[Connection, ...] | list[Connection]) -> 
         return False
     if len(joints) > 1 and axes[0][2] > 0.9:
         return True  # pan, then tilt: the shape alone says head
+    if len(joints) == 1 and not _on_a_chest(d, joints[0]):
+        return False
     return _on_top(d, world.bodies[joints[-1].child])
+
+
+def _on_a_chest(d: Drafter, pan: Connection) -> bool:
+    """Whether a lone pan joint can be a head's: alone on a chest the arms hang from.
+
+    A multirotor's rotors are pans on top too (example-robot-data's Iris), but they are
+    siblings turning about parallel vertical axes; a lower body's waist turns its torso stub,
+    the robot's top, where no arm hangs (Alexander's lower body). A head that only pans turns
+    on the link its arms start from (Unitree H2's and EngineAI PM01's torso).
+    """
+    world, tree = d.world, d.tree
+    parent = world.bodies[pan.parent]
+    for k in world.child_bodies(parent):
+        c = world.parent_connection(k)
+        if c is None or c is pan or c.is_fixed:
+            continue
+        if float(np.abs(tree.axis_in_root(c))[2]) > 0.9:
+            return False  # a sibling spinning about the vertical too: rotors
+    return any(
+        lb.kind == "arm"
+        and parent.index in (lb.root.index, world.bodies[lb.segment.joints[0].parent].index)
+        for lb in d.limbs
+    )
 
 
 def _on_top(d: Drafter, body: Body) -> bool:

@@ -217,29 +217,9 @@ def generate_collision_matrix(
     undecided &= ~hits
 
     rng = np.random.default_rng(seed)
-    always_drawn = 0
-    total = samples + ALWAYS_ROUND
-    done = 0
-
-    def tick(n: int) -> None:
-        nonlocal done
-        done += n
-        if progress is not None:
-            progress(done, total)
-
+    ticks = _Progress(progress, samples + ALWAYS_ROUND)
     limit = math.ceil(always_fraction * ALWAYS_ROUND - 1e-9)
-    for _ in range(_MAX_ALWAYS_ROUNDS):
-        qs = random_configurations(world, ALWAYS_ROUND, rng)
-        always_drawn += ALWAYS_ROUND
-        counts = checker.collisions_batch(qs, pair_mask=undecided).sum(axis=0)
-        tick(ALWAYS_ROUND)
-        found = np.flatnonzero(undecided & (counts >= limit))
-        for k in found.tolist():
-            decide(k, ALWAYS, int(counts[k]), ALWAYS_ROUND)
-        undecided[found] = False
-        if not len(found):
-            break
-        total += ALWAYS_ROUND
+    always_drawn = _always_pass(checker, world, rng, undecided, limit, decide, ticks)
 
     # Drawn block by block as the workers ask: memory stays flat whatever ``samples`` is.
     blocks = RandomBlocks(world, samples, rng)
@@ -257,7 +237,7 @@ def generate_collision_matrix(
         processes=procs,
         on_missing_mesh=on_missing_mesh,
         start_method=start_method,
-        progress=tick,
+        progress=ticks.tick,
         on_chunk=seen,
     )
     for k in np.flatnonzero(undecided & ~ever).tolist():
@@ -277,6 +257,50 @@ def generate_collision_matrix(
         skipped=tuple(checker.skipped),
         first_collision=tuple((*pair_key(*pairs[k]), start) for k, start in sorted(first.items())),
     )
+
+
+@dataclass
+class _Progress:
+    """Samples done of the total expected (which grows with each further round of "always")."""
+
+    report: Callable[[int, int], None] | None
+    total: int
+    done: int = 0
+
+    def tick(self, n: int) -> None:
+        self.done += n
+        if self.report is not None:
+            self.report(self.done, self.total)
+
+
+def _always_pass(
+    checker: SelfCollisionChecker,
+    world: World,
+    rng: np.random.Generator,
+    undecided: NDArray[np.bool_],
+    limit: int,
+    decide: Callable[[int, str, int, int], None],
+    ticks: _Progress,
+) -> int:
+    """Rounds of samples deciding the pairs that collide in nearly all of them; samples drawn.
+
+    Rounds are drawn until one finds no new such pair (at most ``_MAX_ALWAYS_ROUNDS``); each
+    adds its samples to the progress total. ``undecided`` loses the pairs decided.
+    """
+    drawn = 0
+    for _ in range(_MAX_ALWAYS_ROUNDS):
+        qs = random_configurations(world, ALWAYS_ROUND, rng)
+        drawn += ALWAYS_ROUND
+        counts = checker.collisions_batch(qs, pair_mask=undecided).sum(axis=0)
+        ticks.tick(ALWAYS_ROUND)
+        found = np.flatnonzero(undecided & (counts >= limit))
+        for k in found.tolist():
+            decide(k, ALWAYS, int(counts[k]), ALWAYS_ROUND)
+        undecided[found] = False
+        if not len(found):
+            break
+        ticks.total += ALWAYS_ROUND
+    return drawn
 
 
 def generate_for_robot(

@@ -8,9 +8,11 @@ made structural. Each test is a small layout of the rule's shape whose links are
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
 from tests.draft_support import draft_layout as _draft
+from tests.draft_support import joint_xml
 
 _MASS = (
     '<inertial><mass value="{m}"/>'
@@ -24,22 +26,7 @@ def _link(name: str, mass: float | None = 0.3, box: bool = False) -> str:
     return f'<link name="{name}">{inner}</link>'
 
 
-def _joint(
-    name: str,
-    parent: str,
-    child: str,
-    kind: str = "revolute",
-    xyz: str = "0 0 0.15",
-    axis: str = "0 1 0",
-    mimic: str | None = None,
-) -> str:
-    limit = '<limit lower="-0.04" upper="0.04" effort="1" velocity="1"/>'
-    moving = "" if kind == "fixed" else f'<axis xyz="{axis}"/>{limit}'
-    tag = "" if mimic is None else f'<mimic joint="{mimic}"/>'
-    return (
-        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
-        f'<origin xyz="{xyz}"/>{moving}{tag}</joint>'
-    )
+_joint = partial(joint_xml, limit=(-0.04, 0.04))
 
 
 def _arm_with_jaws(box_on_base: bool = False) -> list[str]:

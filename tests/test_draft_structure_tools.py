@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from tests.draft_support import draft_layout as _draft
+from tests.draft_support import joint_xml
 
 _BOX = '<collision><geometry><box size="{s}"/></geometry></collision>'
 _MASS = (
@@ -24,22 +25,7 @@ def _link(name: str, size: str | None = "0.04 0.04 0.04") -> str:
     return f'<link name="{name}">{_MASS if size else ""}{shape}</link>'
 
 
-def _joint(
-    name: str,
-    parent: str,
-    child: str,
-    kind: str = "revolute",
-    xyz: str = "0 0 0.15",
-    axis: str = "0 1 0",
-    mimic: str | None = None,
-) -> str:
-    limit = '<limit lower="-0.5" upper="0.5" effort="1" velocity="1"/>'
-    moving = "" if kind == "fixed" else f'<axis xyz="{axis}"/>{limit}'
-    tag = "" if mimic is None else f'<mimic joint="{mimic}"/>'
-    return (
-        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
-        f'<origin xyz="{xyz}"/>{moving}{tag}</joint>'
-    )
+_joint = joint_xml  # limits -0.5..0.5, mimic tags without a multiplier
 
 
 def _arm() -> list[str]:

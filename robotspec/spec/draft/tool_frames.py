@@ -112,10 +112,8 @@ TCP_NAMES: tuple[str, ...] = (
 )
 
 
-def is_bare_frame(world: World, body: Body) -> bool:
-    """Whether ``body`` is a bare frame: a leaf without geometry on a fixed joint."""
-    c = world.parent_connection(body)
-    return c is not None and c.is_fixed and not world.child_bodies(body) and not own_geometry(body)
+#: A bare frame: a leaf without geometry on a fixed joint (one predicate, two names in use).
+is_bare_frame = bare_fixed_leaf
 
 
 def is_named_tcp(world: World, body: Body) -> bool:

@@ -10,10 +10,11 @@ told nothing. After every part is drafted, this module looks at what is left:
   run is "a tool? a passive joint?", a run carrying drafted chains "a torso?";
 * frames that look like cameras and are no drafted camera's device: a Gazebo sensor of an
   image kind the draft did not take, a link named as a camera (with or without a shape: on
-  the tune half and example-robot-data, shaped ones all sit beside a drafted camera), or a bare
-  frame with a generic name turned as optical frames are (x level, y down: a rear camera, a
-  depth camera tilted down; not at a limb's end or on a finger, where tool frames and tips
-  are); one question per device (frames fixed to one link within 10 cm).
+  the tune half and example-robot-data, shaped ones all sit beside a drafted camera) or drawn
+  with a mesh named as one, or a bare frame with a generic name turned as optical frames are
+  (x level, y down: a rear camera, a depth camera tilted down; not at a limb's end or on a
+  finger, where tool frames and tips are); one question per device (frames fixed to one link
+  within 10 cm): ``unassigned_cameras``.
 
 A drafted neck of more than three joints, or torso of more than four, is asked about too (an
 arm carrying a camera taken for a neck leaves no joint uncovered). A wheel-shaped joint counts
@@ -28,17 +29,13 @@ when a question names it (``tools/draft_score.py``); the spec holds only the com
 
 from __future__ import annotations
 
-import re
 from typing import TYPE_CHECKING
 
-import numpy as np
-
-from robotspec.model.entities import Body, Connection, ConnectionType
+from robotspec.model.entities import Connection, ConnectionType
 from robotspec.spec.draft.model import DraftQuestion
 from robotspec.spec.draft.open_ends import open_end_questions
-from robotspec.spec.draft.sensors import CAMERA_WORDS, IMAGE_KINDS, NOT_CAMERA_WORDS
-from robotspec.spec.draft.stated_cameras import DEVICE_SPAN
 from robotspec.spec.draft.tree import words
+from robotspec.spec.draft.unassigned_cameras import SENSORS, camera_questions
 
 if TYPE_CHECKING:
     from robotspec.spec.draft.build import Drafter
@@ -47,12 +44,9 @@ if TYPE_CHECKING:
 __all__ = ["CHAINS", "MANIPULATORS", "SENSORS", "asked", "find_questions"]
 
 #: The spec sections a question is written in (where the part it asks about would go).
-CHAINS, MANIPULATORS, SENSORS = "chains", "manipulators", "sensors"
+CHAINS, MANIPULATORS = "chains", "manipulators"
 #: A run of at least this many joints is a limb's (an arm, a leg, a head); fewer, a tool's.
 _LIMB_JOINTS = 3
-#: An optical frame's x axis is level (|z component| below this), its y points down (below
-#: minus this): a camera's image rows run level and its columns downwards.
-_LEVEL, _DOWN = 0.2, 0.5
 #: The most joints a drafted neck and torso turn on before they are asked about (a head's pan,
 #: tilt and roll; a mobile manipulator's lift and waist, four on Galaxea's R1).
 _LONGEST = {"neck": 3, "torso": 4}
@@ -60,7 +54,6 @@ _LONGEST = {"neck": 3, "torso": 4}
 _SHOWN = 4
 #: Words naming a rotor's joint (a drone's): it moves the robot, it is no part.
 _ROTORS = frozenset({"rotor", "rotors", "propeller", "prop"})
-_TOKENS = re.compile(r"[^a-z0-9]+")
 
 
 def _covered(d: Drafter) -> set[int]:
@@ -246,92 +239,6 @@ def _has_loose_below(world: object, c: Connection, joints: list[Connection]) -> 
     return any(o is not c and world.is_ancestor(child, world.bodies[o.child]) for o in joints)
 
 
-def _rigid_root(d: Drafter, body: Body) -> Body:
-    world = d.world
-    while (c := world.parent_connection(body)) is not None and c.is_fixed:
-        body = world.bodies[c.parent]
-    return body
-
-
-def _near(d: Drafter, a: Body, b: Body) -> bool:
-    """Whether ``a`` and ``b`` are fixed to one link within 10 cm (one device's frames)."""
-    if _rigid_root(d, a) is not _rigid_root(d, b):
-        return False
-    gap = float(np.linalg.norm(d.tree.position(a) - d.tree.position(b)))
-    return gap <= DEVICE_SPAN
-
-
-def _limb_ends(d: Drafter) -> set[int]:
-    """The links (rigid roots) at the drafted limbs' ends and below the hands' moving joints."""
-    world, draft = d.world, d.draft
-    names = {c.tip for c in draft.chains} | {m.tool_frame for m in draft.manipulators}
-    names |= {f.parent for f in draft.frames}
-    out = {_rigid_root(d, world.get_body_by_name(n)).index for n in names if world.has_body(n)}
-    for m in draft.manipulators:
-        for j in m.joints:
-            if world.has_connection(j):
-                child = world.bodies[world.get_connection_by_name(j).child]
-                out |= {b.index for b in world.subtree(child)}
-    return out
-
-
-def _turned_optical(d: Drafter, b: Body, taken: set[int]) -> bool:
-    """A bare frame (a leaf without shape on a fixed joint) turned as optical frames are.
-
-    Why: a camera whose frame has a generic name and no Gazebo sensor (a rear camera turned
-    180 degrees, a depth camera tilted down) is known only by its axes in the default pose:
-    x level, y pointing down, z ahead (REP 103). A frame named after nothing but turned so is
-    asked about, never drafted: a tool frame or a marker may be turned so too.
-    """
-    world = d.world
-    c = world.parent_connection(b)
-    if c is None or not c.is_fixed or world.child_bodies(b) or b.visuals or b.collisions:
-        return False
-    if _rigid_root(d, b).index in taken:
-        return False  # on a limb's end or a finger: a tool frame, a finger's tip
-    rot = d.tree.poses[b.index][:3, :3]
-    return abs(float(rot[2, 0])) < _LEVEL and float(rot[2, 1]) < -_DOWN
-
-
-def _camera_questions(d: Drafter) -> list[DraftQuestion]:
-    """One question per camera-like device no drafted camera is on."""
-    world, tree, draft = d.world, d.tree, d.draft
-    drafted = [world.get_body_by_name(c.body) for c in draft.cameras if world.has_body(c.body)]
-    taken = _limb_ends(d)
-    why: dict[int, str] = {}
-    for link, kind in d.facts.sensor_links.items():
-        if world.has_body(link) and any(k in kind for k in IMAGE_KINDS):
-            why[world.get_body_by_name(link).index] = f"a Gazebo '{kind}' sensor"
-    for b in world.bodies:
-        if b.index in why or b is tree.root:
-            continue
-        w = words(b.name) | set(_TOKENS.split(b.name.lower()))
-        if w & NOT_CAMERA_WORDS:
-            continue
-        if w & CAMERA_WORDS:
-            why[b.index] = "a frame named as a camera"
-        elif _turned_optical(d, b, taken):
-            why[b.index] = "a bare frame turned as a camera's optical frame (z ahead, y down)"
-    devices: list[list[Body]] = []
-    for i in sorted(why):
-        b = world.bodies[i]
-        if i not in tree.inside or any(b is k or _near(d, b, k) for k in drafted):
-            continue
-        for dev in devices:
-            if _near(d, b, dev[0]):
-                dev.append(b)
-                break
-        else:
-            devices.append([b])
-    out = []
-    for dev in devices:
-        names = [b.name for b in dev]
-        shown = ", ".join(names[:_SHOWN]) + (" ..." if len(names) > _SHOWN else "")
-        text = f"{shown} ({why[dev[0].index]}) is no drafted camera: a camera? which frame?"
-        out.append(DraftQuestion(SENSORS, text, frozenset(), frozenset(names)))
-    return out
-
-
 def _long_part_questions(d: Drafter) -> list[DraftQuestion]:
     """A drafted neck or torso of more joints than a head or a waist turns on: what is it?
 
@@ -355,7 +262,7 @@ def _long_part_questions(d: Drafter) -> list[DraftQuestion]:
 def find_questions(d: Drafter) -> list[DraftQuestion]:
     """Questions about what no drafted part covers (see the module docstring)."""
     return (
-        _joint_questions(d) + _long_part_questions(d) + open_end_questions(d) + _camera_questions(d)
+        _joint_questions(d) + _long_part_questions(d) + open_end_questions(d) + camera_questions(d)
     )
 
 

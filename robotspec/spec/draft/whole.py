@@ -21,16 +21,20 @@ camera        it is one eye of a stereo pair (two identical imagers on one mount
               frame alone is named as the colour channel; the frame is neither where the
               sensor sees from, nor its link, nor a frame its plugin names
 tool frame    the hand (or the chain's end) holds another frame named as a TCP; a gripper's
-              TCP lies behind the hand's root, away from its finger tips; without a hand, a
-              shape hangs past the arm's last joint (a tool bolted on)
+              or hand's TCP moves with a finger, lies behind the hand's root or less than
+              halfway out to between its tips' far ends (the hand's mount: a flange, an
+              SRDF's parent link at the wrist); without a hand, a shape hangs past the arm's
+              last joint (a tool bolted on)
 gripper       the two tips end differently (one on its jaw, one on a pad fixed past its jaw)
-chain         the SRDF group's joints include a prismatic one (a lift: torso or arm?)
+chain         the SRDF group's joints include a prismatic one (a lift: torso or arm?); the
+              group is named as a leg and the tree finds an arm (or the other way round)
 drive         a fixed virtual joint on a robot with wheels (turning, wheel-shaped or on
               fixed joints), casters, a drive plugin, or more than two limbs (legs drafted
               as arms); a floating one on a robot with wheels; drive plugins that disagree,
               one moving the base in the plane (``planar_move``), naming no wheels, leaving
               driven wheels out, or on a robot with legs
-facing        (+x by default, no names said) the robot's two arms or legs lie apart along x
+facing        (+x by default, no names said) the robot's two arms or legs lie apart along x,
+              or a differential base's wheels all turn about x
 ============  ==========================================================================
 
 The camera row's checks read the device around the sensor: ``whole_cameras``.
@@ -40,6 +44,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
+
+from robotspec.model.entities import Body
+from robotspec.model.geometry import Cylinder
 from robotspec.spec.draft.base import fixed_wheels
 from robotspec.spec.draft.confidence import (
     CHAIN_SRDF,
@@ -52,6 +60,8 @@ from robotspec.spec.draft.confidence import (
     TOOL_SRDF,
 )
 from robotspec.spec.draft.model import DraftChain, DraftManipulator
+from robotspec.spec.draft.naming import role_by_name
+from robotspec.spec.draft.tips import between_tips
 from robotspec.spec.draft.tool_frames import is_named_tcp, own_geometry
 from robotspec.spec.draft.tree import words
 from robotspec.spec.draft.whole_cameras import SPOT, camera_marks
@@ -64,12 +74,17 @@ __all__ = ["keep_marks"]
 #: How near (m) two places must be to count as one (a facing's least gap is twice this).
 _SPOT = SPOT
 _TOOLS = (TOOL_SRDF, TOOL_ON_HAND, TOOL_AT_END)
+#: How far out (share of the way from the hand's root to between its tips' far ends) a TCP
+#: lies at least: nearer the root it is the hand's mount.
+_OUT = 0.5
+#: The least |x| of a unit wheel axis turning about x (within 25 degrees).
+_LEVEL_AXIS = 0.9
 
 
 # -------------------------------------------------------------------------- manipulators
 def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str | None:
     """Why a manipulator's stated tool frame or fingers are not the files' whole answer."""
-    world, tree = d.world, d.tree
+    world = d.world
     if not world.has_body(m.root) or not world.has_body(m.tool_frame):
         return None
     root, tool = world.get_body_by_name(m.root), world.get_body_by_name(m.tool_frame)
@@ -84,12 +99,8 @@ def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str |
             shaped = [b.name for b in world.subtree(last) if b is not last and own_geometry(b)]
             if shaped:
                 return f"'{shaped[0]}' hangs past the arm's last joint: a tool, whose TCP?"
-        if m.is_gripper and m.thumb is not None and m.finger is not None:
-            tips = [world.get_body_by_name(f.tip) for f in (m.thumb, m.finger)]
-            base = tree.poses[root.index][:3, 3]
-            reach = sum(tree.poses[t.index][:3, 3] for t in tips) / 2 - base
-            if float((tree.poses[tool.index][:3, 3] - base) @ reach) < 0:
-                return f"the tool frame '{tool.name}' lies behind the hand, away from its tips"
+        if (why := _short_of_tips(d, m, root, tool)) is not None:
+            return why
     if GRIPPER_MIMIC in rules and m.thumb is not None and m.finger is not None:
         # The mimic tag couples the fingers; where their tips are it does not say. Two alike
         # fingers end alike: one ending on its jaw and the other on a pad fixed past its jaw
@@ -104,6 +115,38 @@ def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str |
     return None
 
 
+def _short_of_tips(d: Drafter, m: DraftManipulator, root: Body, tool: Body) -> str | None:
+    """Why a TCP a name or the SRDF states is not where a hand's tool is: between its tips.
+
+    Why: a name or an SRDF end effector's parent link states a frame, not that it is the point
+    the fingers close on. A frame on one finger (below a joint of the hand) moves with that
+    finger; a frame at the hand's mount (a flange, ROS-Industrial's ``tool0`` beside the
+    gripper it carries, an SRDF's parent link at the wrist) is short of the tips: a spec's
+    tool frame is out between the tips' far ends (``docs/getting-started.md``).
+    """
+    world, tree = d.world, d.tree
+    fingers = [f for f in (m.thumb, m.finger, *m.fingers.values()) if f is not None]
+    tips = [world.get_body_by_name(f.tip) for f in fingers if world.has_body(f.tip)]
+    if len(tips) < 2 or not world.is_ancestor(root, tool):
+        return None
+    b = tool
+    while b is not root and (up := world.parent_connection(b)) is not None:
+        if not up.is_fixed:
+            return f"the tool frame '{tool.name}' moves with '{up.name}': on a finger?"
+        b = world.bodies[up.parent]
+    centre = np.asarray(between_tips(tree, root, tips), dtype=np.float64)
+    span = float(centre @ centre)
+    if span < _SPOT**2:
+        return None  # tips hinged at the root itself: no way out is known
+    at = (np.linalg.inv(tree.poses[root.index]) @ tree.poses[tool.index])[:3, 3]
+    share = float(at @ centre) / span
+    if share < 0:
+        return f"the tool frame '{tool.name}' lies behind the hand, away from its tips"
+    if share < _OUT:
+        return f"the tool frame '{tool.name}' lies at the hand's mount, short of its tips"
+    return None
+
+
 def _chain_doubt(d: Drafter, c: DraftChain) -> str | None:
     world = d.world
     lifts = [
@@ -113,6 +156,12 @@ def _chain_doubt(d: Drafter, c: DraftChain) -> str | None:
     ]
     if lifts:
         return f"the SRDF group moves '{lifts[0]}', a prismatic joint: a torso's lift or the arm's?"
+    # The tree's kind against the group's own word for it: two sources that disagree (a
+    # planner's 'left_leg' the tree takes for an arm) state neither.
+    named = role_by_name(c.srdf_group or "")
+    if named in ("arm", "leg") and named != c.role:
+        found = f"{'an' if c.role[:1] in ('a', 'e', 'i', 'o', 'u') else 'a'} {c.role}"
+        return f"the SRDF group '{c.srdf_group}' is named as a {named}; the tree finds {found}"
     return None
 
 
@@ -163,6 +212,8 @@ def _facing_doubt(d: Drafter) -> str | None:
     A pair of arms (or legs) lies across the way the robot faces. When a pair's first links
     lie apart along x, the robot faces +y or -y, and +x (REP 103's default, kept when no side
     names say otherwise) is a guess the files contradict: which side is left only names say.
+    So does a differential base whose wheels all turn about x (it rolls along y), each about
+    its own cylinder's axis.
     """
     world, tree, draft = d.world, d.tree, d.draft
     for role in ("arm", "leg"):
@@ -181,7 +232,23 @@ def _facing_doubt(d: Drafter) -> str | None:
         gap = spots[0] - spots[1]
         if abs(float(gap[0])) > max(2 * abs(float(gap[1])), _SPOT * 2):
             return f"its two {role}s lie apart along x: it faces +y or -y, not +x?"
+    # A differential base rolls across its wheels' axle: an axle along x drives along y. Only
+    # where each wheel's cylinder lies about its joint's axis (an axis a file leaves out is x).
+    if draft.drive is not None and draft.drive.type == "differential" and d.wheels:
+        rolling = all(_rolls_about_axis(world.bodies[c.child], c.axis) for c in d.wheels)
+        axes = [tree.axis_in_root(c) for c in d.wheels]
+        if rolling and all(abs(float(a[0])) > _LEVEL_AXIS for a in axes):
+            return "its wheels turn about x: it drives along y, not x?"
     return None
+
+
+def _rolls_about_axis(body: Body, axis: tuple[float, float, float]) -> bool:
+    """Whether a wheel's own cylinder lies about its joint's ``axis`` (its body's frame)."""
+    for shape in (*body.collisions, *body.visuals):
+        if isinstance(shape.geometry, Cylinder):
+            along = np.asarray(shape.origin)[:3, 2]
+            return abs(float(along @ np.asarray(axis, dtype=np.float64))) > _LEVEL_AXIS
+    return False
 
 
 def keep_marks(d: Drafter) -> None:

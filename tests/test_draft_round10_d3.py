@@ -1,0 +1,137 @@
+"""Marks and questions where the files state only part of an item (issue 30, round 10).
+
+Small layouts built here, one shape each (no robot's files, no robot's name): a TCP a name
+states but at the hand's mount, a link drawn with a camera's mesh, a compound camera name, an
+SRDF group whose name and the tree disagree on the limb's kind, a differential base rolling
+along y.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robotspec.spec.draft.confidence import CHAIN_SRDF, GRIPPER_MIMIC, TOOL_ON_HAND
+from robotspec.spec.draft.unassigned import SENSORS
+from tests.test_draft_blind import _WHEEL, _draft, _draft_srdf, _joint, _link
+from tests.test_draft_marks_whole import _gripper
+
+
+def _tcp_at(xyz: str) -> list[str]:
+    """The 6-joint arm and mimic-coupled gripper of ``_gripper``, its TCP frame at ``xyz``."""
+    return [
+        p.replace('<origin xyz="0 0 0.1" rpy="0 0 0"/>', f'<origin xyz="{xyz}" rpy="0 0 0"/>')
+        for p in _gripper(pad=False)
+    ]
+
+
+def test_a_tcp_out_between_the_tips_is_stated(tmp_path: Path) -> None:
+    (m,) = _draft(tmp_path, "arm", _tcp_at("0 0 0.1")).manipulators
+    assert (m.tool_frame, m.decide, m.stated) == ("tool0", [], (TOOL_ON_HAND, GRIPPER_MIMIC))
+
+
+def test_a_tcp_at_the_hands_mount_keeps_the_mark(tmp_path: Path) -> None:
+    # Named as a TCP and on the hand, but where the gripper is bolted on, not out between the
+    # jaws' far ends (a flange frame): the name states a frame, not the point the jaws close on.
+    (m,) = _draft(tmp_path, "arm", _tcp_at("0 0 0.005")).manipulators
+    assert m.tool_frame == "tool0" and m.stated == ()
+    assert m.decide == ["the tool frame 'tool0' lies at the hand's mount, short of its tips"]
+
+
+def _camera_mount(name: str, mesh: str | None) -> list[str]:
+    """A 4-joint arm on a base carrying a shaped, fixed link ``name`` (drawn with ``mesh``)."""
+    geometry = (
+        None if mesh is None else f'<visual><geometry><mesh filename="{mesh}"/></geometry></visual>'
+    )
+    parts = [_link("base", size=0.1)]
+    above = "base"
+    for i in range(1, 5):
+        parts += [_link(f"link{i}", size=0.04), _joint(f"j{i}", above, f"link{i}", xyz="0 0 0.2")]
+        above = f"link{i}"
+    parts += [_link(name, geometry), _joint(f"{name}_mount", "base", name, "fixed", "0.1 0 0.3")]
+    return parts
+
+
+def _sensor_questions(tmp_path: Path, parts: list[str]) -> list[str]:
+    d = _draft(tmp_path, "arm", parts)
+    assert not d.cameras
+    return [q.text for q in d.questions if q.section == SENSORS]
+
+
+def test_a_link_drawn_with_a_cameras_mesh_is_asked_about(tmp_path: Path) -> None:
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "d405.stl").write_text("solid d405\nendsolid d405\n")
+    parts = _camera_mount("sensor_mount", "meshes/d405.stl")
+    assert _sensor_questions(tmp_path, parts) == [
+        "sensor_mount (a link whose mesh 'd405.stl' is named as a camera) is no drafted "
+        "camera: a camera? which frame?"
+    ]
+
+
+def test_a_plain_mesh_asks_nothing(tmp_path: Path) -> None:
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "bracket.stl").write_text("solid b\nendsolid b\n")
+    assert _sensor_questions(tmp_path, _camera_mount("sensor_mount", "meshes/bracket.stl")) == []
+
+
+def test_a_compound_camera_name_is_asked_about(tmp_path: Path) -> None:
+    # 'handeye' glues two words; the name still closes on a camera's word.
+    texts = _sensor_questions(tmp_path, _camera_mount("handeye", None))
+    assert texts == [
+        "handeye (a frame named as a camera) is no drafted camera: a camera? which frame?"
+    ]
+
+
+def _limb_srdf(group: str) -> str:
+    """A group of the arm's chain and an end effector (a tool plate) hanging on it."""
+    return (
+        f'<group name="{group}"><chain base_link="base" tip_link="link4"/></group>'
+        '<group name="tool"><link name="plate"/></group>'
+        f'<end_effector name="tip" parent_link="link4" group="tool" parent_group="{group}"/>'
+    )
+
+
+def _plated() -> list[str]:
+    return [
+        *_camera_mount("mount", None),
+        _link("plate"),
+        _joint("plate_j", "link4", "plate", "fixed"),
+    ]
+
+
+def test_an_srdf_group_the_tree_confirms_is_stated(tmp_path: Path) -> None:
+    (c,) = _draft_srdf(tmp_path, "arm", _plated(), _limb_srdf("arm")).chains
+    assert (c.role, c.stated, c.decide) == ("arm", CHAIN_SRDF, [])
+
+
+def test_an_srdf_group_named_as_a_leg_the_tree_finds_an_arm_keeps_the_mark(
+    tmp_path: Path,
+) -> None:
+    (c,) = _draft_srdf(tmp_path, "arm", _plated(), _limb_srdf("front_leg")).chains
+    assert c.role == "arm" and c.stated is None
+    assert c.decide == ["the SRDF group 'front_leg' is named as a leg; the tree finds an arm"]
+
+
+def _cart(axis: str) -> list[str]:
+    """A chassis on two continuous wheels turning about ``axis``, 0.3 m apart across it."""
+    sign = {"0 1 0": ("0 {} 0", "0 {} 0"), "1 0 0": ("{} 0 0", "{} 0 0")}[axis]
+    wheel = _WHEEL if axis == "0 1 0" else _WHEEL.replace('rpy="1.5708 0 0"', 'rpy="0 1.5708 0"')
+    return [
+        _link("chassis", size=0.3),
+        _link("wheel_a", wheel),
+        _joint("wheel_a_joint", "chassis", "wheel_a", "continuous", sign[0].format(0.15), axis),
+        _link("wheel_b", wheel),
+        _joint("wheel_b_joint", "chassis", "wheel_b", "continuous", sign[1].format(-0.15), axis),
+    ]
+
+
+def test_a_differential_base_rolling_along_x_faces_x_unasked(tmp_path: Path) -> None:
+    d = _draft(tmp_path, "cart", _cart("0 1 0"))
+    assert d.drive is not None and d.drive.type == "differential"
+    assert d.forward_decide is None
+
+
+def test_a_differential_base_whose_wheels_turn_about_x_asks_its_facing(tmp_path: Path) -> None:
+    d = _draft(tmp_path, "cart", _cart("1 0 0"))
+    assert d.drive is not None and d.drive.type == "differential"
+    assert d.forward == (1.0, 0.0, 0.0)
+    assert d.forward_decide == "its wheels turn about x: it drives along y, not x?"

@@ -28,7 +28,13 @@ from robotspec.spec.draft.limbs import Limb
 from robotspec.spec.draft.model import DraftChain, DraftFrame, DraftManipulator
 from robotspec.spec.draft.naming import unique
 from robotspec.spec.draft.srdf_groups import rigidly_beside
-from robotspec.spec.draft.tips import FLANGE, between_tips, flange_offset, rigid_end
+from robotspec.spec.draft.tips import (
+    FLANGE,
+    between_tips,
+    flange_offset,
+    origin_is_flange,
+    rigid_end,
+)
 from robotspec.spec.draft.tool_frames import (
     bare_run_end,
     fixed_jaw,
@@ -201,6 +207,9 @@ def _tool_name(
         # the URDF gives the hand, whatever its name.
         tool_name = marks[0].name
         decide.append(f"the tool frame '{tool_name}': the one frame fixed on the hand")
+    elif hand is None and not tree.moves_below(top) and origin_is_flange(tree, top):
+        tool_name = top.name  # a frame a few millimetres out would be its origin again
+        decide.append(f"the tool frame '{tool_name}': the last link's origin is on its end face")
     elif not tree.moves_below(top) and (flange := flange_offset(tree, top)) is not None:
         flange_name = "flange" if name == "tool" else f"{name}_flange"
         tool_name = unique(flange_name, self.names | set(world.body_names))

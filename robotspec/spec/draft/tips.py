@@ -28,6 +28,7 @@ __all__ = [
     "between_tips",
     "far_end",
     "flange_offset",
+    "origin_is_flange",
     "rigid_end",
     "mesh_vertices",
     "shape_points",
@@ -141,34 +142,64 @@ def far_end(tree: Tree, body: Body, direction: F64) -> F64:
     return origin + max(reach, 0.0) * d
 
 
+def _farthest_way(points: F64, axis: F64, out: F64) -> tuple[F64, float] | None:
+    """The way ``points`` reach farthest: a joint's axis (either sense) or its offset's way.
+
+    Returns that way and how far they reach along it (``None``: no axis or no points).
+
+    Why these ways: a last link reaches along its joint's axis (a wrist roll, Panda's and iiwa's
+    last link) or the way its offset points (an elbow turning a rigid forearm and hand, Booster
+    T1's); both in the link's frame.
+    """
+    n = float(np.linalg.norm(axis))
+    if n < 1e-9 or not len(points):
+        return None
+    ways = [axis / n, -axis / n]
+    if float(np.linalg.norm(out)) >= MIN_REACH:
+        ways.append(out / np.linalg.norm(out))
+    way = max(ways, key=lambda w: float(np.max(points @ w)))
+    return way, float(np.max(points @ way))
+
+
+def _last_reach(tree: Tree, tip: Body) -> tuple[F64, float] | None:
+    """The way and reach of a last link on a moving joint (``None``: fixed, or no shape)."""
+    c = tree.world.parent_connection(tip)
+    if c is None or c.is_fixed:
+        return None
+    out = c.origin[:3, :3].T @ c.origin[:3, 3]  # the last offset, in the tip's frame
+    return _farthest_way(_body_points(tree, tip), np.asarray(c.axis, dtype=np.float64), out)
+
+
 def flange_offset(tree: Tree, tip: Body) -> tuple[float, float, float] | None:
     """Where a bare arm's flange is on its last link: the far end of it, the way the arm reaches.
 
     Why: an arm with nothing mounted and no flange link (a bare KUKA iiwa, a humanoid's rigid
     hand link) still needs a tool frame, and the one a user would bolt a tool to is the end
     face of the last link: along the last joint's axis or the way its offset points, whichever
-    the link's geometry reaches farther along. ``None`` when it has no geometry out there.
+    the link's geometry reaches farther along. ``None`` when it has no geometry out there, or
+    when the link's origin is on that face already (:func:`origin_is_flange`).
     """
-    c = tree.world.parent_connection(tip)
-    if c is None or c.is_fixed:
+    found = _last_reach(tree, tip)
+    if found is None or found[1] < AT_FACE:
         return None
-    axis = np.asarray(c.axis, dtype=np.float64)
-    points = _body_points(tree, tip)
-    if not len(points) or float(np.linalg.norm(axis)) < 1e-9:
-        return None
-    axis = axis / np.linalg.norm(axis)
-    out = c.origin[:3, :3].T @ c.origin[:3, 3]  # the last offset, in the tip's frame
-    ways = [axis, -axis]
-    if float(np.linalg.norm(out)) >= MIN_REACH:
-        ways.append(out / np.linalg.norm(out))
-    # The way the link reaches farthest: its axis (a wrist roll, Panda's and iiwa's last
-    # link) or its offset (an elbow turning a rigid forearm and hand, Booster T1's).
-    way = max(ways, key=lambda w: float(np.max(points @ w)))
-    reach = float(np.max(points @ way))
-    if reach < MIN_REACH:
-        return None
+    way, reach = found
     x, y, z = (round(float(v), 4) for v in reach * way)
     return (x + 0.0, y + 0.0, z + 0.0)
+
+
+#: How near (m) a bare arm's last link's origin must be to its far end to be its flange.
+AT_FACE = 0.01
+
+
+def origin_is_flange(tree: Tree, tip: Body) -> bool:
+    """Whether a bare arm's last link's origin already lies on its end face (within AT_FACE).
+
+    Why: a frame proposed a few millimetres from a link's own origin is that origin written
+    again; the link itself is the flange a user bolts a tool to (a small arm whose last link is
+    a thin disc with its frame on the face). Only for a last link on a moving joint with a shape.
+    """
+    found = _last_reach(tree, tip)
+    return found is not None and found[1] < AT_FACE
 
 
 def between_tips(tree: Tree, root: Body, tips: Sequence[Body]) -> tuple[float, float, float]:
@@ -199,10 +230,11 @@ RIGID_MAX = 0.5
 def rigid_end(tree: Tree, link: Body) -> tuple[float, float, float] | None:
     """Where a rigid link past an arm's last joint ends: its shape's far end the way it hangs.
 
-    ``None`` when it is not one: a bare frame or a flange plate (on a fixed joint less than
-    RIGID_OUT out), or named as an end (a flange, a tool). A shape reaching farther than
-    RIGID_MAX, or not out at all, gives the link's origin (its mesh is not to scale or placed
-    elsewhere), still a frame on the link that a person moves.
+    ``None`` when it is not one: a bare frame, a flange plate (on a fixed joint less than
+    RIGID_OUT out, its shape reaching less than RIGID_OUT past it), or named as an end (a
+    flange, a tool). Hung out RIGID_OUT or more, a shape reaching farther than RIGID_MAX, or not
+    out at all, gives the link's origin (its mesh is not to scale or placed elsewhere), still a
+    frame on the link that a person moves.
     """
     c = tree.world.parent_connection(link)
     if c is None or not c.is_fixed or not (link.collisions or link.visuals):
@@ -211,12 +243,40 @@ def rigid_end(tree: Tree, link: Body) -> tuple[float, float, float] | None:
         return None
     out = c.origin[:3, :3].T @ c.origin[:3, 3]  # the offset, in the link's frame
     n = float(np.linalg.norm(out))
-    if n < RIGID_OUT:
-        return None
-    way = out / n
     points = _body_points(tree, link)
+    if n < RIGID_OUT:
+        # Fixed at the joint itself: a flange plate, or a rigid hand whose shape reaches out
+        # from the joint (a humanoid's hand link bolted on its forearm's roll): the shape says.
+        return _reach_past_joint(tree, link, c.origin, points)
+    way = out / n
     reach = float(np.max(points @ way)) if len(points) else 0.0
     if not MIN_REACH <= reach <= RIGID_MAX:
         return (0.0, 0.0, 0.0)
+    x, y, z = (round(float(v), 4) for v in reach * way)
+    return (x + 0.0, y + 0.0, z + 0.0)
+
+
+def _reach_past_joint(
+    tree: Tree, link: Body, fixed: F64, points: F64
+) -> tuple[float, float, float] | None:
+    """Where a shaped link fixed (nearly) at the last joint ends, when it reaches far past it.
+
+    Why: a flange plate is a few millimetres thick; a rigid hand or forearm end bolted at the
+    joint reaches several centimetres out, and a tool held there is met at its far end, not at
+    the joint. The way is the last joint's axis or the way its offset points (as for a bare
+    arm's flange, :func:`flange_offset`), in the link's frame; ``None`` when the shape reaches
+    less than RIGID_OUT that way (a plate: the link is the flange) or more than RIGID_MAX.
+    """
+    world = tree.world
+    c = world.parent_connection(link)
+    up = None if c is None else world.parent_connection(world.bodies[c.parent])
+    if up is None or up.is_fixed:
+        return None
+    turn = fixed[:3, :3].T  # the joint's child frame, in the link's axes
+    out = turn @ (up.origin[:3, :3].T @ up.origin[:3, 3])
+    found = _farthest_way(points, turn @ np.asarray(up.axis, dtype=np.float64), out)
+    if found is None or not RIGID_OUT <= found[1] <= RIGID_MAX:
+        return None
+    way, reach = found
     x, y, z = (round(float(v), 4) for v in reach * way)
     return (x + 0.0, y + 0.0, z + 0.0)

@@ -261,6 +261,17 @@ def hand_center(tree: Tree, top: Body) -> tuple[float, float, float] | None:
             and (c := world.parent_connection(world.bodies[up.parent])) is not None
             and not c.is_fixed
         ]
+    if not tips and not any(own_geometry(b) for b in world.subtree(top)):
+        # A hand without any shape (its meshes missing, or a kinematics-only file): its
+        # fingers' last links, past a moving joint, are the tips; the frame lies between their
+        # origins, a guess short of the pads that the draft asks about like any other.
+        tips = [
+            b
+            for b in world.subtree(top)
+            if b is not top
+            and not world.child_bodies(b)
+            and any(not c.is_fixed for c in world.compute_chain_of_connections(top.name, b.name))
+        ]
     if not tips:
         return None
     return between_tips(tree, top, tips)  # at the far ends of the tips' geometry

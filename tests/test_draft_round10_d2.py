@@ -1,0 +1,164 @@
+"""Tool frames and cameras read from the files' shapes (issue 30, round 10, tools and cameras).
+
+Why: each rule here was found on robots the drafter was not tuned for and is stated for any
+maker's files: where a bare arm's last link already has its frame on its end face, where a rigid
+hand bolted at the last joint ends, where a hand without shapes is grasped, which frame of a
+stereo device is its camera. Each test is a small layout of the rule's shape.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+from pathlib import Path
+
+from tests.draft_support import draft_layout as _draft
+from tests.draft_support import joint_xml
+
+_MASS = (
+    '<inertial><mass value="0.3"/>'
+    '<inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial>'
+)
+_joint = partial(joint_xml, limit=(-1.0, 1.0))
+
+
+def _link(name: str, box: str | None = "0.05 0.05 0.05", at: str = "0 0 0") -> str:
+    """A link with a mass, and a box of ``box`` (x y z, m) centred at ``at`` (None: no shape)."""
+    shape = (
+        ""
+        if box is None
+        else f'<collision><origin xyz="{at}"/><geometry><box size="{box}"/></geometry></collision>'
+    )
+    return f'<link name="{name}">{_MASS}{shape}</link>'
+
+
+def _arm(joints: int = 6) -> list[str]:
+    """A fixed base and ``joints`` revolute joints in series, links 'base', 'link1'... ."""
+    parts = [_link("base", "0.2 0.2 0.1")]
+    for i in range(1, joints + 1):
+        axis = "0 0 1" if i % 2 else "0 1 0"
+        parent = "base" if i == 1 else f"link{i - 1}"
+        parts += [_link(f"link{i}"), _joint(f"joint{i}", parent, f"link{i}", axis=axis)]
+    return parts
+
+
+def test_a_last_link_whose_origin_is_on_its_end_face_is_the_flange(tmp_path: Path) -> None:
+    """A thin last link (a disc 8 mm thick ending 4 mm out): no new frame 4 mm from its origin."""
+    parts = _arm(5) + [
+        _link("link6", "0.06 0.06 0.008", at="0 0 0"),
+        _joint("joint6", "link5", "link6", axis="0 0 1"),
+    ]
+    draft = _draft(tmp_path, "thin", parts)
+    [m] = draft.manipulators
+    assert m.tool_frame == "link6"
+    assert not draft.frames
+    assert any("end face" in q for q in m.decide)  # still asked: no tool is named there
+
+
+def test_a_last_link_reaching_out_still_gets_a_flange_frame(tmp_path: Path) -> None:
+    """The same arm whose last link reaches 6 cm along its axis: a frame at the far end."""
+    parts = _arm(5) + [
+        _link("link6", "0.06 0.06 0.06", at="0 0 0.03"),
+        _joint("joint6", "link5", "link6", axis="0 0 1"),
+    ]
+    draft = _draft(tmp_path, "long", parts)
+    [m] = draft.manipulators
+    [frame] = draft.frames
+    assert m.tool_frame == frame.name and frame.parent == "link6"
+    assert frame.xyz == (0.0, 0.0, 0.06)
+
+
+def _rigid_hand(box: str, at: str) -> list[str]:
+    """Five joints, then a shaped 'hand' fixed at the last joint's own origin (no offset)."""
+    return _arm(5) + [
+        _link("hand", box, at=at),
+        _joint("hand_mount", "link5", "hand", kind="fixed", xyz="0 0 0"),
+    ]
+
+
+def test_a_rigid_hand_bolted_at_the_last_joint_is_grasped_at_its_far_end(
+    tmp_path: Path,
+) -> None:
+    """A hand link fixed at the joint, reaching 13 cm along the last axis: the frame is there."""
+    draft = _draft(tmp_path, "rigid_hand", _rigid_hand("0.04 0.04 0.13", "0 0 0.065"))
+    [m] = draft.manipulators
+    [frame] = draft.frames
+    assert m.tool_frame == frame.name and frame.parent == "hand"
+    assert frame.xyz == (0.0, 0.0, 0.13)
+
+
+def test_a_flange_plate_at_the_last_joint_stays_the_tool_frame(tmp_path: Path) -> None:
+    """The same link as a plate 1 cm thick: it is the flange itself, no frame proposed."""
+    draft = _draft(tmp_path, "plate", _rigid_hand("0.06 0.06 0.01", "0 0 0.005"))
+    [m] = draft.manipulators
+    assert m.tool_frame == "hand" and not draft.frames
+
+
+def test_a_hand_without_shapes_is_grasped_between_its_fingers(tmp_path: Path) -> None:
+    """No shape anywhere (meshes missing): the frame is proposed between the fingers' last links.
+
+    Without it the palm itself became the tool frame; the palm is where the frame hangs.
+    """
+    parts = [_link("base", None), _link("palm", None)]
+    parts += [_joint("wrist", "base", "palm", axis="0 0 1")]
+    for f, y in (("a", 0.03), ("b", 0.0), ("c", -0.03)):
+        parts += [_link(f"{f}1", None), _link(f"{f}2", None)]
+        parts += [_joint(f"{f}_j1", "palm", f"{f}1", xyz=f"0 {y} 0.08")]
+        parts += [_joint(f"{f}_j2", f"{f}1", f"{f}2", xyz="0 0 0.04")]
+    parts += [_link("t1", None), _link("t2", None)]
+    parts += [_joint("t_j1", "palm", "t1", xyz="0.03 0 0.03", axis="0 0 1")]
+    parts += [_joint("t_j2", "t1", "t2", xyz="0.03 0 0.02")]
+    draft = _draft(tmp_path, "shapeless_hand", parts)
+    [m] = draft.manipulators
+    assert m.tool_frame != "palm"
+    [frame] = [f for f in draft.frames if f.name == m.tool_frame]
+    assert frame.parent == "palm" and frame.xyz[2] > 0.08
+
+
+def _base_with_device(child: str) -> list[str]:
+    """A box base with a bare 'front_camera_link' carrying one bare frame 5 cm aside."""
+    return [
+        _link("base_link", "0.5 0.4 0.2"),
+        _link("front_camera_link", None),
+        _joint("cam_mount", "base_link", "front_camera_link", kind="fixed", xyz="0.25 0 0.1"),
+        _link(child, None),
+        _joint("cam_channel", "front_camera_link", child, kind="fixed", xyz="0 -0.05 0"),
+    ]
+
+
+def test_a_device_link_carrying_its_infrared_frame_is_the_camera(tmp_path: Path) -> None:
+    """A depth device written as its link and a right infrared frame: one camera, the link."""
+    draft = _draft(tmp_path, "device", _base_with_device("front_camera_right_ir_frame"))
+    assert [c.body for c in draft.cameras] == ["front_camera_link"]
+    assert draft.cameras[0].decide  # named only: a question
+
+
+def test_a_lens_frame_below_a_camera_link_stays_the_camera(tmp_path: Path) -> None:
+    """A frame below the camera's link that names no channel (its lens) is where it sees from."""
+    draft = _draft(tmp_path, "lens", _base_with_device("front_camera_lens"))
+    assert [c.body for c in draft.cameras] == ["front_camera_lens"]
+
+
+def test_a_camera_mount_carrying_channels_is_no_camera(tmp_path: Path) -> None:
+    """A link named as a camera's mount is what it is bolted to, whatever hangs below it."""
+    parts = [
+        _link("base_link", "0.5 0.4 0.2"),
+        _link("camera_mount", None),
+        _joint("m", "base_link", "camera_mount", kind="fixed", xyz="0.25 0 0.1"),
+        _link("camera_depth_frame", None),
+        _joint("d", "camera_mount", "camera_depth_frame", kind="fixed", xyz="0 -0.05 0"),
+    ]
+    draft = _draft(tmp_path, "mount", parts)
+    assert [c.body for c in draft.cameras] == ["camera_depth_frame"]
+
+
+def test_a_kinect_v2_gets_no_kinect_v1_preset(tmp_path: Path) -> None:
+    """'kinect2' names a Kinect v2, whose optics are not the v1 preset's; 'kinect' names a v1."""
+    for name, preset in (("head_kinect2_link", None), ("head_kinect_link", "kinect_v1")):
+        parts = [
+            _link("base_link", "0.5 0.4 0.2"),
+            _link(name, "0.05 0.25 0.05"),
+            _joint("k", "base_link", name, kind="fixed", xyz="0.2 0 0.5"),
+        ]
+        (tmp_path / name).mkdir()
+        [cam] = _draft(tmp_path / name, "kinect", parts).cameras
+        assert cam.preset == preset

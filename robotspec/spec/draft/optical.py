@@ -40,7 +40,7 @@ CAMERA_WORDS = frozenset(
     # Device models a frame is often named after.
     | {"d405", "d435i", "d455", "d457", "l515", "zed2", "zed2i", "zedm", "kinect2", "azure"}
     | {"astra", "orbbec", "femto", "gemini", "primesense", "carmine", "oak", "mynteye"}
-    | {"flir", "basler", "ximea", "pointgrey", "bumblebee"}
+    | {"flir", "basler", "ximea", "pointgrey", "bumblebee", "multisense"}
 )
 #: Words that tell one frame of a device from another: channels and sides.
 TELLING_WORDS = frozenset(

@@ -118,14 +118,23 @@ def add_sensors(d: Drafter) -> None:
 
 
 #: Camera models a frame's name can say, and the preset of ``templates/cameras.yaml`` for each.
-_MODELS = {"d435": "realsense_d435", "xtion": "xtion_pro_live", "kinect": "kinect_v1"}
+_MODELS = {
+    "d435": "realsense_d435",
+    "d435i": "realsense_d435",
+    "xtion": "xtion_pro_live",
+    "kinect": "kinect_v1",
+}
 
 
 def _model_preset(name: str) -> str | None:
-    """The preset of the camera model a frame is named after (G1's 'd435_link'), if shipped."""
+    """The preset of the camera model a frame is named after (G1's 'd435_link'), if shipped.
+
+    Whole words only: 'kinect2' is a Kinect v2 (other optics than the v1 preset), not 'kinect'.
+    """
     from robotspec.spec.draft.render import camera_presets
 
-    tokens = set(re.split(r"[^a-z0-9]+", name.lower())) | words(name)
+    spaced = re.sub(r"(?<=[a-z])(?=[A-Z])", "_", name)  # camelCase splits ('kinectLink')
+    tokens = set(re.split(r"[^a-z0-9]+", spaced.lower()))
     for word, preset in _MODELS.items():
         if word in tokens and preset in camera_presets():
             return preset

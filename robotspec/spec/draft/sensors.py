@@ -30,7 +30,12 @@ from robotspec.spec.draft.optical import (
     root_is_optical,
     upside_down,
 )
-from robotspec.spec.draft.stated_cameras import DEVICE_SPAN, StatedCamera, stated_cameras
+from robotspec.spec.draft.stated_cameras import (
+    DEVICE_SPAN,
+    StatedCamera,
+    channel_words,
+    stated_cameras,
+)
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = [
@@ -169,7 +174,8 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             continue
         if optical and world.child_bodies(b) and not w & CAMERA_WORDS:
             continue  # a link turned as optical frames are, carrying others (iCub's 'neck_2')
-        if optical or (w & CAMERA_WORDS and not world.child_bodies(b)):
+        named = w & CAMERA_WORDS and (not world.child_bodies(b) or _carries_channels(tree, b))
+        if optical or named:
             found.append(CameraFound(_stem(b.name) or b.name, b, optical))
     found = _one_per_nameless_device(tree, found)
     # One per device: drop a camera whose name extends another's on the same rigid body, or
@@ -214,6 +220,34 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             kept.append(cam)
     kept.sort(key=lambda c: c.body.index)
     return kept
+
+
+#: Words of a link that holds a camera rather than being one.
+MOUNT_WORDS = frozenset({"mount", "holder", "bracket", "support", "base", "stand", "adapter"})
+
+
+def _carries_channels(tree: Tree, body: Body) -> bool:
+    """Whether a link named as a camera is a device carrying its channels' frames.
+
+    Why: a stereo or RGB-D device is often written as its link with bare frames fixed below it,
+    one per channel other than colour (a right infrared imager 5 cm aside, a depth frame), none
+    turned as an optical frame; the device's link is the camera a person names, not one of its
+    channels (one device, one camera). Only when everything below it is such a frame on a fixed
+    joint (a lens or colour frame below a camera is where it sees from: that frame stays the
+    camera), and never a link named as a mount or holder (what a camera is bolted to is none).
+    """
+    world = tree.world
+    if words(body.name) & MOUNT_WORDS:
+        return False
+    below = world.subtree(body)[1:]
+    return bool(below) and all(
+        (c := world.parent_connection(k)) is not None
+        and c.is_fixed
+        and not (k.collisions or k.visuals)
+        and (ch := channel_words(k.name))
+        and not ch & _COLOUR
+        for k in below
+    )
 
 
 def _sensor_frame(tree: Tree, facts: FileFacts, body: Body, parent: int) -> bool:

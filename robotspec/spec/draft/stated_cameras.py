@@ -25,7 +25,7 @@ from robotspec.spec.draft.model import DraftCamera
 from robotspec.spec.draft.optical import device_groups, names_silent, pick_channel
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["StatedCamera", "fill_stated", "stated_cameras"]
+__all__ = ["StatedCamera", "channel_words", "fill_stated", "stated_cameras"]
 
 #: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
 _OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
@@ -65,7 +65,8 @@ class StatedCamera:
     doubt: str | None = None
 
 
-def _channel_words(text: str) -> set[str]:
+def channel_words(text: str) -> set[str]:
+    """The channel words of a frame's name (``ired1`` -> ``ired``; colour, depth, infrared...)."""
     ws = words(text) | set(re.split(r"[^a-z0-9]+", text.lower()))
     # 'ired1', 'infra2', 'color1': a channel word with a number after it.
     return {w.rstrip("0123456789") for w in ws} & _CHANNELS
@@ -117,7 +118,7 @@ def _optical_at(
             continue
         if float(np.linalg.norm(pose[:3, 3] - at)) > SPOT:
             continue
-        channel = _channel_words(k.name)
+        channel = channel_words(k.name)
         rank = 0 if channel & _COLOUR else 2 if channel else 1
         below = 0 if tree.world.is_ancestor(link, k) else 1
         rep = 0 if _rep103(tree, k) else 1
@@ -221,7 +222,7 @@ def _one_device(tree: Tree, a: StatedCamera, b: StatedCamera) -> bool:
         rgbd = a.fact.has_depth or b.fact.has_depth
         return rgbd and device_groups(tree, [a.body, b.body]) == [[a.body, b.body]]
     # Channels by their frames' names: a stereo depth camera (Go1's five) is a device alone.
-    if not (_channel_words(a.body.name) and _channel_words(b.body.name)):
+    if not (channel_words(a.body.name) and channel_words(b.body.name)):
         return False
     if tree.rigid_root(a.body) is not tree.rigid_root(b.body):
         return False
@@ -241,7 +242,7 @@ def _view(tree: Tree, c: StatedCamera) -> np.ndarray:
 
 
 def _preference(c: StatedCamera) -> tuple[int, int]:
-    channel = _channel_words(c.body.name) | _channel_words(c.fact.name)
+    channel = channel_words(c.body.name) | channel_words(c.fact.name)
     if channel & _COLOUR:
         return (0, 0)
     return (1 if not channel else 2, 0 if c.optical else 1)

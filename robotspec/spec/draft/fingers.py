@@ -19,6 +19,7 @@ from robotspec.model.world import World
 from robotspec.spec.draft.bare_fingers import bare_branches
 from robotspec.spec.draft.model import DraftFinger
 from robotspec.spec.draft.thumbs import odd_by_shape
+from robotspec.spec.draft.tips import _body_points
 from robotspec.spec.draft.tool_frames import bare_fixed_leaf
 from robotspec.spec.draft.tree import Tree, solid, words
 
@@ -89,12 +90,51 @@ def finger_tip(tree: Tree, branch: Body) -> Body:
         or [b for b in inside if solid(world, b)]  # a file without shapes: links with a mass
     )
     tip = max(parts or moved or [branch], key=lambda b: (world.depth(b), -b.index))
+    tip = _unfolded(tree, branch, tip)
     # A bare frame the URDF fixes at the end of the last phalanx is the tip it names (Ability's
     # 'index_tip', D'Claw's 'link_f1_head'): the only bare leaf hanging there.
     bare = [k for k in world.child_bodies(tip) if bare_fixed_leaf(world, k)]
     if len(bare) == 1 and all(not world.child_bodies(k) for k in world.child_bodies(tip)):
         return bare[0]
     return tip
+
+
+#: How much farther (m) the link above must reach for a folding-back leaf not to be the tip.
+FOLD_MARGIN = 0.01
+
+
+def _unfolded(tree: Tree, branch: Body, tip: Body) -> Body:
+    """The tip, or the moving link it hangs on when the tip folds back toward the finger's base.
+
+    Why: a linkage finger cut open below its pad (TidyBot++'s Robotiq 2F-85, whose inner
+    knuckle hangs on the inner finger) ends on a rod that reaches back to the hand; the finger
+    ends where its geometry reaches farthest from its base, on the link above. Only when both
+    links' shapes are known and the one above reaches clearly farther.
+    """
+    world = tree.world
+    up = world.parent_connection(tip)
+    if tip is branch or up is None or up.is_fixed or world.child_bodies(tip):
+        return tip
+    above = world.bodies[up.parent]
+    if above is not branch and not world.is_ancestor(branch, above):
+        return tip
+    if not _moves(world, above) or not above.collisions:
+        return tip
+    base = tree.position(branch)
+    reach = [_farthest_from(tree, b, base) for b in (above, tip)]
+    if reach[0] is None or reach[1] is None or reach[0] - reach[1] < FOLD_MARGIN:
+        return tip
+    return above
+
+
+def _farthest_from(tree: Tree, body: Body, point: np.ndarray) -> float | None:
+    """How far ``body``'s geometry reaches from ``point`` in the default pose (None: no shape)."""
+    pts = _body_points(tree, body)
+    if not len(pts):
+        return None
+    pose = tree.poses[body.index]
+    at = (pose[:3, :3] @ pts.T).T + pose[:3, 3]
+    return float(np.max(np.linalg.norm(at - point, axis=1)))
 
 
 def _decoration(world: World, body: Body) -> bool:

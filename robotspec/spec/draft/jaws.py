@@ -21,8 +21,9 @@ from robotspec.spec.draft.tree import Segment, Tree
 
 __all__ = ["MAX_JAW_RANGE", "one_jaw"]
 
-#: The widest swing (rad) of a moving jaw; a wrist's last joint turns farther.
-MAX_JAW_RANGE = math.pi
+#: The widest swing (rad) of a moving jaw, three quarters of a turn (a hobby servo's +-120
+#: degrees, AiNex's jaw); a wrist's last joint turns a full turn or more.
+MAX_JAW_RANGE = 1.5 * math.pi
 #: How far from square to the way it sticks out a jaw's axis may be (the cosine between them).
 ACROSS = 0.3
 
@@ -52,8 +53,9 @@ def one_jaw(tree: Tree, seg: Segment, cut: int, named: bool = True) -> bool:
         return True
     # The fixed jaw modelled as the carrier's own shape (Spot's 'arm_link_wr1' holds the front
     # jaw's meshes): it reaches past the hinge by half the moving jaw's length or more (an
-    # upper arm's shape ends near its elbow, well short of half the forearm).
-    if named or not carrier.collisions:
+    # upper arm's shape ends near its elbow, well short of half the forearm). A link named as
+    # a gripper must swing like a jaw too (a wrist turning a gripper rolls about its offset).
+    if not carrier.collisions or (named and not _swings(tree, jaw, hinge)):
         return False
     past = _reach(tree, carrier, carrier, at) - hinge
     return past > 0 and past >= JAW_OVERLAP * _reach(tree, jaw, carrier, at)

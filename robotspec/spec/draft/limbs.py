@@ -138,7 +138,10 @@ def _limb(
     # The link where the run splits into fingers is a palm whatever its name (xArm7's Ability
     # hand: 'thumb_base' carries every finger); only the links above it must not be fingers'.
     palm = cut is None and bodies[-1] is seg.end and len(tree.moving_children(seg.end)) >= 2
-    if len(actuated) < fewest or named(bodies[:-1] if palm else bodies, FINGER_WORDS):
+    # Only the links the run's joints move can be a finger's: those fixed above its first
+    # joint are what it stands on (KMR's 'base_link_middle', named after a chassis layer).
+    moved = bodies[next((i for i, b in enumerate(bodies) if _moved(world, b)), len(bodies)) :]
+    if len(actuated) < fewest or named(moved[:-1] if palm else moved, FINGER_WORDS):
         return None
     reach = tree.length(seg, None if jaw else upto)  # with its jaw, as far as it reaches
     # Shorter is a finger, unless named as a leg and reaching the ground (Mini Pupper's legs).
@@ -193,6 +196,12 @@ def _limb(
     why = f"{n} joint{'s' if n > 1 else ''} in series from '{root.name}' to {ends}"
     tip = chain_end(tree, tip, hand)
     return Limb("arm", root, tip, hand, joints, seg, why)
+
+
+def _moved(world: World, body: Body) -> bool:
+    """Whether ``body`` hangs on a moving joint."""
+    c = world.parent_connection(body)
+    return c is not None and not c.is_fixed
 
 
 def _hand_cut(tree: Tree, seg: Segment) -> tuple[int | None, bool]:

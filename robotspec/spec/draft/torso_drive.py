@@ -50,8 +50,16 @@ def add_torso(d: Drafter) -> None:
         if not path:
             return
     joints = frozenset(c.name for c in path if c.is_active)
+    # An SRDF group of some of these joints and no limb's (SEED-Noid's 'lifter' and 'waist',
+    # grouped again as 'torso') is a part of the torso a planner moves alone: folded into it.
+    parts = {
+        id(ch) for ch in draft.chains if ch.role == "chain" and ch.joints and ch.joints < joints
+    }
     if not joints or any(
-        c.name in ch.joints for c in path for ch in draft.chains if ch.joints != joints
+        c.name in ch.joints
+        for c in path
+        for ch in draft.chains
+        if ch.joints != joints and id(ch) not in parts
     ):
         return
     t = DraftChain(
@@ -67,6 +75,9 @@ def add_torso(d: Drafter) -> None:
     for c in draft.chains:
         if c.joints == joints:
             t.source, t.srdf_group = c.source, c.srdf_group  # still a question (confidence)
+            continue
+        if id(c) in parts:
+            t.decide.append(f"the SRDF group '{c.srdf_group or c.name}' moves part of it")
             continue
         kept.append(c)
     draft.chains = kept
@@ -123,21 +134,25 @@ def add_drive(d: Drafter) -> None:
         virtual = {"omni": "planar"}.get(draft.drive.type, draft.drive.type)
         moves = bool(wheels or len(legs) >= 2 or rotors)
         planner = virtual == "fixed" and bool(wheels) and movable
+    if draft.drive is not None and virtual == "planar" and wheels and movable:
+        # MoveIt models every wheeled base as a planar joint, whatever its wheels: the URDF's
+        # wheels say how it drives (a drive plugin states it; two on one axle: differential).
+        wheeled = _wheeled_drive(d, wheels, casters)
+        if wheeled.type != "omni":
+            wheeled.decide = wheeled.decide and f"{wheeled.decide}; the SRDF's joint is planar"
+            draft.drive = wheeled
+            return
     if draft.drive is not None and not planner:
         draft.drive.decide = drive_question(virtual, moves)
         draft.drive.stated = drive_rule(virtual, moves)
         if virtual == "floating" and not moves:  # nothing can float it: a base bolted down
             draft.drive = DraftDrive("fixed", None, None, draft.drive.source, draft.drive.decide)
         return
-    stated = stated_drive(d.tree, d.facts, wheels) if wheels and movable else None
-    if stated is not None:  # what the transmissions or a Gazebo drive plugin say
-        draft.drive = stated
-        if planner and stated.decide is None:  # the files disagree: asked
+    if wheels and movable:
+        draft.drive = _wheeled_drive(d, wheels, casters)
+        stated = draft.drive
+        if planner and stated.stated is not None:  # the files disagree: asked
             stated.decide, stated.stated = f"{stated.source}, but the SRDF's is fixed", None
-    elif wheels and movable:
-        kind = counted_drive(d.tree, wheels)
-        why = f"{len(wheels)} wheel joints" + (f", {len(casters)} steered casters" * bool(casters))
-        draft.drive = DraftDrive(kind, None, None, "the URDF tree", f"{why}: {kind}?")
     elif (len(legs) >= 2 or rotors) and movable:
         why = f"{len(legs)} legs" if len(legs) >= 2 else f"{len(rotors)} rotors"
         draft.drive = DraftDrive("floating", None, None, "the URDF tree", f"{why}: floating")
@@ -150,3 +165,13 @@ def add_drive(d: Drafter) -> None:
         draft.drive = DraftDrive(
             "fixed", None, None, "the URDF tree", "no wheels, legs or rotors: a fixed base"
         )
+
+
+def _wheeled_drive(d: Drafter, wheels: list[Connection], casters: list[Connection]) -> DraftDrive:
+    """The drive of a wheeled base: what the transmissions or a drive plugin say, else counted."""
+    stated = stated_drive(d.tree, d.facts, wheels)
+    if stated is not None:
+        return stated
+    kind = counted_drive(d.tree, wheels)
+    why = f"{len(wheels)} wheel joints" + (f", {len(casters)} steered casters" * bool(casters))
+    return DraftDrive(kind, None, None, "the URDF tree", f"{why}: {kind}?")

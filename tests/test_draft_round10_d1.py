@@ -1,0 +1,206 @@
+"""Chains, grippers, torso and drive read from the files' structure (issue 30, round 10).
+
+Small layouts built here, one shape each (no robot's files, no robot's name): an arm on a
+chassis whose fixed layers carry a finger's word, a one-jaw gripper named as a gripper swinging
+against the forearm's own shape, SRDF groups that are parts of the torso, two wheels under an
+SRDF planar virtual joint, a linkage finger whose rod hangs below its pad.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from tests.draft_support import draft_layout
+from tests.test_draft_blind import _WHEEL, _draft_srdf, _joint, _link
+
+
+def _box(size: str, xyz: str = "0 0 0") -> str:
+    """A collision box of ``size`` centred at ``xyz`` of its link."""
+    return f'<collision><origin xyz="{xyz}"/><geometry><box size="{size}"/></geometry></collision>'
+
+
+def _arm_on(parent: str, prefix: str = "", joints: int = 4, xyz: str = "0 0 0.2") -> list[str]:
+    """A ``joints``-joint arm of 20 cm links from ``parent``; its last link is PREFIX+'link{n}'."""
+    parts: list[str] = []
+    above = parent
+    for i in range(1, joints + 1):
+        child = f"{prefix}link{i}"
+        axis = "0 0 1" if i % 2 else "0 1 0"
+        parts += [
+            _link(child, size=0.04),
+            _joint(f"{prefix}j{i}", above, child, xyz=xyz if i == 1 else "0 0 0.2", axis=axis),
+        ]
+        above = child
+    return parts
+
+
+def test_links_above_an_arms_first_joint_are_never_a_fingers(tmp_path: Path) -> None:
+    # A chassis built of fixed layers, one named 'middle' (a finger's word in a hand): the arm
+    # standing on them is still an arm; only links its joints move could be a finger's.
+    parts = [
+        _link("base", size=0.3),
+        _link("base_middle", size=0.3),
+        _joint("base_to_middle", "base", "base_middle", "fixed", "0 0 0.2"),
+        _link("base_top", size=0.3),
+        _joint("middle_to_top", "base_middle", "base_top", "fixed", "0 0 0.2"),
+        *_arm_on("base_top"),
+    ]
+    d = draft_layout(tmp_path, "robot", parts)
+    (arm,) = d.chains
+    assert arm.role == "arm" and arm.joints == frozenset({"j1", "j2", "j3", "j4"})
+
+
+def _one_jaw(axis: str, swing: tuple[float, float]) -> list[str]:
+    """A 4-joint arm whose forearm's shape runs 14 cm on past a 'gripper' hinged 9 cm out.
+
+    The gripper is a single 5 cm jaw on a revolute joint about ``axis``, within ``swing``.
+    """
+    parts = [_link("base", size=0.1), *_arm_on("base", joints=3)]
+    parts += [
+        f'<link name="forearm">{_box("0.03 0.03 0.14", "0 0 0.07")}</link>',
+        _joint("elbow_yaw", "link3", "forearm", xyz="0 0 0.2", axis="0 0 1"),
+        f'<link name="gripper">{_box("0.01 0.01 0.05", "0 0 0.025")}</link>',
+        (
+            '<joint name="gripper_joint" type="revolute"><parent link="forearm"/>'
+            f'<child link="gripper"/><origin xyz="0.02 0 0.09"/><axis xyz="{axis}"/>'
+            f'<limit lower="{swing[0]}" upper="{swing[1]}" effort="1" velocity="1"/></joint>'
+        ),
+    ]
+    return parts
+
+
+def test_a_gripper_link_swinging_against_the_forearms_shape_is_its_one_jaw(
+    tmp_path: Path,
+) -> None:
+    # A hobby servo's +-120 degrees about an axis across the hinge's offset, the forearm's
+    # own shape reaching 5 cm past the hinge (the fixed jaw): the joint is the gripper's.
+    d = draft_layout(tmp_path, "robot", _one_jaw("1 0 0", (-2.09, 2.09)))
+    (arm,) = d.chains
+    assert arm.tip == "forearm" and "gripper_joint" not in arm.joints
+    assert arm.joints == frozenset({"j1", "j2", "j3", "elbow_yaw"})
+
+
+def test_a_gripper_link_rolled_about_its_offset_is_turned_by_the_arm(tmp_path: Path) -> None:
+    # The same shapes, the joint turning about the way the link is hung out (a wrist roll):
+    # the arm's last joint, whatever the link is named.
+    d = draft_layout(tmp_path, "robot", _one_jaw("0.2169 0 0.9762", (-2.09, 2.09)))
+    (arm,) = d.chains
+    assert "gripper_joint" in arm.joints
+
+
+def _lifted_torso() -> list[str]:
+    """A base, a 2-joint lift, a 2-joint waist up to 'body', two 4-joint arms from 'body'."""
+    parts = [
+        _link("base", size=0.3),
+        _link("lift1", size=0.1),
+        _joint("lift1_joint", "base", "lift1", "prismatic", "0 0 0.2", "0 0 1"),
+        _link("lift2", size=0.1),
+        _joint("lift2_joint", "lift1", "lift2", "prismatic", "0 0 0.2", "0 0 1"),
+        _link("waist", size=0.1),
+        _joint("waist_yaw", "lift2", "waist", xyz="0 0 0.2", axis="0 0 1"),
+        _link("body", size=0.2),
+        _joint("waist_pitch", "waist", "body", xyz="0 0 0.1", axis="0 1 0"),
+        *_arm_on("body", "l_", xyz="0 0.2 0.1"),
+        *_arm_on("body", "r_", xyz="0 -0.2 0.1"),
+    ]
+    return parts
+
+
+def test_srdf_groups_of_the_lift_and_the_waist_are_the_torsos_parts(tmp_path: Path) -> None:
+    # The SRDF groups the lift and the waist apart (as a planner moves them) and the arms:
+    # the lift and the waist are the torso's, not two chains of unknown kind.
+    groups = (
+        '<group name="lifter"><joint name="lift1_joint"/><joint name="lift2_joint"/></group>'
+        '<group name="waist"><joint name="waist_yaw"/><joint name="waist_pitch"/></group>'
+        '<group name="larm"><chain base_link="body" tip_link="l_link4"/></group>'
+        '<group name="rarm"><chain base_link="body" tip_link="r_link4"/></group>'
+    )
+    d = _draft_srdf(tmp_path, "robot", _lifted_torso(), groups)
+    assert sorted(c.name for c in d.chains) == ["larm", "rarm"]
+    assert d.torso is not None
+    assert d.torso.joints == frozenset({"lift1_joint", "lift2_joint", "waist_yaw", "waist_pitch"})
+    assert any("the SRDF group 'waist' moves part of it" in r for r in d.torso.decide)
+
+
+def _two_wheeled(with_plugin: bool) -> list[str]:
+    """A box base on two continuous wheels on one axle (y), a 4-joint arm on top."""
+    parts = [_link("base_link", size=0.3)]
+    for side, y in (("left", 0.2), ("right", -0.2)):
+        parts += [
+            _link(f"{side}_wheel", _WHEEL),
+            _joint(f"{side}_wheel_joint", "base_link", f"{side}_wheel", "continuous",
+                   f"0 {y} -0.1", "0 1 0"),
+        ]  # fmt: skip
+    parts += _arm_on("base_link")
+    if with_plugin:
+        parts.append(
+            '<gazebo><plugin name="drive" filename="libgazebo_ros_diff_drive.so">'
+            "<leftJoint>left_wheel_joint</leftJoint><rightJoint>right_wheel_joint</rightJoint>"
+            "</plugin></gazebo>"
+        )
+    return parts
+
+
+_PLANAR = (
+    '<virtual_joint name="world_joint" type="planar" parent_frame="odom" child_link="base_link"/>'
+    '<group name="arm"><chain base_link="base_link" tip_link="link4"/></group>'
+)
+
+
+def test_two_wheels_on_one_axle_under_a_planar_virtual_joint_drive_differentially(
+    tmp_path: Path,
+) -> None:
+    # MoveIt models every wheeled base as a planar joint; two wheels on one axle say the base
+    # drives differentially (asked: the planar joint may be an omni base's).
+    d = _draft_srdf(tmp_path, "robot", _two_wheeled(False), _PLANAR)
+    assert d.drive is not None and d.drive.type == "differential"
+    assert d.drive.decide is not None and "the SRDF's joint is planar" in d.drive.decide
+
+
+def test_a_drive_plugin_states_the_drive_under_a_planar_virtual_joint(tmp_path: Path) -> None:
+    d = _draft_srdf(tmp_path, "robot", _two_wheeled(True), _PLANAR)
+    assert d.drive is not None and d.drive.type == "differential" and d.drive.decide is None
+
+
+def _linkage_gripper() -> list[str]:
+    """A 4-joint arm, a palm, two fingers: knuckle, finger (its pad out), a rod folding back.
+
+    Each side: a driven (or mimic) knuckle, a finger on a mimic joint whose shape reaches 6 cm
+    out, and the linkage's rod hung below the finger on a mimic joint, its shape running back
+    toward the palm (a closed loop cut open below the pad).
+    """
+    parts = [_link("base", size=0.1), *_arm_on("base"), _link("palm", size=0.06)]
+    parts.append(_joint("palm_mount", "link4", "palm", "fixed", "0 0 0.1"))
+    for side, sign in (("left", 1), ("right", -1)):
+        mimic = "" if side == "left" else '<mimic joint="left_knuckle_joint"/>'
+        parts += [
+            f'<link name="{side}_knuckle">{_box("0.01 0.01 0.04", "0 0 0.02")}</link>',
+            (
+                f'<joint name="{side}_knuckle_joint" type="revolute"><parent link="palm"/>'
+                f'<child link="{side}_knuckle"/><origin xyz="0 {sign * 0.03} 0.03"/>'
+                f'<axis xyz="{sign} 0 0"/><limit lower="0" upper="0.8" effort="1" velocity="1"/>'
+                f"{mimic}</joint>"
+            ),
+            f'<link name="{side}_finger">{_box("0.01 0.01 0.06", "0 0 0.03")}</link>',
+            (
+                f'<joint name="{side}_finger_joint" type="revolute"><parent link="{side}_knuckle"/>'
+                f'<child link="{side}_finger"/><origin xyz="0 0 0.04"/><axis xyz="{sign} 0 0"/>'
+                '<limit lower="0" upper="0.8" effort="1" velocity="1"/>'
+                '<mimic joint="left_knuckle_joint" multiplier="-1"/></joint>'
+            ),
+            f'<link name="{side}_rod">{_box("0.01 0.01 0.05", "0 0 -0.02")}</link>',
+            (
+                f'<joint name="{side}_rod_joint" type="revolute"><parent link="{side}_finger"/>'
+                f'<child link="{side}_rod"/><origin xyz="0 0 0.01"/><axis xyz="{sign} 0 0"/>'
+                '<limit lower="0" upper="0.8" effort="1" velocity="1"/>'
+                '<mimic joint="left_knuckle_joint"/></joint>'
+            ),
+        ]
+    return parts
+
+
+def test_a_fingers_rod_folding_back_below_its_pad_is_not_its_tip(tmp_path: Path) -> None:
+    d = draft_layout(tmp_path, "robot", _linkage_gripper())
+    (m,) = d.manipulators
+    assert m.is_gripper
+    assert {m.thumb.tip, m.finger.tip} == {"left_finger", "right_finger"}  # type: ignore[union-attr]

@@ -162,3 +162,38 @@ def test_a_kinect_v2_gets_no_kinect_v1_preset(tmp_path: Path) -> None:
         (tmp_path / name).mkdir()
         [cam] = _draft(tmp_path / name, "kinect", parts).cameras
         assert cam.preset == preset
+
+
+def _drill(bit: str) -> list[str]:
+    """Six joints, a flange, a drill body, its bit: a cylinder centred on its origin."""
+    cylinder = (
+        f'<link name="tool_link">{_MASS}<collision><geometry>'
+        f'<cylinder radius="0.004" length="{bit}"/></geometry></collision></link>'
+    )
+    return _arm(6) + [
+        _link("flange", "0.06 0.06 0.01", at="0 0 0.005"),
+        _joint("flange_joint", "link6", "flange", kind="fixed", xyz="0 0 0.05"),
+        _link("drill_link", "0.05 0.05 0.07", at="0 0 0.035"),
+        _joint("drill_joint", "flange", "drill_link", kind="fixed", xyz="0 0 0.0"),
+        cylinder,
+        _joint("bit_joint", "drill_link", "tool_link", kind="fixed", xyz="0.01 0 0.07"),
+    ]
+
+
+def test_a_drill_bit_centred_on_its_origin_is_worked_at_its_tip(tmp_path: Path) -> None:
+    """A bit 7.4 cm long centred on its link's origin: the tool frame is 3.7 cm out, on the bit.
+
+    The way from the flange to the bit is 8 degrees off the bit's axis; the bit's own axis is
+    the one taken.
+    """
+    draft = _draft(tmp_path, "drill", _drill("0.074"))
+    [m] = draft.manipulators
+    [frame] = [f for f in draft.frames if f.name == m.tool_frame]
+    assert frame.parent == "tool_link" and frame.xyz == (0.0, 0.0, 0.037)
+
+
+def test_a_small_tool_link_centred_on_its_origin_stays_the_tool_frame(tmp_path: Path) -> None:
+    """A 1 cm stub centred on its origin (a marker cube): its origin is its tip, no new frame."""
+    draft = _draft(tmp_path, "stub", _drill("0.01"))
+    [m] = draft.manipulators
+    assert m.tool_frame == "tool_link"

@@ -29,8 +29,10 @@ from robotspec.spec.draft.model import DraftChain, DraftFrame, DraftManipulator
 from robotspec.spec.draft.naming import unique
 from robotspec.spec.draft.srdf_groups import rigidly_beside
 from robotspec.spec.draft.tips import (
+    BIT,
     FLANGE,
     between_tips,
+    bit_end,
     flange_offset,
     origin_is_flange,
     rigid_end,
@@ -180,7 +182,11 @@ def _tool_name(
     """The tool frame's name, and the frame proposed when the URDF has none."""
     tree, world = self.tree, self.world
     frame: DraftFrame | None = None
-    if tool is not None:
+    if tool is not None and stated is None and (bit := bit_end(tree, top, tool)) is not None:
+        # A rigid tool's last link centred on its origin (a drill's bit): its tip is out there.
+        tool_name = unique(f"{name}_tip", self.names | set(world.body_names))
+        frame = DraftFrame(tool_name, tool.name, bit, f"the URDF has no tool frame: {BIT}")
+    elif tool is not None:
         tool_name = tool.name
         # Stated or a question: confidence's rule (above the hand: said already).
         at_hand = gripper.root if gripper is not None else hand

@@ -26,6 +26,7 @@ __all__ = [
     "FLANGE",
     "MESH_PATH",
     "between_tips",
+    "bit_end",
     "far_end",
     "flange_offset",
     "origin_is_flange",
@@ -279,4 +280,43 @@ def _reach_past_joint(
         return None
     way, reach = found
     x, y, z = (round(float(v), 4) for v in reach * way)
+    return (x + 0.0, y + 0.0, z + 0.0)
+
+
+#: The cosine within which the way a tool points is taken as one of its link's axes (45 deg).
+ALONG_AXIS = 0.7
+#: Why a frame at a rigid tool's bit is where it is (the draft's ``# from`` note).
+BIT = "the far end of the tool's last link (its bit's tip), the way the tool points"
+
+
+def bit_end(tree: Tree, top: Body, tool: Body) -> tuple[float, float, float] | None:
+    """Where a rigid tool's last link ends, when its origin is not at its end: its working tip.
+
+    Why: a drill's bit, a probe or a pen is often its own link with its origin at the middle of
+    its shape (a cylinder centred on it); the tool works where the shape ends, along the link's
+    axis nearest the way the tool points from the arm (``top`` to ``tool``). Only for a shaped
+    leaf on a fixed joint strictly below ``top`` with nothing moving below ``top`` (a gripper's
+    jaw is not a bit), whose shape reaches AT_FACE or more past its origin that way; the point
+    is in ``tool``'s frame.
+    """
+    world = tree.world
+    c = world.parent_connection(tool)
+    if tool is top or c is None or not c.is_fixed or world.child_bodies(tool):
+        return None
+    if tree.moves_below(top) or not world.is_ancestor(top, tool):
+        return None
+    way = tree.poses[tool.index][:3, 3] - tree.poses[top.index][:3, 3]
+    n = float(np.linalg.norm(way))
+    points = _body_points(tree, tool)
+    if n < MIN_REACH or not len(points):
+        return None
+    local = tree.poses[tool.index][:3, :3].T @ (way / n)  # the way, in the tool's frame
+    # A bit points along one of its link's axes (a cylinder's z): the one nearest that way.
+    axes = np.vstack([np.eye(3), -np.eye(3)])
+    best = axes[int(np.argmax(axes @ local))]
+    local = best if float(best @ local) > ALONG_AXIS else local
+    reach = float(np.max(points @ local))
+    if not AT_FACE <= reach <= RIGID_MAX:
+        return None
+    x, y, z = (round(float(v), 4) for v in reach * local)
     return (x + 0.0, y + 0.0, z + 0.0)

@@ -135,3 +135,35 @@ def test_a_differential_base_whose_wheels_turn_about_x_asks_its_facing(tmp_path:
     assert d.drive is not None and d.drive.type == "differential"
     assert d.forward == (1.0, 0.0, 0.0)
     assert d.forward_decide == "its wheels turn about x: it drives along y, not x?"
+
+
+def _two_arms(extra: bool) -> list[str]:
+    """A trunk and two mirrored 4-joint arms held out level; the left one has a fifth joint."""
+    parts = [_link("trunk", size=0.3)]
+    for side, y in (("left", 0.3), ("right", -0.3)):
+        above = "trunk"
+        count = 5 if extra and side == "left" else 4
+        for i in range(1, count + 1):
+            xyz = f"0 {y} 0.5" if i == 1 else f"0 {y / 1.5} 0"
+            axis = "0 1 0" if i % 2 else "1 0 0"
+            child = f"{side}_link{i}"
+            parts += [
+                _link(child, size=0.04),
+                _joint(f"{side}_j{i}", above, child, xyz=xyz, axis=axis),
+            ]
+            above = child
+    return parts
+
+
+def test_limbs_alike_ask_nothing(tmp_path: Path) -> None:
+    d = _draft(tmp_path, "pair", _two_arms(extra=False))
+    assert [c.role for c in d.chains] == ["arm", "arm"]
+    assert d.questions == []
+
+
+def test_an_arm_longer_than_its_mirror_asks_what_its_extra_joint_carries(tmp_path: Path) -> None:
+    d = _draft(tmp_path, "pair", _two_arms(extra=True))
+    assert sorted(len(c.joints) for c in d.chains) == [4, 5]
+    (q,) = d.questions
+    assert q.joints == frozenset({"left_j5"}) and q.links == frozenset({"left_link5"})
+    assert q.text.endswith("left_j5 carry another part (an arm on the arm? a hand's joint?)")

@@ -17,7 +17,9 @@ told nothing. After every part is drafted, this module looks at what is left:
   within 10 cm): ``unassigned_cameras``.
 
 A drafted neck of more than three joints, or torso of more than four, is asked about too (an
-arm carrying a camera taken for a neck leaves no joint uncovered). A wheel-shaped joint counts
+arm carrying a camera taken for a neck leaves no joint uncovered), and so is a drafted leg (or
+arm) of more joints than another of its kind (an arm mounted on a leg's calf: its joints past
+the shortest leg's count). A wheel-shaped joint counts
 as covered (the drive's) only when nothing but free turning joints moves below it (a ball
 caster's axes): a leg's hip modelled as a continuous joint with a round motor is asked about
 like any other joint.
@@ -31,6 +33,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from robotspec.errors import RobotSpecError
 from robotspec.model.entities import Connection, ConnectionType
 from robotspec.spec.draft.model import DraftQuestion
 from robotspec.spec.draft.open_ends import open_end_questions
@@ -39,7 +42,7 @@ from robotspec.spec.draft.unassigned_cameras import SENSORS, camera_questions
 
 if TYPE_CHECKING:
     from robotspec.spec.draft.build import Drafter
-    from robotspec.spec.draft.model import Draft
+    from robotspec.spec.draft.model import Draft, DraftChain
 
 __all__ = ["CHAINS", "MANIPULATORS", "SENSORS", "asked", "find_questions"]
 
@@ -259,10 +262,61 @@ def _long_part_questions(d: Drafter) -> list[DraftQuestion]:
     return out
 
 
+def _uneven_limb_questions(d: Drafter) -> list[DraftQuestion]:
+    """A drafted leg (or arm) of more joints than the others of its kind: what do they carry?
+
+    Why: a robot's legs are alike, and so are its two arms; a leg of six joints beside legs of
+    three runs on past its foot into another part (an arm mounted on a leg), an arm longer
+    than its mirror into a hand's or a tool's joint. The drafted limb covers those joints, so
+    nothing else would ask about the part they make. The question names the joints past the
+    shortest limb's count and every link they carry.
+    """
+    world = d.world
+    out = []
+    for role in ("leg", "arm"):
+        runs = {c.name: _moving_run(d, c) for c in d.draft.chains if c.role == role}
+        runs = {name: run for name, run in runs.items() if run}
+        if len(runs) < 2:
+            continue
+        least = min(len(run) for run in runs.values())
+        for name, run in runs.items():
+            extra = [j for j in run[least:] if j.is_active]
+            if not extra:
+                continue
+            names = [j.name for j in extra]
+            links = frozenset(b.name for b in world.subtree(world.bodies[extra[0].child]))
+            text = (
+                f"{name} moves {len(run)} joints, another {role} {least}: "
+                f"{_span(names)} carry another part (an arm on the {role}? a hand's joint?)"
+            )
+            out.append(DraftQuestion(CHAINS, text, frozenset(names), links))
+    return out
+
+
+def _moving_run(d: Drafter, c: DraftChain) -> list[Connection]:
+    """The moving joints from a drafted chain's root to its tip, root first, mimics included.
+
+    Why mimics count: a joint one leg drives and the other follows (a hip both legs share)
+    makes the legs alike, not one of them longer.
+    """
+    world = d.world
+    if not (world.has_body(c.root) and world.has_body(c.tip)):
+        return []
+    try:
+        conns = world.compute_chain_of_connections(c.root, c.tip)
+    except RobotSpecError:
+        return []
+    return [j for j in conns if not j.is_fixed]
+
+
 def find_questions(d: Drafter) -> list[DraftQuestion]:
     """Questions about what no drafted part covers (see the module docstring)."""
     return (
-        _joint_questions(d) + _long_part_questions(d) + open_end_questions(d) + camera_questions(d)
+        _joint_questions(d)
+        + _long_part_questions(d)
+        + _uneven_limb_questions(d)
+        + open_end_questions(d)
+        + camera_questions(d)
     )
 
 

@@ -167,3 +167,12 @@ def test_an_arm_longer_than_its_mirror_asks_what_its_extra_joint_carries(tmp_pat
     (q,) = d.questions
     assert q.joints == frozenset({"left_j5"}) and q.links == frozenset({"left_link5"})
     assert q.text.endswith("left_j5 carry another part (an arm on the arm? a hand's joint?)")
+
+
+def test_a_joint_driven_beside_mimic_coupled_fingers_keeps_the_mark(tmp_path: Path) -> None:
+    # The mimic tag couples two fingers; beside them a joint driven on its own (a shapeless
+    # third branch the tree does not take for a finger): the tag does not describe the hand.
+    third = ['<link name="third"/>', _joint("third_q", "gripper_base", "third", axis="1 0 0")]
+    (m,) = _draft(tmp_path, "arm", [*_gripper(pad=False), *third]).manipulators
+    assert m.is_gripper and m.stated == ()
+    assert m.decide == ["'third_q' moves beside the two fingers: a third finger, a hand?"]

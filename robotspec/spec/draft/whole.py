@@ -25,7 +25,8 @@ tool frame    the hand (or the chain's end) holds another frame named as a TCP; 
               halfway out to between its tips' far ends (the hand's mount: a flange, an
               SRDF's parent link at the wrist); without a hand, a shape hangs past the arm's
               last joint (a tool bolted on)
-gripper       the two tips end differently (one on its jaw, one on a pad fixed past its jaw)
+gripper       the two tips end differently (one on its jaw, one on a pad fixed past its jaw);
+              a joint driven on its own moves beside the two fingers (a third finger)
 chain         the SRDF group's joints include a prismatic one (a lift: torso or arm?); the
               group is named as a leg and the tree finds an arm (or the other way round)
 drive         a fixed virtual joint on a robot with wheels (turning, wheel-shaped or on
@@ -112,6 +113,38 @@ def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str |
             return (
                 f"the finger tips '{m.thumb.tip}' and '{m.finger.tip}' end differently: the tips?"
             )
+        # Nor does it say that the two are all the hand's fingers: a joint driven on its own
+        # beside them (a third finger, a spread) makes a hand the tag does not describe.
+        if (third := _beside_fingers(d, m, root)) is not None:
+            return f"'{third}' moves beside the two fingers: a third finger, a hand?"
+    return None
+
+
+def _beside_fingers(d: Drafter, m: DraftManipulator, root: Body) -> str | None:
+    """A joint driven on its own below the hand's root, outside both fingers, if any.
+
+    Driven: not a mimic, and, where the file has transmissions or ``ros2_control`` blocks,
+    one of the joints they drive (PR2's gripper slider and screw are no finger's).
+    """
+    world = d.world
+    held: set[int] = set()
+    for f in (m.thumb, m.finger):
+        if f is None or not world.has_body(f.tip):
+            return None
+        b = world.get_body_by_name(f.tip)  # up to the finger's first link past the root
+        while (up := world.parent_connection(b)) is not None and up.parent != root.index:
+            b = world.bodies[up.parent]
+        if up is None:
+            return None  # the tip is not below the hand's root
+        held |= {k.index for k in world.subtree(b)}
+    act = d.facts.actuation
+    for b in world.subtree(root):
+        up = world.parent_connection(b)
+        if b is root or up is None or not up.is_active or b.index in held:
+            continue
+        if act.stated and up.name not in act.joints:
+            continue  # the control blocks drive it not (a linkage's slider, a screw)
+        return up.name
     return None
 
 

@@ -176,3 +176,35 @@ def test_a_joint_driven_beside_mimic_coupled_fingers_keeps_the_mark(tmp_path: Pa
     (m,) = _draft(tmp_path, "arm", [*_gripper(pad=False), *third]).manipulators
     assert m.is_gripper and m.stated == ()
     assert m.decide == ["'third_q' moves beside the two fingers: a third finger, a hand?"]
+
+
+def _quadruped_turned(turned: bool) -> list[str]:
+    """``_quadruped``'s four legs, their hips at (x, y) or, ``turned``, at (y, x): long along y."""
+    from tests.test_draft_first_sight7_d1 import _quadruped
+
+    parts = _quadruped(0.25)
+    if not turned:
+        return parts
+    swap = {"0.2 0.1 0": "0.1 0.2 0", "0.2 -0.1 0": "-0.1 0.2 0"}
+    swap |= {"-0.2 0.1 0": "0.1 -0.2 0", "-0.2 -0.1 0": "-0.1 -0.2 0"}
+    out = []
+    for p in parts:
+        for old, new in swap.items():
+            p = p.replace(f'xyz="{old}"', f'xyz="{new}"')
+        out.append(p)
+    return out
+
+
+def test_four_legs_long_along_x_face_x_unasked(tmp_path: Path) -> None:
+    d = _draft(tmp_path, "dog", _quadruped_turned(turned=False))
+    assert [c.role for c in d.chains] == ["leg"] * 4
+    assert d.forward_decide is None
+
+
+def test_four_legs_long_along_y_ask_the_facing(tmp_path: Path) -> None:
+    d = _draft(tmp_path, "dog", _quadruped_turned(turned=True))
+    assert [c.role for c in d.chains] == ["leg"] * 4
+    assert d.forward == (1.0, 0.0, 0.0)
+    assert d.forward_decide == (
+        "its four legs stand farther apart along y than x: it faces +y or -y?"
+    )

@@ -35,7 +35,8 @@ drive         a fixed virtual joint on a robot with wheels (turning, wheel-shape
               one moving the base in the plane (``planar_move``), naming no wheels, leaving
               driven wheels out, or on a robot with legs
 facing        (+x by default, no names said) the robot's two arms or legs lie apart along x,
-              or a differential base's wheels all turn about x
+              its four legs stand wider along y than x, or a differential base's wheels all
+              turn about x
 ============  ==========================================================================
 
 The camera row's checks read the device around the sensor: ``whole_cameras``.
@@ -245,26 +246,33 @@ def _facing_doubt(d: Drafter) -> str | None:
     A pair of arms (or legs) lies across the way the robot faces. When a pair's first links
     lie apart along x, the robot faces +y or -y, and +x (REP 103's default, kept when no side
     names say otherwise) is a guess the files contradict: which side is left only names say.
-    So does a differential base whose wheels all turn about x (it rolls along y), each about
-    its own cylinder's axis.
+    So do four legs whose hips stand farther apart across x than along it (a quadruped's trunk
+    is long the way it walks), and a differential base whose wheels all turn about x (it
+    rolls along y), each about its own cylinder's axis.
     """
     world, tree, draft = d.world, d.tree, d.draft
     for role in ("arm", "leg"):
-        pair = [c for c in draft.chains if c.role == role]
-        if len(pair) != 2:
+        limbs = [c for c in draft.chains if c.role == role]
+        if len(limbs) not in (2, 4):
             continue
         spots = []
-        for c in pair:
+        for c in limbs:
             moving = [world.get_connection_by_name(j) for j in c.joints if world.has_connection(j)]
             if not moving:
                 break
             first = min(moving, key=lambda j: world.depth(world.bodies[j.child]))
             spots.append(tree.position(world.bodies[first.child]))
-        if len(spots) != 2:
+        if len(spots) != len(limbs):
             continue
-        gap = spots[0] - spots[1]
-        if abs(float(gap[0])) > max(2 * abs(float(gap[1])), _SPOT * 2):
-            return f"its two {role}s lie apart along x: it faces +y or -y, not +x?"
+        if len(spots) == 2:
+            gap = spots[0] - spots[1]
+            if abs(float(gap[0])) > max(2 * abs(float(gap[1])), _SPOT * 2):
+                return f"its two {role}s lie apart along x: it faces +y or -y, not +x?"
+        elif role == "leg":
+            # Four legs stand longer along the body than across it (a trunk is long).
+            span = np.ptp(np.asarray(spots), axis=0)
+            if float(span[1]) > max(1.5 * float(span[0]), _SPOT * 2):
+                return "its four legs stand farther apart along y than x: it faces +y or -y?"
     # A differential base rolls across its wheels' axle: an axle along x drives along y. Only
     # where each wheel's cylinder lies about its joint's axis (an axis a file leaves out is x).
     if draft.drive is not None and draft.drive.type == "differential" and d.wheels:

@@ -164,10 +164,10 @@ def test_a_kinect_v2_gets_no_kinect_v1_preset(tmp_path: Path) -> None:
         assert cam.preset == preset
 
 
-def _drill(bit: str) -> list[str]:
+def _drill(bit: str, name: str = "tool_link") -> list[str]:
     """Six joints, a flange, a drill body, its bit: a cylinder centred on its origin."""
     cylinder = (
-        f'<link name="tool_link">{_MASS}<collision><geometry>'
+        f'<link name="{name}">{_MASS}<collision><geometry>'
         f'<cylinder radius="0.004" length="{bit}"/></geometry></collision></link>'
     )
     return _arm(6) + [
@@ -176,7 +176,7 @@ def _drill(bit: str) -> list[str]:
         _link("drill_link", "0.05 0.05 0.07", at="0 0 0.035"),
         _joint("drill_joint", "flange", "drill_link", kind="fixed", xyz="0 0 0.0"),
         cylinder,
-        _joint("bit_joint", "drill_link", "tool_link", kind="fixed", xyz="0.01 0 0.07"),
+        _joint("bit_joint", "drill_link", name, kind="fixed", xyz="0.01 0 0.07"),
     ]
 
 
@@ -197,3 +197,10 @@ def test_a_small_tool_link_centred_on_its_origin_stays_the_tool_frame(tmp_path: 
     draft = _draft(tmp_path, "stub", _drill("0.01"))
     [m] = draft.manipulators
     assert m.tool_frame == "tool_link"
+
+
+def test_a_shaped_link_named_as_a_tcp_stays_the_tool_frame(tmp_path: Path) -> None:
+    """'tool0' with a rigid tool drawn on it is the maker's TCP: its shape does not move it."""
+    draft = _draft(tmp_path, "tool0", _drill("0.074", name="tool0"))
+    [m] = draft.manipulators
+    assert m.tool_frame == "tool0"

@@ -32,13 +32,13 @@ from robotspec.spec.draft.tips import (
     BIT,
     FLANGE,
     between_tips,
-    bit_end,
     flange_offset,
     origin_is_flange,
     rigid_end,
 )
 from robotspec.spec.draft.tool_frames import (
     bare_run_end,
+    bit_frame,
     fixed_jaw,
     frame_at_tips,
     is_bare_frame,
@@ -182,7 +182,7 @@ def _tool_name(
     """The tool frame's name, and the frame proposed when the URDF has none."""
     tree, world = self.tree, self.world
     frame: DraftFrame | None = None
-    if tool is not None and stated is None and (bit := bit_end(tree, top, tool)) is not None:
+    if tool is not None and stated is None and (bit := bit_frame(tree, top, tool)) is not None:
         # A rigid tool's last link centred on its origin (a drill's bit): its tip is out there.
         tool_name = unique(f"{name}_tip", self.names | set(world.body_names))
         frame = DraftFrame(tool_name, tool.name, bit, f"the URDF has no tool frame: {BIT}")

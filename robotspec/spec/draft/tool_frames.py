@@ -15,7 +15,7 @@ import numpy as np
 
 from robotspec.model.entities import Body, Connection
 from robotspec.model.world import World
-from robotspec.spec.draft.tips import between_tips
+from robotspec.spec.draft.tips import between_tips, bit_end
 from robotspec.spec.draft.tool_places import (
     AT_END,
     bare_fixed_leaf,
@@ -32,6 +32,7 @@ __all__ = [
     "TOOL_HINTS",
     "bare_fixed_leaf",
     "bare_run_end",
+    "bit_frame",
     "end_frame",
     "find_tool_frame",
     "fixed_jaw",
@@ -114,6 +115,18 @@ TCP_NAMES: tuple[str, ...] = (
 
 #: A bare frame: a leaf without geometry on a fixed joint (one predicate, two names in use).
 is_bare_frame = bare_fixed_leaf
+
+
+def bit_frame(tree: Tree, top: Body, tool: Body) -> tuple[float, float, float] | None:
+    """Where a rigid tool's bit ends (:func:`tips.bit_end`), unless its link is named as a TCP.
+
+    Why: a link named as a TCP ('tool0' with a rigid gripper's jaws drawn on it) is the frame
+    the maker put where the tool works; its shape says nothing against that name.
+    """
+    name = _named_as(tool.name)
+    if any(_matches(hint, name) for hint in TCP_NAMES):
+        return None
+    return bit_end(tree, top, tool)
 
 
 def is_named_tcp(world: World, body: Body) -> bool:

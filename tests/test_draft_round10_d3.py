@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from robotspec.spec.draft.confidence import CHAIN_SRDF, GRIPPER_MIMIC, TOOL_ON_HAND
+from robotspec.spec.draft.confidence import CAMERA_GAZEBO, CHAIN_SRDF, GRIPPER_MIMIC, TOOL_ON_HAND
 from robotspec.spec.draft.unassigned import SENSORS
 from tests.test_draft_blind import _WHEEL, _draft, _draft_srdf, _joint, _link
 from tests.test_draft_marks_whole import _gripper
@@ -208,3 +208,35 @@ def test_four_legs_long_along_y_ask_the_facing(tmp_path: Path) -> None:
     assert d.forward_decide == (
         "its four legs stand farther apart along y than x: it faces +y or -y?"
     )
+
+
+def _pitched_camera(pitch: float) -> list[str]:
+    """``_camera``'s body and optical frame, its sensor pitched by ``pitch``, the frame named.
+
+    The sensor's plugin publishes in the optical frame (``frameName``): the draft takes it.
+    """
+    from tests.test_draft_marks_whole import _camera
+
+    head = '<sensor name="cam_sensor" type="camera">'
+    named = (
+        '<plugin name="p" filename="libgazebo_ros_camera.so">'
+        "<frameName>cam_optical</frameName></plugin></sensor>"
+    )
+    return [
+        p.replace(head, f"{head}<pose>0 0 0 0 {pitch} 0</pose>").replace("</sensor>", named)
+        for p in _camera([("cam_optical", "0 0 0")])
+    ]
+
+
+def test_a_frame_looking_the_sensors_way_is_stated(tmp_path: Path) -> None:
+    (cam,) = _draft(tmp_path, "cam", _pitched_camera(0.1)).cameras
+    assert (cam.body, cam.decide, cam.stated) == ("cam_optical", [], CAMERA_GAZEBO)
+
+
+def test_a_frame_looking_away_from_its_sensor_keeps_the_mark(tmp_path: Path) -> None:
+    # The sensor looks straight down; the optical frame its plugin names looks ahead.
+    (cam,) = _draft(tmp_path, "cam", _pitched_camera(1.5708)).cameras
+    assert cam.body == "cam_optical" and cam.stated is None
+    assert cam.decide == [
+        "'cam_optical' looks another way than its Gazebo sensor: which frame is the camera?"
+    ]

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robotspec.model.entities import Body
+from robotspec.model.rotations import rpy_to_matrix
 from robotspec.spec.draft.confidence import CAMERA_GAZEBO
 from robotspec.spec.draft.model import DraftCamera
 from robotspec.spec.draft.sensors import stated_channels
@@ -37,6 +38,10 @@ SPOT = 0.01
 _SPOT = SPOT
 #: The cosine within which a frame's z axis is a view direction (8 degrees).
 _ALONG = 0.99
+#: The cosine within which a drafted frame looks the way its Gazebo sensor does (25 degrees).
+_AGREE = 0.9
+#: A Gazebo camera looks along +x of its sensor's frame.
+_X = np.array([1.0, 0.0, 0.0])
 #: Fixed joints walked above and below a camera's frame for the frames fixed to it.
 _RIGID_DEPTH = 3
 #: Words naming a device's colour channel.
@@ -109,6 +114,16 @@ def _camera_doubt(d: Drafter, cam: DraftCamera) -> str | None:
     # depth one the sensor sits on; the second eye of a stereo pair): the sensor states a
     # device, not which of its frames a spec names, nor whether a pair is one camera or two.
     view = _view(d, cam, body)
+    # The way the sensor looks (its frame's +x, Gazebo's convention) against the way the frame
+    # drafted for it looks: apart, the file states a camera, not that this frame is its view.
+    looks = [
+        tree.poses[world.get_body_by_name(g.link).index][:3, :3]
+        @ np.asarray(rpy_to_matrix(*g.pose[3:]))
+        @ _X
+        for g in sensors
+    ]
+    if looks and max(float(v @ view) for v in looks) < _AGREE:
+        return f"'{cam.body}' looks another way than its Gazebo sensor: which frame is the camera?"
     for k in _fixed_to(d, body):
         if k is body or float(np.linalg.norm(tree.poses[k.index][:3, 3] - at)) > DEVICE_SPAN:
             continue

@@ -204,3 +204,12 @@ def test_a_shaped_link_named_as_a_tcp_stays_the_tool_frame(tmp_path: Path) -> No
     draft = _draft(tmp_path, "tool0", _drill("0.074", name="tool0"))
     [m] = draft.manipulators
     assert m.tool_frame == "tool0"
+
+
+def test_a_name_glued_to_a_camera_word_is_a_camera(tmp_path: Path) -> None:
+    """'handeye', 'wristcam': a place glued to a camera's word names a camera (asked)."""
+    for name in ("handeye", "wristcam"):
+        parts = _arm(6) + [_link(name, "0.04 0.04 0.03"), _joint("m", "link6", name, kind="fixed")]
+        (tmp_path / name).mkdir()
+        [cam] = _draft(tmp_path / name, "glued", parts).cameras
+        assert cam.body == name and cam.decide

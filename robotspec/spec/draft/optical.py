@@ -24,8 +24,10 @@ from robotspec.model.entities import Body
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = [
+    "CAMERA_CLOSINGS",
     "CAMERA_WORDS",
     "OPTICAL",
+    "camera_words",
     "device_groups",
     "names_silent",
     "optical_from_body",
@@ -42,6 +44,23 @@ CAMERA_WORDS = frozenset(
     | {"astra", "orbbec", "femto", "gemini", "primesense", "carmine", "oak", "mynteye"}
     | {"flir", "basler", "ximea", "pointgrey", "bumblebee", "multisense"}
 )
+#: How a word glued from a place and a camera's word ends (``handeye``, ``wristcam``).
+CAMERA_CLOSINGS = ("camera", "cam", "eye")
+
+
+def camera_words(tokens: set[str]) -> set[str]:
+    """The tokens of a name that name a camera: a camera's word, or a compound closing in one.
+
+    Why compounds: makers glue a place to the word (``handeye``, ``headcamera``, ``wristcam``:
+    a hand-eye camera, a head camera); the glued word names a camera as surely as the word
+    alone. A closing needs a few letters before it ('scam', 'geye' are no compounds).
+    """
+    glued = {
+        t for t in tokens if any(t.endswith(c) and len(t) >= len(c) + 3 for c in CAMERA_CLOSINGS)
+    }
+    return (tokens & CAMERA_WORDS) | glued
+
+
 #: Words that tell one frame of a device from another: channels and sides.
 TELLING_WORDS = frozenset(
     {"color", "colour", "rgb", "depth", "ir", "infra", "infrared", "ired", "fisheye"}

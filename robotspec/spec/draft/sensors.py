@@ -23,6 +23,7 @@ from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.limbs import HEAD_WORDS, eyes
 from robotspec.spec.draft.optical import (
     CAMERA_WORDS,
+    camera_words,
     device_groups,
     names_silent,
     optical_from_body,
@@ -172,9 +173,10 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             continue
         if optical and parent is not None and _sensor_frame(tree, facts, b, parent.parent):
             continue
-        if optical and world.child_bodies(b) and not w & CAMERA_WORDS:
+        cam_words = camera_words(w)
+        if optical and world.child_bodies(b) and not cam_words:
             continue  # a link turned as optical frames are, carrying others (iCub's 'neck_2')
-        named = w & CAMERA_WORDS and (not world.child_bodies(b) or _carries_channels(tree, b))
+        named = cam_words and (not world.child_bodies(b) or _carries_channels(tree, b))
         if optical or named:
             found.append(CameraFound(_stem(b.name) or b.name, b, optical))
     found = _one_per_nameless_device(tree, found)

@@ -239,3 +239,20 @@ def test_a_frame_looking_away_from_its_sensor_keeps_the_mark(tmp_path: Path) -> 
     assert cam.decide == [
         "'cam_optical' looks another way than its Gazebo sensor: which frame is the camera?"
     ]
+
+
+def test_a_camera_files_own_root_is_asked_about_when_no_camera_is_drafted(
+    tmp_path: Path,
+) -> None:
+    # A camera's own URDF, rooted at the camera, a mounting plate below it: the drafter takes
+    # no root for a camera, so a question says what nothing drafted does.
+    parts = [
+        _link("camera_link", size=0.05),
+        _link("mount_plate", size=0.1),
+        _joint("mount", "camera_link", "mount_plate", "fixed", xyz="0 0 -0.05"),
+    ]
+    d = _draft(tmp_path, "cam", parts)
+    assert not d.cameras
+    assert [q.text for q in d.questions] == [
+        "camera_link (a frame named as a camera) is no drafted camera: a camera? which frame?"
+    ]

@@ -17,7 +17,8 @@ import numpy as np
 
 from robotspec.model.entities import Body
 from robotspec.spec.draft.model import DraftQuestion
-from robotspec.spec.draft.sensors import CAMERA_WORDS, IMAGE_KINDS, NOT_CAMERA_WORDS
+from robotspec.spec.draft.optical import camera_words
+from robotspec.spec.draft.sensors import IMAGE_KINDS, NOT_CAMERA_WORDS
 from robotspec.spec.draft.stated_cameras import DEVICE_SPAN
 from robotspec.spec.draft.tree import words
 
@@ -34,8 +35,6 @@ _LEVEL, _DOWN = 0.2, 0.5
 #: Names shown at most in a question.
 _SHOWN = 4
 _TOKENS = re.compile(r"[^a-z0-9]+")
-#: How a compound word naming a camera ends (``handeye``, ``wristcam``, ``headcamera``).
-_CLOSING = ("camera", "cam", "eye")
 
 
 def _rigid_root(d: Drafter, body: Body) -> Body:
@@ -104,15 +103,13 @@ def _camera_mesh(b: Body) -> str | None:
 
 
 def _named_camera(name: str) -> bool:
-    """Whether a name holds a camera's word, alone or closing a compound (``handeye``, ``headcam``).
+    """Whether a name holds a camera's word and no other sensor's word.
 
-    Why compounds: makers glue words (``handEye`` splits, ``handeye`` does not); a word ending
-    in a camera's (``wristcam``, ``headcamera``, ``lefteye``) names one as surely. Asked only.
+    A camera's word alone or closing a compound (``handeye``, ``wristcam``): the drafter's own
+    test (``optical.camera_words``), so a frame is asked about exactly as it would be drafted.
     """
     w = words(name) | set(_TOKENS.split(name.lower()))
-    if w & NOT_CAMERA_WORDS:
-        return False
-    return bool(w & CAMERA_WORDS) or any(t.endswith(_CLOSING) for t in w)
+    return not w & NOT_CAMERA_WORDS and bool(camera_words(w))
 
 
 def camera_questions(d: Drafter) -> list[DraftQuestion]:
@@ -125,8 +122,8 @@ def camera_questions(d: Drafter) -> list[DraftQuestion]:
         if world.has_body(link) and any(k in kind for k in IMAGE_KINDS):
             why[world.get_body_by_name(link).index] = f"a Gazebo '{kind}' sensor"
     for b in world.bodies:
-        if b.index in why or b is tree.root:
-            continue
+        if b.index in why or (b is tree.root and drafted):
+            continue  # the root only when no camera is drafted (a camera's own file)
         if (words(b.name) | set(_TOKENS.split(b.name.lower()))) & NOT_CAMERA_WORDS:
             continue
         if _named_camera(b.name):

@@ -213,3 +213,34 @@ def test_a_name_glued_to_a_camera_word_is_a_camera(tmp_path: Path) -> None:
         (tmp_path / name).mkdir()
         [cam] = _draft(tmp_path / name, "glued", parts).cameras
         assert cam.body == name and cam.decide
+
+
+def test_a_cameras_own_pose_inside_its_sensor_turns_its_view(tmp_path: Path) -> None:
+    """SDF: a <camera>'s <pose> is in its sensor's frame; here it turns the view onto +z.
+
+    The plugin publishes in the link itself; the camera's pose says that link's z is the view,
+    so the link is an optical frame the file states (no question about its axis).
+    """
+    from robotspec.description.gazebo import gazebo_cameras
+    from robotspec.files.xmlsafe import parse_xml_bytes
+    from robotspec.model.rotations import rpy_to_matrix
+
+    sensor = (
+        '<gazebo reference="hand_camera"><sensor name="hand_camera" type="camera">'
+        "<camera><pose>0 0 0 0 -1.570796327 1.570796327</pose>"
+        "<horizontal_fov>1.0</horizontal_fov><image><width>640</width><height>480</height>"
+        '</image></camera><plugin name="p" filename="libgazebo_ros_camera.so">'
+        "<frameName>hand_camera</frameName></plugin></sensor></gazebo>"
+    )
+    parts = _arm(6) + [
+        _link("hand_camera", "0.02 0.02 0.02"),
+        _joint("cam_mount", "link6", "hand_camera", kind="fixed", xyz="0 0.05 0"),
+        sensor,
+    ]
+    (cam,) = gazebo_cameras(
+        parse_xml_bytes(("<robot>" + "".join(parts) + "</robot>").encode(), "r")
+    )
+    view = rpy_to_matrix(*cam.pose[3:])[:, 0]  # a camera looks along +x of its frame
+    assert [round(float(v), 6) + 0.0 for v in view] == [0.0, 0.0, 1.0]
+    [drafted] = _draft(tmp_path, "hand_camera", parts).cameras
+    assert drafted.body == "hand_camera" and drafted.optical and not drafted.decide

@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
 from lxml import etree
 
 from robotspec.files.xmlsafe import line_of
@@ -133,6 +134,20 @@ def _pose(text: str | None) -> tuple[float, float, float, float, float, float] |
     return (v[0], v[1], v[2], v[3], v[4], v[5])
 
 
+def _compose(
+    outer: tuple[float, float, float, float, float, float],
+    inner: tuple[float, float, float, float, float, float],
+) -> tuple[float, float, float, float, float, float]:
+    """The pose ``inner`` (given in ``outer``'s frame) in the frame ``outer`` is given in."""
+    from robotspec.model.rotations import matrix_to_rpy, rpy_to_matrix
+
+    rot = rpy_to_matrix(*outer[3:])
+    at = rot @ np.asarray(inner[:3], dtype=np.float64) + np.asarray(outer[:3], dtype=np.float64)
+    r, p, y = matrix_to_rpy(rot @ rpy_to_matrix(*inner[3:]))
+    x, yy, z = (float(v) for v in at)
+    return (x, yy, z, float(r), float(p), float(y))
+
+
 def _first(sensor: etree._Element, tag: str) -> etree._Element | None:
     """The first ``tag`` at most three levels below ``sensor`` (camera/image/width), in order."""
     level = [sensor]
@@ -209,6 +224,14 @@ def _camera(
         if inner is None or any(inner[3:]):
             inner = zero if inner is None else (*inner[:3], 0.0, 0.0, 0.0)
         pose = (pose[0] + inner[0], pose[1] + inner[1], pose[2] + inner[2], *pose[3:])
+    elif camera is not None and _children(camera, "pose"):
+        # SDF: a <camera>'s own <pose> is relative to its sensor (Baxter's head camera is
+        # pitched and turned so inside a sensor on the link's frame): the camera's frame is
+        # the sensor's moved by it.
+        inner = _pose(_text(_first(camera, "pose")))
+        if inner is None:
+            return None
+        pose = _compose(pose, inner)
     scope = camera if camera is not None else sensor
     return GazeboCamera(
         name=(sensor.get("name") or "").strip() or link,

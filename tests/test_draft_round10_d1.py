@@ -204,3 +204,100 @@ def test_a_fingers_rod_folding_back_below_its_pad_is_not_its_tip(tmp_path: Path)
     (m,) = d.manipulators
     assert m.is_gripper
     assert {m.thumb.tip, m.finger.tip} == {"left_finger", "right_finger"}  # type: ignore[union-attr]
+
+
+def test_a_servo_jaw_of_a_wide_range_beside_a_fixed_jaw_is_the_grippers(tmp_path: Path) -> None:
+    # Unnamed links, every joint written with a servo's +-120 degrees: the last joint swings
+    # a leaf across its offset beside a fixed leaf reaching past its hinge (the fixed jaw).
+    parts = [_link("base", size=0.1), *_arm_on("base", joints=3)]
+    parts += [
+        f'<link name="fixed_part">{_box("0.01 0.01 0.01")}</link>',
+        _joint("fixed_part_joint", "link3", "fixed_part", "fixed", "0.064 -0.01 0"),
+        f'<link name="moving_part">{_box("0.01 0.01 0.04", "0.02 0 0")}</link>',
+        (
+            '<joint name="moving_part_joint" type="revolute"><parent link="link3"/>'
+            '<child link="moving_part"/><origin xyz="0.048 0.01 0"/><axis xyz="0 0 1"/>'
+            '<limit lower="-2.09" upper="2.09" effort="1" velocity="1"/></joint>'
+        ),
+    ]
+    d = draft_layout(tmp_path, "robot", parts)
+    (arm,) = d.chains
+    assert arm.joints == frozenset({"j1", "j2", "j3"})
+
+
+def _leg(prefix: str, x: float, y: float, arm: bool) -> list[str]:
+    """A 3-joint leg (hip about x, thigh and calf about y) ending at a fixed ball foot.
+
+    ``arm``: the calf also carries, on a fixed mount beside the foot, three joints to a
+    gripper body (a loco-manipulator's small arm).
+    """
+    foot = '<collision><geometry><sphere radius="0.02"/></geometry></collision>'
+    parts = [
+        _link(f"{prefix}_hip", size=0.04),
+        _joint(f"{prefix}_hip_joint", "trunk", f"{prefix}_hip", xyz=f"{x} {y} 0", axis="1 0 0"),
+        _link(f"{prefix}_thigh", size=0.04),
+        _joint(f"{prefix}_thigh_joint", f"{prefix}_hip", f"{prefix}_thigh", xyz="0 0 0"),
+        _link(f"{prefix}_calf", size=0.04),
+        _joint(f"{prefix}_calf_joint", f"{prefix}_thigh", f"{prefix}_calf", xyz="0 0 -0.2"),
+        _link(f"{prefix}_foot", foot),
+        _joint(f"{prefix}_foot_fixed", f"{prefix}_calf", f"{prefix}_foot", "fixed", "0 0 -0.2"),
+    ]
+    if arm:
+        parts += [
+            _link(f"{prefix}_mount", size=0.02),
+            _joint(f"{prefix}_mount_fixed", f"{prefix}_calf", f"{prefix}_mount", "fixed",
+                   "0.02 0 -0.15"),
+            _link(f"{prefix}_a1", size=0.02),
+            _joint(f"{prefix}_a1_joint", f"{prefix}_mount", f"{prefix}_a1", xyz="0 0 0"),
+            _link(f"{prefix}_a2", size=0.02),
+            _joint(f"{prefix}_a2_joint", f"{prefix}_a1", f"{prefix}_a2", xyz="0.05 0 0",
+                   axis="1 0 0"),
+            _link(f"{prefix}_a3", size=0.02),
+            _joint(f"{prefix}_a3_joint", f"{prefix}_a2", f"{prefix}_a3", xyz="0.08 0 0",
+                   axis="0 0 1"),
+        ]  # fmt: skip
+    return parts
+
+
+def test_a_leg_carrying_an_arm_ends_where_its_twins_end(tmp_path: Path) -> None:
+    # Four legs alike from one trunk; the two front calves carry three more joints beside
+    # their feet: four 3-joint legs, and two arms carried by the front legs.
+    parts = [_link("trunk", size=0.2)]
+    for prefix, x, y in (("fl", 0.2, 0.05), ("fr", 0.2, -0.05), ("rl", -0.2, 0.05)):
+        parts += _leg(prefix, x, y, arm=x > 0)
+    parts += _leg("rr", -0.2, -0.05, arm=False)
+    d = draft_layout(tmp_path, "robot", parts)
+    legs = {c.tip: c.joints for c in d.chains if c.role == "leg"}
+    arms = {c.root: c.joints for c in d.chains if c.role == "arm"}
+    assert set(legs) == {"fl_foot", "fr_foot", "rl_foot", "rr_foot"}
+    assert all(len(j) == 3 for j in legs.values())
+    assert arms == {
+        side + "_calf": frozenset({f"{side}_a1_joint", f"{side}_a2_joint", f"{side}_a3_joint"})
+        for side in ("fl", "fr")
+    }
+
+
+def test_a_head_on_the_shoulder_is_known_by_its_gazebo_camera(tmp_path: Path) -> None:
+    # A one-arm robot whose first arm link carries a panning head (its screen and camera):
+    # the head's frame is named by a maker's id, but a Gazebo camera sensor is on it. The
+    # shoulder joint below the head is the arm's first, not a torso.
+    parts = [
+        _link("base", size=0.2),
+        _link("l0", size=0.1),
+        _joint("j0", "base", "l0", xyz="0 0 0.1", axis="0 0 1"),
+        _link("pan_link", size=0.08),
+        _joint("pan", "l0", "pan_link", xyz="0 0 0.3", axis="0 0 1"),
+        '<link name="s1_frame"/>',
+        _joint("s1_mount", "pan_link", "s1_frame", "fixed", "0.05 0 0.1"),
+        '<gazebo reference="s1_frame"><sensor name="s1" type="camera"><camera>'
+        "<horizontal_fov>1.0</horizontal_fov><image><width>640</width><height>480</height>"
+        "</image></camera></sensor></gazebo>",
+    ]
+    above = "l0"
+    for i, axis in enumerate(("0 1 0", "0 0 1", "0 1 0", "0 0 1"), 1):
+        parts += [_link(f"l{i}", size=0.04), _joint(f"j{i}", above, f"l{i}",
+                  xyz="0.1 0 0.2" if i == 1 else "0 0 0.2", axis=axis)]  # fmt: skip
+        above = f"l{i}"
+    d = draft_layout(tmp_path, "robot", parts)
+    (arm,) = [c for c in d.chains if c.role == "arm"]
+    assert arm.joints == frozenset({"j0", "j1", "j2", "j3", "j4"}) and d.torso is None

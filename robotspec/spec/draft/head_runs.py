@@ -49,7 +49,20 @@ def pan_tilt(tree: Tree, seg: Segment) -> bool:
         return False
     if tree.moving_children(seg.end):
         return False
-    return any(words(b.name) & LOOK_WORDS for b in world.subtree(seg.end))
+    return any(_camera_frame(tree, b) for b in world.subtree(seg.end))
+
+
+def _camera_frame(tree: Tree, body: Body) -> bool:
+    """Whether ``body`` is a camera's frame: named so, or the link or frame of a Gazebo camera.
+
+    Why not its rotation too: a wrist's bare end frame is turned as an optical frame as often
+    as a head's camera frame is (Wolfgang-OP's 'l_wrist'); a run is a head by what the files
+    state of its cameras, or by their names.
+    """
+    if words(body.name) & LOOK_WORDS:
+        return True
+    facts = tree.memo.get("facts")
+    return facts is not None and any(body.name in (cam.link, cam.frame) for cam in facts.cameras)
 
 
 def head_on_top(tree: Tree, seg: Segment) -> bool:

@@ -21,8 +21,9 @@ from robotspec.spec.draft.tree import Segment, Tree
 
 __all__ = ["MAX_JAW_RANGE", "one_jaw"]
 
-#: The widest swing (rad) of a moving jaw, three quarters of a turn (a hobby servo's +-120
-#: degrees, AiNex's jaw); a wrist's last joint turns a full turn or more.
+#: The widest swing (rad) of a moving jaw: three quarters of a turn (a hobby servo's +-120
+#: degrees, AiNex's jaw). A wrist's last joint turns farther (FAIRINO's +-175 degrees, about
+#: an axis that, in the default pose, may lie across its offset as a jaw's does).
 MAX_JAW_RANGE = 1.5 * math.pi
 #: How far from square to the way it sticks out a jaw's axis may be (the cosine between them).
 ACROSS = 0.3

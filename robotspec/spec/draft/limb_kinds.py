@@ -31,6 +31,7 @@ __all__ = [
     "mirrored",
     "named",
     "paired_arms",
+    "carried_runs",
     "standing_runs",
     "without_digits",
 ]
@@ -256,3 +257,66 @@ MIN_STANDING_RUNS = 4
 MIRROR_OFF = 0.03
 #: How far (m) a foot may lie from its partner's mirror image.
 MIRROR_TOLERANCE = 0.01
+
+
+def carried_runs(tree: Tree) -> list[tuple[Segment, bool]]:
+    """The tree's runs, a leg carrying an arm cut in two where its twins end at their feet.
+
+    Each run comes with whether it is carried by a leg (the part past the cut). Why: a
+    quadruped with a small arm on each front calf (a loco-manipulator) makes one run of the
+    leg's and the arm's joints; its rear legs, from the same trunk with the same first
+    joints, end at the link carrying their foot. A run that passes such a link, a foot
+    fixed on it too, and goes on with two or more joints, is that leg up to the foot and a
+    limb the leg carries past it (not a leg of six joints).
+    """
+    world = tree.world
+    out: list[tuple[Segment, bool]] = []
+    for seg in tree.segments:
+        n = _twins_end(tree, seg)
+        if n is None:
+            out.append((seg, False))
+            continue
+        at = world.bodies[seg.joints[n - 1].child]
+        i = seg.bodies.index(at)
+        out.append((Segment(seg.start, seg.bodies[: i + 1], seg.joints[:n]), False))
+        out.append((Segment(at, seg.bodies[i + 1 :], seg.joints[n:]), True))
+    return out
+
+
+#: The fewest joints past a twin's end that make a limb the leg carries.
+MIN_CARRIED_JOINTS = 2
+
+
+def _twins_end(tree: Tree, seg: Segment) -> int | None:
+    """How many of ``seg``'s joints its shorter twins have, where it carries a foot too."""
+    world = tree.world
+    for twin in tree.segments:
+        n = len(twin.joints)
+        if twin is seg or twin.start is not seg.start or tree.moving_children(twin.end):
+            continue
+        if n < 2 or len(seg.joints) - n < MIN_CARRIED_JOINTS:
+            continue
+        if not all(_same_joint(a, b) for a, b in zip(seg.joints[:n], twin.joints, strict=False)):
+            continue
+        at = world.bodies[seg.joints[n - 1].child]
+        if _foot(tree, at) and _foot(tree, twin.end):
+            return n
+    return None
+
+
+def _same_joint(a: Connection, b: Connection) -> bool:
+    """Whether two joints are alike: one type, one axis in their own frames."""
+    ax, bx = np.asarray(a.axis, dtype=np.float64), np.asarray(b.axis, dtype=np.float64)
+    return a.type == b.type and bool(np.allclose(ax, bx, atol=1e-3))
+
+
+def _foot(tree: Tree, body: Body) -> bool:
+    """Whether a fixed leaf with collision geometry (a foot) hangs on ``body``."""
+    world = tree.world
+    return any(
+        (c := world.parent_connection(k)) is not None
+        and c.is_fixed
+        and not world.child_bodies(k)
+        and bool(k.collisions)
+        for k in world.child_bodies(body)
+    )

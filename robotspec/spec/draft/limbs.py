@@ -25,6 +25,7 @@ from robotspec.spec.draft.limb_kinds import (
     MAX_HAND_SPAN,
     WORLD_WORDS,
     Limb,
+    carried_runs,
     count,
     hand_span,
     is_named,
@@ -289,7 +290,13 @@ def _find_limbs(tree: Tree, wheels: frozenset[str], rolling: bool) -> list[Limb]
     bases: list[Body | None] = []
     ending = {s.end.index: s for s in tree.segments}
     afoot = standing_runs(tree, low, FOOT_CLEARANCE, LEG_DROP)
-    for seg in tree.segments:
+    for seg, carried in carried_runs(tree):
+        if carried:  # an arm a leg carries past its foot: its size need not be an arm's
+            limb = _limb(tree, seg, low, None, wheels, paired=True, stands=False)
+            if limb is not None and limb.kind == "arm":
+                limbs.append(limb)
+                bases.append(None)
+            continue
         if any(world.is_ancestor(lb.tip, seg.start) for lb in limbs):
             continue  # inside a hand (fingers) or hanging below a limb's end
         above = ending.get(seg.start.index)

@@ -256,3 +256,20 @@ def test_a_camera_files_own_root_is_asked_about_when_no_camera_is_drafted(
     assert [q.text for q in d.questions] == [
         "camera_link (a frame named as a camera) is no drafted camera: a camera? which frame?"
     ]
+
+
+def test_a_urdf_declaring_xml_version_0_0_is_drafted_valid_as_written(tmp_path: Path) -> None:
+    # Some exporters write '<?xml version="0.0" ?>'; libxml2 refuses the version, urdfdom
+    # and pybullet read the file: so does robotspec, as version 1.0.
+    from robotspec.compiler import check_spec
+    from robotspec.spec.draft import render_draft
+    from robotspec.spec.draft.run import draft_from_files
+
+    urdf = tmp_path / "ball.urdf"
+    body = "".join(_camera_mount("plate", None))
+    urdf.write_text(f'<?xml version="0.0" ?>\n<robot name="ball">{body}</robot>')
+    draft, _ = draft_from_files(str(urdf), None, folder=tmp_path, base_folder=tmp_path)
+    spec = tmp_path / "ball.yaml"
+    spec.write_text(render_draft(draft))
+    assert check_spec(spec).robot is not None
+    assert [c.role for c in draft.chains] == ["arm"]

@@ -30,6 +30,11 @@ __all__ = [
 #: pinocchio read such files; the extension elements are unknown to URDF and ignored anyway.
 UNDECLARED_NAMESPACE = "urn:robotspec:undeclared:"
 
+#: An XML declaration naming a version libxml2 refuses (``<?xml version="0.0"?>``, written by
+#: some exporters): urdfdom and pybullet read such files, so the version is read as 1.0.
+_DECLARED_VERSION = re.compile(
+    rb"""\A(\s*<\?xml\s+version\s*=\s*["'])(?!1\.[01]["'])[^"'<>]{0,16}(["'])"""
+)
 _UNDECLARED = re.compile(r"Namespace prefix ([A-Za-z_][\w.-]*) (?:for \S+ )?on \S+ is not defined")
 _MAX_UNDECLARED = 64  # prefixes declared for a file; more is not a robot description
 
@@ -99,6 +104,7 @@ def parse_xml_bytes(
             kind="size",
         )
     refuse_entities(data, file, error_type)
+    data = _DECLARED_VERSION.sub(rb"\g<1>1.0\g<2>", data, count=1)
     try:
         root: etree._Element | None = _parse_declaring_prefixes(data)
     except etree.XMLSyntaxError as exc:

@@ -10,7 +10,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from robotspec.spec.draft.confidence import CAMERA_GAZEBO, CHAIN_SRDF, GRIPPER_MIMIC, TOOL_ON_HAND
+from robotspec.spec.draft.confidence import (
+    CAMERA_GAZEBO,
+    CHAIN_SRDF,
+    GRIPPER_MIMIC,
+    TOOL_ON_HAND,
+    TOOL_SRDF,
+)
 from robotspec.spec.draft.unassigned import SENSORS
 from tests.test_draft_blind import _WHEEL, _draft, _draft_srdf, _joint, _link
 from tests.test_draft_marks_whole import _gripper
@@ -273,3 +279,34 @@ def test_a_urdf_declaring_xml_version_0_0_is_drafted_valid_as_written(tmp_path: 
     spec.write_text(render_draft(draft))
     assert check_spec(spec).robot is not None
     assert [c.role for c in draft.chains] == ["arm"]
+
+
+def _cupped(cup_out: str) -> list[str]:
+    """The arm of ``_camera_mount`` with a bare 'tool0' at its flange and a cup fixed past it."""
+    return [
+        *_camera_mount("mount", None),
+        '<link name="tool0"/>',
+        _joint("tool0_j", "link4", "tool0", "fixed", xyz="0 0 0.02"),
+        _link("cup", size=0.03),
+        _joint("cup_j", "link4", "cup", "fixed", xyz=f"0 0 {cup_out}"),
+    ]
+
+
+_CUP_SRDF = (
+    '<group name="arm"><chain base_link="base" tip_link="link4"/></group>'
+    '<group name="tool"><link name="cup"/></group>'
+    '<end_effector name="cup_tool" parent_link="tool0" group="tool" parent_group="arm"/>'
+)
+
+
+def test_an_srdf_tcp_past_which_nothing_reaches_is_stated(tmp_path: Path) -> None:
+    (m,) = _draft_srdf(tmp_path, "arm", _cupped("0.02"), _CUP_SRDF).manipulators
+    assert m.tool_frame == "tool0" and m.stated == (TOOL_SRDF,)
+    assert not any("reaches past" in why for why in m.decide)
+
+
+def test_a_shape_reaching_past_an_srdf_tcp_keeps_the_mark(tmp_path: Path) -> None:
+    # The end effector's parent link is a bare frame at the flange; a cup is fixed 12 cm out.
+    (m,) = _draft_srdf(tmp_path, "arm", _cupped("0.12"), _CUP_SRDF).manipulators
+    assert m.tool_frame == "tool0" and m.stated == ()
+    assert "'cup' reaches past the tool frame: a tool bolted on, whose TCP?" in m.decide

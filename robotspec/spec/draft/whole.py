@@ -24,7 +24,8 @@ tool frame    the hand (or the chain's end) holds another frame named as a TCP; 
               or hand's TCP moves with a finger, lies behind the hand's root or less than
               halfway out to between its tips' far ends (the hand's mount: a flange, an
               SRDF's parent link at the wrist); without a hand, a shape hangs past the arm's
-              last joint (a tool bolted on)
+              last joint (a tool bolted on); without tips, a shaped link fixed with the frame
+              lies farther out than it
 gripper       the two tips end differently (one on its jaw, one on a pad fixed past its jaw);
               a joint driven on its own moves beside the two fingers (a third finger)
 chain         the SRDF group's joints include a prismatic one (a lift: torso or arm?); the
@@ -103,6 +104,8 @@ def _tcp_doubt(d: Drafter, m: DraftManipulator, rules: tuple[str, ...]) -> str |
                 return f"'{shaped[0]}' hangs past the arm's last joint: a tool, whose TCP?"
         if (why := _short_of_tips(d, m, root, tool)) is not None:
             return why
+        if (past := _shape_past(d, m, tool)) is not None:
+            return f"'{past}' reaches past the tool frame: a tool bolted on, whose TCP?"
     if GRIPPER_MIMIC in rules and m.thumb is not None and m.finger is not None:
         # The mimic tag couples the fingers; where their tips are it does not say. Two alike
         # fingers end alike: one ending on its jaw and the other on a pad fixed past its jaw
@@ -146,6 +149,26 @@ def _beside_fingers(d: Drafter, m: DraftManipulator, root: Body) -> str | None:
         if act.stated and up.name not in act.joints:
             continue  # the control blocks drive it not (a linkage's slider, a screw)
         return up.name
+    return None
+
+
+def _shape_past(d: Drafter, m: DraftManipulator, tool: Body) -> str | None:
+    """A shaped link fixed with the tool frame and farther out than it, on a hand without tips.
+
+    Why: a TCP name or an SRDF end effector's parent link at a flange says where the arm
+    ends, not where a rigid tool bolted past it (a suction cup, a torch) meets the work.
+    """
+    world, tree = d.world, d.tree
+    if m.thumb is not None or m.fingers:
+        return None  # a hand with tips: ``_short_of_tips`` says where its TCP lies
+    last = tree.rigid_root(tool)  # the link the last joint moves
+    base = tree.position(last)
+    out = float(np.linalg.norm(tree.position(tool) - base))
+    for b in world.subtree(last):
+        if b is last or not own_geometry(b) or tree.rigid_root(b) is not last:
+            continue
+        if float(np.linalg.norm(tree.position(b) - base)) > out + _SPOT:
+            return b.name
     return None
 
 

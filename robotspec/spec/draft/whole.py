@@ -153,21 +153,26 @@ def _beside_fingers(d: Drafter, m: DraftManipulator, root: Body) -> str | None:
 
 
 def _shape_past(d: Drafter, m: DraftManipulator, tool: Body) -> str | None:
-    """A shaped link fixed with the tool frame and farther out than it, on a hand without tips.
+    """A shaped link fixed with a tipless hand's tool frame, farther out than the frame lies.
 
-    Why: a TCP name or an SRDF end effector's parent link at a flange says where the arm
-    ends, not where a rigid tool bolted past it (a suction cup, a torch) meets the work.
+    Farther out: along the way from the last joint's link to the frame. Why: a TCP name or an
+    SRDF end effector's parent link at a flange says where the arm ends, not where a rigid
+    tool bolted past it (a suction cup, a torch) meets the work.
     """
     world, tree = d.world, d.tree
     if m.thumb is not None or m.fingers:
         return None  # a hand with tips: ``_short_of_tips`` says where its TCP lies
     last = tree.rigid_root(tool)  # the link the last joint moves
     base = tree.position(last)
-    out = float(np.linalg.norm(tree.position(tool) - base))
+    way = tree.position(tool) - base
+    out = float(np.linalg.norm(way))
+    if out < _SPOT:
+        return None  # a frame at the joint: no way out to measure along
+    way = way / out
     for b in world.subtree(last):
         if b is last or not own_geometry(b) or tree.rigid_root(b) is not last:
             continue
-        if float(np.linalg.norm(tree.position(b) - base)) > out + _SPOT:
+        if float((tree.position(b) - base) @ way) > out + _SPOT:
             return b.name
     return None
 

@@ -271,8 +271,11 @@ def carried_runs(tree: Tree) -> list[tuple[Segment, bool]]:
     """
     world = tree.world
     out: list[tuple[Segment, bool]] = []
+    by_start: dict[int, list[Segment]] = {}
     for seg in tree.segments:
-        n = _twins_end(tree, seg)
+        by_start.setdefault(seg.start.index, []).append(seg)
+    for seg in tree.segments:
+        n = _twins_end(tree, seg, by_start[seg.start.index])
         if n is None:
             out.append((seg, False))
             continue
@@ -287,12 +290,15 @@ def carried_runs(tree: Tree) -> list[tuple[Segment, bool]]:
 MIN_CARRIED_JOINTS = 2
 
 
-def _twins_end(tree: Tree, seg: Segment) -> int | None:
-    """How many of ``seg``'s joints its shorter twins have, where it carries a foot too."""
+def _twins_end(tree: Tree, seg: Segment, beside: list[Segment]) -> int | None:
+    """How many of ``seg``'s joints its shorter twins have, where it carries a foot too.
+
+    ``beside``: the runs from ``seg``'s start (itself among them).
+    """
     world = tree.world
-    for twin in tree.segments:
+    for twin in beside:
         n = len(twin.joints)
-        if twin is seg or twin.start is not seg.start or tree.moving_children(twin.end):
+        if twin is seg or tree.moving_children(twin.end):
             continue
         if n < 2 or len(seg.joints) - n < MIN_CARRIED_JOINTS:
             continue

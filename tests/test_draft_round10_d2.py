@@ -244,3 +244,19 @@ def test_a_cameras_own_pose_inside_its_sensor_turns_its_view(tmp_path: Path) -> 
     assert [round(float(v), 6) + 0.0 for v in view] == [0.0, 0.0, 1.0]
     [drafted] = _draft(tmp_path, "hand_camera", parts).cameras
     assert drafted.body == "hand_camera" and drafted.optical and not drafted.decide
+
+
+def test_a_moving_last_link_named_as_a_tool_is_no_tool_frame(tmp_path: Path) -> None:
+    """'eef' on the arm's last (revolute) joint is a part that turns, not a TCP frame.
+
+    The tool frame is proposed on it, at the far end of its shape, as for any bare arm.
+    """
+    parts = _arm(5) + [
+        _link("arm_eef", "0.03 0.03 0.04", at="0 0 0.02"),
+        _joint("joint6", "link5", "arm_eef", axis="0 0 1"),
+    ]
+    draft = _draft(tmp_path, "eef", parts)
+    [m] = draft.manipulators
+    [frame] = draft.frames
+    assert m.tool_frame == frame.name and frame.parent == "arm_eef"
+    assert frame.xyz == (0.0, 0.0, 0.04)

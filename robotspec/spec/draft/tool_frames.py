@@ -164,8 +164,11 @@ def find_tool_frame(
         # flange it is bolted to (Schunk SIH's 'flange-palm'), not a TCP.
         if c is not None and c.is_fixed and not _carries_moving(world, b):
             names[b.index].append(_named_as(c.name))
+    # A link on a moving joint is a part that moves (an arm's last link named 'eef'), never a
+    # frame a name makes a TCP: the tool frame is then proposed on it, not the link itself.
+    named = [b for b in candidates if (c := world.parent_connection(b)) is None or c.is_fixed]
     for hint in TOOL_HINTS:
-        hits = [b for b in candidates if any(_matches(hint, n) for n in names[b.index])]
+        hits = [b for b in named if any(_matches(hint, n) for n in names[b.index])]
         if hits:
             # A TCP is a frame (a leaf), not a link carrying fingers ('fingers_link' on 'ee_bar').
             return min(

@@ -39,6 +39,26 @@ bolted past it; a fixed virtual joint states what a planner assumes, not that th
 wheels; a ``planar_move`` plugin fakes any drive). Drafts of robots seen for the first time
 left wrong items unmarked exactly there.
 
+How each row could still be wrong on a robot nobody here has seen (round 10's audit; where the
+case is plausible, ``whole`` keeps the mark, and the rest is what a mark cannot catch):
+
+* chain: a planner's group cut otherwise than a spec's (a waist joint inside the arm's group on
+  a one-armed robot the tree cannot split; a lift is asked); a group named as a leg the tree
+  reads as an arm (asked);
+* tool frame: a TCP name on a flange or on a finger rather than between the tips (asked when it
+  moves with a finger or lies less than halfway out to the tips); an SRDF parent link at the
+  flange with a tool bolted past it (asked when a shape lies farther out); a TCP name the
+  spec's author does not take although it is the only one (not caught);
+* gripper: a mimic pair that is two fingers of a hand with a third driven on its own (asked);
+  tips the author puts on a pad or a bare frame the tree does not reach (asked where the two
+  sides end differently, not where both do alike);
+* camera: a sensor naming a body link whose optical child is the camera, or a channel beside it
+  (asked when the device holds other frames looking its way), a frame looking away from its
+  sensor (asked), an author who lists no camera for a simulated one (not caught);
+* drive: a floating virtual joint on a robot whose legs the tree misread (arms hanging down:
+  the legs' own marks ask); a fixed one on a base whose wheels the file does not model at all
+  (not caught: nothing in the files says it moves).
+
 Each row that leaves an item unmarked has a code (``CHAIN_SRDF``, ``TOOL_SRDF``...): the draft
 item records it (``stated``, never written into the spec), so that the corpus measure counts,
 per rule, how many items it left unmarked and how many of those were wrong. A rule that leaves

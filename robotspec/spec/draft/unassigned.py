@@ -268,8 +268,9 @@ def _uneven_limb_questions(d: Drafter) -> list[DraftQuestion]:
     Why: a robot's legs are alike, and so are its two arms; a leg of six joints beside legs of
     three runs on past its foot into another part (an arm mounted on a leg), an arm longer
     than its mirror into a hand's or a tool's joint. The drafted limb covers those joints, so
-    nothing else would ask about the part they make. The question names the joints past the
-    shortest limb's count and every link they carry.
+    nothing else would ask about the part they make. Which end holds the joint more the tree
+    does not say (a waist joint inside an arm's run is one too): the question names the joints
+    past the shortest limb's count, the links they carry, and asks about both ends.
     """
     world = d.world
     out = []
@@ -284,12 +285,14 @@ def _uneven_limb_questions(d: Drafter) -> list[DraftQuestion]:
             if not extra:
                 continue
             names = [j.name for j in extra]
+            every = frozenset(j.name for j in run if j.is_active)
             links = frozenset(b.name for b in world.subtree(world.bodies[extra[0].child]))
             text = (
-                f"{name} moves {len(run)} joints, another {role} {least}: "
-                f"{_span(names)} carry another part (an arm on the {role}? a hand's joint?)"
+                f"{name} moves {len(run)} joints, another {role} {least}: a part more at its "
+                f"end ({_span(names)}: an arm on the {role}? a hand's joint?) or at its start "
+                "(a torso's joint)?"
             )
-            out.append(DraftQuestion(CHAINS, text, frozenset(names), links))
+            out.append(DraftQuestion(CHAINS, text, every, links))
     return out
 
 

@@ -260,3 +260,28 @@ def test_a_moving_last_link_named_as_a_tool_is_no_tool_frame(tmp_path: Path) -> 
     [frame] = draft.frames
     assert m.tool_frame == frame.name and frame.parent == "arm_eef"
     assert frame.xyz == (0.0, 0.0, 0.04)
+
+
+def test_a_shapeless_jaw_named_as_the_gripper_is_no_tcp(tmp_path: Path) -> None:
+    """Meshes missing: a jaw 'gripper_link1' that the other jaw mimics is bare like every link.
+
+    Bareness marks a frame (a hand's TCP on the joint its fingers mimic) only in a hand that
+    has shapes; here the tool frame is proposed between the jaws, never on one of them.
+    """
+    parts = [_link("base", None)]
+    for i in range(1, 7):
+        axis = "0 0 1" if i % 2 else "0 1 0"
+        parent = "base" if i == 1 else f"link{i - 1}"
+        parts += [_link(f"link{i}", None), _joint(f"joint{i}", parent, f"link{i}", axis=axis)]
+    parts += [_link("gripper_base", None)]
+    parts += [_joint("mount", "link6", "gripper_base", kind="fixed", xyz="0 0 0.08")]
+    for k, (y, ax, mimic) in enumerate((("0.02", "0 1 0", None), ("-0.02", "0 -1 0", "j1")), 1):
+        parts += [_link(f"gripper_link{k}", None)]
+        parts += [
+            _joint(
+                f"j{k}", "gripper_base", f"gripper_link{k}", "prismatic", f"0 {y} 0.06", ax, mimic
+            )
+        ]
+    draft = _draft(tmp_path, "shapeless_gripper", parts)
+    [m] = draft.manipulators
+    assert m.tool_frame not in ("gripper_link1", "gripper_link2")

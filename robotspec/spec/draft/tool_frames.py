@@ -184,6 +184,9 @@ def find_tool_frame(
     # turned by the joint the fingers mimic (NAO's 'l_gripper' on 'LHand': the hand's TCP).
     # The turned one is the hand's TCP by structure alone, named as anything, when it is out
     # from the hand (at the hand's origin it is the motor's stand-in: HSR-B's, qb SoftHand's).
+    # Bareness tells a frame from a finger only where the hand has shapes (not in a file whose
+    # meshes are missing, where every finger is bare).
+    shaped = any(own_geometry(b) for b in world.subtree(top))
     bare = [
         b
         for b in candidates
@@ -191,7 +194,7 @@ def find_tool_frame(
         and not own_geometry(b)
         and (c := world.parent_connection(b)) is not None
         and (
-            (c.is_fixed or _leads_fingers(world, c, top))
+            (c.is_fixed or (shaped and _leads_fingers(world, c, top)))
             if "gripper" in names[b.index][0][1]
             else _leads_fingers(world, c, top, shaped=True)
             and float(np.linalg.norm(c.origin[:3, 3])) > AT_END

@@ -285,3 +285,30 @@ def test_a_shapeless_jaw_named_as_the_gripper_is_no_tcp(tmp_path: Path) -> None:
     draft = _draft(tmp_path, "shapeless_gripper", parts)
     [m] = draft.manipulators
     assert m.tool_frame not in ("gripper_link1", "gripper_link2")
+
+
+def _drawn_with(tmp_path: Path, name: str, mesh: str) -> list[str]:
+    """A base carrying a leaf ``name`` drawn with ``mesh`` (an empty STL written here)."""
+    (tmp_path / "meshes").mkdir(exist_ok=True)
+    (tmp_path / "meshes" / mesh).write_text("solid m\nendsolid m\n")
+    visual = f'<visual><geometry><mesh filename="meshes/{mesh}"/></geometry></visual>'
+    return [
+        _link("base_link", "0.5 0.4 0.2"),
+        f'<link name="{name}">{_MASS}{visual}</link>',
+        _joint("m", "base_link", name, kind="fixed", xyz="0.25 0 0.3"),
+    ]
+
+
+def test_a_link_named_as_nothing_drawn_with_a_cameras_mesh_is_a_camera(tmp_path: Path) -> None:
+    """A neutral id drawn with 'd435.stl': the file says camera (asked, with the mesh named)."""
+    [cam] = _draft(tmp_path, "mesh", _drawn_with(tmp_path, "n4", "d435.stl")).cameras
+    assert cam.body == "n4" and any("d435.stl" in q for q in cam.decide)
+
+
+def test_a_mount_or_a_sensor_mesh_is_no_camera(tmp_path: Path) -> None:
+    """A link named as a mount, or a mesh named as a lidar beside a camera's word, is none."""
+    for name, mesh in (("camera_mount", "d435.stl"), ("n5", "lidar_camera_unit.stl")):
+        (tmp_path / name).mkdir()
+        assert (
+            _draft(tmp_path / name, "mesh", _drawn_with(tmp_path / name, name, mesh)).cameras == []
+        )

@@ -67,6 +67,11 @@ def add_sensors(d: Drafter) -> None:
                     "named as a camera, not rotated as an optical frame; its z axis, not its x,"
                     " points the way the robot faces"
                 )
+            elif seen.mesh is not None:
+                cam.decide.append(
+                    f"drawn with a mesh named as a camera ('{seen.mesh}'), but not rotated as an"
+                    " optical frame"
+                )
             else:
                 cam.decide.append("named as a camera, but not rotated as an optical frame")
         elif not cam.decide and (q := camera_question(False, _BY_ROTATION)):

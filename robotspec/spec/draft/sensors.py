@@ -69,6 +69,7 @@ class CameraFound:
 
     ``stated``: the Gazebo sensor that makes it a fact (None for a camera found by its name or
     rotation). ``doubt``: why a found camera is a question although its frame looks like one.
+    ``mesh``: the file it is drawn with, when that, not its name, says camera.
     """
 
     name: str
@@ -76,6 +77,7 @@ class CameraFound:
     optical: bool
     stated: StatedCamera | None = None
     doubt: str | None = None
+    mesh: str | None = None
 
 
 @dataclass(frozen=True)
@@ -173,12 +175,14 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             continue
         if optical and parent is not None and _sensor_frame(tree, facts, b, parent.parent):
             continue
-        cam_words = camera_words(w)
-        if optical and world.child_bodies(b) and not cam_words:
+        # What a camera is bolted to is none, whatever it is named or drawn with.
+        cam_words = camera_words(w) if not w & MOUNT_WORDS else set()
+        mesh = None if cam_words else _camera_mesh(b)
+        if optical and world.child_bodies(b) and not (cam_words or mesh):
             continue  # a link turned as optical frames are, carrying others (iCub's 'neck_2')
-        named = cam_words and (not world.child_bodies(b) or _carries_channels(tree, b))
+        named = (cam_words or mesh) and (not world.child_bodies(b) or _carries_channels(tree, b))
         if optical or named:
-            found.append(CameraFound(_stem(b.name) or b.name, b, optical))
+            found.append(CameraFound(_stem(b.name) or b.name, b, optical, mesh=mesh))
     found = _one_per_nameless_device(tree, found)
     # One per device: drop a camera whose name extends another's on the same rigid body, or
     # is extended by it. Optical frames first: 'camera_link' and its child
@@ -217,6 +221,7 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
                 cam.body,
                 cam.optical,
                 doubt="a camera by its frame, though no Gazebo sensor of the URDF simulates it",
+                mesh=cam.mesh,
             )
         if not dup:
             kept.append(cam)
@@ -224,8 +229,29 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
     return kept
 
 
+def _camera_mesh(body: Body) -> str | None:
+    """The file name of the mesh a link is drawn with, when named as a camera (``d435.dae``).
+
+    Why: a link named as nothing (a maker's ids) drawn with a mesh named as a camera is that
+    camera as surely as one so named; never one named as a mount or holder (drawn with the
+    camera's mesh too), nor a mesh named as another sensor. Asked like any camera by its name.
+    """
+    if words(body.name) & MOUNT_WORDS:
+        return None
+    for shape in (*body.visuals, *body.collisions):
+        uri = getattr(shape.geometry, "uri", None)
+        if not isinstance(uri, str):
+            continue
+        file = uri.replace("\\", "/").rsplit("/", 1)[-1]
+        stem = file.rsplit(".", 1)[0]
+        tokens = words(stem) | set(re.split(r"[^a-z0-9]+", stem.lower()))
+        if not tokens & (NOT_CAMERA_WORDS | MOUNT_WORDS) and camera_words(tokens):
+            return file
+    return None
+
+
 #: Words of a link that holds a camera rather than being one.
-MOUNT_WORDS = frozenset({"mount", "holder", "bracket", "support", "base", "stand", "adapter"})
+MOUNT_WORDS = frozenset({"mount", "holder", "bracket", "support", "adapter"})
 
 
 def _carries_channels(tree: Tree, body: Body) -> bool:

@@ -301,3 +301,12 @@ def test_a_head_on_the_shoulder_is_known_by_its_gazebo_camera(tmp_path: Path) ->
     d = draft_layout(tmp_path, "robot", parts)
     (arm,) = [c for c in d.chains if c.role == "arm"]
     assert arm.joints == frozenset({"j0", "j1", "j2", "j3", "j4"}) and d.torso is None
+
+
+def test_wheels_alone_under_a_floating_virtual_joint_say_the_drive(tmp_path: Path) -> None:
+    # A MoveIt config that floats a wheeled base: nothing but the wheels moves it (no legs,
+    # no rotors), so the wheels say the drive, asked.
+    floating = _PLANAR.replace('type="planar"', 'type="floating"')
+    d = _draft_srdf(tmp_path, "robot", _two_wheeled(False), floating)
+    assert d.drive is not None and d.drive.type == "differential"
+    assert d.drive.decide is not None and "the SRDF's joint is floating" in d.drive.decide

@@ -134,12 +134,15 @@ def add_drive(d: Drafter) -> None:
         virtual = {"omni": "planar"}.get(draft.drive.type, draft.drive.type)
         moves = bool(wheels or len(legs) >= 2 or rotors)
         planner = virtual == "fixed" and bool(wheels) and movable
-    if draft.drive is not None and virtual == "planar" and wheels and movable:
-        # MoveIt models every wheeled base as a planar joint, whatever its wheels: the URDF's
-        # wheels say how it drives (a drive plugin states it; two on one axle: differential).
+    rolls = bool(wheels) and movable and len(legs) < 2 and not rotors
+    if draft.drive is not None and virtual in ("planar", "floating") and rolls:
+        # MoveIt models a wheeled base as a planar (or floating) joint, whatever its wheels: the
+        # URDF's wheels say how it drives (a drive plugin states it; two on one axle:
+        # differential). Only on wheels alone: legs or rotors may float the robot.
         wheeled = _wheeled_drive(d, wheels, casters)
-        if wheeled.type != "omni":
-            wheeled.decide = wheeled.decide and f"{wheeled.decide}; the SRDF's joint is planar"
+        if wheeled.type != "omni" or virtual == "floating":
+            said = f"the SRDF's joint is {virtual}"
+            wheeled.decide = wheeled.decide and f"{wheeled.decide}; {said}"
             draft.drive = wheeled
             return
     if draft.drive is not None and not planner:

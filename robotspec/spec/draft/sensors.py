@@ -19,6 +19,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from robotspec.model.entities import Body, Connection
+from robotspec.spec.draft.camera_evidence import (
+    MOUNT_WORDS,
+    NOT_CAMERA_WORDS,
+    camera_mesh,
+    carries_channels,
+)
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.limbs import HEAD_WORDS, eyes
 from robotspec.spec.draft.optical import (
@@ -34,13 +40,13 @@ from robotspec.spec.draft.optical import (
 from robotspec.spec.draft.stated_cameras import (
     DEVICE_SPAN,
     StatedCamera,
-    channel_words,
     stated_cameras,
 )
 from robotspec.spec.draft.tree import Tree, words
 
 __all__ = [
     "CAMERA_WORDS",
+    "NOT_CAMERA_WORDS",
     "CameraFound",
     "NeckFound",
     "find_cameras",
@@ -50,12 +56,6 @@ __all__ = [
 
 #: Gazebo sensor types that take images: the frames of other sensors are theirs, never cameras.
 IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
-NOT_CAMERA_WORDS = frozenset(
-    {"imu", "laser", "lidar", "scan", "hokuyo", "accelerometer", "accel", "gyro", "range"}
-    | {"sonar", "ft", "force", "torque", "contact", "velodyne", "ultrasound", "projector"}
-    | {"gps", "magnetometer", "bumper", "led", "axis", "light", "lamp", "microphone", "mic"}
-    | {"speaker", "flashlight", "thermal_sensor"}
-)
 #: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
 _OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
 #: The cosine within which a tilted optical frame's z axis stays of its parent's x (60 degrees).
@@ -177,10 +177,10 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             continue
         # What a camera is bolted to is none, whatever it is named or drawn with.
         cam_words = camera_words(w) if not w & MOUNT_WORDS else set()
-        mesh = None if cam_words else _camera_mesh(b)
+        mesh = None if cam_words else camera_mesh(b)
         if optical and world.child_bodies(b) and not (cam_words or mesh):
             continue  # a link turned as optical frames are, carrying others (iCub's 'neck_2')
-        named = (cam_words or mesh) and (not world.child_bodies(b) or _carries_channels(tree, b))
+        named = (cam_words or mesh) and (not world.child_bodies(b) or carries_channels(tree, b))
         if optical or named:
             found.append(CameraFound(_stem(b.name) or b.name, b, optical, mesh=mesh))
     found = _one_per_nameless_device(tree, found)
@@ -227,55 +227,6 @@ def _find_cameras(tree: Tree) -> list[CameraFound]:
             kept.append(cam)
     kept.sort(key=lambda c: c.body.index)
     return kept
-
-
-def _camera_mesh(body: Body) -> str | None:
-    """The file name of the mesh a link is drawn with, when named as a camera (``d435.dae``).
-
-    Why: a link named as nothing (a maker's ids) drawn with a mesh named as a camera is that
-    camera as surely as one so named; never one named as a mount or holder (drawn with the
-    camera's mesh too), nor a mesh named as another sensor. Asked like any camera by its name.
-    """
-    if words(body.name) & MOUNT_WORDS:
-        return None
-    for shape in (*body.visuals, *body.collisions):
-        uri = getattr(shape.geometry, "uri", None)
-        if not isinstance(uri, str):
-            continue
-        file = uri.replace("\\", "/").rsplit("/", 1)[-1]
-        stem = file.rsplit(".", 1)[0]
-        tokens = words(stem) | set(re.split(r"[^a-z0-9]+", stem.lower()))
-        if not tokens & (NOT_CAMERA_WORDS | MOUNT_WORDS) and camera_words(tokens):
-            return file
-    return None
-
-
-#: Words of a link that holds a camera rather than being one.
-MOUNT_WORDS = frozenset({"mount", "holder", "bracket", "support", "adapter"})
-
-
-def _carries_channels(tree: Tree, body: Body) -> bool:
-    """Whether a link named as a camera is a device carrying its channels' frames.
-
-    Why: a stereo or RGB-D device is often written as its link with bare frames fixed below it,
-    one per channel other than colour (a right infrared imager 5 cm aside, a depth frame), none
-    turned as an optical frame; the device's link is the camera a person names, not one of its
-    channels (one device, one camera). Only when everything below it is such a frame on a fixed
-    joint (a lens or colour frame below a camera is where it sees from: that frame stays the
-    camera), and never a link named as a mount or holder (what a camera is bolted to is none).
-    """
-    world = tree.world
-    if words(body.name) & MOUNT_WORDS:
-        return False
-    below = world.subtree(body)[1:]
-    return bool(below) and all(
-        (c := world.parent_connection(k)) is not None
-        and c.is_fixed
-        and not (k.collisions or k.visuals)
-        and (ch := channel_words(k.name))
-        and not ch & _COLOUR
-        for k in below
-    )
 
 
 def _sensor_frame(tree: Tree, facts: FileFacts, body: Body, parent: int) -> bool:

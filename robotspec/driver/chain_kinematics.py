@@ -115,11 +115,8 @@ class HPChain:
                 ax, ay, az = sign * r01, sign * r11, sign * r21
             elif kind == 0:
                 ax, ay, az = sign * r00, sign * r10, sign * r20
-            else:
-                hx, hy, hz = self._h_list[i]
-                ax = r00 * hx + r01 * hy + r02 * hz
-                ay = r10 * hx + r11 * hy + r12 * hz
-                az = r20 * hx + r21 * hy + r22 * hz
+            else:  # a general axis (rare on industrial arms)
+                ax, ay, az = _rotate((r00, r01, r02, r10, r11, r12, r20, r21, r22), self._h_list[i])
             if qd is not None:
                 qdi = qd[i]
                 if qdi != 0.0:
@@ -166,18 +163,11 @@ class HPChain:
                 px += r00 * bx + r01 * by + r02 * bz
                 py += r10 * bx + r11 * by + r12 * bz
                 pz += r20 * bx + r21 * by + r22 * bz
-        frames: tuple[tuple[Sequence[float], Sequence[float]], ...] = (
-            (self._flange_r_list, self._flange_p_list),
+        rot, (px, py, pz) = _through_frames(
+            (r00, r01, r02, r10, r11, r12, r20, r21, r22),
+            (px, py, pz),
+            ((self._flange_r_list, self._flange_p_list), (tool_rotation, tool_position)),
         )
-        if tool_rotation is not None and tool_position is not None:
-            frames += ((tool_rotation, tool_position),)
-        rot = (r00, r01, r02, r10, r11, r12, r20, r21, r22)
-        for fr, fp in frames:
-            bx, by, bz = fp
-            px += rot[0] * bx + rot[1] * by + rot[2] * bz
-            py += rot[3] * bx + rot[4] * by + rot[5] * bz
-            pz += rot[6] * bx + rot[7] * by + rot[8] * bz
-            rot = _times(rot, fr)
         vx = wy * pz - wz * py - cx + lx
         vy = wz * px - wx * pz - cy + ly
         vz = wx * py - wy * px - cz + lz
@@ -260,6 +250,39 @@ def _times(r: Sequence[float], a: Sequence[float]) -> _Rot:
         r20 * a01 + r21 * a11 + r22 * a21,
         r20 * a02 + r21 * a12 + r22 * a22,
     )
+
+
+def _rotate(r: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
+    """``r v`` for a rotation row-major in nine plain floats and a 3-vector."""
+    vx, vy, vz = v
+    return (
+        r[0] * vx + r[1] * vy + r[2] * vz,
+        r[3] * vx + r[4] * vy + r[5] * vz,
+        r[6] * vx + r[7] * vy + r[8] * vz,
+    )
+
+
+def _through_frames(
+    rot: _Rot,
+    pos: tuple[float, float, float],
+    frames: tuple[tuple[Sequence[float] | None, Sequence[float] | None], ...],
+) -> tuple[_Rot, tuple[float, float, float]]:
+    """The pose ``(rot, pos)`` carried through fixed frames: the flange, then the tool if given.
+
+    Why apart from :meth:`HPChain.tcp_state`: it runs once per call, after the per-joint walk,
+    and is the one step a reader checks against the flange and tool transforms. A frame whose
+    rotation or position is None (no tool) is skipped.
+    """
+    px, py, pz = pos
+    for fr, fp in frames:
+        if fr is None or fp is None:
+            continue
+        bx, by, bz = fp
+        px += rot[0] * bx + rot[1] * by + rot[2] * bz
+        py += rot[3] * bx + rot[4] * by + rot[5] * bz
+        pz += rot[6] * bx + rot[7] * by + rot[8] * bz
+        rot = _times(rot, fr)
+    return rot, (px, py, pz)
 
 
 def _rodrigues(h: Sequence[float], c: float, s: float) -> _Rot:

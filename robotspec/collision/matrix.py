@@ -183,11 +183,7 @@ def generate_collision_matrix(
             f"always_fraction must be in (0, 1], got {always_fraction}", kind="config"
         )
     started = time.perf_counter()
-    names = (
-        tuple(b.name for b in world.bodies if b.has_collision)
-        if bodies is None
-        else tuple(sorted(set(bodies), key=lambda b: world.get_body_by_name(b).index))
-    )
+    names = _body_names(world, bodies)
     pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
     checker = SelfCollisionChecker(
         world,
@@ -221,24 +217,8 @@ def generate_collision_matrix(
     limit = math.ceil(always_fraction * ALWAYS_ROUND - 1e-9)
     always_drawn = _always_pass(checker, world, rng, undecided, limit, decide, ticks)
 
-    # Drawn block by block as the workers ask: memory stays flat whatever ``samples`` is.
-    blocks = RandomBlocks(world, samples, rng)
-    procs = used_processes(processes, len(blocks))
-    first: dict[int, int] = {}
-
-    def seen(start: int, hits: NDArray[np.bool_]) -> None:
-        for k in np.flatnonzero(hits).tolist():
-            first.setdefault(k, start)
-
-    ever = ever_colliding_parallel(
-        checker,
-        blocks,
-        undecided.copy(),
-        processes=procs,
-        on_missing_mesh=on_missing_mesh,
-        start_method=start_method,
-        progress=ticks.tick,
-        on_chunk=seen,
+    ever, first, procs = _never_pass(
+        checker, world, rng, samples, undecided, processes, on_missing_mesh, start_method, ticks
     )
     for k in np.flatnonzero(undecided & ~ever).tolist():
         decide(k, NEVER, 0, samples)
@@ -301,6 +281,51 @@ def _always_pass(
             break
         ticks.total += ALWAYS_ROUND
     return drawn
+
+
+def _body_names(world: World, bodies: Sequence[str] | None) -> tuple[str, ...]:
+    """The bodies the matrix covers, in the world's order: default every body with geometry."""
+    if bodies is None:
+        return tuple(b.name for b in world.bodies if b.has_collision)
+    return tuple(sorted(set(bodies), key=lambda b: world.get_body_by_name(b).index))
+
+
+def _never_pass(
+    checker: SelfCollisionChecker,
+    world: World,
+    rng: np.random.Generator,
+    samples: int,
+    undecided: NDArray[np.bool_],
+    processes: int | None,
+    on_missing_mesh: MissingMeshPolicy,
+    start_method: str | None,
+    ticks: _Progress,
+) -> tuple[NDArray[np.bool_], dict[int, int], int]:
+    """The "Never" pass: which undecided pairs ever collide in ``samples`` configurations.
+
+    Returns the pairs seen colliding (a mask), the first sample (chunk resolution) each was seen
+    in, and the worker processes used. Samples are drawn block by block as the workers ask, so
+    memory stays flat whatever ``samples`` is; ``undecided`` is not changed.
+    """
+    blocks = RandomBlocks(world, samples, rng)
+    procs = used_processes(processes, len(blocks))
+    first: dict[int, int] = {}
+
+    def seen(start: int, hits: NDArray[np.bool_]) -> None:
+        for k in np.flatnonzero(hits).tolist():
+            first.setdefault(k, start)
+
+    ever = ever_colliding_parallel(
+        checker,
+        blocks,
+        undecided.copy(),
+        processes=procs,
+        on_missing_mesh=on_missing_mesh,
+        start_method=start_method,
+        progress=ticks.tick,
+        on_chunk=seen,
+    )
+    return ever, first, procs
 
 
 def generate_for_robot(

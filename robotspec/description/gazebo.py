@@ -29,6 +29,7 @@ import numpy as np
 from lxml import etree
 
 from robotspec.files.xmlsafe import line_of
+from robotspec.model.rotations import matrix_to_rpy, rpy_to_matrix
 
 __all__ = ["CAMERA_TYPES", "GazeboCamera", "channel_frames", "gazebo_cameras", "sensor_links"]
 
@@ -139,8 +140,6 @@ def _compose(
     inner: tuple[float, float, float, float, float, float],
 ) -> tuple[float, float, float, float, float, float]:
     """The pose ``inner`` (given in ``outer``'s frame) in the frame ``outer`` is given in."""
-    from robotspec.model.rotations import matrix_to_rpy, rpy_to_matrix
-
     rot = rpy_to_matrix(*outer[3:])
     at = rot @ np.asarray(inner[:3], dtype=np.float64) + np.asarray(outer[:3], dtype=np.float64)
     r, p, y = matrix_to_rpy(rot @ rpy_to_matrix(*inner[3:]))

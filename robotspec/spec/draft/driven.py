@@ -21,7 +21,7 @@ from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.model import DraftDrive
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["counted_drive", "plugin_drive", "stated_drive", "stated_wheels"]
+__all__ = ["counted_drive", "stated_drive", "stated_wheels"]
 
 #: The cosine within which two wheel axes are one direction (an axle), or an axis is level.
 _PARALLEL = 0.99
@@ -135,7 +135,7 @@ def _omni_wheels(world: World, wheels: list[Connection]) -> bool:
     return bool(wheels) and all(named(c) for c in wheels)
 
 
-def plugin_drive(tree: Tree, facts: FileFacts) -> DraftDrive | None:
+def _plugin_drive(tree: Tree, facts: FileFacts) -> DraftDrive | None:
     """The drive a Gazebo drive plugin of the URDF states, on wheels the URDF has (else None)."""
     world = tree.world
     for plugin in facts.actuation.drives:
@@ -156,7 +156,7 @@ def stated_drive(tree: Tree, facts: FileFacts, wheels: list[Connection]) -> Draf
     None when they say nothing about the wheels (the count of wheels decides, as before).
     """
     world = tree.world
-    plugin = plugin_drive(tree, facts)
+    plugin = _plugin_drive(tree, facts)
     if plugin is not None:
         return plugin
     names = {c.name for c in wheels}

@@ -19,7 +19,7 @@ from robotspec.model.world import World
 from robotspec.spec.draft.bare_fingers import bare_branches
 from robotspec.spec.draft.model import DraftFinger
 from robotspec.spec.draft.thumbs import odd_by_shape
-from robotspec.spec.draft.tips import _body_points
+from robotspec.spec.draft.tips import world_points
 from robotspec.spec.draft.tool_frames import bare_fixed_leaf
 from robotspec.spec.draft.tree import Tree, solid, words
 
@@ -129,11 +129,9 @@ def _unfolded(tree: Tree, branch: Body, tip: Body) -> Body:
 
 def _farthest_from(tree: Tree, body: Body, point: np.ndarray) -> float | None:
     """How far ``body``'s geometry reaches from ``point`` in the default pose (None: no shape)."""
-    pts = _body_points(tree, body)
-    if not len(pts):
+    at = world_points(tree, body)
+    if not len(at):
         return None
-    pose = tree.poses[body.index]
-    at = (pose[:3, :3] @ pts.T).T + pose[:3, 3]
     return float(np.max(np.linalg.norm(at - point, axis=1)))
 
 

@@ -27,10 +27,12 @@ __all__ = [
     "CAMERA_CLOSINGS",
     "CAMERA_WORDS",
     "OPTICAL",
+    "TILT",
     "camera_words",
     "device_groups",
     "names_silent",
     "optical_from_body",
+    "optical_rotation",
     "pick_channel",
     "root_is_optical",
     "upside_down",
@@ -92,7 +94,7 @@ def names_silent(name: str) -> bool:
     return not tokens & (CAMERA_WORDS | TELLING_WORDS)
 
 
-def _optical_rotation(rot: np.ndarray) -> bool:
+def optical_rotation(rot: np.ndarray) -> bool:
     """Whether ``rot`` (a frame in its body frame's axes) is REP 103's, or it tilted up/down."""
     if np.allclose(rot, OPTICAL, atol=1e-3):
         return True
@@ -134,7 +136,7 @@ def optical_from_body(tree: Tree, body: Body) -> bool:
             break
         up = world.bodies[above.parent]
         rot = tree.poses[up.index][:3, :3].T @ pose[:3, :3]
-        if _optical_rotation(rot) or (upside_down(rot) and names_silent(body.name)):
+        if optical_rotation(rot) or (upside_down(rot) and names_silent(body.name)):
             return True
     for k in world.child_bodies(world.bodies[c.parent]):
         kc = world.parent_connection(k)
@@ -144,7 +146,7 @@ def optical_from_body(tree: Tree, body: Body) -> bool:
             continue
         near = float(np.linalg.norm(tree.poses[k.index][:3, 3] - pose[:3, 3])) <= SAME_SPOT
         rot = tree.poses[k.index][:3, :3].T @ pose[:3, :3]
-        if near and (_optical_rotation(rot) or (upside_down(rot) and names_silent(body.name))):
+        if near and (optical_rotation(rot) or (upside_down(rot) and names_silent(body.name))):
             return True
     return False
 
@@ -164,7 +166,7 @@ def root_is_optical(tree: Tree) -> bool:
         c = world.parent_connection(k)
         if c is None or not c.is_fixed or not (k.collisions or k.visuals):
             continue
-        if float(np.linalg.norm(c.origin[:3, 3])) <= SAME_SPOT and _optical_rotation(
+        if float(np.linalg.norm(c.origin[:3, 3])) <= SAME_SPOT and optical_rotation(
             c.origin[:3, :3].T
         ):
             return True

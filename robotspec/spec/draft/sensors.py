@@ -29,15 +29,19 @@ from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.limbs import HEAD_WORDS, eyes
 from robotspec.spec.draft.optical import (
     CAMERA_WORDS,
+    OPTICAL,
+    TILT,
     camera_words,
     device_groups,
     names_silent,
     optical_from_body,
+    optical_rotation,
     pick_channel,
     root_is_optical,
     upside_down,
 )
 from robotspec.spec.draft.stated_cameras import (
+    COLOUR,
     DEVICE_SPAN,
     StatedCamera,
     stated_cameras,
@@ -57,9 +61,6 @@ __all__ = [
 #: Gazebo sensor types that take images: the frames of other sensors are theirs, never cameras.
 IMAGE_KINDS = ("camera", "depth", "rgbd", "thermal", "image")
 #: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
-_OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
-#: The cosine within which a tilted optical frame's z axis stays of its parent's x (60 degrees).
-_TILT = 0.5
 _STEM = re.compile(r"(_optical)?(_frame|_link)?$")
 
 
@@ -97,11 +98,7 @@ def is_optical(tree: Tree, body: Body) -> bool:
     if c is None or not c.is_fixed:
         return False
     rot = c.origin[:3, :3]
-    if np.allclose(rot, _OPTICAL, atol=1e-3):
-        return True
-    # An optical frame tilted down or up (a camera looking at the floor ahead): x still points
-    # right (-y of the parent), z ahead within 60 degrees of the parent's x.
-    if np.allclose(rot[:, 0], _OPTICAL[:, 0], atol=1e-3) and rot[0, 2] > _TILT:
+    if optical_rotation(rot):  # REP 103's, or tilted down or up (a camera looking at the floor)
         return True
     # The same turned round (a rear camera, B2W's 'r_dc_link'): x right of a camera looking
     # back is the parent's +y, z behind within 60 degrees of the parent's -x. Only on the
@@ -117,7 +114,7 @@ def is_optical(tree: Tree, body: Body) -> bool:
         # head's named body-frame cameras, which it must not hide).
         parent = world.bodies[c.parent]
         return tree.rigid_root(body) is tree.root or bool(parent.collisions or parent.visuals)
-    behind = np.allclose(rot[:, 0], -_OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -_TILT
+    behind = np.allclose(rot[:, 0], -OPTICAL[:, 0], atol=1e-3) and rot[0, 2] < -TILT
     if behind:
         return tree.rigid_root(body) is tree.root
     # Turned so from a body frame higher up its fixed joints or beside it (optical.py).
@@ -262,7 +259,6 @@ def _one_per_nameless_device(tree: Tree, found: list[CameraFound]) -> list[Camer
 
 #: Words naming a channel of a camera device (one device: one camera, on its colour channel).
 _CHANNELS = frozenset({"color", "colour", "rgb", "depth", "ir", "infra", "infra1", "infra2"})
-_COLOUR = frozenset({"color", "colour", "rgb"})
 #: Words naming one of a stereo pair; with a channel word, both are one device's.
 _SIDES = frozenset({"left", "right", "l", "r", "1", "2"})
 
@@ -273,7 +269,7 @@ def _channel_rank(name: str) -> int:
     Why not the shortest name: an OpenNI device's 'camera_ir' is shorter than its 'camera_rgb'.
     """
     parts = set(re.split(r"[^a-z0-9]+", name.lower())) | words(name)
-    return 0 if not parts & _CHANNELS else 1 if parts & _COLOUR else 2
+    return 0 if not parts & _CHANNELS else 1 if parts & COLOUR else 2
 
 
 def _device(name: str) -> str:

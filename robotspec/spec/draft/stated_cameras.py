@@ -22,18 +22,16 @@ from robotspec.model.entities import Body
 from robotspec.model.rotations import rpy_to_matrix
 from robotspec.spec.draft.facts import FileFacts
 from robotspec.spec.draft.model import DraftCamera
-from robotspec.spec.draft.optical import device_groups, names_silent, pick_channel
+from robotspec.spec.draft.optical import OPTICAL, device_groups, names_silent, pick_channel
 from robotspec.spec.draft.tree import Tree, words
 
-__all__ = ["StatedCamera", "channel_words", "fill_stated", "stated_cameras"]
+__all__ = ["COLOUR", "StatedCamera", "channel_words", "fill_stated", "stated_cameras"]
 
-#: REP 103 optical rotation from a body frame (x forward, z up): columns are the optical axes.
-_OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
 #: Words naming a channel of an RGB-D device (a tracking camera's fisheye pair: one device).
 _CHANNELS = frozenset(
     {"color", "colour", "rgb", "depth", "ir", "infra", "infrared", "ired", "fisheye"}
 )
-_COLOUR = frozenset({"color", "colour", "rgb"})
+COLOUR = frozenset({"color", "colour", "rgb"})
 #: How far apart (m) the channels of one device may be (a RealSense's are 1.5 to 5 cm).
 DEVICE_SPAN = 0.1
 #: Camera sensors read per robot (a robot has tens; grouping devices compares pairs of them).
@@ -74,7 +72,7 @@ def channel_words(text: str) -> set[str]:
 
 def _rep103(tree: Tree, body: Body) -> bool:
     c = tree.world.parent_connection(body)
-    return c is not None and c.is_fixed and bool(np.allclose(c.origin[:3, :3], _OPTICAL, atol=1e-3))
+    return c is not None and c.is_fixed and bool(np.allclose(c.origin[:3, :3], OPTICAL, atol=1e-3))
 
 
 def _rigid_group(tree: Tree, link: Body) -> list[Body]:
@@ -119,7 +117,7 @@ def _optical_at(
         if float(np.linalg.norm(pose[:3, 3] - at)) > SPOT:
             continue
         channel = channel_words(k.name)
-        rank = 0 if channel & _COLOUR else 2 if channel else 1
+        rank = 0 if channel & COLOUR else 2 if channel else 1
         below = 0 if tree.world.is_ancestor(link, k) else 1
         rep = 0 if _rep103(tree, k) else 1
         found.append((below, 0 if k is named else 1, rank, rep, k.index, k))
@@ -243,7 +241,7 @@ def _view(tree: Tree, c: StatedCamera) -> np.ndarray:
 
 def _preference(c: StatedCamera) -> tuple[int, int]:
     channel = channel_words(c.body.name) | channel_words(c.fact.name)
-    if channel & _COLOUR:
+    if channel & COLOUR:
         return (0, 0)
     return (1 if not channel else 2, 0 if c.optical else 1)
 

@@ -33,6 +33,7 @@ __all__ = [
     "rigid_end",
     "mesh_vertices",
     "shape_points",
+    "world_points",
 ]
 
 #: The key of ``Tree.memo`` holding how to find a mesh file from its URI (``None``: not found).
@@ -124,6 +125,20 @@ def _body_points(tree: Tree, body: Body) -> F64:
     return known[body.index]
 
 
+def world_points(tree: Tree, body: Body) -> F64:
+    """:func:`_body_points` in the world frame, in the default pose (none: an empty (0, 3))."""
+    pose = tree.poses[body.index]
+    points = _body_points(tree, body)
+    out: F64 = (pose[:3, :3] @ points.T).T + np.asarray(pose[:3, 3], dtype=np.float64)
+    return out
+
+
+def _point(v: F64) -> tuple[float, float, float]:
+    """A point as the draft writes it: to 0.1 mm, with no negative zero."""
+    x, y, z = (round(float(c), 4) for c in v)
+    return (x + 0.0, y + 0.0, z + 0.0)
+
+
 def far_end(tree: Tree, body: Body, direction: F64) -> F64:
     """Where ``body`` ends along ``direction`` (world frame, default pose): a world point.
 
@@ -134,11 +149,10 @@ def far_end(tree: Tree, body: Body, direction: F64) -> F64:
     pose = tree.poses[body.index]
     origin: F64 = np.asarray(pose[:3, 3], dtype=np.float64)
     n = float(np.linalg.norm(direction))
-    points = _body_points(tree, body)
-    if n < 1e-9 or not len(points):
+    world_pts = world_points(tree, body)
+    if n < 1e-9 or not len(world_pts):
         return origin
     d = direction / n
-    world_pts = (pose[:3, :3] @ points.T).T + origin
     reach = float(np.max((world_pts - origin) @ d))
     return origin + max(reach, 0.0) * d
 
@@ -184,8 +198,7 @@ def flange_offset(tree: Tree, tip: Body) -> tuple[float, float, float] | None:
     if found is None or found[1] < AT_FACE:
         return None
     way, reach = found
-    x, y, z = (round(float(v), 4) for v in reach * way)
-    return (x + 0.0, y + 0.0, z + 0.0)
+    return _point(reach * way)
 
 
 #: How near (m) a bare arm's last link's origin must be to its far end to be its flange.
@@ -218,8 +231,7 @@ def between_tips(tree: Tree, root: Body, tips: Sequence[Body]) -> tuple[float, f
         return (0.0, 0.0, 0.0)
     ends = np.mean([far_end(tree, t, reach) for t in tips], axis=0)
     local = np.linalg.inv(tree.poses[root.index]) @ np.append(ends, 1.0)
-    x, y, z = (round(float(v), 4) for v in local[:3])
-    return (x + 0.0, y + 0.0, z + 0.0)
+    return _point(local[:3])
 
 
 #: How far out (m) a fixed last link must hang to be a rigid part of the arm, not a flange.
@@ -253,8 +265,7 @@ def rigid_end(tree: Tree, link: Body) -> tuple[float, float, float] | None:
     reach = float(np.max(points @ way)) if len(points) else 0.0
     if not MIN_REACH <= reach <= RIGID_MAX:
         return (0.0, 0.0, 0.0)
-    x, y, z = (round(float(v), 4) for v in reach * way)
-    return (x + 0.0, y + 0.0, z + 0.0)
+    return _point(reach * way)
 
 
 def _reach_past_joint(
@@ -279,8 +290,7 @@ def _reach_past_joint(
     if found is None or not RIGID_OUT <= found[1] <= RIGID_MAX:
         return None
     way, reach = found
-    x, y, z = (round(float(v), 4) for v in reach * way)
-    return (x + 0.0, y + 0.0, z + 0.0)
+    return _point(reach * way)
 
 
 #: The cosine within which the way a tool points is taken as one of its link's axes (45 deg).
@@ -318,5 +328,4 @@ def bit_end(tree: Tree, top: Body, tool: Body) -> tuple[float, float, float] | N
     reach = float(np.max(points @ local))
     if not AT_FACE <= reach <= RIGID_MAX:
         return None
-    x, y, z = (round(float(v), 4) for v in reach * local)
-    return (x + 0.0, y + 0.0, z + 0.0)
+    return _point(reach * local)

@@ -7,7 +7,6 @@ camera or two; these checks read the device around the sensor (``whole``'s table
 
 from __future__ import annotations
 
-import re
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -17,9 +16,8 @@ from robotspec.model.rotations import rpy_to_matrix
 from robotspec.spec.draft.confidence import CAMERA_GAZEBO
 from robotspec.spec.draft.model import DraftCamera
 from robotspec.spec.draft.sensors import stated_channels
-from robotspec.spec.draft.stated_cameras import DEVICE_SPAN, MAX_SENSORS
+from robotspec.spec.draft.stated_cameras import COLOUR, DEVICE_SPAN, MAX_SENSORS, channel_words
 from robotspec.spec.draft.tool_frames import own_geometry
-from robotspec.spec.draft.tree import words
 
 if TYPE_CHECKING:
     from robotspec.spec.draft.build import Drafter
@@ -44,10 +42,9 @@ _AGREE = 0.9
 _X = np.array([1.0, 0.0, 0.0])
 #: Fixed joints walked above and below a camera's frame for the frames fixed to it.
 _RIGID_DEPTH = 3
+
+
 #: Words naming a device's colour channel.
-_COLOUR = frozenset({"color", "colour", "rgb"})
-
-
 def _fixed_to(d: Drafter, body: Body) -> list[Body]:
     """The frames fixed to ``body`` (a few fixed joints above it, and below those)."""
     world = d.world
@@ -150,8 +147,7 @@ def _only_colour(chosen: str, others: list[str]) -> bool:
 
 
 def _colour(name: str) -> bool:
-    tokens = words(name) | set(re.split(r"[^a-z0-9]+", name.lower()))
-    return bool({t.rstrip("0123456789") for t in tokens} & _COLOUR)
+    return bool(channel_words(name) & COLOUR)
 
 
 def _view(d: Drafter, cam: DraftCamera, body: Body) -> np.ndarray:

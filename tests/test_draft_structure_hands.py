@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from tests.draft_support import draft_layout as _draft
+from tests.draft_support import joint_xml
 
 _MASS = (
     '<inertial><mass value="{m}"/>'
@@ -38,17 +39,8 @@ def _joint(
     multiplier: float = 1.0,
     limit: tuple[float, float] = (0.0, 0.8),
 ) -> str:
-    lo, hi = limit
-    moving = (
-        ""
-        if kind == "fixed"
-        else f'<axis xyz="{axis}"/><limit lower="{lo}" upper="{hi}" effort="1" velocity="1"/>'
-    )
-    tag = "" if mimic is None else f'<mimic joint="{mimic}" multiplier="{multiplier}"/>'
-    return (
-        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
-        f'<origin xyz="{xyz}"/>{moving}{tag}</joint>'
-    )
+    """tests/draft_support.joint_xml with this file's defaults (a mimic writes its multiplier)."""
+    return joint_xml(name, parent, child, kind, xyz, axis, mimic, multiplier, limit)
 
 
 def _arm(hand_mass: float | None = 0.3) -> list[str]:
